@@ -1,0 +1,65 @@
+//! The `wavg` command line: diagnostics, precomputation, forward/inverse problems, benchmarks.
+
+mod bench_project;
+mod bench_roundtrip;
+mod error;
+mod forward;
+mod info;
+mod inverse;
+mod precompute;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+pub use error::CliError;
+
+/// Weighted averages of points on triangle meshes (Panozzo et al., SIGGRAPH 2013).
+#[derive(Parser)]
+#[command(name = "wavg", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Describe a mesh: counts, topology, and every validation problem.
+    Info(info::Args),
+    /// Compute the 8-D embedding of a mesh and write it as a .wavg file.
+    Precompute(precompute::Args),
+    /// Forward problem: anchors + weights -> points on the surface.
+    Forward(forward::Args),
+    /// Inverse problem: anchors + surface points -> weights.
+    Inverse(inverse::Args),
+    /// Benchmarks (report timings and quality figures).
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Phong projection speed and accuracy on random surface points.
+    Project(bench_project::Args),
+    /// The paper's Table 1 protocol: inverse then forward round trips.
+    Roundtrip(bench_roundtrip::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(a) => info::run(a),
+        Command::Precompute(a) => precompute::run(a),
+        Command::Forward(a) => forward::run(a),
+        Command::Inverse(a) => inverse::run(a),
+        Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
+        Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("wavg: {}", e.message);
+            ExitCode::from(e.code)
+        }
+    }
+}

@@ -1,0 +1,10 @@
+//! The 8-D embedding precomputation (paper Section 3.5): landmarks by decimation, geodesic
+//! distances by fast marching, metric MDS, least-squares-mesh upsampling, and the `.wavg` file.
+
+pub mod decimate;
+pub mod file;
+pub mod geodesic;
+pub mod lsmesh;
+pub mod mds;
+pub mod pipeline;
+pub mod quality;

@@ -1,0 +1,253 @@
+//! One pass over a raw mesh: every validation problem, the statistics `wavg info` prints,
+//! and (when the mesh is valid) its topology.
+
+use crate::mesh::TriMesh;
+use crate::problem::{Problem, ValidationReport};
+use crate::topology::{self, Topology};
+
+/// Faces whose doubled area is below this fraction of their longest squared edge are
+/// degenerate. Scale-relative: a needle of area 5e-13 on a unit mesh is caught, a
+/// well-shaped face of a mesh scaled by 1e-6 is not.
+pub const ZERO_AREA_RELATIVE_TOLERANCE: f64 = 1e-10;
+
+/// Counts that describe any parseable mesh, valid or not.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshStats {
+    /// Number of vertices.
+    pub vertices: usize,
+    /// Number of triangles.
+    pub faces: usize,
+    /// Number of undirected edges (over faces with valid, distinct indices).
+    pub edges: usize,
+    /// Connected components of the faces (sharing a vertex connects).
+    pub components: usize,
+    /// Connected components of the graph of edges with exactly one incident face.
+    pub boundary_loops: usize,
+    /// Edges with at most two faces and vertices with a single fan.
+    pub manifold: bool,
+    /// Manifold with consistent orientation.
+    pub oriented: bool,
+    /// Manifold without boundary edges.
+    pub watertight: bool,
+    /// V - E + F over referenced vertices.
+    pub euler_characteristic: i64,
+    /// Sum over components of (2 - chi - b) / 2; `None` unless oriented manifold.
+    pub genus: Option<i64>,
+}
+
+/// Result of [`analyze`].
+#[derive(Clone, Debug)]
+pub struct Analysis {
+    /// Counts.
+    pub stats: MeshStats,
+    /// Every problem found.
+    pub report: ValidationReport,
+    /// The topology, present exactly when the report is valid.
+    pub topology: Option<Topology>,
+}
+
+/// Checks a raw mesh for every problem in [`Problem`] and computes its statistics.
+/// Never panics, whatever the input.
+///
+/// ```
+/// use wavg_mesh::{analyze, procedural};
+/// let a = analyze(&procedural::torus(24, 12, 1.0, 0.3));
+/// assert_eq!(a.stats.genus, Some(1));
+/// assert!(a.report.is_valid() && a.topology.is_some());
+/// ```
+pub fn analyze(mesh: &TriMesh) -> Analysis {
+    let nv = mesh.n_vertices();
+    let nf = mesh.n_faces();
+    let mut problems = Vec::new();
+    if nv == 0 || nf == 0 {
+        problems.push(Problem::Empty {
+            vertices: nv,
+            faces: nf,
+        });
+    }
+    for (v, p) in mesh.positions.iter().enumerate() {
+        if !p.iter().all(|c| c.is_finite()) {
+            problems.push(Problem::NonFiniteCoordinate { vertex: v as u32 });
+        }
+    }
+    // Faces usable for combinatorics: indices in range and distinct.
+    let mut usable = vec![true; nf];
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        if let Some(&bad) = t.iter().find(|&&i| i as usize >= nv) {
+            problems.push(Problem::IndexOutOfRange {
+                face: f as u32,
+                index: bad,
+                vertex_count: nv,
+            });
+            usable[f] = false;
+        }
+    }
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        if usable[f] && (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
+            problems.push(Problem::RepeatedIndex { face: f as u32 });
+            usable[f] = false;
+        }
+    }
+    for f in 0..nf {
+        if usable[f] {
+            let [a, b, c] = mesh.corners(f);
+            if [a, b, c].iter().all(|p| p.iter().all(|x| x.is_finite())) && is_degenerate(a, b, c) {
+                problems.push(Problem::ZeroAreaFace { face: f as u32 });
+            }
+        }
+    }
+    // Duplicate faces: same vertex set.
+    let mut sorted: Vec<([u32; 3], u32)> = (0..nf)
+        .filter(|&f| usable[f])
+        .map(|f| {
+            let mut t = mesh.triangles[f];
+            t.sort_unstable();
+            (t, f as u32)
+        })
+        .collect();
+    sorted.sort_unstable();
+    for w in sorted.windows(2) {
+        if w[0].0 == w[1].0 {
+            problems.push(Problem::DuplicateFace {
+                face: w[1].1,
+                first: w[0].1,
+            });
+        }
+    }
+    drop(sorted);
+
+    let edges = topology::EdgeTable::build(&mesh.triangles, &usable);
+    let mut oriented = true;
+    let mut edge_manifold = true;
+    for g in edges.groups() {
+        let hs = &edges.halfedges[g.clone()];
+        let (a, b) = edges.key_vertices(g.start);
+        if hs.len() > 2 {
+            edge_manifold = false;
+            problems.push(Problem::NonManifoldEdge {
+                a,
+                b,
+                faces: hs.len(),
+            });
+        } else if hs.len() == 2 {
+            let fa = hs[0] / 3;
+            let fb = hs[1] / 3;
+            let dir = |h: u32| mesh.triangles[(h / 3) as usize][(h % 3) as usize];
+            if dir(hs[0]) == dir(hs[1]) {
+                oriented = false;
+                problems.push(Problem::InconsistentOrientation {
+                    face_a: fa,
+                    face_b: fb,
+                    a,
+                    b,
+                });
+            }
+        }
+    }
+    let adj = edges.manifold_adjacency(nf);
+    let incidence = topology::VertexFaces::build(nv, &mesh.triangles, &usable);
+    let mut vertex_manifold = true;
+    let mut referenced = 0usize;
+    for v in 0..nv {
+        let faces = incidence.faces(v);
+        if faces.is_empty() {
+            problems.push(Problem::UnreferencedVertex { vertex: v as u32 });
+            continue;
+        }
+        referenced += 1;
+        let fans = topology::count_fans(v as u32, faces, &mesh.triangles, &adj);
+        if fans > 1 {
+            vertex_manifold = false;
+            problems.push(Problem::NonManifoldVertex {
+                vertex: v as u32,
+                fans,
+            });
+        }
+    }
+    if let Some(uv) = &mesh.uv {
+        check_uv(mesh, uv, &mut problems);
+    }
+    problems.sort_by_key(|p| p.kind());
+
+    let manifold = edge_manifold
+        && vertex_manifold
+        && !problems.iter().any(|p| {
+            matches!(
+                p,
+                Problem::IndexOutOfRange { .. } | Problem::RepeatedIndex { .. }
+            )
+        });
+    let comps = topology::face_components(nv, &mesh.triangles, &usable);
+    let n_edges = edges.groups().count();
+    let boundary = edges.boundary_loop_count(nv, &mesh.triangles);
+    let n_usable = usable.iter().filter(|&&u| u).count();
+    let chi = referenced as i64 - n_edges as i64 + n_usable as i64;
+    let genus = (manifold && oriented)
+        .then(|| topology::genus_per_component(&comps, &edges, &mesh.triangles, &usable));
+    let stats = MeshStats {
+        vertices: nv,
+        faces: nf,
+        edges: n_edges,
+        components: comps.count,
+        boundary_loops: boundary,
+        manifold,
+        oriented: manifold && oriented,
+        watertight: manifold && edges.groups().all(|g| g.len() == 2),
+        euler_characteristic: chi,
+        genus,
+    };
+    let report = ValidationReport { problems };
+    let topology = report
+        .is_valid()
+        .then(|| Topology::from_parts(mesh, adj, incidence, comps, genus.unwrap_or(0), chi));
+    Analysis {
+        stats,
+        report,
+        topology,
+    }
+}
+
+/// Doubled area small against the longest squared edge (collinear or coincident corners).
+pub(crate) fn is_degenerate(
+    a: nalgebra::Vector3<f64>,
+    b: nalgebra::Vector3<f64>,
+    c: nalgebra::Vector3<f64>,
+) -> bool {
+    let (e0, e1, e2) = (b - a, c - b, a - c);
+    let longest = e0
+        .norm_squared()
+        .max(e1.norm_squared())
+        .max(e2.norm_squared());
+    let twice_area = e0.cross(&(c - a)).norm();
+    !(twice_area > ZERO_AREA_RELATIVE_TOLERANCE * longest) || longest == 0.0
+}
+
+fn check_uv(mesh: &TriMesh, uv: &crate::mesh::TexCoords, problems: &mut Vec<Problem>) {
+    if uv.faces.len() != mesh.triangles.len() {
+        problems.push(Problem::InvalidTexCoords {
+            face: uv.faces.len().min(mesh.triangles.len()) as u32,
+            reason: format!(
+                "{} texture faces for {} triangles",
+                uv.faces.len(),
+                mesh.triangles.len()
+            ),
+        });
+        return;
+    }
+    for (f, t) in uv.faces.iter().enumerate() {
+        if let Some(&i) = t.iter().find(|&&i| i as usize >= uv.coords.len()) {
+            problems.push(Problem::InvalidTexCoords {
+                face: f as u32,
+                reason: format!("uv index {i} out of range ({} uvs)", uv.coords.len()),
+            });
+        } else if t
+            .iter()
+            .any(|&i| !uv.coords[i as usize].iter().all(|c| c.is_finite()))
+        {
+            problems.push(Problem::InvalidTexCoords {
+                face: f as u32,
+                reason: "non-finite uv".into(),
+            });
+        }
+    }
+}
