@@ -1,4 +1,4 @@
-//! `wavg bench_project` (not yet implemented).
+//! `wavg bench project` (not yet implemented).
 
 use crate::CliError;
 

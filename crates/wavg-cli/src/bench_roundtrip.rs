@@ -1,4 +1,4 @@
-//! `wavg bench_roundtrip` (not yet implemented).
+//! `wavg bench roundtrip` (not yet implemented).
 
 use crate::CliError;
 

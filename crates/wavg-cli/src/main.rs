@@ -1,5 +1,6 @@
 //! The `wavg` command line: diagnostics, precomputation, forward/inverse problems, benchmarks.
 
+mod bench_load;
 mod bench_project;
 mod bench_roundtrip;
 mod error;
@@ -39,6 +40,8 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchCommand {
+    /// Load + validate + topology time of a mesh file.
+    Load(bench_load::Args),
     /// Phong projection speed and accuracy on random surface points.
     Project(bench_project::Args),
     /// The paper's Table 1 protocol: inverse then forward round trips.
@@ -52,6 +55,7 @@ fn main() -> ExitCode {
         Command::Precompute(a) => precompute::run(a),
         Command::Forward(a) => forward::run(a),
         Command::Inverse(a) => inverse::run(a),
+        Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),
     };

@@ -11,6 +11,7 @@
 //! ```
 
 pub mod analyze;
+pub mod data;
 pub mod error;
 pub mod geometry;
 pub mod mesh;

@@ -1,0 +1,12 @@
+//! `wavg bench load` (not yet implemented).
+
+use crate::CliError;
+
+/// Arguments.
+#[derive(clap::Args)]
+pub struct Args {}
+
+/// Runs the command.
+pub fn run(_args: Args) -> Result<(), CliError> {
+    Err(CliError::failure("not implemented yet"))
+}
