@@ -1,0 +1,81 @@
+//! The crate's error type and progress reporting.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong computing, reading or writing an embedding.
+#[derive(Debug, thiserror::Error)]
+pub enum EmbedError {
+    /// A parameter is out of range or the mesh is unsuitable (message says how to fix it).
+    #[error("{0}")]
+    InvalidArgument(String),
+    /// The caller asked to stop.
+    #[error("cancelled")]
+    Cancelled,
+    /// A numerical step failed (for example a factorisation).
+    #[error("numerical failure: {0}")]
+    Numerical(String),
+    /// Reading or writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A `.wavg` file is corrupt, truncated, from a future version or for another mesh.
+    #[error("{path}: {message}")]
+    BadFile {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The stages of the precomputation, in order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Stage {
+    /// Landmark selection by decimation.
+    Decimate,
+    /// Fast-marching geodesic distances between landmarks.
+    Geodesics,
+    /// Metric multidimensional scaling of the landmarks.
+    Mds,
+    /// Least-squares-mesh upsampling to all vertices.
+    LsMesh,
+}
+
+impl Stage {
+    /// Lower-case name used in JSON and progress bars.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Decimate => "decimate",
+            Self::Geodesics => "geodesics",
+            Self::Mds => "mds",
+            Self::LsMesh => "lsmesh",
+        }
+    }
+}
+
+/// Receives progress and answers whether to stop. Must be cheap: it is called often and
+/// from several threads.
+pub trait Progress: Sync {
+    /// `fraction` of `stage` is done (0..=1).
+    fn report(&self, stage: Stage, fraction: f64);
+    /// True when the caller wants the computation to stop (it then returns `Cancelled`).
+    fn cancelled(&self) -> bool {
+        false
+    }
+}
+
+/// Progress sink that ignores everything and never cancels.
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn report(&self, _stage: Stage, _fraction: f64) {}
+}
+
+/// Returns `Err(Cancelled)` if the sink asks to stop.
+pub fn check_cancel(p: &dyn Progress) -> Result<(), EmbedError> {
+    if p.cancelled() { Err(EmbedError::Cancelled) } else { Ok(()) }
+}
