@@ -22,12 +22,35 @@ pub enum EmbedError {
         /// The underlying error.
         source: std::io::Error,
     },
-    /// A `.wavg` file is corrupt, truncated, from a future version or for another mesh.
+    /// A `.wavg` file is not a `.wavg` file, truncated or corrupt.
     #[error("{path}: {message}")]
     BadFile {
         /// The file.
         path: PathBuf,
         /// What is wrong.
+        message: String,
+    },
+    /// A `.wavg` file written by a newer wavg (format version above the supported one).
+    #[error(
+        "{path}: .wavg format version {found} is newer than the supported version {supported}; \
+         upgrade wavg or recompute the embedding"
+    )]
+    UnsupportedVersion {
+        /// The file.
+        path: PathBuf,
+        /// Version found in the file.
+        found: u32,
+        /// Highest version this build reads.
+        supported: u32,
+    },
+    /// A valid `.wavg` file that was computed for another mesh.
+    #[error(
+        "{path}: embedding belongs to another mesh ({message}); recompute it with `wavg precompute`"
+    )]
+    MeshMismatch {
+        /// The file.
+        path: PathBuf,
+        /// Which part of the fingerprint differs.
         message: String,
     },
 }
@@ -77,5 +100,9 @@ impl Progress for NoProgress {
 
 /// Returns `Err(Cancelled)` if the sink asks to stop.
 pub fn check_cancel(p: &dyn Progress) -> Result<(), EmbedError> {
-    if p.cancelled() { Err(EmbedError::Cancelled) } else { Ok(()) }
+    if p.cancelled() {
+        Err(EmbedError::Cancelled)
+    } else {
+        Ok(())
+    }
 }

@@ -1,1 +1,848 @@
-//! (to be written)
+//! The `.wavg` file: an embedding together with a fingerprint of the mesh it belongs to.
+//!
+//! # Format, version 1
+//!
+//! A small hand-written binary so that C and C++ programs can read it without a library.
+//! Every number is **little-endian**; `f64` is IEEE-754 binary64 stored as its bit pattern.
+//! Offsets are in bytes from the start of the file.
+//!
+//! | offset | type     | field                                                             |
+//! |-------:|----------|-------------------------------------------------------------------|
+//! |      0 | `[u8;8]` | magic `"WAVGEMB\0"` = `57 41 56 47 45 4D 42 00`                   |
+//! |      8 | `u32`    | format version = `1`                                              |
+//! |     12 | `u32`    | `dim`, the embedding dimension, `1..=8` (wavg writes 8)           |
+//! |     16 | `u64`    | `n_vertices` of the mesh                                          |
+//! |     24 | `u64`    | `n_faces` of the mesh                                             |
+//! |     32 | `u64`    | `mesh_hash`: FNV-1a 64 of the mesh, see below                     |
+//! |     40 | `u64`    | `n_landmarks`, number of landmark ids stored (`<= n_vertices`)    |
+//! |     48 | `u64`    | parameter: landmarks requested                                    |
+//! |     56 | `u64`    | parameter: random seed                                            |
+//! |     64 | `u64`    | parameter: MDS (SMACOF) iteration limit                           |
+//! |     72 | `f64`    | parameter: MDS relative stress-change tolerance                   |
+//! |     80 | `u64`    | parameter: vertices of the mesh the geodesics ran on (0 = the mesh itself) |
+//! |     88 | `f64`    | MDS stress of the landmarks (finite, `>= 0`, see [`crate::mds`])  |
+//! |     96 | `f64`    | geodesic relative error, median (NaN = not measured)              |
+//! |    104 | `f64`    | geodesic relative error, 90th percentile (NaN = not measured)     |
+//! |    112 | `[u8;16]`| reserved, must be zero                                            |
+//! |    128 | `f64` x `n_vertices * dim` | coordinates, vertex-major: vertex 0's `dim` values, then vertex 1's, ... (all finite) |
+//! |      C | `u32` x `n_landmarks` | landmark vertex ids (distinct, `< n_vertices`), `C = 128 + 8 n_vertices dim` |
+//! |      P | `u8` x (0 or 4) | zero padding so that the checksum starts at a multiple of 8 |
+//! |  L - 8 | `u64`    | checksum: FNV-1a 64 of bytes `0 .. L-8` (everything before it)    |
+//!
+//! The file length is therefore exactly
+//! `L = 128 + 8 n_vertices dim + 4 n_landmarks + (4 if n_landmarks is odd else 0) + 8`.
+//!
+//! **FNV-1a 64**: `h = 0xcbf29ce484222325`; for each byte `b`: `h = (h XOR b) * 0x100000001b3`
+//! (wrapping 64-bit multiplication). Because each step is a bijection of `h`, any change of a
+//! single byte always changes the checksum.
+//!
+//! **Mesh fingerprint** (`mesh_hash`): FNV-1a 64 over the byte stream
+//! `n_vertices` as `u64`, `n_faces` as `u64`, then every vertex position `x, y, z` as `f64`
+//! (bit pattern, so `-0.0 != 0.0`), then every triangle's three vertex ids as `u32`, all
+//! little-endian, in the mesh's order. It identifies the positions exactly as the mesh loader
+//! produced them; any edit of the mesh (even reordering) makes the file refuse to load.
+//!
+//! A reader must refuse a file whose magic, version, length, checksum, reserved or padding
+//! bytes, counts or fingerprint do not match, or whose values are out of range. [`load`] does
+//! all of that; [`save`] writes atomically (temporary file in the same directory, `fsync`,
+//! rename), so an interrupted run never leaves a partial file under the final name.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use wavg_mesh::TriMesh;
+
+use crate::error::EmbedError;
+
+/// The magic bytes that start every `.wavg` file.
+pub const MAGIC: [u8; 8] = *b"WAVGEMB\0";
+/// The format version this build writes and the highest it reads.
+pub const FORMAT_VERSION: u32 = 1;
+/// Maximum embedding dimension (coordinates are stored in `[f64; MAX_DIM]` in memory).
+pub const MAX_DIM: usize = 8;
+/// Size of the fixed header in bytes.
+pub const HEADER_LEN: usize = 128;
+
+/// The parameters an embedding was computed with (stored for provenance).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EmbeddingParams {
+    /// Number of landmarks requested (the decimation target).
+    pub landmarks_requested: u64,
+    /// Seed of the random choices (quality pairs, any randomised step).
+    pub seed: u64,
+    /// SMACOF iteration limit.
+    pub mds_max_iterations: u64,
+    /// SMACOF relative stress-change tolerance.
+    pub mds_tolerance: f64,
+    /// Vertex count of the mesh the geodesics were computed on; 0 means the mesh itself.
+    pub geodesic_mesh_vertices: u64,
+}
+
+impl Default for EmbeddingParams {
+    fn default() -> Self {
+        Self {
+            landmarks_requested: 1000,
+            seed: 0,
+            mds_max_iterations: 300,
+            mds_tolerance: 1e-6,
+            geodesic_mesh_vertices: 0,
+        }
+    }
+}
+
+/// An embedding of every mesh vertex into R^`dim` (`dim <= 8`), as stored in a `.wavg` file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Embedding {
+    /// Dimension in use; entries `dim..8` of every coordinate are zero.
+    pub dim: usize,
+    /// One point per mesh vertex.
+    pub coords: Vec<[f64; MAX_DIM]>,
+    /// The landmark vertex ids (distinct), in the order MDS saw them.
+    pub landmarks: Vec<u32>,
+    /// How it was computed.
+    pub params: EmbeddingParams,
+    /// Final MDS stress of the landmark embedding.
+    pub stress: f64,
+    /// Median relative error of embedding vs geodesic distance (NaN if not measured).
+    pub geodesic_rel_err_p50: f64,
+    /// 90th percentile of the same (NaN if not measured).
+    pub geodesic_rel_err_p90: f64,
+}
+
+impl Embedding {
+    /// The first `dim` coordinates of vertex `v`.
+    pub fn point(&self, v: usize) -> &[f64] {
+        &self.coords[v][..self.dim]
+    }
+
+    /// Checks the invariants the file format requires, for a mesh with `n_vertices`.
+    pub fn validate(&self, n_vertices: usize) -> Result<(), String> {
+        if self.dim == 0 || self.dim > MAX_DIM {
+            return Err(format!("dimension {} is not in 1..={MAX_DIM}", self.dim));
+        }
+        if self.coords.len() != n_vertices {
+            return Err(format!(
+                "{} coordinates for a mesh with {n_vertices} vertices",
+                self.coords.len()
+            ));
+        }
+        for (v, c) in self.coords.iter().enumerate() {
+            if !c[..self.dim].iter().all(|x| x.is_finite()) {
+                return Err(format!("vertex {v} has a non-finite coordinate"));
+            }
+            if c[self.dim..].iter().any(|&x| x != 0.0) {
+                return Err(format!(
+                    "vertex {v} has non-zero entries beyond dimension {}",
+                    self.dim
+                ));
+            }
+        }
+        if self.landmarks.len() > n_vertices {
+            return Err(format!(
+                "{} landmarks for {n_vertices} vertices",
+                self.landmarks.len()
+            ));
+        }
+        let mut seen = vec![false; n_vertices];
+        for &l in &self.landmarks {
+            let slot = seen.get_mut(l as usize).ok_or_else(|| {
+                format!("landmark id {l} out of range (mesh has {n_vertices} vertices)")
+            })?;
+            if std::mem::replace(slot, true) {
+                return Err(format!("landmark id {l} appears twice"));
+            }
+        }
+        if !(self.stress.is_finite() && self.stress >= 0.0) {
+            return Err(format!(
+                "stress {} is not a finite non-negative number",
+                self.stress
+            ));
+        }
+        for (name, e) in [
+            ("p50", self.geodesic_rel_err_p50),
+            ("p90", self.geodesic_rel_err_p90),
+        ] {
+            if !(e.is_nan() || (e.is_finite() && e >= 0.0)) {
+                return Err(format!("geodesic relative error {name} = {e} is invalid"));
+            }
+        }
+        let t = self.params.mds_tolerance;
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(format!(
+                "MDS tolerance {t} is not a finite non-negative number"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// FNV-1a 64 of `bytes`, continuing from state `h` (start with [`FNV_OFFSET`]).
+#[inline]
+pub fn fnv1a64(mut h: u64, bytes: &[u8]) -> u64 {
+    for &b in bytes {
+        h = (h ^ u64::from(b)).wrapping_mul(FNV_PRIME);
+    }
+    h
+}
+
+/// FNV-1a 64 initial state.
+pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
+
+/// The mesh fingerprint stored in the file (see the module documentation for the exact bytes).
+///
+/// ```
+/// use wavg_embed::file::mesh_hash;
+/// let a = wavg_mesh::procedural::icosphere(1);
+/// let mut b = a.clone();
+/// b.positions[0].x += 1e-12;
+/// assert_ne!(mesh_hash(&a), mesh_hash(&b));
+/// ```
+pub fn mesh_hash(mesh: &TriMesh) -> u64 {
+    let mut h = FNV_OFFSET;
+    h = fnv1a64(h, &(mesh.n_vertices() as u64).to_le_bytes());
+    h = fnv1a64(h, &(mesh.n_faces() as u64).to_le_bytes());
+    for p in &mesh.positions {
+        for c in [p.x, p.y, p.z] {
+            h = fnv1a64(h, &c.to_le_bytes());
+        }
+    }
+    for t in &mesh.triangles {
+        for i in t {
+            h = fnv1a64(h, &i.to_le_bytes());
+        }
+    }
+    h
+}
+
+/// Exact file length for the given counts, or `None` on overflow.
+fn file_len(n_vertices: u64, dim: u64, n_landmarks: u64) -> Option<u64> {
+    let coords = n_vertices.checked_mul(dim)?.checked_mul(8)?;
+    let ids = n_landmarks.checked_mul(4)?;
+    let pad = if n_landmarks % 2 == 1 { 4 } else { 0 };
+    (HEADER_LEN as u64)
+        .checked_add(coords)?
+        .checked_add(ids)?
+        .checked_add(pad)?
+        .checked_add(8)
+}
+
+/// Serialises `emb` for `mesh` into the version-1 byte layout.
+///
+/// Errors if the embedding does not satisfy [`Embedding::validate`] for this mesh.
+pub fn encode(emb: &Embedding, mesh: &TriMesh) -> Result<Vec<u8>, EmbedError> {
+    emb.validate(mesh.n_vertices())
+        .map_err(|m| EmbedError::InvalidArgument(format!("cannot save embedding: {m}")))?;
+    let n = mesh.n_vertices() as u64;
+    let k = emb.landmarks.len() as u64;
+    let len = file_len(n, emb.dim as u64, k)
+        .and_then(|l| usize::try_from(l).ok())
+        .ok_or_else(|| EmbedError::InvalidArgument("embedding too large".into()))?;
+    let mut b = Vec::with_capacity(len);
+    b.extend_from_slice(&MAGIC);
+    b.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    b.extend_from_slice(&(emb.dim as u32).to_le_bytes());
+    b.extend_from_slice(&n.to_le_bytes());
+    b.extend_from_slice(&(mesh.n_faces() as u64).to_le_bytes());
+    b.extend_from_slice(&mesh_hash(mesh).to_le_bytes());
+    b.extend_from_slice(&k.to_le_bytes());
+    let p = &emb.params;
+    b.extend_from_slice(&p.landmarks_requested.to_le_bytes());
+    b.extend_from_slice(&p.seed.to_le_bytes());
+    b.extend_from_slice(&p.mds_max_iterations.to_le_bytes());
+    b.extend_from_slice(&p.mds_tolerance.to_le_bytes());
+    b.extend_from_slice(&p.geodesic_mesh_vertices.to_le_bytes());
+    b.extend_from_slice(&emb.stress.to_le_bytes());
+    b.extend_from_slice(&emb.geodesic_rel_err_p50.to_le_bytes());
+    b.extend_from_slice(&emb.geodesic_rel_err_p90.to_le_bytes());
+    b.extend_from_slice(&[0u8; 16]);
+    debug_assert_eq!(b.len(), HEADER_LEN);
+    for c in &emb.coords {
+        for x in &c[..emb.dim] {
+            b.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    for l in &emb.landmarks {
+        b.extend_from_slice(&l.to_le_bytes());
+    }
+    if k % 2 == 1 {
+        b.extend_from_slice(&[0u8; 4]);
+    }
+    let sum = fnv1a64(FNV_OFFSET, &b);
+    b.extend_from_slice(&sum.to_le_bytes());
+    debug_assert_eq!(b.len(), len);
+    Ok(b)
+}
+
+/// Why a byte buffer is not an acceptable `.wavg` for a mesh (before the path is attached).
+#[derive(Debug)]
+enum Fault {
+    Bad(String),
+    Version(u32),
+    Mesh(String),
+}
+
+impl Fault {
+    fn at(self, path: &Path) -> EmbedError {
+        let path = path.to_path_buf();
+        match self {
+            Fault::Bad(message) => EmbedError::BadFile { path, message },
+            Fault::Version(found) => EmbedError::UnsupportedVersion {
+                path,
+                found,
+                supported: FORMAT_VERSION,
+            },
+            Fault::Mesh(message) => EmbedError::MeshMismatch { path, message },
+        }
+    }
+}
+
+/// Little-endian cursor over a byte slice whose length was checked beforehand.
+struct Reader<'a> {
+    b: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take<const N: usize>(&mut self) -> [u8; N] {
+        let mut a = [0u8; N];
+        a.copy_from_slice(&self.b[self.at..self.at + N]);
+        self.at += N;
+        a
+    }
+    fn u32(&mut self) -> u32 {
+        u32::from_le_bytes(self.take())
+    }
+    fn u64(&mut self) -> u64 {
+        u64::from_le_bytes(self.take())
+    }
+    fn f64(&mut self) -> f64 {
+        f64::from_le_bytes(self.take())
+    }
+}
+
+/// Parsed fixed header.
+struct Header {
+    dim: u32,
+    n_vertices: u64,
+    n_faces: u64,
+    hash: u64,
+    n_landmarks: u64,
+}
+
+/// Checks magic and version and reads the counts; `head` holds the first bytes of the file
+/// (up to [`HEADER_LEN`]) and `total` is the file length.
+fn parse_header(head: &[u8], total: u64) -> Result<Header, Fault> {
+    if head.len() < MAGIC.len() || head[..MAGIC.len()] != MAGIC {
+        return Err(Fault::Bad("not a .wavg file (bad magic bytes)".into()));
+    }
+    if head.len() < 12 {
+        return Err(Fault::Bad(format!(
+            "truncated: {total} bytes, shorter than the header"
+        )));
+    }
+    let mut r = Reader { b: head, at: 8 };
+    let version = r.u32();
+    if version > FORMAT_VERSION {
+        return Err(Fault::Version(version));
+    }
+    if version == 0 {
+        return Err(Fault::Bad("corrupt: format version 0".into()));
+    }
+    if head.len() < HEADER_LEN {
+        return Err(Fault::Bad(format!(
+            "truncated: {total} bytes, shorter than the {HEADER_LEN}-byte header"
+        )));
+    }
+    let dim = r.u32();
+    let n_vertices = r.u64();
+    let n_faces = r.u64();
+    let hash = r.u64();
+    let n_landmarks = r.u64();
+    if dim == 0 || dim as usize > MAX_DIM {
+        return Err(Fault::Bad(format!(
+            "corrupt: dimension {dim} not in 1..={MAX_DIM}"
+        )));
+    }
+    if n_landmarks > n_vertices {
+        return Err(Fault::Bad(format!(
+            "corrupt: {n_landmarks} landmarks for {n_vertices} vertices"
+        )));
+    }
+    let expected = file_len(n_vertices, u64::from(dim), n_landmarks)
+        .ok_or_else(|| Fault::Bad("corrupt: counts overflow".into()))?;
+    if total < expected {
+        return Err(Fault::Bad(format!(
+            "truncated: {total} bytes, the header announces {expected}"
+        )));
+    }
+    if total > expected {
+        return Err(Fault::Bad(format!(
+            "corrupt: {total} bytes, the header announces {expected}"
+        )));
+    }
+    Ok(Header {
+        dim,
+        n_vertices,
+        n_faces,
+        hash,
+        n_landmarks,
+    })
+}
+
+/// Parses and fully checks a `.wavg` image held in memory against `mesh`.
+fn decode_inner(b: &[u8], mesh: &TriMesh) -> Result<Embedding, Fault> {
+    let h = parse_header(&b[..b.len().min(HEADER_LEN)], b.len() as u64)?;
+    let body = b.len() - 8;
+    let stored = u64::from_le_bytes(b[body..].try_into().expect("8 bytes"));
+    if fnv1a64(FNV_OFFSET, &b[..body]) != stored {
+        return Err(Fault::Bad("corrupt: checksum mismatch".into()));
+    }
+    if h.n_vertices != mesh.n_vertices() as u64 || h.n_faces != mesh.n_faces() as u64 {
+        return Err(Fault::Mesh(format!(
+            "file is for {} vertices / {} faces, mesh has {} / {}",
+            h.n_vertices,
+            h.n_faces,
+            mesh.n_vertices(),
+            mesh.n_faces()
+        )));
+    }
+    if h.hash != mesh_hash(mesh) {
+        return Err(Fault::Mesh(
+            "same counts but different positions or faces (fingerprint mismatch)".into(),
+        ));
+    }
+    let mut r = Reader { b, at: 48 };
+    let params = EmbeddingParams {
+        landmarks_requested: r.u64(),
+        seed: r.u64(),
+        mds_max_iterations: r.u64(),
+        mds_tolerance: r.f64(),
+        geodesic_mesh_vertices: r.u64(),
+    };
+    let stress = r.f64();
+    let p50 = r.f64();
+    let p90 = r.f64();
+    if b[112..HEADER_LEN].iter().any(|&x| x != 0) {
+        return Err(Fault::Bad(
+            "corrupt: reserved header bytes are not zero".into(),
+        ));
+    }
+    r.at = HEADER_LEN;
+    let dim = h.dim as usize;
+    let n = mesh.n_vertices();
+    let mut coords = vec![[0.0; MAX_DIM]; n];
+    for c in &mut coords {
+        for x in &mut c[..dim] {
+            *x = r.f64();
+        }
+    }
+    let landmarks: Vec<u32> = (0..h.n_landmarks).map(|_| r.u32()).collect();
+    if b[r.at..body].iter().any(|&x| x != 0) {
+        return Err(Fault::Bad("corrupt: padding bytes are not zero".into()));
+    }
+    let emb = Embedding {
+        dim,
+        coords,
+        landmarks,
+        params,
+        stress,
+        geodesic_rel_err_p50: p50,
+        geodesic_rel_err_p90: p90,
+    };
+    emb.validate(n)
+        .map_err(|m| Fault::Bad(format!("corrupt: {m}")))?;
+    Ok(emb)
+}
+
+/// Parses a `.wavg` image held in memory; `path` only labels errors.
+pub fn decode(bytes: &[u8], mesh: &TriMesh, path: &Path) -> Result<Embedding, EmbedError> {
+    decode_inner(bytes, mesh).map_err(|f| f.at(path))
+}
+
+/// Writes `emb` (computed for `mesh`) to `path` atomically.
+///
+/// The bytes go to a temporary file in the same directory, which is flushed to disk and
+/// then renamed over `path`.
+///
+/// ```
+/// use wavg_embed::file::{Embedding, EmbeddingParams, load, save};
+/// let mesh = wavg_mesh::procedural::icosphere(1);
+/// let emb = Embedding {
+///     dim: 8,
+///     coords: mesh.positions.iter().map(|p| [p.x, p.y, p.z, 0.0, 0.0, 0.0, 0.0, 0.0]).collect(),
+///     landmarks: vec![0, 5, 7],
+///     params: EmbeddingParams::default(),
+///     stress: 0.0,
+///     geodesic_rel_err_p50: f64::NAN,
+///     geodesic_rel_err_p90: f64::NAN,
+/// };
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("sphere.wavg");
+/// save(&path, &emb, &mesh).unwrap();
+/// assert_eq!(load(&path, &mesh).unwrap().coords, emb.coords);
+/// ```
+pub fn save(path: &Path, emb: &Embedding, mesh: &TriMesh) -> Result<(), EmbedError> {
+    let bytes = encode(emb, mesh)?;
+    let io = |source| EmbedError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir: PathBuf = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".wavg-tmp-")
+        .tempfile_in(&dir)
+        .map_err(io)?;
+    tmp.write_all(&bytes).map_err(io)?;
+    tmp.as_file().sync_all().map_err(io)?;
+    tmp.persist(path).map_err(|e| io(e.error))?;
+    // Make the rename itself durable where the platform allows it (best effort).
+    if let Ok(d) = std::fs::File::open(&dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// Reads and checks a `.wavg` file for `mesh`.
+///
+/// Refuses (with [`EmbedError::BadFile`]) anything that is not a complete, uncorrupted
+/// version-1 file; with [`EmbedError::UnsupportedVersion`] a file from a newer format; with
+/// [`EmbedError::MeshMismatch`] a file computed for another mesh. The header is checked
+/// against the real file length before the body is read, so a corrupt header never causes
+/// a large allocation.
+pub fn load(path: &Path, mesh: &TriMesh) -> Result<Embedding, EmbedError> {
+    let io = |source| EmbedError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut f = std::fs::File::open(path).map_err(io)?;
+    let total = f.metadata().map_err(io)?.len();
+    let mut head = Vec::with_capacity(HEADER_LEN);
+    (&mut f)
+        .take(HEADER_LEN as u64)
+        .read_to_end(&mut head)
+        .map_err(io)?;
+    parse_header(&head, total).map_err(|e| e.at(path))?;
+    // The length now matches the header exactly; read the rest.
+    let len = usize::try_from(total)
+        .map_err(|_| Fault::Bad("file too large for this platform".into()).at(path))?;
+    let mut bytes = head;
+    bytes.reserve_exact(len - bytes.len());
+    f.take(total - HEADER_LEN as u64)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() != len {
+        return Err(Fault::Bad("file changed size while being read".into()).at(path));
+    }
+    decode(&bytes, mesh, path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use rand::{Rng, SeedableRng};
+    use wavg_mesh::procedural;
+
+    fn sample(mesh: &TriMesh, dim: usize, n_landmarks: usize, seed: u64) -> Embedding {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let coords = (0..mesh.n_vertices())
+            .map(|_| {
+                let mut c = [0.0; MAX_DIM];
+                for x in &mut c[..dim] {
+                    *x = rng.random_range(-10.0..10.0);
+                }
+                c
+            })
+            .collect();
+        Embedding {
+            dim,
+            coords,
+            landmarks: (0..n_landmarks as u32)
+                .map(|i| i * 5 % mesh.n_vertices() as u32)
+                .collect(),
+            params: EmbeddingParams {
+                landmarks_requested: n_landmarks as u64,
+                seed,
+                mds_max_iterations: 123,
+                mds_tolerance: 1e-7,
+                geodesic_mesh_vertices: 0,
+            },
+            stress: 0.0123,
+            geodesic_rel_err_p50: 0.01,
+            geodesic_rel_err_p90: f64::NAN,
+        }
+    }
+
+    fn bits(e: &Embedding) -> Vec<u64> {
+        let mut v: Vec<u64> = e.coords.iter().flatten().map(|x| x.to_bits()).collect();
+        v.extend(e.landmarks.iter().map(|&l| u64::from(l)));
+        let p = &e.params;
+        v.extend([
+            e.dim as u64,
+            e.stress.to_bits(),
+            e.geodesic_rel_err_p50.to_bits(),
+            e.geodesic_rel_err_p90.to_bits(),
+            p.landmarks_requested,
+            p.seed,
+            p.mds_max_iterations,
+            p.mds_tolerance.to_bits(),
+            p.geodesic_mesh_vertices,
+        ]);
+        v
+    }
+
+    fn p() -> &'static Path {
+        Path::new("test.wavg")
+    }
+
+    #[test]
+    fn round_trip_is_bit_exact_through_a_file() {
+        let mesh = procedural::torus(12, 8, 1.0, 0.3);
+        for (dim, k) in [(8, 7), (8, 8), (3, 0), (1, 1)] {
+            let emb = sample(&mesh, dim, k, 42 + k as u64);
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("t.wavg");
+            save(&path, &emb, &mesh).unwrap();
+            let back = load(&path, &mesh).unwrap();
+            assert_eq!(bits(&back), bits(&emb));
+            let len = std::fs::metadata(&path).unwrap().len();
+            assert_eq!(
+                Some(len),
+                file_len(mesh.n_vertices() as u64, dim as u64, k as u64)
+            );
+            // Only the final file is left in the directory.
+            assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        }
+    }
+
+    #[test]
+    fn header_layout_matches_the_documentation() {
+        let mesh = procedural::icosphere(0);
+        let emb = sample(&mesh, 8, 3, 1);
+        let b = encode(&emb, &mesh).unwrap();
+        assert_eq!(&b[..8], b"WAVGEMB\0");
+        assert_eq!(u32::from_le_bytes(b[8..12].try_into().unwrap()), 1);
+        assert_eq!(u32::from_le_bytes(b[12..16].try_into().unwrap()), 8);
+        assert_eq!(u64::from_le_bytes(b[16..24].try_into().unwrap()), 12);
+        assert_eq!(u64::from_le_bytes(b[24..32].try_into().unwrap()), 20);
+        assert_eq!(
+            u64::from_le_bytes(b[32..40].try_into().unwrap()),
+            mesh_hash(&mesh)
+        );
+        assert_eq!(u64::from_le_bytes(b[40..48].try_into().unwrap()), 3);
+        assert_eq!(
+            f64::from_le_bytes(b[88..96].try_into().unwrap()),
+            emb.stress
+        );
+        let c0 = f64::from_le_bytes(b[128..136].try_into().unwrap());
+        assert_eq!(c0, emb.coords[0][0]);
+        let ids = 128 + 12 * 8 * 8;
+        assert_eq!(
+            u32::from_le_bytes(b[ids + 4..ids + 8].try_into().unwrap()),
+            emb.landmarks[1]
+        );
+        let body = b.len() - 8;
+        assert_eq!(body % 8, 0);
+        let sum = u64::from_le_bytes(b[body..].try_into().unwrap());
+        assert_eq!(sum, fnv1a64(FNV_OFFSET, &b[..body]));
+    }
+
+    #[test]
+    fn fnv1a64_reference_values() {
+        // Published FNV-1a 64 test vectors.
+        assert_eq!(fnv1a64(FNV_OFFSET, b""), 0xcbf29ce484222325);
+        assert_eq!(fnv1a64(FNV_OFFSET, b"a"), 0xaf63dc4c8601ec8c);
+        assert_eq!(fnv1a64(FNV_OFFSET, b"foobar"), 0x85944171f73967e8);
+    }
+
+    #[test]
+    fn every_truncation_is_refused() {
+        let mesh = procedural::icosphere(0);
+        let b = encode(&sample(&mesh, 8, 5, 3), &mesh).unwrap();
+        for cut in 0..b.len() {
+            let e = decode(&b[..cut], &mesh, p()).unwrap_err();
+            assert!(matches!(e, EmbedError::BadFile { .. }), "cut {cut}: {e}");
+        }
+        // And through the file system, at a few offsets including inside the header.
+        let dir = tempfile::tempdir().unwrap();
+        for cut in [0, 7, 8, 11, 60, 127, 128, b.len() - 1] {
+            let path = dir.path().join(format!("cut{cut}.wavg"));
+            std::fs::write(&path, &b[..cut]).unwrap();
+            assert!(matches!(
+                load(&path, &mesh),
+                Err(EmbedError::BadFile { .. })
+            ));
+        }
+        assert!(decode(&b, &mesh, p()).is_ok());
+    }
+
+    #[test]
+    fn every_single_byte_change_is_refused() {
+        let mesh = procedural::icosphere(0);
+        let b = encode(&sample(&mesh, 8, 5, 3), &mesh).unwrap();
+        for at in 0..b.len() {
+            for x in [0x01u8, 0x80, 0xff] {
+                let mut c = b.clone();
+                c[at] ^= x;
+                assert!(
+                    decode(&c, &mesh, p()).is_err(),
+                    "flip {x:#x} at {at} accepted"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn appended_bytes_are_refused() {
+        let mesh = procedural::icosphere(0);
+        let mut b = encode(&sample(&mesh, 8, 2, 3), &mesh).unwrap();
+        b.push(0);
+        assert!(matches!(
+            decode(&b, &mesh, p()),
+            Err(EmbedError::BadFile { .. })
+        ));
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+        #[test]
+        fn random_multi_byte_corruption_is_refused(
+            flips in proptest::collection::vec((any::<prop::sample::Index>(), 1u8..=255), 1..6)
+        ) {
+            let mesh = procedural::icosphere(1);
+            let b = encode(&sample(&mesh, 8, 9, 5), &mesh).unwrap();
+            let mut c = b.clone();
+            for (i, x) in &flips {
+                let at = i.index(c.len());
+                c[at] ^= x;
+            }
+            prop_assume!(c != b);
+            prop_assert!(decode(&c, &mesh, p()).is_err());
+        }
+    }
+
+    #[test]
+    fn another_mesh_is_refused() {
+        let mesh = procedural::icosphere(1);
+        let b = encode(&sample(&mesh, 8, 4, 3), &mesh).unwrap();
+        // Different counts.
+        let other = procedural::icosphere(2);
+        assert!(matches!(
+            decode(&b, &other, p()),
+            Err(EmbedError::MeshMismatch { .. })
+        ));
+        // Same counts, one coordinate moved by one ulp.
+        let mut moved = mesh.clone();
+        moved.positions[17].y = f64::from_bits(moved.positions[17].y.to_bits() + 1);
+        assert!(matches!(
+            decode(&b, &moved, p()),
+            Err(EmbedError::MeshMismatch { .. })
+        ));
+        // Same positions, faces relabelled (rotated corners).
+        let mut rotated = mesh.clone();
+        let t = rotated.triangles[3];
+        rotated.triangles[3] = [t[1], t[2], t[0]];
+        assert!(matches!(
+            decode(&b, &rotated, p()),
+            Err(EmbedError::MeshMismatch { .. })
+        ));
+    }
+
+    /// Rewrites the checksum after an edit, so the check under test is not the checksum.
+    fn reseal(b: &mut [u8]) {
+        let body = b.len() - 8;
+        let s = fnv1a64(FNV_OFFSET, &b[..body]);
+        b[body..].copy_from_slice(&s.to_le_bytes());
+    }
+
+    #[test]
+    fn future_version_is_refused_with_a_typed_error() {
+        let mesh = procedural::icosphere(0);
+        let mut b = encode(&sample(&mesh, 8, 2, 3), &mesh).unwrap();
+        b[8..12].copy_from_slice(&2u32.to_le_bytes());
+        reseal(&mut b);
+        match decode(&b, &mesh, p()) {
+            Err(EmbedError::UnsupportedVersion {
+                found: 2,
+                supported: 1,
+                ..
+            }) => {}
+            other => panic!("expected UnsupportedVersion, got {other:?}"),
+        }
+        // Even a future file with a different (unknown) layout length is reported as such.
+        assert!(matches!(
+            decode(&b[..40], &mesh, p()),
+            Err(EmbedError::UnsupportedVersion { .. })
+        ));
+    }
+
+    #[test]
+    fn resealed_invalid_values_are_refused() {
+        let mesh = procedural::icosphere(0);
+        let good = encode(&sample(&mesh, 8, 2, 3), &mesh).unwrap();
+        let ids = 128 + 12 * 8 * 8;
+        let edits: Vec<(usize, Vec<u8>)> = vec![
+            (128, f64::NAN.to_le_bytes().to_vec()), // non-finite coordinate
+            (128 + 8, f64::INFINITY.to_le_bytes().to_vec()), // non-finite coordinate
+            (ids, 12u32.to_le_bytes().to_vec()),    // landmark out of range
+            (ids + 4, 0u32.to_le_bytes().to_vec()), // duplicate landmark (ids 0, 0)
+            (112, vec![1]),                         // reserved byte
+            (88, (-1.0f64).to_le_bytes().to_vec()), // negative stress
+            (12, 9u32.to_le_bytes().to_vec()),      // dimension 9
+            (40, u64::MAX.to_le_bytes().to_vec()),  // absurd landmark count
+            (16, (u64::MAX / 4).to_le_bytes().to_vec()), // absurd vertex count
+        ];
+        for (at, bytes) in edits {
+            let mut b = good.clone();
+            b[at..at + bytes.len()].copy_from_slice(&bytes);
+            reseal(&mut b);
+            assert!(
+                matches!(decode(&b, &mesh, p()), Err(EmbedError::BadFile { .. })),
+                "edit at {at} accepted"
+            );
+        }
+    }
+
+    #[test]
+    fn save_rejects_inconsistent_embeddings_and_keeps_old_file() {
+        let mesh = procedural::icosphere(0);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("e.wavg");
+        let good = sample(&mesh, 8, 2, 3);
+        save(&path, &good, &mesh).unwrap();
+        let mut bad = good.clone();
+        bad.coords[3][2] = f64::NAN;
+        assert!(matches!(
+            save(&path, &bad, &mesh),
+            Err(EmbedError::InvalidArgument(_))
+        ));
+        let mut bad = sample(&mesh, 3, 2, 3);
+        bad.coords[0][5] = 1.0;
+        assert!(save(&path, &bad, &mesh).is_err());
+        let mut bad = good.clone();
+        bad.coords.pop();
+        assert!(save(&path, &bad, &mesh).is_err());
+        assert_eq!(bits(&load(&path, &mesh).unwrap()), bits(&good));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn missing_file_and_garbage_are_refused() {
+        let mesh = procedural::icosphere(0);
+        let dir = tempfile::tempdir().unwrap();
+        assert!(matches!(
+            load(&dir.path().join("none.wavg"), &mesh),
+            Err(EmbedError::Io { .. })
+        ));
+        let path = dir.path().join("g.wavg");
+        std::fs::write(&path, b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").unwrap();
+        assert!(matches!(
+            load(&path, &mesh),
+            Err(EmbedError::BadFile { .. })
+        ));
+    }
+}

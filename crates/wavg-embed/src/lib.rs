@@ -10,3 +10,4 @@ pub mod mds;
 pub mod pipeline;
 pub mod quality;
 pub use error::{EmbedError, NoProgress, Progress, Stage};
+pub use file::{Embedding, EmbeddingParams};
