@@ -1,0 +1,217 @@
+//! Seeded sampling for benchmarks and tests: surface points uniform by area, and anchor
+//! vertices by farthest-point sampling.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use rand::distr::Distribution;
+use rand::distr::weighted::WeightedIndex;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use wavg_mesh::geometry::face_areas;
+use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, VertexId};
+
+use crate::Vec8;
+use crate::error::SolveError;
+
+/// `n` surface points distributed uniformly by area (face chosen with probability
+/// proportional to its area, then a uniform point in it), reproducible from `seed`.
+///
+/// ```
+/// use wavg_mesh::procedural;
+/// let m = procedural::icosphere(2);
+/// let pts = wavg_solve::sampling::uniform_surface_points(&m, 100, 7).unwrap();
+/// assert_eq!(pts, wavg_solve::sampling::uniform_surface_points(&m, 100, 7).unwrap());
+/// assert!(pts.iter().all(|p| (p.bary.iter().sum::<f64>() - 1.0).abs() < 1e-12));
+/// ```
+pub fn uniform_surface_points(
+    mesh: &TriMesh,
+    n: usize,
+    seed: u64,
+) -> Result<Vec<SurfacePoint>, SolveError> {
+    let areas = face_areas(mesh);
+    let pick = WeightedIndex::new(&areas)
+        .map_err(|e| SolveError::InvalidParameter(format!("cannot sample by area: {e}")))?;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    Ok((0..n)
+        .map(|_| {
+            let f = pick.sample(&mut rng) as u32;
+            let r1: f64 = rng.random();
+            let r2: f64 = rng.random();
+            let s = r1.sqrt();
+            let b1 = s * (1.0 - r2);
+            let b2 = s * r2;
+            SurfacePoint::new(f, [1.0 - b1 - b2, b1, b2])
+        })
+        .collect())
+}
+
+/// Which distance farthest-point sampling maximises.
+#[derive(Clone, Copy, Debug)]
+pub enum FpsMetric<'a> {
+    /// Shortest paths along mesh edges (3-D edge lengths): an upper bound of the geodesic
+    /// distance that does not depend on any embedding, so anchor sets are the same with or
+    /// without one. The default.
+    EdgeGraph,
+    /// Straight-line distance between the vertices' coordinates in R^8 (one per vertex).
+    Embedding(&'a [Vec8]),
+}
+
+/// `k` distinct vertices by farthest-point sampling: the first is drawn at random from
+/// `seed`, each next one is the vertex farthest (in `metric`) from those already chosen
+/// (ties to the lowest index). Vertices of other connected components are infinitely far,
+/// so every component gets an anchor before any gets a second one.
+///
+/// ```
+/// use wavg_mesh::{ValidMesh, procedural};
+/// use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
+/// let m = ValidMesh::new(procedural::icosphere(2)).unwrap();
+/// let a = farthest_point_vertices(&m, 10, 1, FpsMetric::EdgeGraph).unwrap();
+/// assert_eq!(a.len(), 10);
+/// ```
+pub fn farthest_point_vertices(
+    mesh: &ValidMesh,
+    k: usize,
+    seed: u64,
+    metric: FpsMetric<'_>,
+) -> Result<Vec<VertexId>, SolveError> {
+    let nv = mesh.n_vertices();
+    if k > nv {
+        return Err(SolveError::InvalidParameter(format!(
+            "cannot choose {k} anchors among {nv} vertices"
+        )));
+    }
+    if let FpsMetric::Embedding(c) = metric
+        && c.len() != nv
+    {
+        return Err(SolveError::InvalidParameter(format!(
+            "{} embedded coordinates for {nv} vertices",
+            c.len()
+        )));
+    }
+    let mut out = Vec::with_capacity(k);
+    if k == 0 {
+        return Ok(out);
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut dist = vec![f64::INFINITY; nv];
+    let mut next = rng.random_range(0..nv) as VertexId;
+    let mut heap = BinaryHeap::new();
+    for _ in 0..k {
+        out.push(next);
+        match metric {
+            FpsMetric::EdgeGraph => relax_from(mesh, next, &mut dist, &mut heap),
+            FpsMetric::Embedding(c) => {
+                let y = c[next as usize];
+                for (d, x) in dist.iter_mut().zip(c) {
+                    *d = d.min((x - y).norm());
+                }
+            }
+        }
+        let mut best = 0usize;
+        for (v, &d) in dist.iter().enumerate() {
+            if d > dist[best] {
+                best = v;
+            }
+        }
+        next = best as VertexId;
+    }
+    Ok(out)
+}
+
+/// Min-heap entry for Dijkstra.
+#[derive(PartialEq)]
+struct Entry(f64, VertexId);
+impl Eq for Entry {}
+impl Ord for Entry {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.0.total_cmp(&self.0).then(o.1.cmp(&self.1))
+    }
+}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+/// Lowers `dist` to the edge-graph distance from `source` where that is shorter; only the
+/// region that improves is visited, so the whole sampling costs about one full Dijkstra.
+fn relax_from(mesh: &ValidMesh, source: VertexId, dist: &mut [f64], heap: &mut BinaryHeap<Entry>) {
+    let topo = mesh.topology();
+    let pos = &mesh.positions;
+    heap.clear();
+    dist[source as usize] = 0.0;
+    heap.push(Entry(0.0, source));
+    while let Some(Entry(d, u)) = heap.pop() {
+        if d > dist[u as usize] {
+            continue;
+        }
+        for &v in topo.ring(u) {
+            let nd = d + (pos[u as usize] - pos[v as usize]).norm();
+            if nd < dist[v as usize] {
+                dist[v as usize] = nd;
+                heap.push(Entry(nd, v));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wavg_mesh::procedural;
+
+    #[test]
+    fn fps_is_distinct_seeded_and_spread() {
+        let m = ValidMesh::new(procedural::icosphere(3)).unwrap();
+        let a = farthest_point_vertices(&m, 20, 5, FpsMetric::EdgeGraph).unwrap();
+        let mut s = a.clone();
+        s.sort();
+        s.dedup();
+        assert_eq!(s.len(), 20);
+        assert_eq!(
+            a,
+            farthest_point_vertices(&m, 20, 5, FpsMetric::EdgeGraph).unwrap()
+        );
+        // The second anchor is (nearly) antipodal to the first on the unit sphere.
+        let p = |v: VertexId| m.positions[v as usize];
+        assert!((p(a[0]) + p(a[1])).norm() < 0.2);
+        let coords: Vec<Vec8> = m
+            .positions
+            .iter()
+            .map(|p| Vec8::from_fn(|k, _| if k < 3 { p[k] } else { 0.0 }))
+            .collect();
+        let b = farthest_point_vertices(&m, 20, 5, FpsMetric::Embedding(&coords)).unwrap();
+        assert_eq!(b[0], a[0]);
+        assert!((p(b[0]) + p(b[1])).norm() < 1e-9);
+        assert!(farthest_point_vertices(&m, 643, 5, FpsMetric::EdgeGraph).is_err());
+        assert!(farthest_point_vertices(&m, 3, 5, FpsMetric::Embedding(&coords[1..])).is_err());
+    }
+
+    #[test]
+    fn area_sampling_follows_area() {
+        // Two faces of very different areas: counts follow the area ratio.
+        let m = procedural::grid(2, 1, 3.0, 1.0).map_positions(|p| {
+            if p.x > 1.6 {
+                nalgebra::Vector3::new(p.x * 3.0, p.y, p.z)
+            } else {
+                p
+            }
+        });
+        let areas = face_areas(&m);
+        let pts = uniform_surface_points(&m, 20000, 3).unwrap();
+        let total: f64 = areas.iter().sum();
+        for (f, a) in areas.iter().enumerate() {
+            let c = pts.iter().filter(|p| p.face as usize == f).count() as f64 / 20000.0;
+            assert!(
+                (c - a / total).abs() < 0.02,
+                "face {f}: {c} vs {}",
+                a / total
+            );
+        }
+        assert!(
+            pts.iter()
+                .all(|p| p.bary.iter().all(|&b| (0.0..=1.0).contains(&b)))
+        );
+    }
+}
