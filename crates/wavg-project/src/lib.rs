@@ -1,1 +1,42 @@
 //! Phong projection onto meshes embedded in R^8 (paper Sections 3.2-3.3).
+//!
+//! The pipeline: an [`EmbeddedMesh`] (a valid mesh with per-vertex coordinates in R^8),
+//! per-vertex tangent frames ([`frames`]), per-triangle interpolated tangent planes `Psi`
+//! ([`triangle`]), and a [`Projector`] that finds the closest valid Phong projection of a
+//! point of R^8 onto the mesh: a fast local search that is certified against a bounding
+//! volume hierarchy, an exhaustive (branch and bound) search, a literal brute force, and
+//! the Euclidean closest point as a baseline.
+//!
+//! ```
+//! use std::sync::Arc;
+//! use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+//! use wavg_project::{EmbeddedMesh, Projector};
+//!
+//! let mesh = Arc::new(ValidMesh::new(procedural::icosphere(2)).unwrap());
+//! let emb = Arc::new(EmbeddedMesh::from_positions(mesh));
+//! let proj = Projector::new(emb.clone()).unwrap();
+//! let p = SurfacePoint::new(7, [0.2, 0.3, 0.5]);
+//! let y = emb.point(&p);
+//! let hit = proj.project(&y, 0).unwrap();
+//! assert!((emb.point(&hit.point) - y).norm() < 1e-6);
+//! ```
+
+pub mod bvh;
+pub mod embedded;
+pub mod error;
+pub mod euclid;
+pub mod frames;
+pub mod ort;
+pub mod projector;
+pub mod triangle;
+
+pub use embedded::EmbeddedMesh;
+pub use error::ProjectError;
+pub use projector::{Projection, ProjectionPath, Projector};
+
+/// Dimension of the embedding space.
+pub const DIM: usize = 8;
+/// A point or vector of the embedding space R^8.
+pub type Vec8 = nalgebra::SVector<f64, 8>;
+/// Two rows spanning a plane of R^8 (a tangent frame or an interpolated tangent plane).
+pub type Mat2x8 = nalgebra::SMatrix<f64, 2, 8>;

@@ -10,4 +10,5 @@
 //! ```
 
 pub use wavg_mesh as mesh;
+pub use wavg_project as project;
 pub use wavg_mesh::{MeshError, SurfacePoint, TriMesh, ValidMesh};

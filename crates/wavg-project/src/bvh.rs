@@ -1,0 +1,172 @@
+//! A bounding volume hierarchy of the embedded triangles in R^8 (axis-aligned boxes, f32,
+//! rounded outwards so the bounds stay conservative). It turns "is there a closer valid
+//! projection anywhere?" into a branch and bound that only visits triangles whose box is
+//! closer than the best answer so far.
+
+use crate::Vec8;
+
+/// Triangles per leaf.
+const LEAF: usize = 4;
+/// Traversal stack size; the median split keeps the depth near log2(faces / LEAF).
+const STACK: usize = 96;
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    lo: [f32; 8],
+    hi: [f32; 8],
+    /// Leaf: first index into `items`; interior: index of the right child (left is next).
+    a: u32,
+    /// Leaf: number of items (> 0); interior: 0.
+    n: u32,
+}
+
+/// The hierarchy: nodes in depth-first order and the face ids in leaf order.
+#[derive(Clone, Debug)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    items: Vec<u32>,
+}
+
+fn down(x: f64) -> f32 {
+    let f = x as f32;
+    if f as f64 > x { f.next_down() } else { f }
+}
+
+fn up(x: f64) -> f32 {
+    let f = x as f32;
+    if (f as f64) < x { f.next_up() } else { f }
+}
+
+impl Bvh {
+    /// Builds the hierarchy over boxes `(lo, hi)`, one per face.
+    pub fn new(boxes: &[(Vec8, Vec8)]) -> Self {
+        let mut items: Vec<u32> = (0..boxes.len() as u32).collect();
+        let centers: Vec<Vec8> = boxes.iter().map(|(l, h)| (l + h) * 0.5).collect();
+        let mut nodes = Vec::with_capacity(2 * boxes.len() / LEAF + 1);
+        if !boxes.is_empty() {
+            build(&mut nodes, &mut items, 0, boxes, &centers);
+        }
+        Self { nodes, items }
+    }
+
+    /// Heap bytes used.
+    pub fn bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<Node>() + self.items.len() * 4
+    }
+
+    /// Branch and bound: visits (in roughly nearest-first order) every face whose box is
+    /// closer to `y` than `sqrt(*best)`; `visit(face, best)` may lower `*best`.
+    pub fn search(&self, y: &Vec8, best: &mut f64, mut visit: impl FnMut(u32, &mut f64)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = [0u32; STACK];
+        let mut sp = 1;
+        let mut dist = [0.0f64; STACK];
+        dist[0] = box_dist2(&self.nodes[0], y);
+        while sp > 0 {
+            sp -= 1;
+            let ni = stack[sp] as usize;
+            if dist[sp] >= *best {
+                continue;
+            }
+            let node = &self.nodes[ni];
+            if node.n > 0 {
+                for &f in &self.items[node.a as usize..(node.a + node.n) as usize] {
+                    visit(f, best);
+                }
+                continue;
+            }
+            let (l, r) = (ni + 1, node.a as usize);
+            let dl = box_dist2(&self.nodes[l], y);
+            let dr = box_dist2(&self.nodes[r], y);
+            // Push the farther child first so the nearer is explored first.
+            let (first, df, second, ds) = if dl <= dr {
+                (r, dr, l, dl)
+            } else {
+                (l, dl, r, dr)
+            };
+            if sp + 2 > STACK {
+                // Cannot happen with median splits; be safe: visit the subtree exhaustively.
+                self.visit_all(first, &mut visit, best);
+                self.visit_all(second, &mut visit, best);
+                continue;
+            }
+            if df < *best {
+                stack[sp] = first as u32;
+                dist[sp] = df;
+                sp += 1;
+            }
+            if ds < *best {
+                stack[sp] = second as u32;
+                dist[sp] = ds;
+                sp += 1;
+            }
+        }
+    }
+
+    fn visit_all(&self, ni: usize, visit: &mut impl FnMut(u32, &mut f64), best: &mut f64) {
+        let node = &self.nodes[ni];
+        if node.n > 0 {
+            for &f in &self.items[node.a as usize..(node.a + node.n) as usize] {
+                visit(f, best);
+            }
+        } else {
+            self.visit_all(ni + 1, visit, best);
+            self.visit_all(node.a as usize, visit, best);
+        }
+    }
+}
+
+#[inline]
+fn box_dist2(n: &Node, y: &Vec8) -> f64 {
+    let mut s = 0.0;
+    for k in 0..8 {
+        let lo = n.lo[k] as f64;
+        let hi = n.hi[k] as f64;
+        let d = (lo - y[k]).max(y[k] - hi).max(0.0);
+        s += d * d;
+    }
+    s
+}
+
+fn build(
+    nodes: &mut Vec<Node>,
+    items: &mut [u32],
+    offset: usize,
+    boxes: &[(Vec8, Vec8)],
+    centers: &[Vec8],
+) {
+    let mut lo = Vec8::repeat(f64::INFINITY);
+    let mut hi = Vec8::repeat(f64::NEG_INFINITY);
+    let mut clo = Vec8::repeat(f64::INFINITY);
+    let mut chi = Vec8::repeat(f64::NEG_INFINITY);
+    for &f in items.iter() {
+        let (l, h) = &boxes[f as usize];
+        lo = lo.inf(l);
+        hi = hi.sup(h);
+        clo = clo.inf(&centers[f as usize]);
+        chi = chi.sup(&centers[f as usize]);
+    }
+    let me = nodes.len();
+    nodes.push(Node {
+        lo: std::array::from_fn(|k| down(lo[k])),
+        hi: std::array::from_fn(|k| up(hi[k])),
+        a: offset as u32,
+        n: items.len() as u32,
+    });
+    if items.len() <= LEAF {
+        return;
+    }
+    let axis = (chi - clo).imax();
+    let mid = items.len() / 2;
+    items.select_nth_unstable_by(mid, |&a, &b| {
+        centers[a as usize][axis].total_cmp(&centers[b as usize][axis])
+    });
+    let (left, right) = items.split_at_mut(mid);
+    build(nodes, left, offset, boxes, centers);
+    let r = nodes.len();
+    build(nodes, right, offset + mid, boxes, centers);
+    nodes[me].a = r as u32;
+    nodes[me].n = 0;
+}

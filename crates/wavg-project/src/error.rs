@@ -1,0 +1,39 @@
+//! Errors of the projection crate.
+
+use wavg_mesh::VertexId;
+
+/// Why an embedding could not be used or a point could not be projected.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum ProjectError {
+    /// The embedding has a different number of points than the mesh has vertices.
+    #[error("embedding has {got} coordinates but the mesh has {expected} vertices")]
+    CoordinateCount {
+        /// Vertices of the mesh.
+        expected: usize,
+        /// Coordinates given.
+        got: usize,
+    },
+    /// A vertex's embedded coordinates are NaN or infinite.
+    #[error("embedded coordinates of vertex {vertex} are not finite")]
+    NonFinite {
+        /// The offending vertex.
+        vertex: VertexId,
+    },
+    /// The mesh has no faces to project onto.
+    #[error("the mesh has no faces")]
+    EmptyMesh,
+    /// The query point is NaN or infinite.
+    #[error("the query point is not finite")]
+    NonFiniteQuery,
+    /// The start vertex is not a vertex of the mesh.
+    #[error("start vertex {vertex} is out of range (the mesh has {n_vertices} vertices)")]
+    StartOutOfRange {
+        /// The given vertex.
+        vertex: VertexId,
+        /// Vertices of the mesh.
+        n_vertices: usize,
+    },
+    /// No triangle of the mesh has a valid Phong projection of the point.
+    #[error("no triangle has a valid Phong projection of the point")]
+    NoProjection,
+}

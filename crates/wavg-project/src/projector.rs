@@ -1,0 +1,474 @@
+//! Projection of points of R^8 onto the embedded mesh: Phong (fast, exhaustive, brute
+//! force) and Euclidean.
+//!
+//! The fast path walks greedily over the vertex graph from a start vertex to a vertex
+//! locally closest to the target, then tests the triangles around it (most promising
+//! first) and their neighbours. A valid projection at (numerically) zero distance is a
+//! global minimum and is returned at once. Any other local answer is *certified*: a
+//! branch and bound over the bounding volume hierarchy visits every triangle whose box is
+//! closer than that answer, so the fast path returns the same closest valid projection as
+//! the exhaustive search, never a far-off triangle. `ProjectionPath` says which happened.
+
+use std::sync::Arc;
+
+use rayon::prelude::*;
+use wavg_mesh::{FaceId, NONE, SurfacePoint, VertexId};
+
+use crate::bvh::Bvh;
+use crate::euclid::closest_point_barycentric;
+use crate::frames::FrameKind;
+use crate::triangle::{Frame32, TriData, frame_apply, frame_to_f32, frame_to_f64};
+use crate::{EmbeddedMesh, Mat2x8, ProjectError, Vec8};
+
+/// A distance below this fraction of the triangle's longest edge counts as zero: such a
+/// projection is a global minimum up to the f32 precision of the per-triangle data.
+pub const ZERO_DISTANCE: f64 = 1e-5;
+
+/// Faces the local search may test before certifying or falling back.
+const LOCAL_BUDGET: usize = 128;
+
+/// Which search produced a projection.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProjectionPath {
+    /// The local search around the walk's end found it (certified closest).
+    Local,
+    /// The local search found nothing or was beaten; the global search was used.
+    Fallback,
+    /// The exhaustive search (branch and bound or brute force).
+    Exhaustive,
+    /// Euclidean closest point (not a Phong projection).
+    Euclidean,
+}
+
+/// A projected point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projection {
+    /// Face and barycentrics (non-negative, summing to 1).
+    pub point: SurfacePoint,
+    /// Distance in R^8 between the embedded point and the query.
+    pub distance: f64,
+    /// Which search found it.
+    pub path: ProjectionPath,
+}
+
+/// Precomputed frames and per-triangle data of an embedded mesh; `Send + Sync`.
+pub struct Projector {
+    emb: Arc<EmbeddedMesh>,
+    frames: Vec<Frame32>,
+    frame_kinds: [usize; 4],
+    tris: Vec<TriData>,
+    bvh: Bvh,
+}
+
+/// Small fixed set of face ids (no allocation per query).
+struct Tested {
+    ids: [u32; LOCAL_BUDGET],
+    n: usize,
+}
+
+impl Tested {
+    fn new() -> Self {
+        Self {
+            ids: [0; LOCAL_BUDGET],
+            n: 0,
+        }
+    }
+    fn contains(&self, f: u32) -> bool {
+        self.ids[..self.n].contains(&f)
+    }
+    fn full(&self) -> bool {
+        self.n == LOCAL_BUDGET
+    }
+    fn push(&mut self, f: u32) {
+        self.ids[self.n] = f;
+        self.n += 1;
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Best {
+    face: u32,
+    xi: [f64; 3],
+    d2: f64,
+}
+
+impl Projector {
+    /// Computes the vertex frames, the per-triangle data and the bounding volume hierarchy.
+    pub fn new(emb: Arc<EmbeddedMesh>) -> Result<Self, ProjectError> {
+        let mesh = emb.mesh();
+        if mesh.n_faces() == 0 {
+            return Err(ProjectError::EmptyMesh);
+        }
+        let coords = emb.coords();
+        let chunk = 4096;
+        let framed: Vec<(Mat2x8, FrameKind)> = (0..mesh.n_vertices())
+            .into_par_iter()
+            .with_min_len(chunk)
+            .map(|v| crate::frames::vertex_frame(mesh, coords, v as u32))
+            .collect();
+        let mut frame_kinds = [0; 4];
+        let frames: Vec<Frame32> = framed
+            .iter()
+            .map(|(t, k)| {
+                frame_kinds[*k as usize] += 1;
+                frame_to_f32(t)
+            })
+            .collect();
+        let tris: Vec<TriData> = mesh
+            .triangles
+            .par_iter()
+            .with_min_len(chunk)
+            .map(|t| {
+                TriData::new(
+                    t.map(|v| &frames[v as usize]),
+                    t.map(|v| coords[v as usize]),
+                )
+            })
+            .collect();
+        let boxes: Vec<(Vec8, Vec8)> = (0..mesh.n_faces())
+            .map(|f| {
+                let [a, b, c] = emb.corners(f);
+                (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
+            })
+            .collect();
+        let bvh = Bvh::new(&boxes);
+        Ok(Self {
+            emb,
+            frames,
+            frame_kinds,
+            tris,
+            bvh,
+        })
+    }
+
+    /// The embedded mesh.
+    pub fn embedded(&self) -> &Arc<EmbeddedMesh> {
+        &self.emb
+    }
+
+    /// Tangent frame of vertex `v` (orthonormal rows, as stored in f32).
+    pub fn frame(&self, v: VertexId) -> Mat2x8 {
+        frame_to_f64(&self.frames[v as usize])
+    }
+
+    /// How many vertex frames came from each rule: interior stencil, boundary rules,
+    /// fitted plane, arbitrary completion.
+    pub fn frame_kind_counts(&self) -> [usize; 4] {
+        self.frame_kinds
+    }
+
+    /// Bytes of the projector's own data plus the embedded coordinates.
+    pub fn bytes(&self) -> usize {
+        self.frames.len() * std::mem::size_of::<Frame32>()
+            + self.tris.len() * std::mem::size_of::<TriData>()
+            + self.bvh.bytes()
+            + self.emb.coords().len() * std::mem::size_of::<Vec8>()
+    }
+
+    fn face_frames(&self, f: FaceId) -> [&Frame32; 3] {
+        self.emb.mesh().triangles[f as usize].map(|v| &self.frames[v as usize])
+    }
+
+    /// Interpolated tangent plane at a surface point (rows span it; near-orthonormal).
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// let m = Arc::new(ValidMesh::new(procedural::grid(3, 3, 1.0, 1.0)).unwrap());
+    /// let p = Projector::new(Arc::new(EmbeddedMesh::from_positions(m))).unwrap();
+    /// let psi = p.psi(&SurfacePoint::new(4, [0.2, 0.3, 0.5]));
+    /// assert!(psi.column(2).norm() < 1e-6); // the grid lies in the z = 0 plane
+    /// ```
+    pub fn psi(&self, p: &SurfacePoint) -> Mat2x8 {
+        self.tris[p.face as usize].psi(self.face_frames(p.face), &p.bary)
+    }
+
+    /// Partial derivatives of `Psi` with respect to the three barycentrics at `p`.
+    pub fn psi_derivatives(&self, p: &SurfacePoint) -> [Mat2x8; 3] {
+        self.tris[p.face as usize].psi_derivatives(self.face_frames(p.face), &p.bary)
+    }
+
+    /// Phong projection of `y` onto face `f` alone (barycentrics), if Newton finds one.
+    pub fn project_onto_face(&self, y: &Vec8, f: FaceId) -> Option<[f64; 3]> {
+        self.try_face(f, y).map(|b| b.xi)
+    }
+
+    #[inline]
+    fn try_face(&self, f: FaceId, y: &Vec8) -> Option<Best> {
+        let t = self.emb.mesh().triangles[f as usize];
+        let c = self.emb.coords();
+        let v = t.map(|i| &c[i as usize]);
+        let h = [0, 1, 2].map(|i| frame_apply(&self.frames[t[i] as usize], &(y - v[i])));
+        let xi = self.tris[f as usize].solve(&h)?;
+        let p = v[0] * xi[0] + v[1] * xi[1] + v[2] * xi[2];
+        Some(Best {
+            face: f,
+            xi,
+            d2: (p - y).norm_squared(),
+        })
+    }
+
+    fn is_zero(&self, b: &Best) -> bool {
+        let s = self.tris[b.face as usize].scale as f64 * ZERO_DISTANCE;
+        b.d2 <= s * s
+    }
+
+    fn finish(b: Best, path: ProjectionPath) -> Projection {
+        Projection {
+            point: SurfacePoint::new(b.face, b.xi),
+            distance: b.d2.sqrt(),
+            path,
+        }
+    }
+
+    /// Fast path: greedy vertex walk from `start` towards `y` in R^8, then a local triangle
+    /// search, certified against the bounding volume hierarchy; the global search is used
+    /// when the local one finds nothing or is beaten (reported as `Fallback`).
+    pub fn project(&self, y: &Vec8, start: VertexId) -> Result<Projection, ProjectError> {
+        let mesh = self.emb.mesh();
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(ProjectError::NonFiniteQuery);
+        }
+        if start as usize >= mesh.n_vertices() {
+            return Err(ProjectError::StartOutOfRange {
+                vertex: start,
+                n_vertices: mesh.n_vertices(),
+            });
+        }
+        let topo = mesh.topology();
+        let c = self.emb.coords();
+        // 1. Greedy walk.
+        let mut v = start;
+        let mut dv = (c[v as usize] - y).norm_squared();
+        let mut ring_d = [0.0f64; 64];
+        loop {
+            let mut next = None;
+            for (j, &u) in topo.ring(v).iter().enumerate() {
+                let d = (c[u as usize] - y).norm_squared();
+                if j < 64 {
+                    ring_d[j] = d;
+                }
+                if d < dv {
+                    dv = d;
+                    next = Some(u);
+                }
+            }
+            match next {
+                Some(u) => v = u,
+                None => break,
+            }
+        }
+        // 2. Faces around v, most promising first (nearest opposite corners).
+        let ring = topo.ring(v);
+        let faces = topo.ring_faces(v);
+        let dist = |j: usize| {
+            if j < 64 {
+                ring_d[j]
+            } else {
+                (c[ring[j] as usize] - y).norm_squared()
+            }
+        };
+        let mut order = [(0.0f64, 0u32); 64];
+        let m = faces.len().min(64);
+        for j in 0..m {
+            let score = dist(j) + dist((j + 1) % ring.len());
+            order[j] = (score, faces[j]);
+        }
+        order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let mut tested = Tested::new();
+        let mut best: Option<Best> = None;
+        let consider = |f: u32, tested: &mut Tested, best: &mut Option<Best>| -> bool {
+            tested.push(f);
+            if let Some(b) = self.try_face(f, y) {
+                if best.is_none_or(|x| b.d2 < x.d2) {
+                    *best = Some(b);
+                }
+                return self.is_zero(&b);
+            }
+            false
+        };
+        for &(_, f) in &order[..m] {
+            if consider(f, &mut tested, &mut best) {
+                return Ok(Self::finish(
+                    best.unwrap_or_else(|| unreachable!()),
+                    ProjectionPath::Local,
+                ));
+            }
+        }
+        for &f in faces.iter().skip(m) {
+            if tested.full() {
+                break;
+            }
+            if consider(f, &mut tested, &mut best) {
+                return Ok(Self::finish(
+                    best.unwrap_or_else(|| unreachable!()),
+                    ProjectionPath::Local,
+                ));
+            }
+        }
+        // 3. Their neighbours across edges.
+        if best.is_none() {
+            let n_ring = tested.n;
+            'outer: for i in 0..n_ring {
+                for g in topo.face_neighbors(tested.ids[i]) {
+                    if g == NONE || tested.contains(g) {
+                        continue;
+                    }
+                    if tested.full() {
+                        break 'outer;
+                    }
+                    if consider(g, &mut tested, &mut best) {
+                        return Ok(Self::finish(
+                            best.unwrap_or_else(|| unreachable!()),
+                            ProjectionPath::Local,
+                        ));
+                    }
+                }
+            }
+        }
+        // 4. Certify (or search globally).
+        match best {
+            Some(local) => {
+                let mut improved = None;
+                let mut bound = local.d2;
+                self.bvh.search(y, &mut bound, |f, bound| {
+                    if tested.contains(f) {
+                        return;
+                    }
+                    if let Some(b) = self.try_face_bounded(f, y, *bound) {
+                        *bound = b.d2;
+                        improved = Some(b);
+                    }
+                });
+                Ok(match improved {
+                    Some(b) => Self::finish(b, ProjectionPath::Fallback),
+                    None => Self::finish(local, ProjectionPath::Local),
+                })
+            }
+            None => self
+                .exhaustive(y)
+                .map(|b| Self::finish(b, ProjectionPath::Fallback))
+                .ok_or(ProjectError::NoProjection),
+        }
+    }
+
+    /// `try_face` if the triangle's own box is closer than `sqrt(bound)` and the answer
+    /// is strictly closer than that.
+    #[inline]
+    fn try_face_bounded(&self, f: FaceId, y: &Vec8, bound: f64) -> Option<Best> {
+        let [a, b, c] = self.emb.corners(f as usize);
+        let lo = a.inf(&b).inf(&c);
+        let hi = a.sup(&b).sup(&c);
+        let mut s = 0.0;
+        for k in 0..8 {
+            let d = (lo[k] - y[k]).max(y[k] - hi[k]).max(0.0);
+            s += d * d;
+        }
+        if s >= bound {
+            return None;
+        }
+        self.try_face(f, y).filter(|r| r.d2 < bound)
+    }
+
+    fn exhaustive(&self, y: &Vec8) -> Option<Best> {
+        let mut bound = f64::INFINITY;
+        let mut best = None;
+        self.bvh.search(y, &mut bound, |f, bound| {
+            if let Some(b) = self.try_face_bounded(f, y, *bound) {
+                *bound = b.d2;
+                best = Some(b);
+            }
+        });
+        best
+    }
+
+    /// Guaranteed path: the closest valid Phong projection over all triangles (branch and
+    /// bound over the bounding volume hierarchy, exact).
+    pub fn project_exhaustive(&self, y: &Vec8) -> Result<Projection, ProjectError> {
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(ProjectError::NonFiniteQuery);
+        }
+        self.exhaustive(y)
+            .map(|b| Self::finish(b, ProjectionPath::Exhaustive))
+            .ok_or(ProjectError::NoProjection)
+    }
+
+    /// The closest valid Phong projection by a literal scan over every triangle (skipping
+    /// only triangles whose bounding box is farther than the best so far). Slow; for tests
+    /// and for checking the other two paths.
+    pub fn project_brute_force(&self, y: &Vec8) -> Result<Projection, ProjectError> {
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(ProjectError::NonFiniteQuery);
+        }
+        let mut best: Option<Best> = None;
+        for f in 0..self.tris.len() as u32 {
+            let bound = best.map_or(f64::INFINITY, |b| b.d2);
+            if let Some(b) = self.try_face_bounded(f, y, bound) {
+                best = Some(b);
+            }
+        }
+        best.map(|b| Self::finish(b, ProjectionPath::Exhaustive))
+            .ok_or(ProjectError::NoProjection)
+    }
+
+    /// Euclidean closest point on the embedded mesh (baseline; discontinuous). A
+    /// non-finite query gives a point of face 0 at infinite distance.
+    pub fn project_euclidean(&self, y: &Vec8) -> Projection {
+        let mut best = Best {
+            face: 0,
+            xi: [1.0 / 3.0; 3],
+            d2: f64::INFINITY,
+        };
+        if y.iter().all(|v| v.is_finite()) {
+            let mut bound = f64::INFINITY;
+            self.bvh.search(y, &mut bound, |f, bound| {
+                let [a, b, c] = self.emb.corners(f as usize);
+                let xi = closest_point_barycentric(y, &a, &b, &c);
+                let d2 = (a * xi[0] + b * xi[1] + c * xi[2] - y).norm_squared();
+                if d2 < *bound {
+                    *bound = d2;
+                    best = Best { face: f, xi, d2 };
+                }
+            });
+        }
+        Self::finish(best, ProjectionPath::Euclidean)
+    }
+
+    /// Vertex closest to `y` in R^8 (brute force).
+    pub fn nearest_vertex(&self, y: &Vec8) -> VertexId {
+        let mut best = (f64::INFINITY, 0u32);
+        for (v, c) in self.emb.coords().iter().enumerate() {
+            let d = (c - y).norm_squared();
+            if d < best.0 {
+                best = (d, v as u32);
+            }
+        }
+        best.1
+    }
+}
+
+/// Compile-time check that the projector can be shared across threads.
+const _: fn() = || {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Projector>();
+};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frames::vertex_frames;
+    use wavg_mesh::{ValidMesh, procedural};
+
+    #[test]
+    fn frames_and_vertex_frames_agree() {
+        let m = Arc::new(ValidMesh::new(procedural::icosphere(1)).unwrap());
+        let emb = Arc::new(EmbeddedMesh::from_positions(m.clone()));
+        let p = Projector::new(emb.clone()).unwrap();
+        let f = vertex_frames(&m, emb.coords());
+        for v in 0..m.n_vertices() {
+            assert!((p.frame(v as u32) - f[v].0).norm() < 1e-6);
+        }
+        assert_eq!(p.frame_kind_counts()[0], m.n_vertices());
+    }
+}
