@@ -3,6 +3,7 @@
 mod bench_load;
 mod bench_project;
 mod bench_roundtrip;
+mod common;
 mod error;
 mod forward;
 mod info;

@@ -14,6 +14,7 @@ pub mod analyze;
 pub mod data;
 pub mod error;
 pub mod geometry;
+pub mod io;
 pub mod mesh;
 pub mod problem;
 pub mod procedural;

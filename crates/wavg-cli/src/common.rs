@@ -1,0 +1,55 @@
+//! Helpers shared by the subcommands: loading a mesh from a file or a builtin name, and
+//! validating it with a message that says what is wrong and how to repair it.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use wavg_mesh::{MeshError, TriMesh, ValidMesh, io, procedural};
+
+use crate::CliError;
+
+/// Prefix that names a procedural mesh instead of a file, e.g. `builtin:torus`.
+pub const BUILTIN_PREFIX: &str = "builtin:";
+
+/// Loads `builtin:NAME` (see `wavg info --builtin`) or a mesh file (.obj/.off/.ply, .gz).
+/// Unreadable or unparseable input is a [`CliError::input`] (exit status 2) whose one-line
+/// message names the file and, for parse errors, the line.
+pub fn load_mesh(path_or_builtin: &str) -> Result<TriMesh, CliError> {
+    match path_or_builtin.strip_prefix(BUILTIN_PREFIX) {
+        Some(name) => procedural::builtin(name).map_err(CliError::input),
+        None => io::load(Path::new(path_or_builtin)).map_err(|e| CliError::input(one_line(&e))),
+    }
+}
+
+/// Loads and validates a mesh. When validation fails, the problems (counts and first
+/// offending indices) are printed to stderr with a hint, and the error is returned
+/// (exit status 2: the input is not usable).
+#[allow(dead_code)] // for precompute/forward/inverse
+pub fn load_valid(path_or_builtin: &str) -> Result<Arc<ValidMesh>, CliError> {
+    let mesh = load_mesh(path_or_builtin)?;
+    match ValidMesh::new(mesh) {
+        Ok(m) => Ok(Arc::new(m)),
+        Err(MeshError::Invalid(report)) => {
+            eprintln!("{path_or_builtin}: the mesh is not a valid oriented manifold:");
+            for line in report.lines() {
+                eprintln!("  {line}");
+            }
+            eprintln!(
+                "hint: run `wavg info {path_or_builtin}` for details; duplicate vertices, \
+                 degenerate/duplicate faces, unreferenced vertices and extra components can \
+                 be removed with wavg_mesh::repair (repair_all)"
+            );
+            Err(CliError::input(format!(
+                "{path_or_builtin}: invalid mesh ({} problem{})",
+                report.problems.len(),
+                if report.problems.len() == 1 { "" } else { "s" }
+            )))
+        }
+        Err(e) => Err(CliError::input(one_line(&e))),
+    }
+}
+
+/// An error's message on one line (the CLI prints exactly one line per failure).
+pub fn one_line(e: &dyn std::fmt::Display) -> String {
+    e.to_string().replace('\n', " ")
+}

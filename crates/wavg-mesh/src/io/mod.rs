@@ -1,0 +1,183 @@
+//! Reading and writing mesh files: OBJ, OFF and PLY (ASCII and binary), each optionally
+//! gzip-compressed (`.gz` suffix).
+//!
+//! Readers produce a raw [`TriMesh`] that keeps the file's vertex indexing exactly
+//! (unreferenced vertices stay, out-of-range indices stay so that validation can name
+//! them); polygons are fan-triangulated. Whatever the bytes, a reader returns a mesh or a
+//! typed [`MeshError`], never panics. Malformed text gives [`MeshError::Parse`] with the
+//! path and the 1-based line.
+//!
+//! ```
+//! use wavg_mesh::{io, procedural};
+//! let dir = tempfile::tempdir().unwrap();
+//! let path = dir.path().join("sphere.off");
+//! let mesh = procedural::icosphere(1);
+//! io::save(&path, &mesh).unwrap();
+//! let back = io::load(&path).unwrap();
+//! assert_eq!(back.triangles, mesh.triangles);
+//! assert_eq!(back.positions, mesh.positions); // shortest round-trip float text: bit-exact
+//! ```
+
+mod obj;
+mod off;
+mod ply;
+mod text;
+
+use std::io::{Read, Write};
+use std::path::Path;
+
+use crate::error::MeshError;
+use crate::mesh::TriMesh;
+
+/// Facts about a file that the [`TriMesh`] does not keep, for diagnostics (`wavg info`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct LoadNotes {
+    /// The format that was read.
+    pub format: Option<Format>,
+    /// Polygons read from the file, before fan triangulation.
+    pub polygons: usize,
+    /// Polygons with more than three corners (they were fan-triangulated).
+    pub non_triangles: usize,
+    /// Faces with fewer than three corners (OBJ 1- and 2-index faces), skipped.
+    pub skipped_faces: usize,
+    /// Texture coordinates were present on some but not all faces and were dropped.
+    pub uv_dropped: bool,
+}
+
+/// The mesh file formats wavg reads and writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Wavefront OBJ (positions, texture coordinates, polygons).
+    Obj,
+    /// Object File Format (ASCII).
+    Off,
+    /// Stanford PLY (ASCII or binary).
+    Ply,
+}
+
+impl Format {
+    /// The format for a path from its extension (a trailing `.gz` is looked through),
+    /// and whether the file is gzip-compressed.
+    ///
+    /// ```
+    /// use wavg_mesh::io::Format;
+    /// use std::path::Path;
+    /// assert_eq!(Format::from_path(Path::new("a/b.off.gz")).unwrap(), (Format::Off, true));
+    /// assert!(Format::from_path(Path::new("b.stl")).is_err());
+    /// ```
+    pub fn from_path(path: &Path) -> Result<(Format, bool), MeshError> {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let (stem, gz) = match name.strip_suffix(".gz") {
+            Some(s) => (s.to_string(), true),
+            None => (name.clone(), false),
+        };
+        let ext = Path::new(&stem)
+            .extension()
+            .map(|e| e.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let format = match ext.as_str() {
+            "obj" => Format::Obj,
+            "off" => Format::Off,
+            "ply" => Format::Ply,
+            _ => {
+                return Err(MeshError::Unsupported {
+                    path: path.to_path_buf(),
+                    message: format!(
+                        "unknown extension {:?} (expected .obj, .off or .ply, optionally .gz)",
+                        ext
+                    ),
+                });
+            }
+        };
+        Ok((format, gz))
+    }
+}
+
+/// Reads a mesh file, choosing the format from the extension (`.obj`, `.off`, `.ply`,
+/// each optionally followed by `.gz`).
+pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
+    load_with_notes(path).map(|(m, _)| m)
+}
+
+/// Like [`load`], also returning what the file held beyond the triangle mesh.
+pub fn load_with_notes(path: &Path) -> Result<(TriMesh, LoadNotes), MeshError> {
+    let (format, gz) = Format::from_path(path)?;
+    let bytes = read_bytes(path, gz)?;
+    parse_bytes(&bytes, format, path)
+}
+
+/// Parses an in-memory (uncompressed) file of the given format; `path` is only used in
+/// error messages.
+pub fn parse_bytes(
+    bytes: &[u8],
+    format: Format,
+    path: &Path,
+) -> Result<(TriMesh, LoadNotes), MeshError> {
+    let located = |e: text::ParseError| MeshError::Parse {
+        path: path.to_path_buf(),
+        line: e.line,
+        message: e.message,
+    };
+    let (mesh, mut notes) = match format {
+        Format::Obj => obj::parse(text::as_text(bytes).map_err(located)?).map_err(located)?,
+        Format::Off => off::parse(text::as_text(bytes).map_err(located)?).map_err(located)?,
+        Format::Ply => ply::parse(bytes).map_err(located)?,
+    };
+    notes.format = Some(format);
+    Ok((mesh, notes))
+}
+
+fn io_err(path: &Path, source: std::io::Error) -> MeshError {
+    MeshError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+fn read_bytes(path: &Path, gz: bool) -> Result<Vec<u8>, MeshError> {
+    let raw = std::fs::read(path).map_err(|e| io_err(path, e))?;
+    if !gz {
+        return Ok(raw);
+    }
+    let mut out = Vec::with_capacity(raw.len() * 4);
+    flate2::read::MultiGzDecoder::new(&raw[..])
+        .read_to_end(&mut out)
+        .map_err(|e| MeshError::Parse {
+            path: path.to_path_buf(),
+            line: 0,
+            message: format!("gzip: {e}"),
+        })?;
+    Ok(out)
+}
+
+/// Writes a mesh, choosing the format from the extension: OBJ (with `vt` when the mesh has
+/// texture coordinates), OFF (positions and triangles only) or binary little-endian PLY
+/// (double positions; texture coordinates as a per-face `texcoord` list). A trailing `.gz`
+/// compresses. Positions are written exactly (shortest round-trip decimal, or raw doubles).
+pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
+    let (format, gz) = Format::from_path(path)?;
+    let bytes = to_bytes(mesh, format).map_err(|e| io_err(path, e))?;
+    let file = std::fs::File::create(path).map_err(|e| io_err(path, e))?;
+    let mut w = std::io::BufWriter::new(file);
+    let res = if gz {
+        let mut enc = flate2::write::GzEncoder::new(w, flate2::Compression::default());
+        enc.write_all(&bytes)
+            .and_then(|_| enc.finish())
+            .and_then(|mut w| w.flush())
+    } else {
+        w.write_all(&bytes).and_then(|_| w.flush())
+    };
+    res.map_err(|e| io_err(path, e))
+}
+
+/// Serialises a mesh in memory (uncompressed).
+pub fn to_bytes(mesh: &TriMesh, format: Format) -> std::io::Result<Vec<u8>> {
+    match format {
+        Format::Obj => Ok(obj::write(mesh)),
+        Format::Off => Ok(off::write(mesh)),
+        Format::Ply => ply::write(mesh),
+    }
+}

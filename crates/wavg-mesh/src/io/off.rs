@@ -1,0 +1,161 @@
+//! ASCII OFF: `[ST][C][N]OFF` header, `nv nf ne` counts, `nv` vertex lines, `nf` face lines
+//! `n i0 .. i(n-1) [colour]` with 0-based indices; `#` comments and blank lines anywhere.
+//!
+//! Strict: a missing or malformed line is an error naming the line (a truncated file must
+//! not come back as a smaller mesh). Extra values after the coordinates or after a face's
+//! indices (colours, normals, texture coordinates) are ignored.
+
+use nalgebra::Vector3;
+
+use super::LoadNotes;
+use super::text::{ParseError, Result, next_float, strip_comment};
+use crate::mesh::TriMesh;
+
+/// Lines with content (comments stripped), numbered from 1.
+struct Lines<'a> {
+    inner: std::iter::Enumerate<std::str::Lines<'a>>,
+    last: usize,
+}
+
+impl<'a> Lines<'a> {
+    fn next_content(&mut self) -> Option<(usize, &'a str)> {
+        for (i, raw) in self.inner.by_ref() {
+            self.last = i + 1;
+            let s = strip_comment(raw).trim();
+            if !s.is_empty() {
+                return Some((i + 1, s));
+            }
+        }
+        None
+    }
+}
+
+/// Parses the count line `nv nf [ne]`.
+fn counts(s: &str, line: usize) -> Result<(usize, usize)> {
+    let mut it = s.split_ascii_whitespace();
+    let mut num = |what: &str| -> Result<usize> {
+        let tok = it
+            .next()
+            .ok_or_else(|| ParseError::new(line, format!("missing {what} count")))?;
+        tok.parse::<usize>()
+            .map_err(|_| ParseError::new(line, format!("{what} count {tok:?} is not a count")))
+    };
+    let nv = num("vertex")?;
+    let nf = num("face")?;
+    if nv > u32::MAX as usize - 1 {
+        return Err(ParseError::new(line, format!("{nv} vertices is too many")));
+    }
+    Ok((nv, nf))
+}
+
+pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
+    let mut lines = Lines {
+        inner: text.lines().enumerate(),
+        last: 0,
+    };
+    let Some((hline, header)) = lines.next_content() else {
+        return Err(ParseError::new(1, "empty file (expected an OFF header)"));
+    };
+    let mut words = header.split_ascii_whitespace();
+    let keyword = words.next().unwrap_or("");
+    let Some(prefix) = keyword.strip_suffix("OFF") else {
+        return Err(ParseError::new(
+            hline,
+            format!("expected an OFF header, found {keyword:?}"),
+        ));
+    };
+    // Vertex lines of ST/C/N variants carry extra values, which are ignored anyway.
+    if !prefix.chars().all(|c| matches!(c, 'S' | 'T' | 'C' | 'N')) {
+        return Err(ParseError::new(
+            hline,
+            format!("unsupported OFF variant {keyword:?} (only 3-D [ST][C][N]OFF)"),
+        ));
+    }
+    let rest: Vec<&str> = words.collect();
+    if rest.first() == Some(&"BINARY") {
+        return Err(ParseError::new(hline, "binary OFF is not supported"));
+    }
+    let (nv, nf) = if rest.is_empty() {
+        let Some((l, s)) = lines.next_content() else {
+            return Err(ParseError::new(hline + 1, "missing vertex/face counts"));
+        };
+        counts(s, l)?
+    } else {
+        counts(&rest.join(" "), hline)?
+    };
+
+    // Never trust the header for allocation: a corrupt count must not exhaust memory.
+    let cap = text.len() / 6 + 1;
+    let mut positions = Vec::with_capacity(nv.min(cap));
+    for k in 0..nv {
+        let Some((line, s)) = lines.next_content() else {
+            return Err(ParseError::new(
+                lines.last + 1,
+                format!("file ends after {k} of {nv} vertices"),
+            ));
+        };
+        let mut it = s.split_ascii_whitespace();
+        let x = next_float(&mut it, line, "vertex x")?;
+        let y = next_float(&mut it, line, "vertex y")?;
+        let z = next_float(&mut it, line, "vertex z")?;
+        positions.push(Vector3::new(x, y, z));
+    }
+
+    let mut notes = LoadNotes::default();
+    let mut triangles = Vec::with_capacity(nf.min(cap));
+    let mut poly: Vec<u32> = Vec::new();
+    for k in 0..nf {
+        let Some((line, s)) = lines.next_content() else {
+            return Err(ParseError::new(
+                lines.last + 1,
+                format!("file ends after {k} of {nf} faces"),
+            ));
+        };
+        let mut it = s.split_ascii_whitespace();
+        let n_tok = it.next().unwrap_or("");
+        let n: usize = n_tok
+            .parse()
+            .map_err(|_| ParseError::new(line, format!("face size {n_tok:?} is not a count")))?;
+        if n < 3 {
+            return Err(ParseError::new(
+                line,
+                format!("face with {n} vertices (at least 3 needed)"),
+            ));
+        }
+        poly.clear();
+        for j in 0..n {
+            let tok = it.next().ok_or_else(|| {
+                ParseError::new(
+                    line,
+                    format!("face has {j} of the {n} vertex indices it announces"),
+                )
+            })?;
+            let idx: u32 = tok.parse().ok().filter(|&i| i != u32::MAX).ok_or_else(|| {
+                ParseError::new(line, format!("vertex index {tok:?} is not a valid index"))
+            })?;
+            poly.push(idx);
+        }
+        notes.polygons += 1;
+        if n > 3 {
+            notes.non_triangles += 1;
+        }
+        for j in 1..n - 1 {
+            triangles.push([poly[0], poly[j], poly[j + 1]]);
+        }
+    }
+    Ok((TriMesh::new(positions, triangles), notes))
+}
+
+/// `OFF` with triangles; floats in shortest round-trip form (bit-exact when read back).
+pub(crate) fn write(mesh: &TriMesh) -> Vec<u8> {
+    use std::fmt::Write;
+    let mut s = String::with_capacity(mesh.n_vertices() * 40 + mesh.n_faces() * 24);
+    let _ = writeln!(s, "OFF\n{} {} 0", mesh.n_vertices(), mesh.n_faces());
+    for p in &mesh.positions {
+        let _ = writeln!(s, "{:?} {:?} {:?}", p.x, p.y, p.z);
+    }
+    for t in &mesh.triangles {
+        let _ = writeln!(s, "3 {} {} {}", t[0], t[1], t[2]);
+    }
+    s.into_bytes()
+}
