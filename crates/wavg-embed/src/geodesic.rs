@@ -1,1 +1,891 @@
-//! (to be written)
+//! Geodesic distances by fast marching (Kimmel & Sethian 1998) on a triangle mesh.
+//!
+//! # Method
+//!
+//! The classic first-order scheme: vertices are frozen in order of increasing distance
+//! (a binary heap with lazy deletion); when a vertex `v` freezes, every unfrozen neighbour
+//! `x` is updated
+//! * along each edge: `u(x) <= u(v) + |xv|` (Dijkstra), and
+//! * across each *update stencil* `(x; v, w)` whose other vertex `w` is frozen: the planar
+//!   wavefront through `(v, u(v))`, `(w, u(w))` with unit gradient gives `t`; it is used only
+//!   if its characteristic (the direction `-grad u`) lies inside the stencil's angle at `x`
+//!   (upwind condition). Otherwise only the edge updates apply (the standard fallback).
+//!
+//! With the stencil's edge vectors `a = v - x`, `b = w - x`, Gram matrix `G` and `Q = G^-1`,
+//! `grad u = [a b] Q (U - t 1)` where `U = (u(v), u(w))`; `|grad u| = 1` is a quadratic in `t`
+//! (its larger root), and upwind means both components of `Q (U - t 1)` are `<= 0`.
+//!
+//! **Obtuse triangles** are handled as Kimmel & Sethian propose: a corner `x` with an angle
+//! above 90 degrees is split by a *virtual edge* to a vertex `W` found by unfolding the
+//! triangles beyond the opposite edge into the triangle's plane (up to
+//! [`MAX_UNFOLD_STEPS`] triangles) until `W` falls inside the section of directions making
+//! at most 90 degrees with both edges at `x`. The corner then gets two acute stencils
+//! `(x; v, W)` and `(x; W, w)` with the unfolded geometry, and `u(W) + |xW|` (unfolded
+//! length) is used as an extra edge update. If the unfolding runs into a boundary or does
+//! not find such a vertex, the obtuse stencil is kept as it is (its update is still applied
+//! only when upwind, so the result stays a valid upper bound of the edge-graph distance).
+//!
+//! All geometry is precomputed once per mesh in [`FastMarching`] (a flat list of
+//! update entries per freezing vertex, single precision), so one run only touches the
+//! distance array, the heap and that list. [`Workspace`] holds the per-run buffers so that
+//! repeated runs do not allocate.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use nalgebra::Vector2;
+use rayon::prelude::*;
+use wavg_mesh::{NONE, ValidMesh};
+
+use crate::error::{EmbedError, Progress, Stage, check_cancel};
+
+/// How many triangles the obtuse-angle unfolding may cross before giving up.
+pub const MAX_UNFOLD_STEPS: usize = 40;
+
+/// One update that freezing a vertex `v` triggers on a neighbour `x`.
+///
+/// `q_vv, q_vo, q_oo` are the entries of the inverse Gram matrix of the stencil
+/// `(x; v, other)` (all zero for an edge-only entry); `len` is `|x - v|` (unfolded for a
+/// virtual edge).
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    x: u32,
+    other: u32,
+    q_vv: f32,
+    q_vo: f32,
+    q_oo: f32,
+    len: f32,
+}
+
+/// Precomputed fast-marching structure of one mesh; reusable for any number of runs, from
+/// any number of threads.
+///
+/// ```
+/// use wavg_embed::geodesic::FastMarching;
+/// use wavg_mesh::{ValidMesh, procedural};
+/// let mesh = ValidMesh::new(procedural::grid(20, 20, 1.0, 1.0)).unwrap();
+/// let fm = FastMarching::new(&mesh);
+/// let mut ws = fm.workspace();
+/// let d = fm.run(&mut ws, &[0]).to_vec();
+/// // Corner to opposite corner of the unit square: sqrt(2) up to discretisation error.
+/// assert!((d[440] - 2f64.sqrt()).abs() < 0.02);
+/// ```
+#[derive(Clone, Debug)]
+pub struct FastMarching {
+    n: usize,
+    offsets: Vec<u32>,
+    entries: Vec<Entry>,
+    /// Number of obtuse corners, and how many of them were split by unfolding.
+    obtuse: (usize, usize),
+}
+
+/// Per-run buffers (distances, frozen flags, heap). Make one per thread with
+/// [`FastMarching::workspace`].
+#[derive(Clone, Debug)]
+pub struct Workspace {
+    dist: Vec<f64>,
+    frozen: Vec<bool>,
+    heap: BinaryHeap<Reverse<(u64, u32)>>,
+}
+
+/// A stencil `(x; A, B)` with the 2-D (or 3-D, only dot products matter) edge vectors.
+struct Stencil {
+    x: u32,
+    a: u32,
+    b: u32,
+    /// Gram entries `a.a`, `a.b`, `b.b`.
+    g: [f64; 3],
+}
+
+impl FastMarching {
+    /// Precomputes the update stencils of `mesh` (unfolding obtuse corners).
+    pub fn new(mesh: &ValidMesh) -> Self {
+        Self::build(mesh, true)
+    }
+
+    fn build(mesh: &ValidMesh, unfold_obtuse: bool) -> Self {
+        let n = mesh.n_vertices();
+        let topo = mesh.topology();
+        let pos = &mesh.positions;
+        let mut stencils: Vec<Stencil> = Vec::with_capacity(mesh.n_faces() * 3 + 1024);
+        let mut virtual_edges: Vec<(u32, u32, f64)> = Vec::new();
+        let mut obtuse = (0usize, 0usize);
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let x = t[k];
+                let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+                let px = pos[x as usize];
+                let va = pos[a as usize] - px;
+                let vb = pos[b as usize] - px;
+                let g = [va.dot(&va), va.dot(&vb), vb.dot(&vb)];
+                if g[1] >= 0.0 {
+                    stencils.push(Stencil { x, a, b, g });
+                    continue;
+                }
+                obtuse.0 += 1;
+                let split = if unfold_obtuse {
+                    unfold(mesh, f as u32, k, topo)
+                } else {
+                    None
+                };
+                match split {
+                    Some((w, a2, w2, b2)) => {
+                        obtuse.1 += 1;
+                        stencils.push(Stencil {
+                            x,
+                            a,
+                            b: w,
+                            g: [a2.dot(&a2), a2.dot(&w2), w2.dot(&w2)],
+                        });
+                        stencils.push(Stencil {
+                            x,
+                            a: w,
+                            b,
+                            g: [w2.dot(&w2), w2.dot(&b2), b2.dot(&b2)],
+                        });
+                        virtual_edges.push((w, x, w2.norm()));
+                    }
+                    None => stencils.push(Stencil { x, a, b, g }),
+                }
+            }
+        }
+        // Entries grouped by the freezing vertex (counting sort).
+        let mut offsets = vec![0u32; n + 1];
+        for s in &stencils {
+            offsets[s.a as usize + 1] += 1;
+            offsets[s.b as usize + 1] += 1;
+        }
+        for &(w, _, _) in &virtual_edges {
+            offsets[w as usize + 1] += 1;
+        }
+        for i in 0..n {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut fill: Vec<u32> = offsets[..n].to_vec();
+        let empty = Entry {
+            x: 0,
+            other: 0,
+            q_vv: 0.0,
+            q_vo: 0.0,
+            q_oo: 0.0,
+            len: 0.0,
+        };
+        let mut entries = vec![empty; offsets[n] as usize];
+        let mut put = |v: u32, e: Entry| {
+            entries[fill[v as usize] as usize] = e;
+            fill[v as usize] += 1;
+        };
+        for s in &stencils {
+            let [gaa, gab, gbb] = s.g;
+            let det = gaa * gbb - gab * gab;
+            // Degenerate (sliver) stencils only contribute their edges.
+            let q = if det > 1e-12 * gaa * gbb && det > 0.0 {
+                [gbb / det, -gab / det, gaa / det]
+            } else {
+                [0.0; 3]
+            };
+            let (la, lb) = (gaa.sqrt() as f32, gbb.sqrt() as f32);
+            put(
+                s.a,
+                Entry {
+                    x: s.x,
+                    other: s.b,
+                    q_vv: q[0] as f32,
+                    q_vo: q[1] as f32,
+                    q_oo: q[2] as f32,
+                    len: la,
+                },
+            );
+            put(
+                s.b,
+                Entry {
+                    x: s.x,
+                    other: s.a,
+                    q_vv: q[2] as f32,
+                    q_vo: q[1] as f32,
+                    q_oo: q[0] as f32,
+                    len: lb,
+                },
+            );
+        }
+        for &(w, x, len) in &virtual_edges {
+            put(
+                w,
+                Entry {
+                    x,
+                    other: x,
+                    len: len as f32,
+                    ..empty
+                },
+            );
+        }
+        Self {
+            n,
+            offsets,
+            entries,
+            obtuse,
+        }
+    }
+
+    /// Number of vertices of the mesh.
+    pub fn n_vertices(&self) -> usize {
+        self.n
+    }
+
+    /// `(obtuse corners, obtuse corners split by unfolding)`, for diagnostics.
+    pub fn obtuse_corners(&self) -> (usize, usize) {
+        self.obtuse
+    }
+
+    /// Fresh per-run buffers for this mesh.
+    pub fn workspace(&self) -> Workspace {
+        Workspace {
+            dist: vec![f64::INFINITY; self.n],
+            frozen: vec![false; self.n],
+            heap: BinaryHeap::with_capacity(1024),
+        }
+    }
+
+    /// Distances from the nearest of `sources` to every vertex (`INFINITY` where
+    /// unreachable); returns a view into `ws`. Out-of-range source ids are ignored.
+    pub fn run<'w>(&self, ws: &'w mut Workspace, sources: &[u32]) -> &'w [f64] {
+        self.run_until(ws, sources, None);
+        &ws.dist
+    }
+
+    /// Like [`run`](Self::run), but stops as soon as every vertex flagged in `targets`
+    /// (`targets[v] == true`, `n_targets` of them) is frozen. Distances of vertices not yet
+    /// frozen are then upper bounds (or `INFINITY`).
+    pub fn run_until_targets<'w>(
+        &self,
+        ws: &'w mut Workspace,
+        sources: &[u32],
+        targets: &[bool],
+        n_targets: usize,
+    ) -> &'w [f64] {
+        self.run_until(ws, sources, Some((targets, n_targets)));
+        &ws.dist
+    }
+
+    fn run_until(&self, ws: &mut Workspace, sources: &[u32], stop: Option<(&[bool], usize)>) {
+        let Workspace { dist, frozen, heap } = ws;
+        dist.fill(f64::INFINITY);
+        frozen.fill(false);
+        heap.clear();
+        for &s in sources {
+            if (s as usize) < self.n {
+                dist[s as usize] = 0.0;
+                heap.push(Reverse((0, s)));
+            }
+        }
+        let mut remaining = stop.map_or(usize::MAX, |(_, k)| k);
+        if remaining == 0 {
+            return;
+        }
+        while let Some(Reverse((key, v))) = heap.pop() {
+            let vi = v as usize;
+            if frozen[vi] || key != dist[vi].to_bits() {
+                continue;
+            }
+            frozen[vi] = true;
+            if let Some((targets, _)) = stop {
+                if targets[vi] {
+                    remaining -= 1;
+                    if remaining == 0 {
+                        return;
+                    }
+                }
+            }
+            let uv = dist[vi];
+            let range = self.offsets[vi] as usize..self.offsets[vi + 1] as usize;
+            for e in &self.entries[range] {
+                let xi = e.x as usize;
+                if frozen[xi] {
+                    continue;
+                }
+                let mut cand = uv + e.len as f64;
+                let oi = e.other as usize;
+                if e.q_vv > 0.0 && frozen[oi] {
+                    if let Some(t) = triangle_update(uv, dist[oi], e) {
+                        cand = cand.min(t);
+                    }
+                }
+                if cand < dist[xi] {
+                    dist[xi] = cand;
+                    heap.push(Reverse((cand.to_bits(), e.x)));
+                }
+            }
+        }
+    }
+}
+
+/// The planar-wavefront value at `x` from frozen values `uv` (at `v`) and `uo` (at the
+/// stencil's other vertex), or `None` when the characteristic is not inside the stencil.
+#[inline(always)]
+fn triangle_update(uv: f64, uo: f64, e: &Entry) -> Option<f64> {
+    let (qvv, qvo, qoo) = (e.q_vv as f64, e.q_vo as f64, e.q_oo as f64);
+    // Shift so that u(v) = 0: t' = t - uv, delta = uo - uv.
+    let delta = uo - uv;
+    let a = qvv + 2.0 * qvo + qoo;
+    let b = (qvo + qoo) * delta;
+    let c = qoo * delta * delta - 1.0;
+    let disc = b * b - a * c;
+    if disc < 0.0 || a <= 0.0 {
+        return None;
+    }
+    let t = (b + disc.sqrt()) / a;
+    // Upwind: Q (U - t 1) <= 0 componentwise, with U - t 1 = (-t, delta - t).
+    let g0 = -qvv * t + qvo * (delta - t);
+    let g1 = -qvo * t + qoo * (delta - t);
+    if g0 <= 0.0 && g1 <= 0.0 && t >= delta.max(0.0) {
+        Some(uv + t)
+    } else {
+        None
+    }
+}
+
+/// Splits the obtuse corner `k` of face `f` (Kimmel & Sethian's unfolding). Returns the
+/// vertex `W` found and the 2-D vectors from `x` to `A`, `W`, `B` in the unfolded plane.
+fn unfold(
+    mesh: &ValidMesh,
+    f: u32,
+    k: usize,
+    topo: &wavg_mesh::Topology,
+) -> Option<(u32, Vector2<f64>, Vector2<f64>, Vector2<f64>)> {
+    let pos = &mesh.positions;
+    let t = mesh.triangles[f as usize];
+    let x = t[k];
+    let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+    let px = pos[x as usize];
+    let va = pos[a as usize] - px;
+    let vb = pos[b as usize] - px;
+    let la = va.norm();
+    let a2 = Vector2::new(la, 0.0);
+    let b2 = Vector2::new(va.dot(&vb) / la, va.cross(&vb).norm() / la);
+    // Current edge (p, r) with p on A's side and r on B's side, crossed from face `face`.
+    let (mut p, mut r) = (a, b);
+    let (mut p2, mut r2) = (a2, b2);
+    let mut face = f;
+    for _ in 0..MAX_UNFOLD_STEPS {
+        let next = across(mesh, topo, face, p, r)?;
+        let tn = mesh.triangles[next as usize];
+        let w = tn.into_iter().find(|&v| v != p && v != r)?;
+        if w == x {
+            return None;
+        }
+        let w2 = place(
+            p2,
+            r2,
+            (pos[w as usize] - pos[p as usize]).norm(),
+            (pos[w as usize] - pos[r as usize]).norm(),
+        )?;
+        let (da, db) = (w2.dot(&a2), w2.dot(&b2));
+        if da > 0.0 && db > 0.0 {
+            return Some((w, a2, w2, b2));
+        }
+        if db <= 0.0 {
+            // W is on A's side of the section: continue across (W, r).
+            p = w;
+            p2 = w2;
+        } else {
+            r = w;
+            r2 = w2;
+        }
+        face = next;
+    }
+    None
+}
+
+/// The face on the other side of edge `{p, r}` of `face`, if any.
+fn across(mesh: &ValidMesh, topo: &wavg_mesh::Topology, face: u32, p: u32, r: u32) -> Option<u32> {
+    let t = mesh.triangles[face as usize];
+    for i in 0..3 {
+        let (s, e) = (t[i], t[(i + 1) % 3]);
+        if (s == p && e == r) || (s == r && e == p) {
+            let g = topo.face_neighbors(face)[i];
+            return (g != NONE).then_some(g);
+        }
+    }
+    None
+}
+
+/// The point at distances `lp` from `p2` and `lr` from `r2`, on the side of line `p2 r2`
+/// away from the origin.
+fn place(p2: Vector2<f64>, r2: Vector2<f64>, lp: f64, lr: f64) -> Option<Vector2<f64>> {
+    let e = r2 - p2;
+    let l = e.norm();
+    if l <= 0.0 {
+        return None;
+    }
+    let ex = e / l;
+    let mut ey = Vector2::new(-ex.y, ex.x);
+    if (-p2).dot(&ey) > 0.0 {
+        ey = -ey;
+    }
+    let along = (lp * lp - lr * lr + l * l) / (2.0 * l);
+    let h = (lp * lp - along * along).max(0.0).sqrt();
+    let w = p2 + ex * along + ey * h;
+    w.iter().all(|c| c.is_finite()).then_some(w)
+}
+
+/// Fast-marching distances from the nearest of `sources` to every vertex of `mesh`
+/// (`f64::INFINITY` for vertices in other components). Out-of-range source ids are ignored;
+/// with no valid source every distance is infinite.
+///
+/// For many runs on one mesh, build a [`FastMarching`] once instead.
+///
+/// ```
+/// use wavg_embed::geodesic::distances_from;
+/// use wavg_mesh::{ValidMesh, procedural};
+/// let sphere = ValidMesh::new(procedural::icosphere(4)).unwrap();
+/// let d = distances_from(&sphere, &[0]);
+/// let p0 = sphere.positions[0];
+/// // Antipode of vertex 0: half the great circle, pi.
+/// let far = (0..d.len()).min_by(|&a, &b| sphere.positions[a].dot(&p0).total_cmp(&sphere.positions[b].dot(&p0))).unwrap();
+/// assert!((d[far] - std::f64::consts::PI).abs() < 0.03);
+/// ```
+pub fn distances_from(mesh: &ValidMesh, sources: &[u32]) -> Vec<f64> {
+    let fm = FastMarching::new(mesh);
+    let mut ws = fm.workspace();
+    fm.run(&mut ws, sources);
+    ws.dist
+}
+
+/// Geodesic distances between all pairs of `landmarks`, symmetrised: the `n x n` matrix
+/// `Q = (D + D^T) / 2` row-major (`n = landmarks.len()`), where row `i` of `D` is one fast
+/// marching run from landmark `i`. Runs go in parallel (rayon), each stopping once all
+/// landmarks are frozen; progress is reported as [`Stage::Geodesics`] and cancellation is
+/// checked between runs.
+///
+/// Errors: a landmark id out of range or repeated, or a pair of landmarks in different
+/// components (infinite distance).
+pub fn landmark_distances(
+    mesh: &ValidMesh,
+    landmarks: &[u32],
+    progress: &dyn Progress,
+) -> Result<Vec<f64>, EmbedError> {
+    let fm = FastMarching::new(mesh);
+    landmark_distances_with(&fm, landmarks, progress)
+}
+
+/// [`landmark_distances`] with a prebuilt [`FastMarching`] (of the same mesh).
+pub fn landmark_distances_with(
+    fm: &FastMarching,
+    landmarks: &[u32],
+    progress: &dyn Progress,
+) -> Result<Vec<f64>, EmbedError> {
+    let n = landmarks.len();
+    let mut is_target = vec![false; fm.n];
+    for &l in landmarks {
+        let slot = is_target.get_mut(l as usize).ok_or_else(|| {
+            EmbedError::InvalidArgument(format!(
+                "landmark {l} out of range (mesh has {} vertices)",
+                fm.n
+            ))
+        })?;
+        if std::mem::replace(slot, true) {
+            return Err(EmbedError::InvalidArgument(format!(
+                "landmark {l} appears twice"
+            )));
+        }
+    }
+    check_cancel(progress)?;
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let rows: Vec<Vec<f64>> = (0..n)
+        .into_par_iter()
+        .map_init(
+            || fm.workspace(),
+            |ws, i| {
+                check_cancel(progress)?;
+                let d = fm.run_until_targets(ws, &landmarks[i..i + 1], &is_target, n);
+                let row: Vec<f64> = landmarks.iter().map(|&l| d[l as usize]).collect();
+                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress.report(Stage::Geodesics, k as f64 / n as f64);
+                Ok(row)
+            },
+        )
+        .collect::<Result<_, EmbedError>>()?;
+    let mut q = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            q[i * n + j] = 0.5 * (rows[i][j] + rows[j][i]);
+        }
+        q[i * n + i] = 0.0;
+    }
+    if let Some(k) = q.iter().position(|d| !d.is_finite()) {
+        return Err(EmbedError::InvalidArgument(format!(
+            "landmarks {} and {} are in different components (no geodesic between them); \
+             keep only one component (`--largest-component`)",
+            landmarks[k / n],
+            landmarks[k % n]
+        )));
+    }
+    Ok(q)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::NoProgress;
+    use nalgebra::Vector3;
+    use proptest::prelude::*;
+    use wavg_mesh::{TriMesh, procedural};
+
+    fn valid(m: TriMesh) -> ValidMesh {
+        ValidMesh::new(m).unwrap()
+    }
+
+    /// Mean and max relative error of `d` against `exact` over vertices with exact > `min`.
+    fn rel_err(d: &[f64], exact: &[f64], min: f64) -> (f64, f64) {
+        let (mut sum, mut max, mut k) = (0.0, 0.0f64, 0);
+        for (a, e) in d.iter().zip(exact) {
+            if *e > min {
+                let r = (a - e).abs() / e;
+                sum += r;
+                max = max.max(r);
+                k += 1;
+            }
+        }
+        (sum / k as f64, max)
+    }
+
+    /// Plain Dijkstra on the edge graph (reference upper bound).
+    fn dijkstra(mesh: &ValidMesh, s: u32) -> Vec<f64> {
+        let mut d = vec![f64::INFINITY; mesh.n_vertices()];
+        let mut h = BinaryHeap::new();
+        d[s as usize] = 0.0;
+        h.push(Reverse((0u64, s)));
+        while let Some(Reverse((k, v))) = h.pop() {
+            if k != d[v as usize].to_bits() {
+                continue;
+            }
+            for &w in mesh.topology().ring(v) {
+                let c = d[v as usize]
+                    + (mesh.positions[v as usize] - mesh.positions[w as usize]).norm();
+                if c < d[w as usize] {
+                    d[w as usize] = c;
+                    h.push(Reverse((c.to_bits(), w)));
+                }
+            }
+        }
+        d
+    }
+
+    #[test]
+    fn icosphere_matches_great_circle_distance() {
+        let mesh = valid(procedural::icosphere(6));
+        assert_eq!(mesh.n_vertices(), 40962);
+        let fm = FastMarching::new(&mesh);
+        let mut ws = fm.workspace();
+        let mut worst_mean = 0.0f64;
+        for s in [0u32, 12345, 40000] {
+            let d = fm.run(&mut ws, &[s]);
+            let ps = mesh.positions[s as usize];
+            let exact: Vec<f64> = mesh
+                .positions
+                .iter()
+                .map(|p| p.dot(&ps).clamp(-1.0, 1.0).acos())
+                .collect();
+            let (mean, max) = rel_err(d, &exact, 1e-9);
+            let (mean_far, _) = rel_err(d, &exact, 0.2);
+            eprintln!(
+                "icosphere(6) 40962 v, source {s}: mean rel err {:.4}%, beyond 0.2 rad {:.4}%, max {:.2}%",
+                mean * 100.0,
+                mean_far * 100.0,
+                max * 100.0
+            );
+            worst_mean = worst_mean.max(mean);
+        }
+        assert!(worst_mean < 0.01, "mean relative error {worst_mean}");
+    }
+
+    /// Mean relative error against the Euclidean distance over all vertices and over those
+    /// farther than 10 mean edge lengths, worst over `sources`.
+    fn plane_errors(
+        mesh: &ValidMesh,
+        fm: &FastMarching,
+        sources: &[u32],
+        label: &str,
+    ) -> (f64, f64) {
+        let mut ws = fm.workspace();
+        let h = wavg_mesh::geometry::mean_edge_length(mesh);
+        let (mut worst, mut worst_far) = (0.0f64, 0.0f64);
+        for &s in sources {
+            let d = fm.run(&mut ws, &[s]);
+            let ps = mesh.positions[s as usize];
+            let exact: Vec<f64> = mesh.positions.iter().map(|p| (p - ps).norm()).collect();
+            let (mean, max) = rel_err(d, &exact, 1e-12);
+            let (mean_far, _) = rel_err(d, &exact, 10.0 * h);
+            // In the plane the geodesic is the straight line; first-order fast marching may
+            // undershoot it only slightly.
+            for (a, e) in d.iter().zip(&exact) {
+                assert!(*a >= e * (1.0 - 1e-2), "{label}: {a} < euclidean {e}");
+            }
+            eprintln!(
+                "{label} ({} v, obtuse corners / split {:?}), source {s}: mean rel err {:.3}%, beyond 10 h {:.3}%, max {:.1}%",
+                mesh.n_vertices(),
+                fm.obtuse_corners(),
+                mean * 100.0,
+                mean_far * 100.0,
+                max * 100.0
+            );
+            worst = worst.max(mean);
+            worst_far = worst_far.max(mean_far);
+        }
+        (worst, worst_far)
+    }
+
+    #[test]
+    fn flat_grid_matches_euclidean_distance() {
+        let mesh = valid(procedural::grid(120, 80, 3.0, 2.0));
+        let center = 40 * 121 + 60;
+        let fm = FastMarching::new(&mesh);
+        let (worst, _) = plane_errors(&mesh, &fm, &[0, center, 121 * 81 - 1], "grid 120x80");
+        assert!(worst < 0.01, "{worst}");
+    }
+
+    fn sheared(shear: f64, squash: f64) -> ValidMesh {
+        valid(
+            procedural::grid(120, 80, 1.0, 1.0)
+                .map_positions(|p| Vector3::new(p.x + shear * p.y, squash * p.y, 0.0)),
+        )
+    }
+
+    #[test]
+    fn sheared_grids_with_obtuse_triangles_match_euclidean_distance() {
+        let sources = [0, 40 * 121 + 60, 121 * 81 - 1];
+        // Half of the triangles have a 130 degree corner.
+        let mesh = sheared(0.5, 0.6);
+        let fm = FastMarching::new(&mesh);
+        let (obtuse, split) = fm.obtuse_corners();
+        assert!(obtuse == 9600 && split == obtuse, "{obtuse} {split}");
+        let (mean, _) = plane_errors(&mesh, &fm, &sources, "grid sheared to 130 deg");
+        let plain = FastMarching::build(&mesh, false);
+        let (mean_plain, _) = plane_errors(&mesh, &plain, &sources, "  same without unfolding");
+        assert!(mean < 0.01, "{mean}");
+        assert!(
+            mean < mean_plain,
+            "unfolding should help: {mean} vs {mean_plain}"
+        );
+        // Extreme: 167 degree corners. Near the source the error is large (vertices closer
+        // than the shortest edge are not neighbours), farther away it is small.
+        let mesh = sheared(1.5, 0.35);
+        let fm = FastMarching::new(&mesh);
+        let (_, far) = plane_errors(&mesh, &fm, &sources, "grid sheared to 167 deg");
+        let plain = FastMarching::build(&mesh, false);
+        let (_, far_plain) = plane_errors(&mesh, &plain, &sources, "  same without unfolding");
+        assert!(far < 0.01, "{far}");
+        assert!(
+            far < far_plain,
+            "unfolding should help: {far} vs {far_plain}"
+        );
+    }
+
+    #[test]
+    fn noisy_anisotropic_triangulation_in_the_plane() {
+        // 4:1 cells, vertices jittered in the plane: acute and obtuse triangles of all shapes.
+        let (nx, ny) = (160u32, 40u32);
+        let base = procedural::grid(nx, ny, 1.0, 1.0);
+        let noisy = procedural::with_noise(base.clone(), 0.25, 3);
+        let w = nx as usize + 1;
+        let pos = noisy
+            .positions
+            .iter()
+            .zip(&base.positions)
+            .enumerate()
+            .map(|(i, (n, b))| {
+                // Keep the boundary straight so that the domain stays convex.
+                let (ix, iy) = (i % w, i / w);
+                let on_b = ix == 0 || ix == nx as usize || iy == 0 || iy == ny as usize;
+                if on_b {
+                    *b
+                } else {
+                    Vector3::new(n.x, n.y, 0.0)
+                }
+            })
+            .collect();
+        let mesh = valid(TriMesh::new(pos, base.triangles.clone()));
+        let fm = FastMarching::new(&mesh);
+        let sources = [0, 20 * w as u32 + 80, 7 * w as u32 + 150];
+        let (worst, _) = plane_errors(&mesh, &fm, &sources, "jittered 4:1 grid");
+        let plain = FastMarching::build(&mesh, false);
+        let (worst_plain, _) = plane_errors(&mesh, &plain, &sources, "  same without unfolding");
+        // Heavy jitter (40% of the short edges): first-order fast marching loses accuracy.
+        assert!(
+            worst < 0.025 && worst < worst_plain,
+            "{worst} {worst_plain}"
+        );
+    }
+
+    #[test]
+    fn disconnected_components_are_unreachable() {
+        let a = procedural::icosphere(2);
+        let mut b = procedural::icosphere(2).map_positions(|p| p + Vector3::new(5.0, 0.0, 0.0));
+        let off = a.n_vertices() as u32;
+        for t in &mut b.triangles {
+            *t = t.map(|v| v + off);
+        }
+        let mut m = a.clone();
+        m.positions.extend(b.positions);
+        m.triangles.extend(b.triangles);
+        let mesh = valid(m);
+        let d = distances_from(&mesh, &[0]);
+        assert!(d[..off as usize].iter().all(|x| x.is_finite()));
+        assert!(d[off as usize..].iter().all(|x| *x == f64::INFINITY));
+        let e = landmark_distances(&mesh, &[0, off + 3], &NoProgress).unwrap_err();
+        assert!(matches!(e, EmbedError::InvalidArgument(_)), "{e}");
+    }
+
+    #[test]
+    fn no_valid_source_gives_infinity_everywhere() {
+        let mesh = valid(procedural::icosphere(1));
+        let d = distances_from(&mesh, &[1000]);
+        assert!(d.iter().all(|x| x.is_infinite()));
+        let d = distances_from(&mesh, &[]);
+        assert!(d.iter().all(|x| x.is_infinite()));
+    }
+
+    #[test]
+    fn multi_source_is_the_minimum_of_single_sources() {
+        let mesh = valid(procedural::with_noise(procedural::icosphere(4), 0.3, 9));
+        let fm = FastMarching::new(&mesh);
+        let mut ws = fm.workspace();
+        let srcs = [3u32, 700, 1500];
+        let singles: Vec<Vec<f64>> = srcs
+            .iter()
+            .map(|&s| fm.run(&mut ws, &[s]).to_vec())
+            .collect();
+        let multi = fm.run(&mut ws, &srcs).to_vec();
+        let h = wavg_mesh::geometry::mean_edge_length(&mesh);
+        for v in 0..mesh.n_vertices() {
+            let m = singles.iter().map(|d| d[v]).fold(f64::INFINITY, f64::min);
+            // Fronts meeting may interact through a triangle update (slightly lower value).
+            assert!(
+                multi[v] <= m + 1e-12 && multi[v] >= m - 0.2 * h,
+                "{v}: {} vs {m}",
+                multi[v]
+            );
+        }
+        for &s in &srcs {
+            assert_eq!(multi[s as usize], 0.0);
+        }
+    }
+
+    #[test]
+    fn landmark_matrix_is_nearly_symmetric_and_symmetrised() {
+        // First-order fast marching is not exactly symmetric; the worst pairs are the
+        // closest ones (about 10-20 edge lengths apart).
+        asymmetry(0.1, 0.025);
+        asymmetry(0.3, 0.025);
+    }
+
+    fn asymmetry(noise: f64, bound: f64) {
+        let mesh = valid(procedural::with_noise(
+            procedural::torus(200, 80, 1.0, 0.35),
+            noise,
+            4,
+        ));
+        let lm: Vec<u32> = (0..60).map(|i| i * 263 + 5).collect();
+        let fm = FastMarching::new(&mesh);
+        let mut ws = fm.workspace();
+        let n = lm.len();
+        let d: Vec<Vec<f64>> = lm
+            .iter()
+            .map(|&s| {
+                let r = fm.run(&mut ws, &[s]);
+                lm.iter().map(|&l| r[l as usize]).collect()
+            })
+            .collect();
+        let h = wavg_mesh::geometry::mean_edge_length(&mesh);
+        let (mut worst, mut worst_far, mut sum) = (0.0f64, 0.0f64, 0.0);
+        for i in 0..n {
+            for j in 0..i {
+                let q = 0.5 * (d[i][j] + d[j][i]);
+                let a = (d[i][j] - d[j][i]).abs() / q;
+                worst = worst.max(a);
+                sum += a;
+                if q > 10.0 * h {
+                    worst_far = worst_far.max(a);
+                }
+            }
+        }
+        let mean = sum / (n * (n - 1) / 2) as f64;
+        eprintln!(
+            "torus 16k v, noise {noise}, 60 landmarks: asymmetry |D_ij - D_ji| / Q_ij mean {:.3}%, max {:.3}%, max beyond 10 edge lengths {:.3}%",
+            mean * 100.0,
+            worst * 100.0,
+            worst_far * 100.0
+        );
+        assert!(worst_far < bound && mean < 0.005, "{worst_far} {mean}");
+        let q = landmark_distances(&mesh, &lm, &NoProgress).unwrap();
+        for i in 0..n {
+            assert_eq!(q[i * n + i], 0.0);
+            for j in 0..n {
+                assert_eq!(q[i * n + j], q[j * n + i]);
+                if i != j {
+                    let want = 0.5 * (d[i][j] + d[j][i]);
+                    assert!((q[i * n + j] - want).abs() <= 1e-12 * want, "{i} {j}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn landmark_distances_rejects_bad_ids_and_honours_cancellation() {
+        let mesh = valid(procedural::icosphere(2));
+        let n = mesh.n_vertices() as u32;
+        assert!(matches!(
+            landmark_distances(&mesh, &[0, n], &NoProgress),
+            Err(EmbedError::InvalidArgument(_))
+        ));
+        assert!(matches!(
+            landmark_distances(&mesh, &[4, 4], &NoProgress),
+            Err(EmbedError::InvalidArgument(_))
+        ));
+        assert!(
+            landmark_distances(&mesh, &[], &NoProgress)
+                .unwrap()
+                .is_empty()
+        );
+        struct Stop;
+        impl Progress for Stop {
+            fn report(&self, _: Stage, _: f64) {}
+            fn cancelled(&self) -> bool {
+                true
+            }
+        }
+        assert!(matches!(
+            landmark_distances(&mesh, &[0, 1, 2], &Stop),
+            Err(EmbedError::Cancelled)
+        ));
+        // Progress reaches 1.
+        struct Last(std::sync::Mutex<f64>);
+        impl Progress for Last {
+            fn report(&self, s: Stage, f: f64) {
+                assert_eq!(s, Stage::Geodesics);
+                let mut l = self.0.lock().unwrap();
+                *l = l.max(f);
+            }
+        }
+        let p = Last(std::sync::Mutex::new(0.0));
+        landmark_distances(&mesh, &[0, 10, 20, 30], &p).unwrap();
+        assert_eq!(*p.0.lock().unwrap(), 1.0);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+        /// Between the straight-line (chord) lower bound and the edge-graph (Dijkstra) upper bound.
+        #[test]
+        fn bounded_by_chord_and_dijkstra(seed in 0u64..1000, amp in 0.0f64..0.6, src in 0u32..642) {
+            let mesh = valid(procedural::with_noise(procedural::icosphere(3), amp, seed));
+            let d = distances_from(&mesh, &[src]);
+            let dj = dijkstra(&mesh, src);
+            let ps = mesh.positions[src as usize];
+            for v in 0..mesh.n_vertices() {
+                let chord = (mesh.positions[v] - ps).norm();
+                prop_assert!(d[v] <= dj[v] * (1.0 + 1e-6), "{} > dijkstra {}", d[v], dj[v]);
+                prop_assert!(d[v] >= chord * (1.0 - 1e-3), "{} < chord {}", d[v], chord);
+            }
+        }
+    }
+}
