@@ -88,8 +88,8 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
             usable[f] = false;
         }
     }
-    for f in 0..nf {
-        if usable[f] {
+    for (f, &ok) in usable.iter().enumerate() {
+        if ok {
             let [a, b, c] = mesh.corners(f);
             if [a, b, c].iter().all(|p| p.iter().all(|x| x.is_finite())) && is_degenerate(a, b, c) {
                 problems.push(Problem::ZeroAreaFace { face: f as u32 });
@@ -219,7 +219,9 @@ pub(crate) fn is_degenerate(
         .max(e1.norm_squared())
         .max(e2.norm_squared());
     let twice_area = e0.cross(&(c - a)).norm();
-    !(twice_area > ZERO_AREA_RELATIVE_TOLERANCE * longest) || longest == 0.0
+    // Written so that NaN counts as degenerate.
+    let well_shaped = twice_area > ZERO_AREA_RELATIVE_TOLERANCE * longest && longest > 0.0;
+    !well_shaped
 }
 
 fn check_uv(mesh: &TriMesh, uv: &crate::mesh::TexCoords, problems: &mut Vec<Problem>) {

@@ -18,6 +18,7 @@ pub mod io;
 pub mod mesh;
 pub mod problem;
 pub mod procedural;
+pub mod repair;
 pub mod topology;
 pub mod valid;
 

@@ -326,6 +326,7 @@ impl Topology {
         let mut boundary = vec![false; nv];
         ring_offsets.push(0);
         face_offsets.push(0);
+        #[allow(clippy::needless_range_loop)] // v indexes incidence, boundary and rings alike
         for v in 0..nv {
             let faces = incidence.faces(v);
             let vid = v as u32;

@@ -1,0 +1,245 @@
+//! Repairs: each fixes its problem, keeps everything else, and its index maps are right.
+
+use nalgebra::Vector3;
+use proptest::prelude::*;
+use wavg_mesh::repair::{self, RepairOptions, Repaired};
+use wavg_mesh::{NONE, ProblemKind, TexCoords, TriMesh, ValidMesh, analyze, procedural};
+
+/// Every face of the result is the mapped original face, every position is the original's,
+/// and the two vertex maps are consistent.
+fn check_maps(orig: &TriMesh, r: &Repaired) {
+    assert_eq!(r.vertex_map.len(), r.mesh.n_vertices());
+    assert_eq!(r.face_map.len(), r.mesh.n_faces());
+    assert_eq!(r.original_to_new.len(), orig.n_vertices());
+    for (new, &o) in r.vertex_map.iter().enumerate() {
+        assert_eq!(r.mesh.positions[new], orig.positions[o as usize]);
+        assert_eq!(r.original_to_new[o as usize], new as u32);
+    }
+    for (o, &new) in r.original_to_new.iter().enumerate() {
+        if new != NONE {
+            let p = orig.positions[o];
+            let q = r.mesh.positions[new as usize];
+            assert!((p - q).norm() <= 1e-6 || (p == q), "vertex {o} moved");
+        }
+    }
+    for (f, &of) in r.face_map.iter().enumerate() {
+        let ot = orig.triangles[of as usize];
+        let nt = r.mesh.triangles[f];
+        for c in 0..3 {
+            assert_eq!(
+                r.original_to_new[ot[c] as usize], nt[c],
+                "face {f} corner {c}"
+            );
+        }
+        if let (Some(ou), Some(nu)) = (&orig.uv, &r.mesh.uv) {
+            assert_eq!(nu.faces[f], ou.faces[of as usize]);
+        }
+    }
+}
+
+/// Each triangle gets its own three vertices (as an STL export would).
+fn soup(m: &TriMesh) -> TriMesh {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for f in 0..m.n_faces() {
+        let base = positions.len() as u32;
+        positions.extend(m.corners(f));
+        triangles.push([base, base + 1, base + 2]);
+    }
+    TriMesh::new(positions, triangles)
+}
+
+#[test]
+fn weld_exact_restores_a_soup() {
+    let m = procedural::icosphere(2);
+    let s = soup(&m);
+    assert!(analyze(&s).stats.components > 1);
+    let r = repair::weld_vertices(&s, 0.0);
+    check_maps(&s, &r);
+    assert_eq!(r.mesh.n_vertices(), m.n_vertices());
+    assert_eq!(r.removed_vertices(), s.n_vertices() - m.n_vertices());
+    let v = ValidMesh::new(r.mesh).expect("welded soup is valid");
+    assert_eq!(v.topology().genus(), 0);
+    assert_eq!(v.topology().n_components(), 1);
+}
+
+#[test]
+fn weld_with_tolerance_merges_near_points_only() {
+    let m = procedural::torus(16, 8, 1.0, 0.3);
+    let mut s = soup(&m);
+    // Jitter every soup vertex by < 1e-9.
+    for (i, p) in s.positions.iter_mut().enumerate() {
+        p.x += ((i % 7) as f64) * 1e-10;
+    }
+    assert_eq!(
+        repair::weld_vertices(&s, 0.0).mesh.n_vertices(),
+        s.n_vertices() - count_exact_dups(&s)
+    );
+    let r = repair::weld_vertices(&s, 1e-6);
+    check_maps(&s, &r);
+    assert_eq!(r.mesh.n_vertices(), m.n_vertices());
+    let v = ValidMesh::new(r.mesh).unwrap();
+    assert_eq!(v.topology().genus(), 1);
+}
+
+fn count_exact_dups(m: &TriMesh) -> usize {
+    let mut seen = std::collections::HashSet::new();
+    m.positions
+        .iter()
+        .filter(|p| !seen.insert([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]))
+        .count()
+}
+
+#[test]
+fn weld_never_merges_non_finite_points() {
+    let m = TriMesh::new(
+        vec![
+            Vector3::new(f64::NAN, 0.0, 0.0),
+            Vector3::new(f64::NAN, 0.0, 0.0),
+        ],
+        vec![],
+    );
+    assert_eq!(repair::weld_vertices(&m, 0.0).mesh.n_vertices(), 2);
+    assert_eq!(repair::weld_vertices(&m, 1.0).mesh.n_vertices(), 2);
+}
+
+#[test]
+fn degenerate_duplicate_and_unreferenced_are_removed() {
+    let mut m = procedural::icosphere(1);
+    let nf = m.n_faces() as u32;
+    let nv = m.n_vertices() as u32;
+    let mut t0 = m.triangles[0];
+    m.triangles.push([0, 0, 1]); // repeated index
+    m.triangles.push([0, 1, nv + 10]); // out of range
+    t0.reverse();
+    m.triangles.push(t0); // duplicate of face 0 (flipped)
+    m.triangles.push(m.triangles[5]); // duplicate of face 5
+    // Collinear face on a new vertex at the midpoint of an edge.
+    let [a, b] = [m.triangles[3][0], m.triangles[3][1]];
+    let mid = (m.positions[a as usize] + m.positions[b as usize]) / 2.0;
+    m.positions.push(mid);
+    m.triangles.push([a, b, nv]);
+    m.positions.push(Vector3::new(5.0, 5.0, 5.0)); // unreferenced
+    let a0 = analyze(&m);
+    for k in [
+        ProblemKind::RepeatedIndex,
+        ProblemKind::IndexOutOfRange,
+        ProblemKind::DuplicateFace,
+        ProblemKind::ZeroAreaFace,
+        ProblemKind::UnreferencedVertex,
+    ] {
+        assert!(a0.report.count(k) > 0, "{k:?} not detected");
+    }
+
+    let d = repair::drop_degenerate_faces(&m);
+    check_maps(&m, &d);
+    assert_eq!(d.face_map.len(), m.n_faces() - 3);
+    let dd = repair::drop_duplicate_faces(&d.mesh);
+    check_maps(&d.mesh, &dd);
+    assert_eq!(dd.mesh.n_faces(), nf as usize);
+    let u = repair::drop_unreferenced_vertices(&dd.mesh);
+    check_maps(&dd.mesh, &u);
+    assert_eq!(u.mesh.n_vertices(), nv as usize);
+    assert!(ValidMesh::new(u.mesh.clone()).is_ok());
+
+    let all = repair::repair_all(&m, &RepairOptions::default());
+    check_maps(&m, &all);
+    assert_eq!(all.mesh.triangles, u.mesh.triangles);
+    assert_eq!(all.new_vertex(nv + 1), None);
+    assert!(ValidMesh::new(all.mesh).is_ok());
+}
+
+#[test]
+fn unreferenced_drop_keeps_out_of_range_indices_out_of_range() {
+    let mut m = procedural::icosphere(0);
+    m.positions.insert(0, Vector3::new(9.0, 9.0, 9.0));
+    for t in &mut m.triangles {
+        *t = t.map(|i| i + 1);
+    }
+    m.triangles.push([1, 2, 13]); // 13 == n_vertices: out of range
+    let r = repair::drop_unreferenced_vertices(&m);
+    assert_eq!(r.mesh.n_vertices(), 12);
+    assert!(r.mesh.triangles.last().unwrap()[2] >= 12);
+    assert_eq!(
+        analyze(&r.mesh).report.count(ProblemKind::IndexOutOfRange),
+        1
+    );
+}
+
+#[test]
+fn largest_component_is_kept_with_uvs() {
+    let big = procedural::icosphere(2);
+    let small =
+        procedural::torus(8, 4, 1.0, 0.3).map_positions(|p| p + Vector3::new(5.0, 0.0, 0.0));
+    let mut m = small.clone();
+    let off = m.n_vertices() as u32;
+    m.positions.extend(&big.positions);
+    m.triangles
+        .extend(big.triangles.iter().map(|t| t.map(|i| i + off)));
+    let n = m.n_faces() as u32;
+    m.uv = Some(TexCoords {
+        coords: vec![nalgebra::Vector2::new(0.0, 0.0); n as usize * 3],
+        faces: (0..n).map(|f| [3 * f, 3 * f + 1, 3 * f + 2]).collect(),
+    });
+    let r = repair::keep_largest_component(&m);
+    check_maps(&m, &r);
+    assert_eq!(r.mesh.n_vertices(), big.n_vertices());
+    assert_eq!(r.mesh.n_faces(), big.n_faces());
+    assert_eq!(r.vertex_map[0], off);
+    assert_eq!(r.mesh.uv.as_ref().unwrap().faces.len(), big.n_faces());
+    let v = ValidMesh::new(r.mesh).unwrap();
+    assert_eq!(v.topology().n_components(), 1);
+}
+
+#[test]
+fn repairs_of_an_empty_mesh_do_not_panic() {
+    let m = TriMesh::default();
+    let r = repair::repair_all(
+        &m,
+        &RepairOptions {
+            weld: Some(1e-3),
+            keep_largest_component: true,
+            ..RepairOptions::default()
+        },
+    );
+    assert_eq!(r.mesh.n_vertices(), 0);
+}
+
+fn damaged(level: u32, seed: u64, dup: usize, deg: usize, extra: usize, split: bool) -> TriMesh {
+    let mut m = procedural::with_noise(procedural::icosphere(level), 0.1, seed);
+    if split {
+        m = soup(&m);
+    }
+    let nf = m.n_faces();
+    let nv = m.n_vertices() as u32;
+    for k in 0..dup {
+        let t = m.triangles[(k * 7919 + seed as usize) % nf];
+        m.triangles.push([t[2], t[1], t[0]]);
+    }
+    for k in 0..deg {
+        let v = (k as u32 * 31 + seed as u32) % nv;
+        m.triangles.push([v, v, (v + 1) % nv]);
+    }
+    for k in 0..extra {
+        m.positions.push(Vector3::new(10.0 + k as f64, 0.0, 0.0));
+    }
+    m
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    #[test]
+    fn repair_all_makes_damaged_spheres_valid(
+        level in 0u32..3, seed in 0u64..1000, dup in 0usize..5, deg in 0usize..5,
+        extra in 0usize..4, split: bool,
+    ) {
+        let m = damaged(level, seed, dup, deg, extra, split);
+        let r = repair::repair_all(&m, &RepairOptions::default());
+        check_maps(&m, &r);
+        let v = ValidMesh::new(r.mesh.clone());
+        prop_assert!(v.is_ok(), "{:?}", v.err());
+        let v = v.unwrap();
+        prop_assert_eq!(v.topology().genus(), 0);
+        prop_assert_eq!(v.n_faces(), 20 * 4usize.pow(level));
+    }
+}
