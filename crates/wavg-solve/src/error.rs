@@ -83,7 +83,10 @@ pub enum SolveError {
     /// A parameter is out of its valid range.
     #[error("invalid parameter: {0}")]
     InvalidParameter(String),
+    /// The tangent plane at a point is degenerate (its rows do not span a plane).
+    #[error("degenerate tangent plane at the point")]
+    DegenerateTangentPlane,
     /// An error from the projection layer other than "no projection".
     #[error("projection failed: {0}")]
-    Project(String),
+    Project(#[from] wavg_project::ProjectError),
 }

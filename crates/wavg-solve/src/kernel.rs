@@ -120,9 +120,7 @@ fn distances(
     let g01: f64 = p0.iter().zip(&p1).map(|(x, y)| x * y).sum();
     let det = g00 * g11 - g01 * g01;
     if det.is_nan() || det <= 1e-12 * g00 * g11 || !det.is_finite() {
-        return Err(SolveError::Project(format!(
-            "degenerate tangent plane (Gram determinant {det:e})"
-        )));
+        return Err(SolveError::DegenerateTangentPlane);
     }
     // Inverse Gram matrix, so |v_T|^2 = a^T G^{-1} a.
     let (h00, h01, h11) = (g11 / det, -g01 / det, g00 / det);
@@ -164,7 +162,9 @@ fn distances(
         dmax = dmax.max(d);
     }
     if !dmin.is_finite() || !dmax.is_finite() {
-        return Err(SolveError::Project("non-finite anchor distance".into()));
+        return Err(SolveError::InvalidParameter(
+            "non-finite anchor or point coordinates".into(),
+        ));
     }
     Ok((dmin, imin, dmax))
 }

@@ -190,7 +190,7 @@ fn degenerate_inputs_are_typed_errors() {
     ));
     assert!(matches!(
         solve(&Mat2x8::zeros(), &p(0.0, 0.0), &ys, 10.0),
-        Err(SolveError::Project(_))
+        Err(SolveError::DegenerateTangentPlane)
     ));
 }
 

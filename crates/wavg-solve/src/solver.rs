@@ -1,0 +1,349 @@
+//! The forward problem (weights -> surface point) and the inverse problem (surface point
+//! -> weights) for one anchor set, single and batched.
+
+use std::sync::Arc;
+
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use wavg_mesh::{SurfacePoint, VertexId};
+use wavg_project::{ProjectError, ProjectionPath};
+
+use crate::anchors::AnchorSet;
+use crate::error::SolveError;
+use crate::kernel::{DEFAULT_GAMMA, InverseScratch, inverse_weights};
+use crate::points::{check_point, nearest_corner};
+use crate::weights::{Normalization, validate};
+use crate::{Projector, Vec8};
+
+/// How the forward problem searches for the projection.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SearchMode {
+    /// Greedy walk from a start vertex, then local triangle search (the paper's method),
+    /// certified by the projector (falls back to the global search when needed).
+    #[default]
+    Fast,
+    /// Exhaustive search over all triangles for the closest valid projection.
+    Exact,
+}
+
+/// Options of the forward problem.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ForwardOptions {
+    /// Fast (default) or exact search.
+    pub mode: SearchMode,
+    /// Reject (default) or normalise weights that do not sum to 1.
+    pub normalization: Normalization,
+    /// The previous answer, if any: the search starts from its nearest corner instead of
+    /// the highest-weight anchor.
+    pub warm_start: Option<SurfacePoint>,
+}
+
+impl ForwardOptions {
+    /// These options with a warm start.
+    pub fn warm(self, previous: SurfacePoint) -> Self {
+        Self {
+            warm_start: Some(previous),
+            ..self
+        }
+    }
+}
+
+/// Where the forward search started.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// At the nearest corner of the warm start.
+    Warm(VertexId),
+    /// At the start vertex of the anchor with the highest weight.
+    HighestWeight {
+        /// The anchor.
+        anchor: usize,
+        /// Its start vertex.
+        vertex: VertexId,
+    },
+    /// Nowhere: the exact mode searches every triangle.
+    Exhaustive,
+}
+
+/// Answer of the forward problem.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ForwardResult {
+    /// The weighted average on the surface.
+    pub point: SurfacePoint,
+    /// Its 3-D position.
+    pub position: Vector3<f64>,
+    /// Distance in R^8 between the averaged point and its projection.
+    pub distance: f64,
+    /// Which search of the projector found it.
+    pub path: ProjectionPath,
+    /// Where the search started.
+    pub start: Start,
+}
+
+/// Forward and inverse problems for one anchor set on one projector.
+///
+/// ```
+/// use std::sync::Arc;
+/// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+/// use wavg_solve::{EmbeddedMesh, ForwardOptions, Projector, Solver, points::Anchor};
+/// let mesh = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
+/// let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
+/// let anchors = [0u32, 50, 100, 200, 300, 400, 500, 600].map(Anchor::Vertex);
+/// let solver = Solver::new(proj, anchors).unwrap();
+/// let x = SurfacePoint::new(10, [0.2, 0.3, 0.5]);
+/// let w = solver.inverse(&x).unwrap();
+/// assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+/// let back = solver.forward(&w, &ForwardOptions::default()).unwrap();
+/// assert!((back.position - x.position(solver.mesh())).norm() < 1e-6);
+/// ```
+#[derive(Clone)]
+pub struct Solver {
+    projector: Arc<Projector>,
+    anchors: AnchorSet,
+    gamma: f64,
+}
+
+impl Solver {
+    /// A solver with the given anchors (validated) and `gamma` = [`DEFAULT_GAMMA`].
+    pub fn new(
+        projector: Arc<Projector>,
+        anchors: impl IntoIterator<Item = crate::points::Anchor>,
+    ) -> Result<Self, SolveError> {
+        let set = AnchorSet::with_anchors(projector.embedded().clone(), anchors)?;
+        Ok(Self {
+            projector,
+            anchors: set,
+            gamma: DEFAULT_GAMMA,
+        })
+    }
+
+    /// A solver over an existing anchor set (which must live on the projector's mesh).
+    pub fn with_anchor_set(
+        projector: Arc<Projector>,
+        anchors: AnchorSet,
+    ) -> Result<Self, SolveError> {
+        if !Arc::ptr_eq(anchors.embedded(), projector.embedded()) {
+            return Err(SolveError::InvalidParameter(
+                "the anchor set belongs to a different embedded mesh".into(),
+            ));
+        }
+        Ok(Self {
+            projector,
+            anchors,
+            gamma: DEFAULT_GAMMA,
+        })
+    }
+
+    /// Sets the inverse problem's `gamma` (> 0; the paper uses 10).
+    pub fn set_gamma(&mut self, gamma: f64) -> Result<(), SolveError> {
+        if !(gamma.is_finite() && gamma > 0.0) {
+            return Err(SolveError::InvalidParameter(format!(
+                "gamma must be finite and positive, got {gamma}"
+            )));
+        }
+        self.gamma = gamma;
+        Ok(())
+    }
+
+    /// The inverse problem's `gamma`.
+    pub fn gamma(&self) -> f64 {
+        self.gamma
+    }
+
+    /// The projector.
+    pub fn projector(&self) -> &Arc<Projector> {
+        &self.projector
+    }
+
+    /// The mesh.
+    pub fn mesh(&self) -> &wavg_mesh::ValidMesh {
+        self.projector.embedded().mesh()
+    }
+
+    /// The anchors.
+    pub fn anchors(&self) -> &AnchorSet {
+        &self.anchors
+    }
+
+    /// The anchors, for editing (add, move, remove).
+    pub fn anchors_mut(&mut self) -> &mut AnchorSet {
+        &mut self.anchors
+    }
+
+    /// Number of anchors (the length every weight vector must have).
+    pub fn n_anchors(&self) -> usize {
+        self.anchors.len()
+    }
+
+    /// The weighted average `sum w_i y_i` in R^8 of validated weights.
+    pub fn average(&self, weights: &[f64], norm: Normalization) -> Result<Vec8, SolveError> {
+        let scale = validate(weights, self.n_anchors(), norm)?;
+        Ok(self.anchors.coords().weighted_sum(weights, scale))
+    }
+
+    /// Forward problem: the point of the surface that is the weighted average of the
+    /// anchors. [`SolveError::NoWeightedAverage`] when the averaged point has no Phong
+    /// projection.
+    pub fn forward(
+        &self,
+        weights: &[f64],
+        opts: &ForwardOptions,
+    ) -> Result<ForwardResult, SolveError> {
+        let ybar = self.average(weights, opts.normalization)?;
+        let mesh = self.mesh();
+        let (proj, start) = match opts.mode {
+            SearchMode::Exact => (self.projector.project_exhaustive(&ybar), Start::Exhaustive),
+            SearchMode::Fast => {
+                let start = match opts.warm_start {
+                    Some(p) => Start::Warm(nearest_corner(mesh, &check_point(mesh, &p)?)),
+                    None => {
+                        // Highest weight; ties to the lowest index.
+                        let mut anchor = 0;
+                        for (i, &w) in weights.iter().enumerate() {
+                            if w > weights[anchor] {
+                                anchor = i;
+                            }
+                        }
+                        Start::HighestWeight {
+                            anchor,
+                            vertex: self.anchors.starts()[anchor],
+                        }
+                    }
+                };
+                let v = match start {
+                    Start::Warm(v) | Start::HighestWeight { vertex: v, .. } => v,
+                    Start::Exhaustive => unreachable!("fast mode always has a start vertex"),
+                };
+                (self.projector.project(&ybar, v), start)
+            }
+        };
+        let p = proj.map_err(|e| match e {
+            ProjectError::NoProjection => SolveError::NoWeightedAverage,
+            e => SolveError::Project(e),
+        })?;
+        Ok(ForwardResult {
+            point: p.point,
+            position: p.point.position(mesh),
+            distance: p.distance,
+            path: p.path,
+            start,
+        })
+    }
+
+    /// Inverse problem: weights (one per anchor, summing to 1) whose weighted average is
+    /// `point`: the paper's minimum-norm weights with `D_ii = |v_T|^2 + gamma |v_O|^2`.
+    pub fn inverse(&self, point: &SurfacePoint) -> Result<Vec<f64>, SolveError> {
+        let mut out = Vec::with_capacity(self.n_anchors());
+        self.inverse_into(point, &mut InverseScratch::default(), &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Solver::inverse`] into caller-owned buffers (no allocation once they are sized).
+    pub fn inverse_into(
+        &self,
+        point: &SurfacePoint,
+        scratch: &mut InverseScratch,
+        out: &mut Vec<f64>,
+    ) -> Result<(), SolveError> {
+        let p = check_point(self.mesh(), point)?;
+        let psi = self.projector.psi(&p);
+        let yhat = self.projector.embedded().point(&p);
+        inverse_weights(&psi, &yhat, self.anchors.coords(), self.gamma, scratch, out)
+    }
+
+    /// Forward problem for many weight vectors in parallel; result `i` belongs to
+    /// `weights[i]`. Every query is independent, so the results do not depend on the
+    /// number of threads.
+    pub fn forward_batch<W: AsRef<[f64]> + Sync>(
+        &self,
+        weights: &[W],
+        opts: &ForwardOptions,
+    ) -> Vec<Result<ForwardResult, SolveError>> {
+        weights
+            .par_iter()
+            .with_min_len(64)
+            .map(|w| self.forward(w.as_ref(), opts))
+            .collect()
+    }
+
+    /// Forward problem for a sequence of nearby queries (e.g. samples along a curve):
+    /// each query warm-starts from the previous answer. For parallelism the sequence is cut
+    /// into chunks of `chunk` queries (independent of the thread count, so the results are
+    /// too); the first query of each chunk starts cold (or from `opts.warm_start`).
+    pub fn forward_batch_warm<W: AsRef<[f64]> + Sync>(
+        &self,
+        weights: &[W],
+        opts: &ForwardOptions,
+        chunk: usize,
+    ) -> Vec<Result<ForwardResult, SolveError>> {
+        weights
+            .par_chunks(chunk.max(1))
+            .flat_map_iter(|c| {
+                let mut o = *opts;
+                c.iter()
+                    .map(move |w| {
+                        let r = self.forward(w.as_ref(), &o);
+                        if let Ok(r) = &r {
+                            o.warm_start = Some(r.point);
+                        }
+                        r
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
+
+    /// Inverse problem for many points in parallel (see [`BatchWeights`]).
+    pub fn inverse_batch(&self, points: &[SurfacePoint]) -> BatchWeights {
+        let n = self.n_anchors();
+        let mut data = vec![0.0; points.len() * n.max(1)];
+        let status = data
+            .par_chunks_mut(n.max(1))
+            .zip(points.par_iter())
+            .with_min_len(64)
+            .map_init(
+                || (InverseScratch::default(), Vec::with_capacity(n)),
+                |(scratch, buf), (row, p)| {
+                    let r = self.inverse_into(p, scratch, buf);
+                    if r.is_ok() {
+                        row.copy_from_slice(buf);
+                    }
+                    r
+                },
+            )
+            .collect();
+        BatchWeights { n, data, status }
+    }
+}
+
+/// Weights of a batch of inverse problems: one row of `n_anchors` weights per point.
+#[derive(Clone, Debug)]
+pub struct BatchWeights {
+    n: usize,
+    data: Vec<f64>,
+    status: Vec<Result<(), SolveError>>,
+}
+
+impl BatchWeights {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.status.len()
+    }
+
+    /// Whether the batch is empty.
+    pub fn is_empty(&self) -> bool {
+        self.status.is_empty()
+    }
+
+    /// Weights of point `i`, or why there are none.
+    pub fn get(&self, i: usize) -> Result<&[f64], &SolveError> {
+        match &self.status[i] {
+            Ok(()) => Ok(&self.data[i * self.n..(i + 1) * self.n]),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// All rows in order.
+    pub fn iter(&self) -> impl Iterator<Item = Result<&[f64], &SolveError>> {
+        (0..self.len()).map(|i| self.get(i))
+    }
+}
