@@ -11,4 +11,5 @@
 
 pub use wavg_mesh as mesh;
 pub use wavg_project as project;
+pub use wavg_solve as solve;
 pub use wavg_mesh::{MeshError, SurfacePoint, TriMesh, ValidMesh};
