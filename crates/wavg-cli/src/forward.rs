@@ -1,12 +1,118 @@
-//! `wavg forward` (not yet implemented).
+//! `wavg forward`: anchors + weights -> points on the surface.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use wavg_solve::{ForwardOptions, Normalization, SearchMode, SolveError};
 
 use crate::CliError;
+use crate::textio::{self, located, write_numbers};
+
+const LONG_ABOUT: &str = "\
+Forward problem: for each line of weights, the point of the surface that is the weighted
+average of the anchors (average the anchors' embedded points in R^8, then Phong-project
+the average onto the embedded mesh; paper Section 3.3).
+
+Output: one line per weight line, 'FACE B0 B1 B2 X Y Z' (face, barycentric coordinates,
+3-D position), or 'none REASON' when no weighted average exists for that line (the
+averaged point has no Phong projection onto any triangle). Weight lines that are
+malformed, have the wrong count, non-finite values, or do not sum to 1 (without
+--normalize) are input errors: the command exits with status 2 naming the line, and writes
+nothing.
+
+Searches start from the vertex of the highest-weight anchor (the paper's method) and are
+certified against a bounding volume hierarchy; --exact searches all triangles; --warm
+starts each line from the previous line's answer (for sequences of nearby queries).";
 
 /// Arguments.
 #[derive(clap::Args)]
-pub struct Args {}
+#[command(after_long_help = format!("{LONG_ABOUT}\n\n{}", textio::FORMAT_HELP))]
+pub struct Args {
+    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    #[arg(long)]
+    pub mesh: String,
+    /// Embedding (.wavg from `wavg precompute`); default: the mesh's 3-D positions.
+    #[arg(long)]
+    pub embedding: Option<PathBuf>,
+    /// Anchors file ('v VERTEX' or 'f FACE B0 B1 B2' per line).
+    #[arg(long)]
+    pub anchors: PathBuf,
+    /// Weights file (one line of numbers per query, one number per anchor).
+    #[arg(long)]
+    pub weights: PathBuf,
+    /// Output file ('-' for stdout).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Divide each weight line by its sum instead of rejecting lines that do not sum to 1.
+    #[arg(long)]
+    pub normalize: bool,
+    /// Exhaustive search over all triangles (slow; for checking).
+    #[arg(long, conflicts_with = "warm")]
+    pub exact: bool,
+    /// Start each query from the previous line's answer.
+    #[arg(long)]
+    pub warm: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
 
 /// Runs the command.
-pub fn run(_args: Args) -> Result<(), CliError> {
-    Err(CliError::failure("not implemented yet"))
+pub fn run(args: Args) -> Result<(), CliError> {
+    let text = textio::read_text(&args.weights)?;
+    let lines =
+        textio::parse_weights(&text).map_err(|e| located(&args.weights, e.line, &e.message))?;
+    let solver = textio::load_solver(&args.mesh, args.embedding.as_deref(), &args.anchors)?;
+    let normalization = if args.normalize {
+        Normalization::Normalize
+    } else {
+        Normalization::Reject
+    };
+    // Check every line before computing anything, so errors name their line.
+    for (line, w) in &lines {
+        wavg_solve::weights::validate(w, solver.n_anchors(), normalization)
+            .map_err(|e| located(&args.weights, *line, &e))?;
+    }
+    let opts = ForwardOptions {
+        mode: if args.exact {
+            SearchMode::Exact
+        } else {
+            SearchMode::Fast
+        },
+        normalization,
+        warm_start: None,
+    };
+    let weights: Vec<&[f64]> = lines.iter().map(|(_, w)| &w[..]).collect();
+    let results = textio::with_threads(args.threads, || {
+        if args.warm {
+            solver.forward_batch_warm(&weights, &opts, 256)
+        } else {
+            solver.forward_batch(&weights, &opts)
+        }
+    })?;
+    // Anything but "no average" after validation is a bug or a broken mesh: fail whole.
+    for (r, (line, _)) in results.iter().zip(&lines) {
+        if let Err(e) = r
+            && *e != SolveError::NoWeightedAverage
+        {
+            return Err(CliError::failure(format!(
+                "{}:{line}: {e}",
+                args.weights.display()
+            )));
+        }
+    }
+    textio::write_atomic(&args.output, |w: &mut dyn Write| {
+        for r in &results {
+            match r {
+                Ok(r) => {
+                    let p = r.point;
+                    write!(w, "{} ", p.face)?;
+                    write_numbers(w, p.bary.into_iter().chain(r.position.iter().copied()))?;
+                }
+                Err(e) => write!(w, "none {}", crate::common::one_line(e))?,
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    })
 }

@@ -9,6 +9,7 @@ mod forward;
 mod info;
 mod inverse;
 mod precompute;
+mod textio;
 
 use std::process::ExitCode;
 

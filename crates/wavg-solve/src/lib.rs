@@ -40,5 +40,5 @@ pub use anchors::AnchorSet;
 pub use error::SolveError;
 pub use points::Anchor;
 pub use solver::{BatchWeights, ForwardOptions, ForwardResult, SearchMode, Solver, Start};
-pub use wavg_project::{DIM, EmbeddedMesh, Mat2x8, ProjectError, Projector, Vec8};
+pub use wavg_project::{DIM, EmbeddedMesh, Mat2x8, ProjectError, ProjectionPath, Projector, Vec8};
 pub use weights::Normalization;

@@ -46,6 +46,41 @@ pub fn uniform_surface_points(
         .collect())
 }
 
+/// An ordering of `points` along a Morton (Z-order) curve over their bounding box, so that
+/// consecutive points are usually close: the order for warm-started query sequences.
+///
+/// ```
+/// use nalgebra::Vector3;
+/// let p = [Vector3::new(1.0, 1.0, 0.0), Vector3::new(0.0, 0.0, 0.0), Vector3::new(0.9, 1.0, 0.0)];
+/// assert_eq!(wavg_solve::sampling::spatial_order(&p), vec![1, 2, 0]);
+/// ```
+pub fn spatial_order(points: &[nalgebra::Vector3<f64>]) -> Vec<usize> {
+    let mut lo = nalgebra::Vector3::repeat(f64::INFINITY);
+    let mut hi = nalgebra::Vector3::repeat(f64::NEG_INFINITY);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let ext = (hi - lo).max().max(f64::MIN_POSITIVE);
+    let key = |p: &nalgebra::Vector3<f64>| -> u64 {
+        let mut k = 0u64;
+        let q = (p - lo).map(|x| ((x / ext) * 2097151.0).clamp(0.0, 2097151.0) as u64);
+        for bit in (0..21).rev() {
+            for c in 0..3 {
+                k = (k << 1) | ((q[c] >> bit) & 1);
+            }
+        }
+        k
+    };
+    let mut idx: Vec<(u64, usize)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (key(p), i))
+        .collect();
+    idx.sort_unstable();
+    idx.into_iter().map(|(_, i)| i).collect()
+}
+
 /// Which distance farthest-point sampling maximises.
 #[derive(Clone, Copy, Debug)]
 pub enum FpsMetric<'a> {
