@@ -31,7 +31,7 @@ pub struct MeshStats {
     pub watertight: bool,
     /// V - E + F over referenced vertices.
     pub euler_characteristic: i64,
-    /// Sum over components of (2 - chi - b) / 2; `None` unless oriented manifold.
+    /// Sum over components of (2 - chi - b) / 2; `None` unless a non-empty oriented manifold.
     pub genus: Option<i64>,
 }
 
@@ -182,7 +182,8 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
     let boundary = edges.boundary_loop_count(nv, &mesh.triangles);
     let n_usable = usable.iter().filter(|&&u| u).count();
     let chi = referenced as i64 - n_edges as i64 + n_usable as i64;
-    let genus = (manifold && oriented)
+    // Undefined for a mesh without any usable face (nothing to take the genus of).
+    let genus = (manifold && oriented && n_usable > 0)
         .then(|| topology::genus_per_component(&comps, &edges, &mesh.triangles, &usable));
     let stats = MeshStats {
         vertices: nv,

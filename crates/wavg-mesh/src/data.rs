@@ -26,8 +26,13 @@ pub fn require_data_dir(test: &str) -> Option<PathBuf> {
         Some(d) => Some(d),
         None => {
             let ci = std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0");
-            assert!(!ci, "{test}: WAVG_DATA_DIR is missing in CI; the data tests must run there");
-            eprintln!("SKIPPED {test}: no data folder (set WAVG_DATA_DIR or put ../shared/data beside the repository)");
+            assert!(
+                !ci,
+                "{test}: WAVG_DATA_DIR is missing in CI; the data tests must run there"
+            );
+            eprintln!(
+                "SKIPPED {test}: no data folder (set WAVG_DATA_DIR or put ../shared/data beside the repository)"
+            );
             None
         }
     }
@@ -36,6 +41,10 @@ pub fn require_data_dir(test: &str) -> Option<PathBuf> {
 /// A file inside the data folder, or `None` (printing the skip) when the folder is missing.
 pub fn require_data_file(test: &str, relative: &str) -> Option<PathBuf> {
     let p = require_data_dir(test)?.join(relative);
-    assert!(p.exists(), "{test}: {} is missing from the data folder", p.display());
+    assert!(
+        p.exists(),
+        "{test}: {} is missing from the data folder",
+        p.display()
+    );
     Some(p)
 }

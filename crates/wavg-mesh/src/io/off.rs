@@ -64,7 +64,9 @@ pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
             format!("expected an OFF header, found {keyword:?}"),
         ));
     };
-    // Vertex lines of ST/C/N variants carry extra values, which are ignored anyway.
+    // Vertex lines of ST/C/N variants carry extra values (ignored); plain OFF has exactly
+    // three, which also catches a face line read as a vertex in a truncated file.
+    let exact_xyz = prefix.is_empty();
     if !prefix.chars().all(|c| matches!(c, 'S' | 'T' | 'C' | 'N')) {
         return Err(ParseError::new(
             hline,
@@ -98,6 +100,17 @@ pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
         let x = next_float(&mut it, line, "vertex x")?;
         let y = next_float(&mut it, line, "vertex y")?;
         let z = next_float(&mut it, line, "vertex z")?;
+        if exact_xyz && it.next().is_some() {
+            let n = s.split_ascii_whitespace().count();
+            return Err(ParseError::new(
+                line,
+                format!(
+                    "vertex {} of {nv}: expected 3 coordinates, found {n} values \
+                     (fewer vertices than the header says?)",
+                    k + 1
+                ),
+            ));
+        }
         positions.push(Vector3::new(x, y, z));
     }
 

@@ -1,0 +1,175 @@
+//! `wavg info` run as a process: exit codes, JSON keys, one-line errors, no panics.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use wavg_mesh::{data, io, procedural};
+
+fn wavg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(args)
+        .output()
+        .expect("run wavg")
+}
+
+fn info_json(path: &Path) -> Value {
+    let out = wavg(&["info", "--json", path.to_str().unwrap()]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object")
+}
+
+const KEYS: [&str; 7] = [
+    "vertices",
+    "faces",
+    "components",
+    "boundary_loops",
+    "genus",
+    "manifold",
+    "problems",
+];
+
+#[test]
+fn valid_file_reports_counts_and_genus() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("torus.obj");
+    io::save(&path, &procedural::torus(12, 6, 1.0, 0.3)).unwrap();
+    let j = info_json(&path);
+    for k in KEYS {
+        assert!(j.get(k).is_some(), "missing key {k}");
+    }
+    assert_eq!(j["vertices"], 72);
+    assert_eq!(j["faces"], 144);
+    assert_eq!(j["components"], 1);
+    assert_eq!(j["boundary_loops"], 0);
+    assert_eq!(j["genus"], 1);
+    assert_eq!(j["manifold"], true);
+    assert_eq!(j["valid"], true);
+    assert_eq!(j["problems"].as_array().unwrap().len(), 0);
+}
+
+#[test]
+fn text_output_names_every_figure() {
+    let out = wavg(&["info", "--builtin", "grid"]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).unwrap();
+    for word in [
+        "vertices:",
+        "faces:",
+        "components:",
+        "boundary loops:       1",
+        "genus:                0",
+        "manifold:             yes",
+    ] {
+        assert!(text.contains(word), "{word:?} missing in\n{text}");
+    }
+}
+
+#[test]
+fn builtin_json_and_unknown_builtin() {
+    let out = wavg(&["info", "--builtin", "torus", "--json"]);
+    assert_eq!(out.status.code(), Some(0));
+    let j: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["genus"], 1);
+    let out = wavg(&["info", "--builtin", "teapot"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("teapot"));
+}
+
+#[test]
+fn invalid_but_parseable_file_exits_zero_and_lists_problems() {
+    let dir = tempfile::tempdir().unwrap();
+    // A fin: three triangles on edge (0, 1), plus an unreferenced vertex.
+    let path = dir.path().join("fin.off");
+    std::fs::write(
+        &path,
+        "OFF\n6 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n9 9 9\n3 0 1 2\n3 1 0 3\n3 0 1 4\n",
+    )
+    .unwrap();
+    let j = info_json(&path);
+    assert_eq!(j["manifold"], false);
+    assert_eq!(j["valid"], false);
+    assert!(j["genus"].is_null());
+    let problems: Vec<String> = j["problems"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_str().unwrap().to_string())
+        .collect();
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.contains("non-manifold edges") && p.contains("(0, 1)")),
+        "{problems:?}"
+    );
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.contains("unreferenced") && p.contains("vertex 5")),
+        "{problems:?}"
+    );
+    let out = wavg(&["info", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("valid:                no"), "{text}");
+    assert!(text.contains("drop unreferenced vertices"), "{text}");
+}
+
+#[test]
+fn unparseable_files_exit_2_with_one_line_naming_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("trunc.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n", ":5:"),
+        ("word.obj", "v 0 0 0\nv 1 x 0\n", ":2:"),
+        ("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", ":4:"),
+        ("bin.off", "OFF\n1 0 0\n\u{0}\u{1}\n", ":3:"),
+        ("bad.ply", "ply\nformat ascii 1.0\nelement vertex 1\n", ":"),
+    ];
+    for (name, body, line) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, body).unwrap();
+        for json in [false, true] {
+            let mut args = vec!["info", path.to_str().unwrap()];
+            if json {
+                args.push("--json");
+            }
+            let out = wavg(&args);
+            assert_eq!(out.status.code(), Some(2), "{name}");
+            assert!(out.stdout.is_empty());
+            let err = String::from_utf8(out.stderr).unwrap();
+            assert_eq!(err.lines().count(), 1, "{name}: {err}");
+            assert!(err.contains(name) && err.contains(line), "{name}: {err}");
+            assert!(!err.contains("panicked"));
+        }
+    }
+    let out = wavg(&["info", "/no/such/file.obj"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = wavg(&["info", dir.path().join("x.stl").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn shared_data_good_bad_and_unparseable() {
+    let Some(good) = data::require_data_file("info_shared_data", "meshes/torus.obj") else {
+        return;
+    };
+    let j = info_json(&good);
+    assert_eq!(
+        (j["vertices"].as_u64(), j["genus"].as_i64()),
+        (Some(2304), Some(1))
+    );
+    let bad = data::require_data_file("info_shared_data", "bad/cow.obj").unwrap();
+    let j = info_json(&bad);
+    assert_eq!(j["manifold"], false);
+    assert!(j["problems"][0].as_str().unwrap().contains("pinched"));
+    let trunc = data::require_data_file("info_shared_data", "bad/synthetic/truncated.off").unwrap();
+    let out = wavg(&["info", trunc.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("truncated.off:7:"), "{err}");
+}
