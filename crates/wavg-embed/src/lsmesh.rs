@@ -1,1 +1,380 @@
-//! (to be written)
+//! Least-squares mesh (paper Section 3.5): extend the landmark embedding to every vertex.
+//!
+//! The coordinates `v` (one column per embedding dimension) minimise the discrete
+//! bi-Laplacian energy `tr(vᵀ A v)` with `A = L M⁻¹ L` (L the positive semidefinite cotangent
+//! stiffness, M the lumped mass) subject to `v_s = e(s)` at the landmarks. Splitting the
+//! vertices into free (F) and fixed (S) ones, the minimiser solves the SPD system
+//! `A_FF v_F = -A_FS v_S`, factored once by a sparse Cholesky (faer, AMD ordering,
+//! sequential) and solved for all columns at once.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
+use faer::sparse::linalg::matmul::sparse_sparse_matmul;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use faer::{Conj, Mat, Par, Side};
+use wavg_mesh::{TriMesh, ValidMesh, geometry};
+
+use crate::error::{EmbedError, Progress, Stage, check_cancel};
+use crate::file::MAX_DIM;
+
+/// The bi-Laplacian `A = L M⁻¹ L` of a mesh (n x n, symmetric positive semidefinite,
+/// constants in its kernel).
+pub fn bilaplacian(mesh: &TriMesh) -> Result<SparseColMat<usize, f64>, EmbedError> {
+    let mesh_err = |e: wavg_mesh::MeshError| EmbedError::InvalidArgument(e.to_string());
+    let l = geometry::cotan_stiffness(mesh).map_err(mesh_err)?;
+    let mass = geometry::lumped_mass(mesh);
+    if let Some(v) = mass.iter().position(|&m| !(m > 0.0 && m.is_finite())) {
+        return Err(EmbedError::InvalidArgument(format!(
+            "vertex {v} has zero or invalid area; the least-squares mesh needs a mesh \
+             without isolated vertices or degenerate faces"
+        )));
+    }
+    // M⁻¹ L: scale row i of L by 1/m_i.
+    let (sym, vals) = l.clone().into_parts();
+    let mut scaled = vals;
+    for j in 0..sym.ncols() {
+        for k in sym.col_range(j) {
+            scaled[k] /= mass[sym.row_idx()[k]];
+        }
+    }
+    let minv_l = SparseColMat::new(sym, scaled);
+    sparse_sparse_matmul(l.as_ref(), minv_l.as_ref(), 1.0, Par::Seq)
+        .map_err(|e| EmbedError::Numerical(format!("bi-Laplacian assembly: {e:?}")))
+}
+
+/// Checks landmark ids (distinct, in range, at least one) and returns the fixed-vertex mask.
+fn fixed_mask(n: usize, landmarks: &[u32]) -> Result<Vec<bool>, EmbedError> {
+    if landmarks.is_empty() {
+        return Err(EmbedError::InvalidArgument(
+            "the least-squares mesh needs at least one landmark".into(),
+        ));
+    }
+    let mut fixed = vec![false; n];
+    for &s in landmarks {
+        let slot = fixed.get_mut(s as usize).ok_or_else(|| {
+            EmbedError::InvalidArgument(format!("landmark {s} out of range ({n} vertices)"))
+        })?;
+        if std::mem::replace(slot, true) {
+            return Err(EmbedError::InvalidArgument(format!(
+                "landmark {s} appears twice"
+            )));
+        }
+    }
+    Ok(fixed)
+}
+
+/// Solves the least-squares mesh: returns one point per vertex, equal to `values[k]` at
+/// vertex `landmarks[k]` and minimising the bi-Laplacian energy elsewhere. Only the first
+/// `dim` entries of each value are used; the rest of the output is zero.
+///
+/// The mesh should be connected (otherwise a component without landmarks makes the system
+/// singular, reported as [`EmbedError::Numerical`]).
+///
+/// ```
+/// use wavg_embed::lsmesh::least_squares_mesh;
+/// use wavg_embed::NoProgress;
+/// use wavg_mesh::{ValidMesh, procedural};
+/// let mesh = ValidMesh::new(procedural::icosphere(2)).unwrap();
+/// // Fixing every vertex to a constant extends to the constant.
+/// let landmarks = vec![0, 10, 20];
+/// let values = vec![[1.0; 8]; 3];
+/// let x = least_squares_mesh(&mesh, &landmarks, &values, 8, &NoProgress).unwrap();
+/// assert!(x.iter().all(|p| p.iter().all(|&c| (c - 1.0).abs() < 1e-9)));
+/// ```
+pub fn least_squares_mesh(
+    mesh: &ValidMesh,
+    landmarks: &[u32],
+    values: &[[f64; MAX_DIM]],
+    dim: usize,
+    progress: &dyn Progress,
+) -> Result<Vec<[f64; MAX_DIM]>, EmbedError> {
+    let n = mesh.n_vertices();
+    if dim == 0 || dim > MAX_DIM {
+        return Err(EmbedError::InvalidArgument(format!(
+            "embedding dimension {dim} not in 1..={MAX_DIM}"
+        )));
+    }
+    if values.len() != landmarks.len() {
+        return Err(EmbedError::InvalidArgument(format!(
+            "{} values for {} landmarks",
+            values.len(),
+            landmarks.len()
+        )));
+    }
+    if values
+        .iter()
+        .any(|v| v[..dim].iter().any(|c| !c.is_finite()))
+    {
+        return Err(EmbedError::InvalidArgument(
+            "landmark values must be finite".into(),
+        ));
+    }
+    let fixed = fixed_mask(n, landmarks)?;
+    progress.report(Stage::LsMesh, 0.0);
+    check_cancel(progress)?;
+
+    let mut out = vec![[0.0; MAX_DIM]; n];
+    for (&s, v) in landmarks.iter().zip(values) {
+        out[s as usize][..dim].copy_from_slice(&v[..dim]);
+    }
+    // Free-vertex numbering.
+    let mut free_id = vec![usize::MAX; n];
+    let mut free = Vec::with_capacity(n - landmarks.len());
+    for v in 0..n {
+        if !fixed[v] {
+            free_id[v] = free.len();
+            free.push(v);
+        }
+    }
+    let nf = free.len();
+    if nf == 0 {
+        progress.report(Stage::LsMesh, 1.0);
+        return Ok(out);
+    }
+
+    let a = bilaplacian(mesh)?;
+    progress.report(Stage::LsMesh, 0.15);
+    check_cancel(progress)?;
+
+    // A_FF (lower triangle only, which is all the factorisation reads) and the right-hand
+    // side -A_FS v_S, in one sweep over the columns of the symmetric A.
+    let (sym, vals) = a.parts();
+    let mut col_ptr = Vec::with_capacity(nf + 1);
+    let mut row_idx = Vec::new();
+    let mut ff_vals = Vec::new();
+    let mut rhs = Mat::<f64>::zeros(nf, dim);
+    col_ptr.push(0usize);
+    for &j in &free {
+        let jf = free_id[j];
+        let mut entries: Vec<(usize, f64)> = Vec::new();
+        for k in sym.col_range(j) {
+            let i = sym.row_idx()[k];
+            let x = vals[k];
+            if fixed[i] {
+                // A symmetric: A_FS[jf, i] = A[i, j].
+                for c in 0..dim {
+                    rhs[(jf, c)] -= x * out[i][c];
+                }
+            } else if free_id[i] >= jf {
+                entries.push((free_id[i], x));
+            }
+        }
+        entries.sort_unstable_by_key(|e| e.0);
+        for (i, x) in entries {
+            row_idx.push(i);
+            ff_vals.push(x);
+        }
+        col_ptr.push(row_idx.len());
+    }
+    let a_ff = SparseColMat::new(
+        SymbolicSparseColMat::new_checked(nf, nf, col_ptr, None, row_idx),
+        ff_vals,
+    );
+    check_cancel(progress)?;
+
+    let par = Par::Seq;
+    let symbolic = factorize_symbolic_cholesky(
+        a_ff.symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Amd,
+        Default::default(),
+    )
+    .map_err(|e| EmbedError::Numerical(format!("least-squares mesh symbolic Cholesky: {e:?}")))?;
+    progress.report(Stage::LsMesh, 0.3);
+    check_cancel(progress)?;
+    let mut l_values = vec![0.0; symbolic.len_val()];
+    let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+    let llt = symbolic
+        .factorize_numeric_llt(
+            &mut l_values,
+            a_ff.as_ref(),
+            Side::Lower,
+            LltRegularization::default(),
+            par,
+            MemStack::new(&mut MemBuffer::new(scratch)),
+            Default::default(),
+        )
+        .map_err(|e| {
+            EmbedError::Numerical(format!(
+                "least-squares mesh system is not positive definite ({e:?}); \
+                 is every connected component given a landmark?"
+            ))
+        })?;
+    progress.report(Stage::LsMesh, 0.9);
+    check_cancel(progress)?;
+    let scratch = symbolic.solve_in_place_scratch::<f64>(dim, par);
+    llt.solve_in_place_with_conj(
+        Conj::No,
+        rhs.as_mut(),
+        par,
+        MemStack::new(&mut MemBuffer::new(scratch)),
+    );
+    for (jf, &v) in free.iter().enumerate() {
+        for c in 0..dim {
+            out[v][c] = rhs[(jf, c)];
+        }
+    }
+    if out.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
+        return Err(EmbedError::Numerical(
+            "least-squares mesh produced non-finite coordinates".into(),
+        ));
+    }
+    progress.report(Stage::LsMesh, 1.0);
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::NoProgress;
+    use rand::seq::index::sample;
+    use rand::{Rng, SeedableRng};
+    use wavg_mesh::procedural;
+
+    fn random_landmarks(n: usize, k: usize, seed: u64) -> Vec<u32> {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        sample(&mut rng, n, k)
+            .into_iter()
+            .map(|i| i as u32)
+            .collect()
+    }
+
+    /// `A x` for the full bi-Laplacian, column `c` of the points.
+    fn apply(a: &SparseColMat<usize, f64>, x: &[[f64; MAX_DIM]], c: usize) -> Vec<f64> {
+        let (sym, vals) = a.parts();
+        let mut y = vec![0.0; x.len()];
+        for j in 0..sym.ncols() {
+            for k in sym.col_range(j) {
+                y[sym.row_idx()[k]] += vals[k] * x[j][c];
+            }
+        }
+        y
+    }
+
+    #[test]
+    fn landmarks_kept_exactly_and_gradient_vanishes_at_free_vertices() {
+        for (mesh, k) in [
+            (procedural::torus(40, 20, 1.0, 0.35), 60),
+            (procedural::grid(30, 20, 3.0, 2.0), 25), // open mesh
+            (
+                procedural::with_noise(procedural::icosphere(3), 0.01, 4),
+                40,
+            ),
+        ] {
+            let mesh = ValidMesh::new(mesh).unwrap();
+            let n = mesh.n_vertices();
+            let lm = random_landmarks(n, k, 5);
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
+            let values: Vec<[f64; MAX_DIM]> = lm
+                .iter()
+                .map(|_| std::array::from_fn(|_| rng.random_range(-1.0..1.0)))
+                .collect();
+            let x = least_squares_mesh(&mesh, &lm, &values, 8, &NoProgress).unwrap();
+            for (&s, v) in lm.iter().zip(&values) {
+                assert_eq!(x[s as usize], *v, "landmark {s} moved");
+            }
+            let a = bilaplacian(&mesh).unwrap();
+            let mut fixed = vec![false; n];
+            for &s in &lm {
+                fixed[s as usize] = true;
+            }
+            for c in 0..8 {
+                let ax = apply(&a, &x, c);
+                // Residual at free vertices relative to the right-hand side -A_FS v_S.
+                let mut only_fixed = vec![[0.0; MAX_DIM]; n];
+                for &s in &lm {
+                    only_fixed[s as usize] = x[s as usize];
+                }
+                let b = apply(&a, &only_fixed, c);
+                let (mut r2, mut b2) = (0.0, 0.0);
+                for v in (0..n).filter(|&v| !fixed[v]) {
+                    r2 += ax[v] * ax[v];
+                    b2 += b[v] * b[v];
+                }
+                let rel = (r2 / b2).sqrt();
+                assert!(rel < 1e-8, "relative residual {rel}");
+            }
+        }
+    }
+
+    #[test]
+    fn bilaplacian_is_symmetric_with_constant_kernel() {
+        let mesh = procedural::with_noise(procedural::torus(20, 10, 1.0, 0.4), 0.02, 1);
+        let a = bilaplacian(&mesh).unwrap();
+        let ones = vec![[1.0; MAX_DIM]; mesh.n_vertices()];
+        let y = apply(&a, &ones, 0);
+        let scale = a.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(y.iter().all(|v| v.abs() < 1e-10 * scale));
+        let dense = a.to_dense();
+        for i in 0..dense.nrows() {
+            for j in 0..i {
+                assert!((dense[(i, j)] - dense[(j, i)]).abs() <= 1e-12 * scale);
+            }
+        }
+    }
+
+    #[test]
+    fn own_positions_reproduce_the_surface() {
+        // Landmarks given their own 3-D positions: the LS mesh is a smooth approximation of
+        // the original surface.
+        let mesh = ValidMesh::new(procedural::bump_sphere(4, 0.1)).unwrap();
+        let n = mesh.n_vertices();
+        let diag = mesh.bounding_box_diagonal();
+        for k in [100, 400] {
+            let lm = random_landmarks(n, k, 9);
+            let values: Vec<[f64; MAX_DIM]> = lm
+                .iter()
+                .map(|&s| {
+                    let p = mesh.positions[s as usize];
+                    [p.x, p.y, p.z, 0.0, 0.0, 0.0, 0.0, 0.0]
+                })
+                .collect();
+            let x = least_squares_mesh(&mesh, &lm, &values, 3, &NoProgress).unwrap();
+            let dev: Vec<f64> = (0..n)
+                .map(|v| {
+                    let p = mesh.positions[v];
+                    let q = x[v];
+                    ((p.x - q[0]).powi(2) + (p.y - q[1]).powi(2) + (p.z - q[2]).powi(2)).sqrt()
+                        / diag
+                })
+                .collect();
+            let mean = dev.iter().sum::<f64>() / n as f64;
+            let max = dev.iter().fold(0.0f64, |m, &d| m.max(d));
+            eprintln!(
+                "LS mesh of own positions, {n} vertices, {k} landmarks: deviation / bbox \
+                 diagonal mean {mean:.2e}, max {max:.2e}"
+            );
+            assert!(mean < 0.01 && max < 0.05, "mean {mean}, max {max}");
+            assert!(x.iter().all(|p| p[3..].iter().all(|&c| c == 0.0)));
+        }
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let mesh = ValidMesh::new(procedural::icosphere(1)).unwrap();
+        let v = [[0.0; MAX_DIM]; 2];
+        let run = |lm: &[u32], vals: &[[f64; MAX_DIM]], dim| {
+            least_squares_mesh(&mesh, lm, vals, dim, &NoProgress)
+        };
+        assert!(run(&[], &[], 8).is_err());
+        assert!(run(&[0, 0], &v, 8).is_err());
+        assert!(run(&[0, 1000], &v, 8).is_err());
+        assert!(run(&[0, 1], &v[..1], 8).is_err());
+        assert!(run(&[0, 1], &v, 0).is_err());
+        assert!(run(&[0, 1], &v, 9).is_err());
+        let mut nan = v;
+        nan[1][2] = f64::NAN;
+        assert!(run(&[0, 1], &nan, 8).is_err());
+        assert!(run(&[0, 1], &v, 8).is_ok());
+    }
+
+    #[test]
+    fn every_vertex_a_landmark_is_the_identity() {
+        let mesh = ValidMesh::new(procedural::icosphere(0)).unwrap();
+        let lm: Vec<u32> = (0..12).collect();
+        let vals: Vec<[f64; MAX_DIM]> = (0..12).map(|i| [i as f64; MAX_DIM]).collect();
+        let x = least_squares_mesh(&mesh, &lm, &vals, 8, &NoProgress).unwrap();
+        assert_eq!(x, vals);
+    }
+}
