@@ -1,12 +1,361 @@
-//! `wavg bench project` (not yet implemented).
+//! `wavg bench project`: Phong projection speed and accuracy on random surface points.
+//!
+//! Protocol (issue 3): build the projector (`init_s`, `bytes_per_face`); (a) project N
+//! random on-surface points (uniform by area, seeded), each from a start vertex three
+//! rings away, on one thread: mean time and the fraction that return to themselves
+//! (same face within 1e-5 in barycentrics, or the same position within 1e-5 mean edge
+//! lengths on a face sharing a vertex); (b) the same with the points offset from the
+//! surface by 0.1 mean edge length along the face normal (with `--embedding`: a seeded
+//! random direction of R^8 orthogonal to the embedded face), timed, and on the first
+//! 1,000 compared with the brute-force search.
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use wavg::mesh::{SurfacePoint, ValidMesh, VertexId, io};
+use wavg::project::{EmbeddedMesh, Projection, Projector, Vec8};
 
 use crate::CliError;
 
 /// Arguments.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Mesh file (OBJ/OFF/PLY, optionally .gz).
+    #[arg(long)]
+    mesh: PathBuf,
+    /// A .wavg embedding of the mesh (default: the 3-D positions, zero-padded).
+    #[arg(long)]
+    embedding: Option<PathBuf>,
+    /// Number of random queries per test.
+    #[arg(long, default_value_t = 100_000)]
+    queries: usize,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Points checked against the brute-force search.
+const BRUTE_FORCE_CHECKS: usize = 1000;
+/// Ring distance of the start vertex from the query's face.
+const HINT_RINGS: usize = 3;
+/// Tolerance of "the same point" (barycentrics, or mean edge lengths for positions).
+const SAME: f64 = 1e-5;
 
 /// Runs the command.
-pub fn run(_args: Args) -> Result<(), CliError> {
-    Err(CliError::failure("not implemented yet"))
+pub fn run(args: Args) -> Result<(), CliError> {
+    if args.queries == 0 {
+        return Err(CliError::input("--queries must be at least 1"));
+    }
+    let tri = io::load(&args.mesh)
+        .map_err(|e| CliError::input(format!("{}: {e}", args.mesh.display())))?;
+    let mesh = Arc::new(
+        ValidMesh::new(tri)
+            .map_err(|e| CliError::input(format!("{}: {e}", args.mesh.display())))?,
+    );
+    let emb = match &args.embedding {
+        None => EmbeddedMesh::from_positions(mesh.clone()),
+        Some(p) => {
+            let e = wavg_embed::file::load(p, &mesh)
+                .map_err(|e| CliError::input(format!("{}: {e}", p.display())))?;
+            let coords = e
+                .coords
+                .iter()
+                .map(|c| Vec8::from_column_slice(c))
+                .collect();
+            EmbeddedMesh::new(mesh.clone(), coords)
+                .map_err(|e| CliError::input(format!("{}: {e}", p.display())))?
+        }
+    };
+    let emb = Arc::new(emb);
+    let t0 = Instant::now();
+    let projector = Projector::new(emb.clone()).map_err(CliError::failure)?;
+    let init_s = t0.elapsed().as_secs_f64();
+    let bytes_per_face = projector.bytes() as f64 / mesh.n_faces() as f64;
+
+    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let sampler = AreaSampler::new(&mesh);
+    let mut hints = HintFinder::new(mesh.n_vertices());
+    let points: Vec<SurfacePoint> = (0..args.queries)
+        .map(|_| sampler.sample(&mut rng))
+        .collect();
+    let starts: Vec<VertexId> = points
+        .iter()
+        .map(|p| hints.find(&mesh, mesh.triangles[p.face as usize][0], &mut rng))
+        .collect();
+    let mean_edge = emb.mean_edge_length();
+
+    // (a) on-surface points.
+    let ys: Vec<Vec8> = points.iter().map(|p| emb.point(p)).collect();
+    let (on, onsurface_us) = timed(&projector, &ys, &starts);
+    let mut back = 0usize;
+    for ((p, r), y) in points.iter().zip(&on).zip(&ys) {
+        if let Ok(r) = r {
+            if returns_to(&mesh, &emb, p, y, r, mean_edge) {
+                back += 1;
+            }
+        }
+    }
+    let onsurface_self_fraction = back as f64 / points.len() as f64;
+
+    // (b) offset points.
+    let padded = args.embedding.is_none();
+    let offset: Vec<Vec8> = points
+        .iter()
+        .zip(&ys)
+        .map(|(p, y)| {
+            y + offset_direction(&mesh, &emb, p.face, padded, &mut rng) * (0.1 * mean_edge)
+        })
+        .collect();
+    let (off, offset_us) = timed(&projector, &offset, &starts);
+    let n_check = BRUTE_FORCE_CHECKS.min(offset.len());
+    let agree = brute_force_agreement(&projector, &offset[..n_check], &off[..n_check], mean_edge);
+    let offset_bruteforce_agree_fraction = agree as f64 / n_check as f64;
+
+    let name = args.mesh.display().to_string();
+    if args.json {
+        let j = serde_json::json!({
+            "mesh": name,
+            "vertices": mesh.n_vertices(),
+            "faces": mesh.n_faces(),
+            "queries": args.queries,
+            "init_s": init_s,
+            "bytes_per_face": bytes_per_face,
+            "onsurface_us": onsurface_us,
+            "onsurface_self_fraction": onsurface_self_fraction,
+            "offset_us": offset_us,
+            "offset_bruteforce_agree_fraction": offset_bruteforce_agree_fraction,
+        });
+        println!("{j}");
+    } else {
+        let paths = |v: &[Result<Projection, _>]| {
+            let mut n = [0usize; 3];
+            for r in v.iter().flatten() {
+                n[(r.path as usize).min(2)] += 1;
+            }
+            n
+        };
+        let (pa, pb) = (paths(&on), paths(&off));
+        println!("mesh                              {name}");
+        println!(
+            "vertices / faces                  {} / {}",
+            mesh.n_vertices(),
+            mesh.n_faces()
+        );
+        println!("queries                           {}", args.queries);
+        println!("init_s                            {init_s:.3}");
+        println!("bytes_per_face                    {bytes_per_face:.1}");
+        println!("onsurface_us                      {onsurface_us:.3}");
+        println!("onsurface_self_fraction           {onsurface_self_fraction:.6}");
+        println!(
+            "  paths local/fallback/none       {}/{}/{}",
+            pa[0],
+            pa[1],
+            on.len() - pa[0] - pa[1]
+        );
+        println!("offset_us                         {offset_us:.3}");
+        println!(
+            "offset_bruteforce_agree_fraction  {offset_bruteforce_agree_fraction:.6} (of {n_check})"
+        );
+        println!(
+            "  paths local/fallback/none       {}/{}/{}",
+            pb[0],
+            pb[1],
+            off.len() - pb[0] - pb[1]
+        );
+    }
+    Ok(())
+}
+
+type Answer = Result<Projection, wavg::project::ProjectError>;
+
+/// Projects every query on one thread; mean microseconds per query.
+fn timed(p: &Projector, ys: &[Vec8], starts: &[VertexId]) -> (Vec<Answer>, f64) {
+    let mut out = Vec::with_capacity(ys.len());
+    let t = Instant::now();
+    for (y, &s) in ys.iter().zip(starts) {
+        out.push(p.project(y, s));
+    }
+    let us = t.elapsed().as_secs_f64() * 1e6 / ys.len() as f64;
+    (out, us)
+}
+
+/// Whether projection `r` of `y = e(p)` is `p` itself.
+fn returns_to(
+    mesh: &ValidMesh,
+    emb: &EmbeddedMesh,
+    p: &SurfacePoint,
+    y: &Vec8,
+    r: &Projection,
+    mean_edge: f64,
+) -> bool {
+    if r.point.face == p.face {
+        let d = (0..3)
+            .map(|i| (r.point.bary[i] - p.bary[i]).abs())
+            .fold(0.0, f64::max);
+        return d <= SAME;
+    }
+    let (a, b) = (
+        mesh.triangles[p.face as usize],
+        mesh.triangles[r.point.face as usize],
+    );
+    a.iter().any(|v| b.contains(v)) && (emb.point(&r.point) - y).norm() <= SAME * mean_edge
+}
+
+/// Unit offset direction for face `f`: the 3-D normal (padded) or a random direction
+/// orthogonal to the embedded face.
+fn offset_direction(
+    mesh: &ValidMesh,
+    emb: &EmbeddedMesh,
+    f: u32,
+    padded: bool,
+    rng: &mut ChaCha8Rng,
+) -> Vec8 {
+    if padded {
+        let n = wavg::mesh::geometry::face_normal(mesh, f as usize);
+        let mut v = Vec8::zeros();
+        v.fixed_rows_mut::<3>(0).copy_from(&n);
+        return v;
+    }
+    let [a, b, c] = emb.corners(f as usize);
+    let e1 = (b - a).normalize();
+    let e2 = {
+        let w = c - a;
+        (w - e1 * e1.dot(&w)).normalize()
+    };
+    loop {
+        let r = Vec8::from_fn(|_, _| rng.random_range(-1.0..1.0));
+        let n = r - e1 * e1.dot(&r) - e2 * e2.dot(&r);
+        let len = n.norm();
+        if len > 1e-3 && len.is_finite() {
+            return n / len;
+        }
+    }
+}
+
+/// How many of the fast answers equal the brute-force ones (same point, or a tie in
+/// distance, or both "no projection"); the brute force runs on all cores.
+fn brute_force_agreement(p: &Projector, ys: &[Vec8], fast: &[Answer], mean_edge: f64) -> usize {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let chunk = ys.len().div_ceil(threads).max(1);
+    std::thread::scope(|s| {
+        let handles: Vec<_> = ys
+            .chunks(chunk)
+            .zip(fast.chunks(chunk))
+            .map(|(ys, fast)| {
+                s.spawn(move || {
+                    ys.iter()
+                        .zip(fast)
+                        .filter(|(y, f)| {
+                            let b = p.project_brute_force(y);
+                            match (f, &b) {
+                                (Err(_), Err(_)) => true,
+                                (Ok(f), Ok(b)) => {
+                                    let emb = p.embedded();
+                                    (emb.point(&f.point) - emb.point(&b.point)).norm()
+                                        <= SAME * mean_edge
+                                        || (f.distance - b.distance).abs()
+                                            <= 1e-9 * (b.distance + mean_edge)
+                                }
+                                _ => false,
+                            }
+                        })
+                        .count()
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap_or(0)).sum()
+    })
+}
+
+/// Uniform sampling of surface points by 3-D area.
+struct AreaSampler {
+    cumulative: Vec<f64>,
+}
+
+impl AreaSampler {
+    fn new(mesh: &ValidMesh) -> Self {
+        let mut s = 0.0;
+        let cumulative = wavg::mesh::geometry::face_areas(mesh)
+            .into_iter()
+            .map(|a| {
+                s += a;
+                s
+            })
+            .collect();
+        Self { cumulative }
+    }
+
+    fn sample(&self, rng: &mut ChaCha8Rng) -> SurfacePoint {
+        let total = *self.cumulative.last().unwrap_or(&0.0);
+        let t = rng.random_range(0.0..1.0) * total;
+        let f = self
+            .cumulative
+            .partition_point(|&c| c <= t)
+            .min(self.cumulative.len() - 1);
+        let (mut u, mut v): (f64, f64) = (rng.random_range(0.0..1.0), rng.random_range(0.0..1.0));
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        SurfacePoint::new(f as u32, [1.0 - u - v, u, v])
+    }
+}
+
+/// Breadth-first search for a vertex `HINT_RINGS` rings away (reused stamps, no clearing).
+struct HintFinder {
+    stamp: Vec<u32>,
+    depth: Vec<u8>,
+    round: u32,
+    queue: VecDeque<u32>,
+    ring: Vec<u32>,
+}
+
+impl HintFinder {
+    fn new(n: usize) -> Self {
+        Self {
+            stamp: vec![0; n],
+            depth: vec![0; n],
+            round: 0,
+            queue: VecDeque::new(),
+            ring: Vec::new(),
+        }
+    }
+
+    fn find(&mut self, mesh: &ValidMesh, from: VertexId, rng: &mut ChaCha8Rng) -> VertexId {
+        self.round += 1;
+        self.queue.clear();
+        self.ring.clear();
+        let mut farthest = (0u8, from);
+        self.stamp[from as usize] = self.round;
+        self.depth[from as usize] = 0;
+        self.queue.push_back(from);
+        while let Some(v) = self.queue.pop_front() {
+            let d = self.depth[v as usize];
+            if d as usize == HINT_RINGS {
+                self.ring.push(v);
+                continue;
+            }
+            if d > farthest.0 {
+                farthest = (d, v);
+            }
+            for &u in mesh.topology().ring(v) {
+                if self.stamp[u as usize] != self.round {
+                    self.stamp[u as usize] = self.round;
+                    self.depth[u as usize] = d + 1;
+                    self.queue.push_back(u);
+                }
+            }
+        }
+        if self.ring.is_empty() {
+            farthest.1
+        } else {
+            self.ring[rng.random_range(0..self.ring.len())]
+        }
+    }
 }

@@ -27,14 +27,30 @@ pub struct Bvh {
     items: Vec<u32>,
 }
 
+/// The largest f32 not above `x` (conservative lower bound).
 fn down(x: f64) -> f32 {
     let f = x as f32;
-    if f as f64 > x { f.next_down() } else { f }
+    if f as f64 > x { step(f, false) } else { f }
 }
 
+/// The smallest f32 not below `x` (conservative upper bound).
 fn up(x: f64) -> f32 {
     let f = x as f32;
-    if (f as f64) < x { f.next_up() } else { f }
+    if (f as f64) < x { step(f, true) } else { f }
+}
+
+/// Neighbouring f32 towards +inf (`up`) or -inf (`f32::next_up` needs Rust 1.86).
+fn step(f: f32, up: bool) -> f32 {
+    if f.is_nan() || f.is_infinite() {
+        return f;
+    }
+    if f == 0.0 {
+        let tiny = f32::from_bits(1);
+        return if up { tiny } else { -tiny };
+    }
+    let b = f.to_bits();
+    let away = (f > 0.0) == up;
+    f32::from_bits(if away { b + 1 } else { b - 1 })
 }
 
 impl Bvh {

@@ -21,6 +21,12 @@
 //! assert!((emb.point(&hit.point) - y).norm() < 1e-6);
 //! ```
 
+// `!(x > tol)` is used on purpose throughout: it is also true for NaN, which must take the
+// degenerate branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// The small fixed-size kernels index several arrays in step; explicit indices read better.
+#![allow(clippy::needless_range_loop)]
+
 pub mod bvh;
 pub mod embedded;
 pub mod error;

@@ -17,7 +17,7 @@ use wavg_mesh::{FaceId, NONE, SurfacePoint, VertexId};
 use crate::bvh::Bvh;
 use crate::euclid::closest_point_barycentric;
 use crate::frames::FrameKind;
-use crate::triangle::{Frame32, TriData, frame_apply, frame_to_f32, frame_to_f64};
+use crate::triangle::{Frame32, TriData, frame_apply_diff, frame_to_f32, frame_to_f64};
 use crate::{EmbeddedMesh, Mat2x8, ProjectError, Vec8};
 
 /// A distance below this fraction of the triangle's longest edge counts as zero: such a
@@ -58,6 +58,23 @@ pub struct Projector {
     frame_kinds: [usize; 4],
     tris: Vec<TriData>,
     bvh: Bvh,
+    walk_origin: Vec8,
+    walk_coords: Vec<WalkPoint>,
+}
+
+/// A vertex in the walk's compact coordinates (f32, relative to the bounding box centre).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+struct WalkPoint([f32; 8]);
+
+#[inline(always)]
+fn dist2(a: &WalkPoint, b: &WalkPoint) -> f32 {
+    let mut s = 0.0;
+    for k in 0..8 {
+        let d = a.0[k] - b.0[k];
+        s += d * d;
+    }
+    s
 }
 
 /// Small fixed set of face ids (no allocation per query).
@@ -132,12 +149,23 @@ impl Projector {
             })
             .collect();
         let bvh = Bvh::new(&boxes);
+        let (lo, hi) = coords.iter().fold(
+            (Vec8::repeat(f64::INFINITY), Vec8::repeat(f64::NEG_INFINITY)),
+            |(l, h), c| (l.inf(c), h.sup(c)),
+        );
+        let walk_origin = (lo + hi) * 0.5;
+        let walk_coords = coords
+            .iter()
+            .map(|c| WalkPoint(std::array::from_fn(|k| (c[k] - walk_origin[k]) as f32)))
+            .collect();
         Ok(Self {
             emb,
             frames,
             frame_kinds,
             tris,
             bvh,
+            walk_origin,
+            walk_coords,
         })
     }
 
@@ -162,7 +190,8 @@ impl Projector {
         self.frames.len() * std::mem::size_of::<Frame32>()
             + self.tris.len() * std::mem::size_of::<TriData>()
             + self.bvh.bytes()
-            + self.emb.coords().len() * std::mem::size_of::<Vec8>()
+            + self.walk_coords.len() * std::mem::size_of::<WalkPoint>()
+            + std::mem::size_of_val(self.emb.coords())
     }
 
     fn face_frames(&self, f: FaceId) -> [&Frame32; 3] {
@@ -198,20 +227,30 @@ impl Projector {
     fn try_face(&self, f: FaceId, y: &Vec8) -> Option<Best> {
         let t = self.emb.mesh().triangles[f as usize];
         let c = self.emb.coords();
-        let v = t.map(|i| &c[i as usize]);
-        let h = [0, 1, 2].map(|i| frame_apply(&self.frames[t[i] as usize], &(y - v[i])));
+        let (v0, v1, v2) = (&c[t[0] as usize], &c[t[1] as usize], &c[t[2] as usize]);
+        let h = [
+            frame_apply_diff(&self.frames[t[0] as usize], y, v0),
+            frame_apply_diff(&self.frames[t[1] as usize], y, v1),
+            frame_apply_diff(&self.frames[t[2] as usize], y, v2),
+        ];
         let xi = self.tris[f as usize].solve(&h)?;
-        let p = v[0] * xi[0] + v[1] * xi[1] + v[2] * xi[2];
-        Some(Best {
-            face: f,
-            xi,
-            d2: (p - y).norm_squared(),
-        })
+        let (a, b, cc) = (&v0.data.0[0], &v1.data.0[0], &v2.data.0[0]);
+        let yy = &y.data.0[0];
+        let mut d2 = 0.0;
+        for k in 0..8 {
+            let d = a[k] * xi[0] + b[k] * xi[1] + cc[k] * xi[2] - yy[k];
+            d2 += d * d;
+        }
+        Some(Best { face: f, xi, d2 })
     }
 
     fn is_zero(&self, b: &Best) -> bool {
-        let s = self.tris[b.face as usize].scale as f64 * ZERO_DISTANCE;
-        b.d2 <= s * s
+        let [p, q, r] = self.emb.corners(b.face as usize);
+        let scale2 = (q - p)
+            .norm_squared()
+            .max((r - q).norm_squared())
+            .max((p - r).norm_squared());
+        b.d2 <= ZERO_DISTANCE * ZERO_DISTANCE * scale2
     }
 
     fn finish(b: Best, path: ProjectionPath) -> Projection {
@@ -237,39 +276,21 @@ impl Projector {
             });
         }
         let topo = mesh.topology();
-        let c = self.emb.coords();
         // 1. Greedy walk.
-        let mut v = start;
-        let mut dv = (c[v as usize] - y).norm_squared();
-        let mut ring_d = [0.0f64; 64];
-        loop {
-            let mut next = None;
-            for (j, &u) in topo.ring(v).iter().enumerate() {
-                let d = (c[u as usize] - y).norm_squared();
-                if j < 64 {
-                    ring_d[j] = d;
-                }
-                if d < dv {
-                    dv = d;
-                    next = Some(u);
-                }
-            }
-            match next {
-                Some(u) => v = u,
-                None => break,
-            }
-        }
+        let mut ring_d = [0.0f32; 64];
+        let v = self.walk_inner(y, start, &mut ring_d);
         // 2. Faces around v, most promising first (nearest opposite corners).
         let ring = topo.ring(v);
         let faces = topo.ring_faces(v);
+        let yw = self.walk_point(y);
         let dist = |j: usize| {
             if j < 64 {
                 ring_d[j]
             } else {
-                (c[ring[j] as usize] - y).norm_squared()
+                dist2(&self.walk_coords[ring[j] as usize], &yw)
             }
         };
-        let mut order = [(0.0f64, 0u32); 64];
+        let mut order = [(0.0f32, 0u32); 64];
         let m = faces.len().min(64);
         for j in 0..m {
             let score = dist(j) + dist((j + 1) % ring.len());
@@ -433,6 +454,51 @@ impl Projector {
             });
         }
         Self::finish(best, ProjectionPath::Euclidean)
+    }
+
+    /// Greedy walk over the vertex graph from `start`: moves to the neighbour closest to
+    /// `y` until no neighbour is closer; returns that vertex (a local minimum of the
+    /// distance to `y`, a good start for the next query near `y`).
+    pub fn walk(&self, y: &Vec8, start: VertexId) -> VertexId {
+        let mut ring_d = [0.0f32; 64];
+        self.walk_inner(y, start.min(self.walk_coords.len() as u32 - 1), &mut ring_d)
+    }
+
+    /// The query in the walk's compact coordinates.
+    #[inline]
+    fn walk_point(&self, y: &Vec8) -> WalkPoint {
+        let mut p = WalkPoint([0.0; 8]);
+        for k in 0..8 {
+            p.0[k] = (y[k] - self.walk_origin[k]) as f32;
+        }
+        p
+    }
+
+    /// The walk; leaves the squared distances of the final vertex's ring in `ring_d`.
+    #[inline]
+    fn walk_inner(&self, y: &Vec8, start: VertexId, ring_d: &mut [f32; 64]) -> VertexId {
+        let topo = self.emb.mesh().topology();
+        let w = &self.walk_coords;
+        let yw = self.walk_point(y);
+        let mut v = start;
+        let mut dv = dist2(&w[v as usize], &yw);
+        loop {
+            let mut next = v;
+            for (j, &u) in topo.ring(v).iter().enumerate() {
+                let d = dist2(&w[u as usize], &yw);
+                if j < 64 {
+                    ring_d[j] = d;
+                }
+                if d < dv {
+                    dv = d;
+                    next = u;
+                }
+            }
+            if next == v {
+                return v;
+            }
+            v = next;
+        }
     }
 
     /// Vertex closest to `y` in R^8 (brute force).

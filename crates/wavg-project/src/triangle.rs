@@ -50,8 +50,9 @@ pub fn frame_to_f64(f: &Frame32) -> Mat2x8 {
 }
 
 /// `T (d)` for a stored frame: the 2-D tangent coordinates of `d`.
-#[inline]
+#[inline(always)]
 pub fn frame_apply(f: &Frame32, d: &Vec8) -> [f64; 2] {
+    let d: &[f64; 8] = &d.data.0[0];
     let mut a = 0.0;
     let mut b = 0.0;
     for c in 0..8 {
@@ -61,78 +62,132 @@ pub fn frame_apply(f: &Frame32, d: &Vec8) -> [f64; 2] {
     [a, b]
 }
 
-/// Precomputed data of one triangle (196 bytes).
+/// `T (y - v)` for a stored frame, without forming `y - v`.
+#[inline(always)]
+pub fn frame_apply_diff(f: &Frame32, y: &Vec8, v: &Vec8) -> [f64; 2] {
+    let y: &[f64; 8] = &y.data.0[0];
+    let v: &[f64; 8] = &v.data.0[0];
+    let mut a = 0.0;
+    let mut b = 0.0;
+    for c in 0..8 {
+        let d = y[c] - v[c];
+        a += f[c] as f64 * d;
+        b += f[8 + c] as f64 * d;
+    }
+    [a, b]
+}
+
+/// Precomputed data of one triangle (192 bytes, three cache lines).
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
 pub struct TriData {
     /// The six 2x2 blend matrices `X_e` (row-major).
     pub x: [[f32; 4]; 6],
     /// `G_e`: `X_e T_i (v_{i+1} - v_i)` then `X_e T_i (v_{i+2} - v_i)`, `i` = [`TERM_VERTEX`]`[e]`.
     pub g: [[f32; 4]; 6],
-    /// Longest embedded edge (the triangle's length scale).
-    pub scale: f32,
 }
 
-/// The edge alignments `R_k = Ort(T_{k+1} T_k^T)` and rotations `E_k` of a triangle with
-/// frames `t` (block coordinate descent, [`PROCRUSTES_SWEEPS`] sweeps from identities).
-/// Also returns the Procrustes energy after each sweep (non-increasing).
-pub fn alignments(t: &[Mat2x8; 3]) -> ([M2; 3], [M2; 3], [f64; PROCRUSTES_SWEEPS + 1]) {
-    let mut r = [ort::I2; 3];
-    let mut bases = [Mat2x8::zeros(); 6];
-    for k in 0..3 {
-        let (ti, tj) = (&t[k], &t[(k + 1) % 3]);
-        r[k] = ort::ort(&to_m2(&(tj * ti.transpose())));
-        bases[2 * k] = from_m2(&r[k]) * ti;
-        bases[2 * k + 1] = *tj;
-    }
-    let mut gram = [[ort::I2; 6]; 6];
-    for a in 0..6 {
-        for b in a..6 {
-            let g = to_m2(&(bases[a] * bases[b].transpose()));
-            gram[a][b] = g;
-            gram[b][a] = ort::transpose(&g);
+/// Gram blocks `T_i T_j^T` of the three corner frames (`[C01, C12, C20]`).
+fn frame_products(t: &[Mat2x8; 3]) -> [M2; 3] {
+    [0, 1, 2].map(|i| {
+        let (a, b) = (&t[i], &t[(i + 1) % 3]);
+        let mut m = [0.0; 4];
+        for r in 0..2 {
+            for c in 0..2 {
+                m[r * 2 + c] = a.row(r).dot(&b.row(c));
+            }
         }
+        m
+    })
+}
+
+/// Everything the Procrustes step needs, in 2x2 blocks: the six un-rotated bases are
+/// `Q_a T_{corner(a)}` with `Q = [R_0, I, R_1, I, R_2, I]`, so their Gram blocks are
+/// `Q_a (T_i T_j^T) Q_b^T` and need only the three frame products.
+struct Procrustes {
+    r: [M2; 3],
+    gram: [[M2; 6]; 6],
+}
+
+impl Procrustes {
+    fn new(t: &[Mat2x8; 3]) -> Self {
+        let c = frame_products(t);
+        // cross(i, j) = T_i T_j^T; frames are orthonormal so T_i T_i^T = I.
+        let cross = |i: usize, j: usize| -> M2 {
+            if i == j {
+                ort::I2
+            } else if (i + 1) % 3 == j {
+                c[i]
+            } else {
+                ort::transpose(&c[j])
+            }
+        };
+        // R_k = Ort(T_{k+1} T_k^T).
+        let r = [0, 1, 2].map(|k| ort::ort(&cross((k + 1) % 3, k)));
+        let q = [r[0], ort::I2, r[1], ort::I2, r[2], ort::I2];
+        let corner = [0, 1, 1, 2, 2, 0];
+        let mut gram = [[ort::I2; 6]; 6];
+        for a in 0..6 {
+            for b in 0..6 {
+                let m = ort::mul(&q[a], &cross(corner[a], corner[b]));
+                gram[a][b] = ort::mul(&m, &ort::transpose(&q[b]));
+            }
+        }
+        Self { r, gram }
     }
-    let mut e = [ort::I2; 3];
-    let mut energy = [0.0; PROCRUSTES_SWEEPS + 1];
-    energy[0] = procrustes_energy(&e, &gram);
-    for sweep in 0..PROCRUSTES_SWEEPS {
-        for k in 0..3 {
-            let mut m = [0.0; 4];
-            for j in 0..3 {
-                if j == k {
-                    continue;
-                }
+
+    /// Block coordinate descent from identities; returns `E` after `sweeps` sweeps.
+    fn rotations(&self, sweeps: usize) -> [M2; 3] {
+        // h[j][k] = sum over a in pair j, b in pair k of G_ab.
+        let mut h = [[[0.0; 4]; 3]; 3];
+        for (j, hj) in h.iter_mut().enumerate() {
+            for (k, hjk) in hj.iter_mut().enumerate() {
                 for a in [2 * j, 2 * j + 1] {
                     for b in [2 * k, 2 * k + 1] {
-                        m = ort::add(&m, &ort::mul(&e[j], &gram[a][b]));
+                        *hjk = ort::add(hjk, &self.gram[a][b]);
                     }
                 }
             }
-            e[k] = ort::ort(&m);
         }
-        energy[sweep + 1] = procrustes_energy(&e, &gram);
+        let mut e = [ort::I2; 3];
+        for _ in 0..sweeps {
+            for k in 0..3 {
+                let (j1, j2) = ((k + 1) % 3, (k + 2) % 3);
+                let m = ort::add(&ort::mul(&e[j1], &h[j1][k]), &ort::mul(&e[j2], &h[j2][k]));
+                e[k] = ort::ort(&m);
+            }
+        }
+        e
     }
-    (r, e, energy)
+
+    /// `sum_{a<b} |A_a - A_b|^2` with `A_a = E_{pair(a)} B_a`.
+    fn energy(&self, e: &[M2; 3]) -> f64 {
+        let g = &self.gram;
+        let mut s = 0.0;
+        for a in 0..6 {
+            for b in (a + 1)..6 {
+                let cross = ort::mul(&ort::mul(&e[a / 2], &g[a][b]), &ort::transpose(&e[b / 2]));
+                s +=
+                    g[a][a][0] + g[a][a][3] + g[b][b][0] + g[b][b][3] - 2.0 * (cross[0] + cross[3]);
+            }
+        }
+        s
+    }
 }
 
-/// `sum_{a<b} |A_a - A_b|^2` with `A_a = E_{pair(a)} B_a`, from the Gram blocks.
-fn procrustes_energy(e: &[M2; 3], gram: &[[M2; 6]; 6]) -> f64 {
-    let mut s = 0.0;
-    for a in 0..6 {
-        for b in (a + 1)..6 {
-            // |A_a|^2 + |A_b|^2 - 2 tr(E_a G_ab E_b^T)
-            let ea = &e[a / 2];
-            let eb = &e[b / 2];
-            let cross = ort::mul(&ort::mul(ea, &gram[a][b]), &ort::transpose(eb));
-            s += gram[a][a][0] + gram[a][a][3] + gram[b][b][0] + gram[b][b][3]
-                - 2.0 * (cross[0] + cross[3]);
-        }
-    }
-    s
+/// The edge alignments `R_k = Ort(T_{k+1} T_k^T)` and rotations `E_k` of a triangle with
+/// orthonormal frames `t` (block coordinate descent, [`PROCRUSTES_SWEEPS`] sweeps from
+/// identities).
+pub fn alignments(t: &[Mat2x8; 3]) -> ([M2; 3], [M2; 3]) {
+    let p = Procrustes::new(t);
+    (p.r, p.rotations(PROCRUSTES_SWEEPS))
 }
 
-fn to_m2(m: &nalgebra::Matrix2<f64>) -> M2 {
-    [m[(0, 0)], m[(0, 1)], m[(1, 0)], m[(1, 1)]]
+/// The Procrustes energy after 0, 1, ..., [`PROCRUSTES_SWEEPS`] sweeps (non-increasing;
+/// for tests and diagnostics).
+pub fn procrustes_energies(t: &[Mat2x8; 3]) -> [f64; PROCRUSTES_SWEEPS + 1] {
+    let p = Procrustes::new(t);
+    std::array::from_fn(|s| p.energy(&p.rotations(s)))
 }
 
 fn from_m2(m: &M2) -> nalgebra::Matrix2<f64> {
@@ -143,7 +198,7 @@ impl TriData {
     /// Precomputes a triangle from its stored corner frames and embedded corners.
     pub fn new(frames: [&Frame32; 3], corners: [Vec8; 3]) -> Self {
         let t = frames.map(frame_to_f64);
-        let (r, e, _) = alignments(&t);
+        let (r, e) = alignments(&t);
         let mut d = TriData::default();
         for k in 0..3 {
             let a = ort::mul(&e[k], &r[k]);
@@ -160,11 +215,6 @@ impl TriData {
                 d.g[term][2 * s + 1] = xg[1] as f32;
             }
         }
-        let mut scale: f64 = 0.0;
-        for i in 0..3 {
-            scale = scale.max((corners[(i + 1) % 3] - corners[i]).norm());
-        }
-        d.scale = scale as f32;
         d
     }
 
@@ -197,41 +247,30 @@ impl TriData {
     /// kept inside the triangle; `h[i] = T_i (y - v_i)`. Returns the barycentrics of a
     /// projection, or `None` when Newton finds none (the root lies outside the triangle,
     /// the Jacobian is singular, or it does not converge in [`MAX_NEWTON`] steps).
+    ///
+    /// Convergence is tested relative to the triangle's size and the query's distance
+    /// (`|F| <= 1e-11 (|G| + |h|)`), so it does not depend on the mesh's scale or position.
+    #[inline]
     pub fn solve(&self, h: &[[f64; 2]; 3]) -> Option<[f64; 3]> {
-        let mut q = [[0.0f64; 2]; 6];
-        let mut g = [[0.0f64; 4]; 6];
-        let mut hmax: f64 = 0.0;
-        for hi in h {
-            hmax = hmax.max(hi[0].abs()).max(hi[1].abs());
-        }
-        for e in 0..6 {
-            let x = self.x[e];
-            let hi = h[TERM_VERTEX[e]];
-            q[e] = [
-                x[0] as f64 * hi[0] + x[1] as f64 * hi[1],
-                x[2] as f64 * hi[0] + x[3] as f64 * hi[1],
-            ];
-            g[e] = self.g[e].map(|v| v as f64);
-        }
-        let fscale = self.scale as f64 + hmax;
-        let ftol = 1e-11 * fscale;
-        let mut xi = [1.0 / 3.0; 3];
+        let sys = System::new(self, h);
+        let ftol = 1e-11 * sys.fscale;
+        let mut xi = sys.initial_guess();
         let mut stuck = 0;
         for _ in 0..MAX_NEWTON {
-            let (f, j) = residual(&g, &q, &xi);
-            let fn_ = f[0].abs().max(f[1].abs());
-            if fn_ <= ftol {
+            let (f, j) = sys.eval(&xi);
+            if f[0].abs().max(f[1].abs()) <= ftol {
                 return Some(xi);
             }
             let det = j[0] * j[3] - j[1] * j[2];
-            let jn = j.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let jn = j[0].abs().max(j[1].abs()).max(j[2].abs()).max(j[3].abs());
             if !(det.abs() > 1e-14 * jn * jn) {
                 return None;
             }
-            let d0 = -(j[3] * f[0] - j[1] * f[1]) / det;
-            let d1 = -(-j[2] * f[0] + j[0] * f[1]) / det;
+            let inv = 1.0 / det;
+            let d0 = (j[1] * f[1] - j[3] * f[0]) * inv;
+            let d1 = (j[2] * f[0] - j[0] * f[1]) * inv;
             let d = [d0, d1, -d0 - d1];
-            // Largest step in direction d that stays in the triangle.
+            // Largest step along d that stays in the triangle.
             let mut t: f64 = 1.0;
             for k in 0..3 {
                 if xi[k] + d[k] < 0.0 {
@@ -239,33 +278,19 @@ impl TriData {
                 }
             }
             if t < 1e-9 {
+                // On the boundary and pushing out: slide (clamp the full step); twice in
+                // a row means the root is outside.
                 stuck += 1;
                 if stuck >= 2 {
                     return None;
                 }
-                // Slide: clamp the full step onto the triangle.
-                let mut n = [0.0; 3];
-                for k in 0..3 {
-                    n[k] = (xi[k] + d[k]).max(0.0);
-                }
-                let s = n[0] + n[1] + n[2];
-                if !(s > 0.0) {
-                    return None;
-                }
-                xi = n.map(|v| v / s);
+                xi = renormalize([xi[0] + d[0], xi[1] + d[1], xi[2] + d[2]])?;
             } else {
                 stuck = 0;
-                for k in 0..3 {
-                    xi[k] = (xi[k] + t * d[k]).max(0.0);
-                }
-                let s = xi[0] + xi[1] + xi[2];
-                xi = xi.map(|v| v / s);
-                let step = (t * d0).abs().max((t * d1).abs());
-                if step < 1e-13 {
-                    let (f, _) = residual(&g, &q, &xi);
-                    if f[0].abs().max(f[1].abs()) <= 1e-8 * fscale {
-                        return Some(xi);
-                    }
+                xi = renormalize([xi[0] + t * d[0], xi[1] + t * d[1], xi[2] + t * d[2]])?;
+                if (t * d0).abs().max((t * d1).abs()) < 1e-13 {
+                    let (f, _) = sys.eval(&xi);
+                    return (f[0].abs().max(f[1].abs()) <= 1e-8 * sys.fscale).then_some(xi);
                 }
             }
         }
@@ -274,54 +299,166 @@ impl TriData {
 
     /// `F(xi) = Psi(xi) (p(xi) - y)` given `h[i] = T_i (y - v_i)` (for tests).
     pub fn tangent_residual(&self, h: &[[f64; 2]; 3], xi: &[f64; 3]) -> [f64; 2] {
-        let mut q = [[0.0f64; 2]; 6];
-        let mut g = [[0.0f64; 4]; 6];
-        for e in 0..6 {
-            let x = self.x[e].map(|v| v as f64);
-            let hi = h[TERM_VERTEX[e]];
-            q[e] = [x[0] * hi[0] + x[1] * hi[1], x[2] * hi[0] + x[3] * hi[1]];
-            g[e] = self.g[e].map(|v| v as f64);
-        }
-        residual(&g, &q, xi).0
+        System::new(self, h).eval(xi).0
     }
 }
 
-/// `F(xi)` and its Jacobian with respect to `(xi_0, xi_1)` (`xi_2 = 1 - xi_0 - xi_1`),
-/// row-major.
-#[inline]
-fn residual(g: &[[f64; 4]; 6], q: &[[f64; 2]; 6], xi: &[f64; 3]) -> ([f64; 2], [f64; 4]) {
-    let (c, dc) = coefficients(xi);
-    let mut f = [0.0; 2];
-    let mut df = [[0.0; 2]; 3];
-    for e in 0..6 {
-        let i = TERM_VERTEX[e];
-        let k1 = if i == 2 { 0 } else { i + 1 };
-        let k2 = if i == 0 { 2 } else { i - 1 };
-        let ge = &g[e];
-        let z = [
-            xi[k1] * ge[0] + xi[k2] * ge[2] - q[e][0],
-            xi[k1] * ge[1] + xi[k2] * ge[3] - q[e][1],
-        ];
-        f[0] += c[e] * z[0];
-        f[1] += c[e] * z[1];
-        for k in 0..3 {
-            df[k][0] += dc[e][k] * z[0];
-            df[k][1] += dc[e][k] * z[1];
+/// One triangle's tangent equations for one query, in f64.
+struct System {
+    /// `G_e`, two 2-vectors per term.
+    g: [[f64; 4]; 6],
+    /// `q_e = X_e h_{i(e)}`.
+    q: [[f64; 2]; 6],
+    /// Size of the triangle plus distance of the query: the scale of `F`.
+    fscale: f64,
+}
+
+impl System {
+    #[inline(always)]
+    fn new(d: &TriData, h: &[[f64; 2]; 3]) -> Self {
+        let mut q = [[0.0f64; 2]; 6];
+        let mut g = [[0.0f64; 4]; 6];
+        let mut m: f64 = 0.0;
+        for e in 0..6 {
+            let x = d.x[e];
+            let hi = h[TERM_VERTEX[e]];
+            q[e] = [
+                x[0] as f64 * hi[0] + x[1] as f64 * hi[1],
+                x[2] as f64 * hi[0] + x[3] as f64 * hi[1],
+            ];
+            for k in 0..4 {
+                g[e][k] = d.g[e][k] as f64;
+                let a = g[e][k].abs();
+                if a > m {
+                    m = a;
+                }
+            }
         }
-        df[k1][0] += c[e] * ge[0];
-        df[k1][1] += c[e] * ge[1];
-        df[k2][0] += c[e] * ge[2];
-        df[k2][1] += c[e] * ge[3];
+        for hi in h {
+            for &v in hi {
+                if v.abs() > m {
+                    m = v.abs();
+                }
+            }
+        }
+        Self { g, q, fscale: m }
     }
-    (
-        f,
-        [
-            df[0][0] - df[2][0],
-            df[1][0] - df[2][0],
-            df[0][1] - df[2][1],
-            df[1][1] - df[2][1],
-        ],
-    )
+
+    /// Start of the Newton iteration: the root of the tangent equations with the blend
+    /// frozen at the centroid (linear in `xi`), clamped into the triangle. Exact for a
+    /// point on the triangle (every term vanishes there), so such queries converge at once.
+    #[inline(always)]
+    fn initial_guess(&self) -> [f64; 3] {
+        let g = &self.g;
+        let q = &self.q;
+        let c = 1.0 / 3.0;
+        let mut f = [0.0; 2];
+        let mut ju = [0.0; 2];
+        let mut jv = [0.0; 2];
+        for r in 0..2 {
+            let mut s = -(q[0][r] + q[1][r] + q[2][r] + q[3][r] + q[4][r] + q[5][r]);
+            for e in 0..6 {
+                s += c * (g[e][r] + g[e][2 + r]);
+            }
+            f[r] = s;
+            ju[r] =
+                -g[0][2 + r] + g[1][2 + r] - g[1][r] + g[2][2 + r] - g[2][r] + g[3][r] + g[4][r]
+                    - g[5][2 + r];
+            jv[r] = g[0][r] - g[0][2 + r] - g[1][r] - g[2][r] + g[3][2 + r] + g[4][2 + r] + g[5][r]
+                - g[5][2 + r];
+        }
+        let det = ju[0] * jv[1] - jv[0] * ju[1];
+        let jn = ju[0]
+            .abs()
+            .max(ju[1].abs())
+            .max(jv[0].abs())
+            .max(jv[1].abs());
+        if !(det.abs() > 1e-12 * jn * jn) {
+            return [c; 3];
+        }
+        let inv = 1.0 / det;
+        let du = (jv[0] * f[1] - jv[1] * f[0]) * inv;
+        let dv = (ju[1] * f[0] - ju[0] * f[1]) * inv;
+        renormalize([c + du, c + dv, c - du - dv]).unwrap_or([c; 3])
+    }
+
+    /// `F(xi)` and its Jacobian with respect to `(xi_0, xi_1)` (`xi_2 = 1 - xi_0 - xi_1`),
+    /// row-major.
+    #[inline(always)]
+    fn eval(&self, x: &[f64; 3]) -> ([f64; 2], [f64; 4]) {
+        let (c, dc) = coefficients_reduced(x);
+        let g = &self.g;
+        let q = &self.q;
+        // z_e = x_{i+1} G_e,a + x_{i+2} G_e,b - q_e and its (u, v) derivatives.
+        let (x0, x1, x2) = (x[0], x[1], x[2]);
+        let mut f = [0.0; 2];
+        let mut ju = [0.0; 2];
+        let mut jv = [0.0; 2];
+        for r in 0..2 {
+            let z = [
+                x1 * g[0][r] + x2 * g[0][2 + r] - q[0][r],
+                x2 * g[1][r] + x0 * g[1][2 + r] - q[1][r],
+                x2 * g[2][r] + x0 * g[2][2 + r] - q[2][r],
+                x0 * g[3][r] + x1 * g[3][2 + r] - q[3][r],
+                x0 * g[4][r] + x1 * g[4][2 + r] - q[4][r],
+                x1 * g[5][r] + x2 * g[5][2 + r] - q[5][r],
+            ];
+            let zu = [
+                -g[0][2 + r],
+                g[1][2 + r] - g[1][r],
+                g[2][2 + r] - g[2][r],
+                g[3][r],
+                g[4][r],
+                -g[5][2 + r],
+            ];
+            let zv = [
+                g[0][r] - g[0][2 + r],
+                -g[1][r],
+                -g[2][r],
+                g[3][2 + r],
+                g[4][2 + r],
+                g[5][r] - g[5][2 + r],
+            ];
+            let mut fr = 0.0;
+            let mut ur = 0.0;
+            let mut vr = 0.0;
+            for e in 0..6 {
+                fr += c[e] * z[e];
+                ur += dc[e][0] * z[e] + c[e] * zu[e];
+                vr += dc[e][1] * z[e] + c[e] * zv[e];
+            }
+            f[r] = fr;
+            ju[r] = ur;
+            jv[r] = vr;
+        }
+        (f, [ju[0], jv[0], ju[1], jv[1]])
+    }
+}
+
+/// [`coefficients`] with derivatives along `(xi_0, xi_1)` on the plane `sum xi = 1`
+/// (`d/du = d/dxi_0 - d/dxi_2`, `d/dv = d/dxi_1 - d/dxi_2`).
+#[inline(always)]
+fn coefficients_reduced(x: &[f64; 3]) -> ([f64; 6], [[f64; 2]; 6]) {
+    let (c, dc) = coefficients(x);
+    let mut r = [[0.0; 2]; 6];
+    for e in 0..6 {
+        r[e] = [dc[e][0] - dc[e][2], dc[e][1] - dc[e][2]];
+    }
+    (c, r)
+}
+
+/// Clamps negative barycentrics to zero and rescales to sum 1 (`None` if nothing is left).
+#[inline(always)]
+fn renormalize(n: [f64; 3]) -> Option<[f64; 3]> {
+    let a = if n[0] > 0.0 { n[0] } else { 0.0 };
+    let b = if n[1] > 0.0 { n[1] } else { 0.0 };
+    let c = if n[2] > 0.0 { n[2] } else { 0.0 };
+    let s = a + b + c;
+    if !(s > 0.0) || !s.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / s;
+    Some([a * inv, b * inv, c * inv])
 }
 
 /// Blend coefficients `c_e(xi)` of the six terms and their partial derivatives.
@@ -331,7 +468,7 @@ fn residual(g: &[[f64; 4]; 6], q: &[[f64; 2]; 6], xi: &[f64; 3]) -> ([f64; 2], [
 /// At a vertex (`S` ~ 0) the values take the symmetric limit (half on each of the two
 /// terms of that corner, so `Psi` spans the corner's frame) and the derivatives are those
 /// at a point just inside, so nothing divides by zero.
-#[inline]
+#[inline(always)]
 pub fn coefficients(xi: &[f64; 3]) -> ([f64; 6], [[f64; 3]; 6]) {
     let s = xi[0] * xi[1] + xi[1] * xi[2] + xi[2] * xi[0];
     if s >= S_MIN {
@@ -354,7 +491,7 @@ pub fn coefficients(xi: &[f64; 3]) -> ([f64; 6], [[f64; 3]; 6]) {
     (c, dc)
 }
 
-#[inline]
+#[inline(always)]
 fn coefficients_regular(xi: &[f64; 3], s: f64) -> ([f64; 6], [[f64; 3]; 6]) {
     let p = xi[0] * xi[1] * xi[2];
     let dp = [xi[1] * xi[2], xi[0] * xi[2], xi[0] * xi[1]];
@@ -367,12 +504,12 @@ fn coefficients_regular(xi: &[f64; 3], s: f64) -> ([f64; 6], [[f64; 3]; 6]) {
         let (a, b) = (xi[k], xi[l]);
         // first: a^2 b + P/2
         let n1 = a * a * b + 0.5 * p;
-        let mut dn1 = dp.map(|v| 0.5 * v);
+        let mut dn1 = [0.5 * dp[0], 0.5 * dp[1], 0.5 * dp[2]];
         dn1[k] += 2.0 * a * b;
         dn1[l] += a * a;
         // second: a b^2 + P/2
         let n2 = a * b * b + 0.5 * p;
-        let mut dn2 = dp.map(|v| 0.5 * v);
+        let mut dn2 = [0.5 * dp[0], 0.5 * dp[1], 0.5 * dp[2]];
         dn2[k] += b * b;
         dn2[l] += 2.0 * a * b;
         let c1 = n1 * inv;
