@@ -66,6 +66,8 @@ pub enum Stage {
     Mds,
     /// Least-squares-mesh upsampling to all vertices.
     LsMesh,
+    /// Quality check: embedding vs geodesic distance on random vertex pairs.
+    Quality,
 }
 
 impl Stage {
@@ -76,6 +78,7 @@ impl Stage {
             Self::Geodesics => "geodesics",
             Self::Mds => "mds",
             Self::LsMesh => "lsmesh",
+            Self::Quality => "quality",
         }
     }
 }
