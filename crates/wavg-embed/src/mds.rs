@@ -472,7 +472,7 @@ fn smacof_normalised(
 /// use wavg_embed::mds::{MdsOptions, metric_mds};
 /// use wavg_embed::NoProgress;
 /// // Four corners of a unit square.
-/// let p = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+/// let p: [[f64; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
 /// let q: Vec<f64> = (0..16)
 ///     .map(|k| {
 ///         let (a, b) = (p[k / 4], p[k % 4]);
