@@ -1,12 +1,99 @@
-//! `wavg bench load` (not yet implemented).
+//! `wavg bench load`: how long reading, parsing, and validating + building the topology
+//! of a mesh take (best of N runs each), in release builds.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use serde_json::json;
+use wavg_mesh::{analyze, io};
 
 use crate::CliError;
+use crate::common::one_line;
 
 /// Arguments.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Mesh file (.obj, .off, .ply, optionally .gz).
+    #[arg(long)]
+    pub mesh: PathBuf,
+    /// Number of runs; each stage reports its best time.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    pub repeat: u32,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Best times in seconds of each stage and of a whole run.
+struct Times {
+    read: f64,
+    parse: f64,
+    analyze: f64,
+    total: f64,
+}
 
 /// Runs the command.
-pub fn run(_args: Args) -> Result<(), CliError> {
-    Err(CliError::failure("not implemented yet"))
+pub fn run(args: Args) -> Result<(), CliError> {
+    let mut best = Times {
+        read: f64::INFINITY,
+        parse: f64::INFINITY,
+        analyze: f64::INFINITY,
+        total: f64::INFINITY,
+    };
+    let mut facts = None;
+    for _ in 0..args.repeat {
+        let t0 = Instant::now();
+        let (format, bytes) =
+            io::read_file(&args.mesh).map_err(|e| CliError::input(one_line(&e)))?;
+        let t1 = Instant::now();
+        let (mesh, _) = io::parse_bytes(&bytes, format, &args.mesh)
+            .map_err(|e| CliError::input(one_line(&e)))?;
+        let t2 = Instant::now();
+        let a = analyze(&mesh);
+        let t3 = Instant::now();
+        best.read = best.read.min((t1 - t0).as_secs_f64());
+        best.parse = best.parse.min((t2 - t1).as_secs_f64());
+        best.analyze = best.analyze.min((t3 - t2).as_secs_f64());
+        best.total = best.total.min((t3 - t0).as_secs_f64());
+        facts = Some((
+            mesh.n_vertices(),
+            mesh.n_faces(),
+            bytes.len(),
+            a.report.is_valid(),
+            a.topology.is_some(),
+        ));
+        drop((a, mesh, bytes));
+    }
+    let (nv, nf, nbytes, valid, topo) = facts.expect("repeat >= 1");
+    if args.json {
+        println!(
+            "{}",
+            json!({
+                "mesh": args.mesh.display().to_string(),
+                "vertices": nv,
+                "faces": nf,
+                "bytes": nbytes,
+                "repeat": args.repeat,
+                "valid": valid,
+                "topology_built": topo,
+                "read_s": best.read,
+                "parse_s": best.parse,
+                "validate_topology_s": best.analyze,
+                "total_s": best.total,
+            })
+        );
+    } else {
+        println!(
+            "{}: {nv} vertices, {nf} faces, {:.1} MB uncompressed, valid: {}",
+            args.mesh.display(),
+            nbytes as f64 / 1e6,
+            if valid { "yes" } else { "no" }
+        );
+        println!("stage (best of {})          time", args.repeat);
+        println!("read + decompress       {:>8.1} ms", best.read * 1e3);
+        println!("parse                   {:>8.1} ms", best.parse * 1e3);
+        println!("validate + topology     {:>8.1} ms", best.analyze * 1e3);
+        println!("total (best run)        {:>8.1} ms", best.total * 1e3);
+    }
+    Ok(())
 }

@@ -104,9 +104,15 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
 
 /// Like [`load`], also returning what the file held beyond the triangle mesh.
 pub fn load_with_notes(path: &Path) -> Result<(TriMesh, LoadNotes), MeshError> {
-    let (format, gz) = Format::from_path(path)?;
-    let bytes = read_bytes(path, gz)?;
+    let (format, bytes) = read_file(path)?;
     parse_bytes(&bytes, format, path)
+}
+
+/// The (decompressed) bytes of a mesh file and its format: the I/O half of [`load`],
+/// for callers that time reading and parsing separately.
+pub fn read_file(path: &Path) -> Result<(Format, Vec<u8>), MeshError> {
+    let (format, gz) = Format::from_path(path)?;
+    Ok((format, read_bytes(path, gz)?))
 }
 
 /// Parses an in-memory (uncompressed) file of the given format; `path` is only used in
