@@ -23,10 +23,15 @@ use crate::{DIM, Mat2x8, Vec8};
 /// Default `gamma`: how much more the distance off the tangent plane counts (the paper's 10).
 pub const DEFAULT_GAMMA: f64 = 10.0;
 
-/// Anchor coordinates in R^8, one array per coordinate (structure of arrays).
+/// Lanes of the per-anchor reductions; storage is padded to a multiple of this.
+pub const LANES: usize = 4;
+
+/// Anchor coordinates in R^8, one array per coordinate (structure of arrays) so the
+/// per-anchor loops vectorise; each array is padded with zeros to a multiple of [`LANES`].
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AnchorCoords {
     dims: [Vec<f64>; DIM],
+    n: usize,
 }
 
 impl AnchorCoords {
@@ -46,23 +51,33 @@ impl AnchorCoords {
 
     /// Number of anchors.
     pub fn len(&self) -> usize {
-        self.dims[0].len()
+        self.n
     }
 
     /// Whether there are no anchors.
     pub fn is_empty(&self) -> bool {
-        self.len() == 0
+        self.n == 0
+    }
+
+    /// Padded length of the coordinate arrays.
+    fn padded(&self) -> usize {
+        self.dims[0].len()
     }
 
     /// Appends an anchor.
     pub fn push(&mut self, y: &Vec8) {
-        for k in 0..DIM {
-            self.dims[k].push(y[k]);
+        if self.n == self.padded() {
+            for d in &mut self.dims {
+                d.resize(self.n + LANES, 0.0);
+            }
         }
+        self.n += 1;
+        self.set(self.n - 1, y);
     }
 
     /// Replaces anchor `i` (panics when out of range; callers check).
     pub fn set(&mut self, i: usize, y: &Vec8) {
+        assert!(i < self.n, "anchor {i} out of range");
         for k in 0..DIM {
             self.dims[k][i] = y[k];
         }
@@ -70,25 +85,44 @@ impl AnchorCoords {
 
     /// Removes anchor `i`, keeping the order of the others (panics when out of range).
     pub fn remove(&mut self, i: usize) {
-        for k in 0..DIM {
-            self.dims[k].remove(i);
+        assert!(i < self.n, "anchor {i} out of range");
+        for d in &mut self.dims {
+            d.remove(i);
+            d.push(0.0);
+        }
+        self.n -= 1;
+        let padded = self.padded();
+        if padded - self.n >= LANES {
+            for d in &mut self.dims {
+                d.truncate(padded - LANES);
+            }
         }
     }
 
-    /// Anchor `i`'s coordinates.
+    /// Anchor `i`'s coordinates (panics when out of range).
     pub fn get(&self, i: usize) -> Vec8 {
+        assert!(i < self.n, "anchor {i} out of range");
         Vec8::from_fn(|k, _| self.dims[k][i])
     }
 
-    /// `sum_j w_j y_j * scale`: the weighted average in R^8.
+    /// `sum_j w_j y_j * scale`: the weighted average in R^8 (`weights` has one entry per
+    /// anchor; extra entries are ignored, missing ones count as zero).
     pub fn weighted_sum(&self, weights: &[f64], scale: f64) -> Vec8 {
-        let n = self.len().min(weights.len());
+        let n = self.n.min(weights.len());
         let w = &weights[..n];
         Vec8::from_fn(|k, _| {
             let y = &self.dims[k][..n];
-            let mut s = 0.0;
-            for j in 0..n {
-                s += w[j] * y[j];
+            let mut acc = [0.0; LANES];
+            let (wc, yc) = (w.chunks_exact(LANES), y.chunks_exact(LANES));
+            let (wr, yr) = (wc.remainder(), yc.remainder());
+            for (wc, yc) in wc.zip(yc) {
+                for l in 0..LANES {
+                    acc[l] += wc[l] * yc[l];
+                }
+            }
+            let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+            for (a, b) in wr.iter().zip(yr) {
+                s += a * b;
             }
             s * scale
         })
@@ -101,72 +135,6 @@ pub struct InverseScratch {
     a0: Vec<f64>,
     a1: Vec<f64>,
     d: Vec<f64>,
-}
-
-/// Squared-distance weights `d_j` (see the module docs) and `a_j = Psi (y_j - yhat)`,
-/// written into `scratch`; returns `(d_min, index of d_min, d_max)`.
-fn distances(
-    psi: &Mat2x8,
-    yhat: &Vec8,
-    anchors: &AnchorCoords,
-    gamma: f64,
-    scratch: &mut InverseScratch,
-) -> Result<(f64, usize, f64), SolveError> {
-    let n = anchors.len();
-    let p0: [f64; DIM] = std::array::from_fn(|k| psi[(0, k)]);
-    let p1: [f64; DIM] = std::array::from_fn(|k| psi[(1, k)]);
-    let g00: f64 = p0.iter().map(|x| x * x).sum();
-    let g11: f64 = p1.iter().map(|x| x * x).sum();
-    let g01: f64 = p0.iter().zip(&p1).map(|(x, y)| x * y).sum();
-    let det = g00 * g11 - g01 * g01;
-    if det.is_nan() || det <= 1e-12 * g00 * g11 || !det.is_finite() {
-        return Err(SolveError::DegenerateTangentPlane);
-    }
-    // Inverse Gram matrix, so |v_T|^2 = a^T G^{-1} a.
-    let (h00, h01, h11) = (g11 / det, -g01 / det, g00 / det);
-    let yh: [f64; DIM] = std::array::from_fn(|k| yhat[k]);
-    scratch.a0.resize(n, 0.0);
-    scratch.a1.resize(n, 0.0);
-    scratch.d.resize(n, 0.0);
-    let ys: [&[f64]; DIM] = std::array::from_fn(|k| &anchors.dims[k][..n]);
-    let (a0s, a1s, ds) = (
-        &mut scratch.a0[..n],
-        &mut scratch.a1[..n],
-        &mut scratch.d[..n],
-    );
-    let gm1 = gamma - 1.0;
-    for j in 0..n {
-        let mut vv = 0.0;
-        let mut a0 = 0.0;
-        let mut a1 = 0.0;
-        for k in 0..DIM {
-            let v = ys[k][j] - yh[k];
-            vv += v * v;
-            a0 += p0[k] * v;
-            a1 += p1[k] * v;
-        }
-        let vt = (h00 * a0 * a0 + 2.0 * h01 * a0 * a1 + h11 * a1 * a1).min(vv);
-        // |v_T|^2 + gamma |v_O|^2 with |v_O|^2 = |v|^2 - |v_T|^2 >= 0.
-        ds[j] = gamma * vv - gm1 * vt;
-        a0s[j] = a0;
-        a1s[j] = a1;
-    }
-    let mut dmin = f64::INFINITY;
-    let mut imin = 0;
-    let mut dmax = 0.0f64;
-    for (j, &d) in ds.iter().enumerate() {
-        if d < dmin {
-            dmin = d;
-            imin = j;
-        }
-        dmax = dmax.max(d);
-    }
-    if !dmin.is_finite() || !dmax.is_finite() {
-        return Err(SolveError::InvalidParameter(
-            "non-finite anchor or point coordinates".into(),
-        ));
-    }
-    Ok((dmin, imin, dmax))
 }
 
 /// Solves the inverse problem for one point: `psi` is the tangent plane at the point,
@@ -207,47 +175,195 @@ pub fn inverse_weights(
             "gamma must be finite and positive, got {gamma}"
         )));
     }
-    let (dmin, m, dmax) = distances(psi, yhat, anchors, gamma, scratch)?;
-    out.resize(n, 0.0);
+    let p0: [f64; DIM] = std::array::from_fn(|k| psi[(0, k)]);
+    let p1: [f64; DIM] = std::array::from_fn(|k| psi[(1, k)]);
+    let g00: f64 = p0.iter().map(|x| x * x).sum();
+    let g11: f64 = p1.iter().map(|x| x * x).sum();
+    let g01: f64 = p0.iter().zip(&p1).map(|(x, y)| x * y).sum();
+    let det = g00 * g11 - g01 * g01;
+    if det.is_nan() || det <= 1e-12 * g00 * g11 || !det.is_finite() {
+        return Err(SolveError::DegenerateTangentPlane);
+    }
+    let ctx = Ctx {
+        p0,
+        p1,
+        yh: std::array::from_fn(|k| yhat[k]),
+        // Inverse Gram matrix, so |v_T|^2 = a^T G^{-1} a.
+        h: [g11 / det, -g01 / det, g00 / det],
+        gamma,
+        n,
+    };
+    let padded = anchors.padded();
+    scratch.a0.resize(padded, 0.0);
+    scratch.a1.resize(padded, 0.0);
+    scratch.d.resize(padded, 0.0);
+    out.resize(padded, 0.0);
+    let r = dispatch(&ctx, anchors, scratch, out);
+    out.truncate(if r.is_ok() { n } else { 0 });
+    r
+}
+
+/// The per-query constants of the kernel.
+struct Ctx {
+    p0: [f64; DIM],
+    p1: [f64; DIM],
+    yh: [f64; DIM],
+    h: [f64; 3],
+    gamma: f64,
+    n: usize,
+}
+
+/// Runs [`kernel`] compiled for AVX2 when the CPU has it (same operations in the same
+/// order, so the same results bit for bit; only wider registers).
+fn dispatch(
+    ctx: &Ctx,
+    ys: &AnchorCoords,
+    sc: &mut InverseScratch,
+    out: &mut [f64],
+) -> Result<(), SolveError> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: `kernel_avx2` only requires AVX2, which the CPU was just checked to have.
+        return unsafe { kernel_avx2(ctx, ys, sc, out) };
+    }
+    kernel(ctx, ys, sc, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn kernel_avx2(
+    ctx: &Ctx,
+    ys: &AnchorCoords,
+    sc: &mut InverseScratch,
+    out: &mut [f64],
+) -> Result<(), SolveError> {
+    kernel(ctx, ys, sc, out)
+}
+
+/// The inverse problem's passes over the anchors, written as loops over contiguous arrays
+/// (or [`LANES`]-wide partial sums) so they vectorise. `sc` and `out` have the padded
+/// length; padded entries get `d = inf`, hence `s = 0` and no influence.
+#[inline(always)]
+fn kernel(
+    ctx: &Ctx,
+    ys: &AnchorCoords,
+    sc: &mut InverseScratch,
+    out: &mut [f64],
+) -> Result<(), SolveError> {
+    let Ctx {
+        p0,
+        p1,
+        yh,
+        h,
+        gamma,
+        n,
+    } = ctx;
+    let (gamma, n) = (*gamma, *n);
+    let len = ys.padded();
+    let (a0, a1, ds) = (&mut sc.a0[..len], &mut sc.a1[..len], &mut sc.d[..len]);
+    let out = &mut out[..len];
+    // Pass 1, [`LANES`] anchors at a time with the sums in registers:
+    // a_j = Psi (y_j - yhat), |v_j|^2 and d_j = |v_T|^2 + gamma |v_O|^2, where
+    // |v_O|^2 = |v|^2 - |v_T|^2 >= 0.
+    let gm1 = gamma - 1.0;
+    let chunks = a0
+        .chunks_exact_mut(LANES)
+        .zip(a1.chunks_exact_mut(LANES))
+        .zip(ds.chunks_exact_mut(LANES))
+        .enumerate();
+    for (c, ((x0s, x1s), dd)) in chunks {
+        let mut vv = [0.0; LANES];
+        let mut x0 = [0.0; LANES];
+        let mut x1 = [0.0; LANES];
+        for k in 0..DIM {
+            let y = &ys.dims[k][c * LANES..(c + 1) * LANES];
+            for l in 0..LANES {
+                let v = y[l] - yh[k];
+                vv[l] += v * v;
+                x0[l] += p0[k] * v;
+                x1[l] += p1[k] * v;
+            }
+        }
+        for l in 0..LANES {
+            let vt = h[0] * x0[l] * x0[l] + 2.0 * h[1] * x0[l] * x1[l] + h[2] * x1[l] * x1[l];
+            let vt = if vt < vv[l] { vt } else { vv[l] };
+            dd[l] = gamma * vv[l] - gm1 * vt;
+            x0s[l] = x0[l];
+            x1s[l] = x1[l];
+        }
+    }
+    // Smallest d (first index), largest, and a NaN check.
+    let (mut dmin, mut m, mut dmax, mut bad) = (f64::INFINITY, 0, 0.0f64, false);
+    for (j, &d) in ds[..n].iter().enumerate() {
+        if d < dmin {
+            dmin = d;
+            m = j;
+        }
+        if d > dmax {
+            dmax = d;
+        }
+        bad |= d.is_nan();
+    }
+    if bad || !dmax.is_finite() {
+        return Err(SolveError::InvalidParameter(
+            "non-finite anchor or point coordinates".into(),
+        ));
+    }
     if dmin <= 0.0 {
-        return one_hot(&scratch.d[..n], out);
+        one_hot(&ds[..n], &mut out[..n]);
+        return Ok(());
     }
-    let (a0s, a1s, ds) = (&scratch.a0[..n], &scratch.a1[..n], &scratch.d[..n]);
-    let (am0, am1) = (a0s[m], a1s[m]);
-    // Constraint rows centred on anchor m; s_j = (d_min/d_j)^2 in `out` for now.
-    let (mut m00, mut m01, mut m02, mut m11, mut m12, mut m22) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    for j in 0..n {
-        let r = dmin / ds[j];
-        let s = r * r;
-        let c0 = a0s[j] - am0;
-        let c1 = a1s[j] - am1;
-        let sc0 = s * c0;
-        let sc1 = s * c1;
-        m00 += sc0 * c0;
-        m01 += sc0 * c1;
-        m02 += sc0;
-        m11 += sc1 * c1;
-        m12 += sc1;
-        m22 += s;
-        out[j] = s;
+    ds[n..].fill(f64::INFINITY);
+    let (am0, am1) = (a0[m], a1[m]);
+    // Pass 2: constraint rows centred on anchor m, s_j = (d_min/d_j)^2 (kept in `out`).
+    let mut acc = [[0.0; LANES]; 6];
+    let chunks = a0
+        .chunks_exact(LANES)
+        .zip(a1.chunks_exact(LANES))
+        .zip(ds.chunks_exact(LANES))
+        .zip(out.chunks_exact_mut(LANES));
+    for (((x0, x1), d), ss) in chunks {
+        for l in 0..LANES {
+            let r = dmin / d[l];
+            let s = r * r;
+            let c0 = x0[l] - am0;
+            let c1 = x1[l] - am1;
+            let sc0 = s * c0;
+            let sc1 = s * c1;
+            acc[0][l] += sc0 * c0;
+            acc[1][l] += sc0 * c1;
+            acc[2][l] += sc0;
+            acc[3][l] += sc1 * c1;
+            acc[4][l] += sc1;
+            acc[5][l] += s;
+            ss[l] = s;
+        }
     }
+    let [m00, m01, m02, m11, m12, m22] = acc.map(|a| (a[0] + a[1]) + (a[2] + a[3]));
     let b = [-am0, -am1, 1.0];
     let Some(z) = solve_scaled_3x3([[m00, m01, m02], [m01, m11, m12], [m02, m12, m22]], b) else {
         // Singular: either the other anchors' contributions underflowed because the point
         // is (to within ~1e-150 relative) at an anchor, or the anchors are degenerate.
         if dmin <= 1e-100 * dmax {
-            return one_hot(ds, out);
+            one_hot(&ds[..n], &mut out[..n]);
+            return Ok(());
         }
         return Err(SolveError::DegenerateAnchors);
     };
-    let mut sum = 0.0;
-    for j in 0..n {
-        let c0 = a0s[j] - am0;
-        let c1 = a1s[j] - am1;
-        let w = out[j] * (c0 * z[0] + c1 * z[1] + z[2]);
-        out[j] = w;
-        sum += w;
+    // Pass 3: w_j = s_j c_j . z.
+    let mut sums = [0.0; LANES];
+    let chunks = a0
+        .chunks_exact(LANES)
+        .zip(a1.chunks_exact(LANES))
+        .zip(out.chunks_exact_mut(LANES));
+    for ((x0, x1), ws) in chunks {
+        for l in 0..LANES {
+            let w = ws[l] * ((x0[l] - am0) * z[0] + (x1[l] - am1) * z[1] + z[2]);
+            ws[l] = w;
+            sums[l] += w;
+        }
     }
+    let sum = (sums[0] + sums[1]) + (sums[2] + sums[3]);
     if !sum.is_finite() || (sum - 1.0).abs() > 1e-6 {
         return Err(SolveError::DegenerateAnchors);
     }
@@ -258,14 +374,13 @@ pub fn inverse_weights(
     Ok(())
 }
 
-/// Equal weights on the anchors with `d == 0`, zero elsewhere.
-fn one_hot(ds: &[f64], out: &mut [f64]) -> Result<(), SolveError> {
+/// Equal weights on the anchors with the smallest `d` (the point is at them), zero elsewhere.
+fn one_hot(ds: &[f64], out: &mut [f64]) {
     let dmin = ds.iter().copied().fold(f64::INFINITY, f64::min);
     let hits = ds.iter().filter(|&&d| d <= dmin).count() as f64;
     for (w, &d) in out.iter_mut().zip(ds) {
         *w = if d <= dmin { 1.0 / hits } else { 0.0 };
     }
-    Ok(())
 }
 
 /// Solves the symmetric positive semi-definite 3x3 system `m z = b` after Jacobi scaling
@@ -296,4 +411,64 @@ fn solve_scaled_3x3(m: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
     let z1 = (c01 * bs[0] + c11 * bs[1] + c12 * bs[2]) * inv;
     let z2 = (c02 * bs[0] + c12 * bs[1] + c22 * bs[2]) * inv;
     Some([z0 * s[0], z1 * s[1], z2 * s[2]])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// The AVX2 build of the kernel gives the portable build's results bit for bit, so
+    /// answers do not depend on the machine.
+    #[test]
+    fn simd_and_portable_kernels_agree_exactly() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        for n in [1usize, 3, 4, 5, 27, 100] {
+            let ys: Vec<Vec8> = (0..n)
+                .map(|_| Vec8::from_fn(|_, _| rng.random_range(-1.0..1.0)))
+                .collect();
+            let coords = AnchorCoords::from_points(&ys);
+            let ctx = Ctx {
+                p0: std::array::from_fn(|_| rng.random_range(-1.0..1.0)),
+                p1: std::array::from_fn(|_| rng.random_range(-1.0..1.0)),
+                yh: std::array::from_fn(|_| rng.random_range(-1.0..1.0)),
+                h: [1.1, 0.1, 0.9],
+                gamma: 10.0,
+                n,
+            };
+            let padded = coords.padded();
+            type Kernel<'a> = &'a dyn Fn(&mut InverseScratch, &mut [f64]) -> Result<(), SolveError>;
+            let run = |f: Kernel<'_>| {
+                let mut sc = InverseScratch {
+                    a0: vec![0.0; padded],
+                    a1: vec![0.0; padded],
+                    d: vec![0.0; padded],
+                };
+                let mut out = vec![0.0; padded];
+                f(&mut sc, &mut out).map(|()| out)
+            };
+            let a = run(&|sc, out| dispatch(&ctx, &coords, sc, out));
+            let b = run(&|sc, out| kernel(&ctx, &coords, sc, out));
+            assert_eq!(a, b, "n = {n}");
+        }
+    }
+
+    #[test]
+    fn storage_edits_keep_order_and_zero_padding() {
+        let p = |x: f64| Vec8::from_fn(|k, _| x + k as f64);
+        let mut c = AnchorCoords::from_points(&[p(0.0), p(10.0), p(20.0), p(30.0), p(40.0)]);
+        c.remove(1);
+        assert_eq!(c.len(), 4);
+        assert_eq!(c.padded(), 4);
+        assert_eq!(
+            (0..4).map(|i| c.get(i)[0]).collect::<Vec<_>>(),
+            [0.0, 20.0, 30.0, 40.0]
+        );
+        c.set(0, &p(5.0));
+        c.push(&p(50.0));
+        assert_eq!(c.padded(), 8);
+        assert!(c.dims.iter().all(|d| d[5..].iter().all(|&x| x == 0.0)));
+        let w = [0.0, 0.0, 0.5, 0.0, 0.5];
+        assert_eq!(c.weighted_sum(&w, 1.0)[0], 40.0);
+    }
 }
