@@ -97,24 +97,37 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
         }
     }
     // Duplicate faces: same vertex set.
-    let mut sorted: Vec<([u32; 3], u32)> = (0..nf)
-        .filter(|&f| usable[f])
-        .map(|f| {
-            let mut t = mesh.triangles[f];
-            t.sort_unstable();
-            (t, f as u32)
-        })
-        .collect();
-    sorted.sort_unstable();
-    for w in sorted.windows(2) {
-        if w[0].0 == w[1].0 {
-            problems.push(Problem::DuplicateFace {
-                face: w[1].1,
-                first: w[0].1,
-            });
+    // Sorted by (smallest vertex, middle, largest, face): equal vertex sets are adjacent.
+    let by_vertices = topology::bucket_sorted((0..nf).filter(|&f| usable[f]).map(|f| {
+        let mut t = mesh.triangles[f];
+        t.sort_unstable();
+        ((t[0] as u64) << 32 | t[1] as u64, f as u32)
+    }));
+    let mut i = 0;
+    while i < by_vertices.len() {
+        // Within a run of equal (smallest, middle), group by the largest vertex.
+        let mut j = i + 1;
+        while j < by_vertices.len() && by_vertices[j].0 == by_vertices[i].0 {
+            j += 1;
         }
+        if j - i > 1 {
+            let mut run: Vec<(u32, u32)> = by_vertices[i..j]
+                .iter()
+                .map(|&(_, f)| (mesh.triangles[f as usize].into_iter().max().unwrap_or(0), f))
+                .collect();
+            run.sort_unstable();
+            for w in run.windows(2) {
+                if w[0].0 == w[1].0 {
+                    problems.push(Problem::DuplicateFace {
+                        face: w[1].1,
+                        first: w[0].1,
+                    });
+                }
+            }
+        }
+        i = j;
     }
-    drop(sorted);
+    drop(by_vertices);
 
     let edges = topology::EdgeTable::build(&mesh.triangles, &usable);
     let mut oriented = true;
@@ -147,6 +160,7 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
     let adj = edges.manifold_adjacency(nf);
     let incidence = topology::VertexFaces::build(nv, &mesh.triangles, &usable);
     let mut vertex_manifold = true;
+    let (mut fan_seen, mut fan_stack) = (Vec::new(), Vec::new());
     let mut referenced = 0usize;
     for v in 0..nv {
         let faces = incidence.faces(v);
@@ -155,7 +169,14 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
             continue;
         }
         referenced += 1;
-        let fans = topology::count_fans(v as u32, faces, &mesh.triangles, &adj);
+        let fans = topology::count_fans(
+            v as u32,
+            faces,
+            &mesh.triangles,
+            &adj,
+            &mut fan_seen,
+            &mut fan_stack,
+        );
         if fans > 1 {
             vertex_manifold = false;
             problems.push(Problem::NonManifoldVertex {

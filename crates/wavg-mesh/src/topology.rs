@@ -15,18 +15,15 @@ pub(crate) struct EdgeTable {
 
 impl EdgeTable {
     pub(crate) fn build(tris: &[[u32; 3]], usable: &[bool]) -> Self {
-        let mut pairs: Vec<(u64, u32)> = Vec::with_capacity(tris.len() * 3);
-        for (f, t) in tris.iter().enumerate() {
-            if !usable[f] {
-                continue;
-            }
-            for c in 0..3 {
-                let (a, b) = (t[c], t[(c + 1) % 3]);
-                let key = ((a.min(b) as u64) << 32) | a.max(b) as u64;
-                pairs.push((key, (f * 3 + c) as u32));
-            }
-        }
-        pairs.sort_unstable();
+        let key = |a: u32, b: u32| ((a.min(b) as u64) << 32) | a.max(b) as u64;
+        let pairs = bucket_sorted(
+            tris.iter()
+                .enumerate()
+                .filter(|&(f, _)| usable[f])
+                .flat_map(|(f, t)| {
+                    (0..3).map(move |c| (key(t[c], t[(c + 1) % 3]), (f * 3 + c) as u32))
+                }),
+        );
         let mut starts = Vec::with_capacity(pairs.len() / 2 + 1);
         for i in 0..pairs.len() {
             if i == 0 || pairs[i].0 != pairs[i - 1].0 {
@@ -82,6 +79,41 @@ impl EdgeTable {
     }
 }
 
+/// `(key, payload)` pairs sorted by key then payload, where the key's high 32 bits are a
+/// vertex index: a counting sort on the vertex, then a sort of each (small) bucket. Same
+/// order as a full sort, several times faster on meshes (comparison sorts of ~1M items
+/// dominated validation time).
+pub(crate) fn bucket_sorted(items: impl Iterator<Item = (u64, u32)> + Clone) -> Vec<(u64, u32)> {
+    let n_buckets = items
+        .clone()
+        .map(|(k, _)| (k >> 32) as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut offsets = vec![0u32; n_buckets + 1];
+    let mut total = 0usize;
+    for (k, _) in items.clone() {
+        offsets[(k >> 32) as usize + 1] += 1;
+        total += 1;
+    }
+    for i in 0..n_buckets {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut out = vec![(0u64, 0u32); total];
+    let mut fill = offsets.clone();
+    for item in items {
+        let b = (item.0 >> 32) as usize;
+        out[fill[b] as usize] = item;
+        fill[b] += 1;
+    }
+    for w in offsets.windows(2) {
+        let bucket = &mut out[w[0] as usize..w[1] as usize];
+        if bucket.len() > 1 {
+            bucket.sort_unstable();
+        }
+    }
+    out
+}
+
 /// Vertex to incident faces (CSR), in face order.
 pub(crate) struct VertexFaces {
     offsets: Vec<u32>,
@@ -130,13 +162,22 @@ fn corner_of(t: &[u32; 3], v: u32) -> usize {
 }
 
 /// Number of edge-connected fans among the faces around `v` (1 for a manifold vertex).
-pub(crate) fn count_fans(v: u32, faces: &[u32], tris: &[[u32; 3]], adj: &[u32]) -> usize {
+/// `seen` and `stack` are scratch buffers reused across vertices (no allocation per vertex).
+pub(crate) fn count_fans(
+    v: u32,
+    faces: &[u32],
+    tris: &[[u32; 3]],
+    adj: &[u32],
+    seen: &mut Vec<bool>,
+    stack: &mut Vec<u32>,
+) -> usize {
     if faces.len() <= 1 {
         return faces.len();
     }
-    let mut seen = vec![false; faces.len()];
+    seen.clear();
+    seen.resize(faces.len(), false);
+    stack.clear();
     let mut fans = 0;
-    let mut stack = Vec::new();
     for s in 0..faces.len() {
         if seen[s] {
             continue;
@@ -229,7 +270,14 @@ pub(crate) fn genus_per_component(
 ) -> i64 {
     let k = comps.count;
     let mut chi = vec![0i64; k];
-    let mut verts_seen = std::collections::HashSet::new();
+    let nv = tris
+        .iter()
+        .zip(usable)
+        .filter(|(_, u)| **u)
+        .map(|(t, _)| t[0].max(t[1]).max(t[2]) as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut verts_seen = vec![false; nv];
     for (f, t) in tris.iter().enumerate() {
         if !usable[f] {
             continue;
@@ -237,14 +285,15 @@ pub(crate) fn genus_per_component(
         let c = comps.of_face[f] as usize;
         chi[c] += 1;
         for &v in t {
-            if verts_seen.insert(v) {
+            if !std::mem::replace(&mut verts_seen[v as usize], true) {
                 chi[c] += 1;
             }
         }
     }
     // Boundary loops per component: each boundary edge belongs to its face's component.
     let mut uf = UnionFind::new(tris.len() * 3);
-    let mut bnd_start: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+    // Oriented manifold: at most one boundary halfedge leaves each vertex.
+    let mut bnd_start = vec![usize::MAX; nv];
     let mut bnd: Vec<usize> = Vec::new();
     for g in edges.groups() {
         let h = edges.halfedges[g.start];
@@ -254,14 +303,15 @@ pub(crate) fn genus_per_component(
             bnd.push(h as usize);
             let t = tris[(h / 3) as usize];
             let a = t[(h % 3) as usize];
-            bnd_start.insert(a, h as usize);
+            bnd_start[a as usize] = h as usize;
         }
     }
     // Join each boundary halfedge to the one leaving its end vertex.
     for &h in &bnd {
         let t = tris[h / 3];
         let end = t[(h % 3 + 1) % 3];
-        if let Some(&next) = bnd_start.get(&end) {
+        let next = bnd_start[end as usize];
+        if next != usize::MAX {
             uf.union(h, next);
         }
     }
