@@ -33,7 +33,7 @@ fn bench_load_reports_every_stage() {
     let stages = ["read_s", "parse_s", "validate_topology_s", "total_s"];
     for k in stages {
         let t = j[k].as_f64().unwrap_or(-1.0);
-        assert!(t >= 0.0 && t < 10.0, "{k} = {t}");
+        assert!((0.0..10.0).contains(&t), "{k} = {t}");
     }
     let sum: f64 = stages[..3].iter().map(|k| j[k].as_f64().unwrap()).sum();
     assert!(j["total_s"].as_f64().unwrap() >= sum * 0.999);
