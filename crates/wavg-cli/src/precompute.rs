@@ -1,12 +1,248 @@
-//! `wavg precompute` (not yet implemented).
+//! `wavg precompute MESH -o OUT.wavg`: the 8-D embedding of a mesh, written as a `.wavg`
+//! file (format: `wavg_embed::file`).
+//!
+//! Progress bars appear on stderr only when it is a terminal. `--json` prints one object:
+//! `seconds` (the precomputation itself, excluding loading the mesh and writing the file,
+//! which are `load_seconds` and `save_seconds`), `stages` (`decimate`, `geodesics`, `mds`,
+//! `lsmesh`, `quality`), `landmarks`, `dim`, `stress`, `geodesic_rel_err_p50`,
+//! `geodesic_rel_err_p90`, `vertices`, `faces`, and a few more.
+
+use std::collections::HashMap;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::Mutex;
+use std::time::Instant;
+
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde_json::json;
+use wavg::embed::{self, PrecomputeOptions, Progress, Stage};
+use wavg_mesh::{MeshError, ValidMesh, repair};
 
 use crate::CliError;
+use crate::common::{load_mesh, one_line};
 
 /// Arguments.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// Mesh file (.obj, .off, .ply, optionally .gz) or builtin:NAME.
+    pub mesh: String,
+    /// Output .wavg file (written atomically).
+    #[arg(short, long, value_name = "OUT.wavg")]
+    pub output: PathBuf,
+    /// Number of landmarks (the paper uses 1000).
+    #[arg(long, default_value_t = 1000)]
+    pub landmarks: usize,
+    /// Seed of the quality-check pairs (every other stage is deterministic).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Vertex pairs of the quality check (0 skips it).
+    #[arg(long, default_value_t = 1024)]
+    pub quality_pairs: usize,
+    /// Keep only the largest connected component before embedding. The embedding then
+    /// belongs to the repaired mesh: save it with --repaired-mesh to use it later.
+    #[arg(long)]
+    pub largest_component: bool,
+    /// Write the mesh the embedding belongs to (after --largest-component) to this file.
+    #[arg(long, value_name = "MESH")]
+    pub repaired_mesh: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
 
 /// Runs the command.
-pub fn run(_args: Args) -> Result<(), CliError> {
-    Err(CliError::failure("not implemented yet"))
+pub fn run(args: Args) -> Result<(), CliError> {
+    let t_load = Instant::now();
+    let mut mesh = load_mesh(&args.mesh)?;
+    let mut removed = None;
+    if args.largest_component {
+        let before = (mesh.n_vertices(), mesh.n_faces());
+        mesh = repair::keep_largest_component(&mesh).mesh;
+        removed = Some((before.0 - mesh.n_vertices(), before.1 - mesh.n_faces()));
+    }
+    let mesh = validate(&args.mesh, mesh)?;
+    if let Some(path) = &args.repaired_mesh {
+        wavg_mesh::io::save(path, &mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    }
+    let load_seconds = t_load.elapsed().as_secs_f64();
+
+    let opts = PrecomputeOptions {
+        landmarks: args.landmarks,
+        seed: args.seed,
+        quality_pairs: args.quality_pairs,
+        ..Default::default()
+    };
+    let bars = Bars::new(std::io::stderr().is_terminal());
+    let result = embed::precompute(&mesh, &opts, &bars);
+    bars.clear();
+    let (embedding, report) = result.map_err(|e| match e {
+        embed::EmbedError::InvalidArgument(m) => CliError::input(format!("{}: {m}", args.mesh)),
+        e => CliError::failure(format!("{}: {}", args.mesh, one_line(&e))),
+    })?;
+
+    let t_save = Instant::now();
+    embed::file::save(&args.output, &embedding, &mesh)
+        .map_err(|e| CliError::failure(one_line(&e)))?;
+    let save_seconds = t_save.elapsed().as_secs_f64();
+
+    let s = &report.stages;
+    if args.json {
+        let v = json!({
+            "mesh": args.mesh,
+            "output": args.output,
+            "seconds": report.seconds,
+            "stages": {
+                "decimate": s.decimate,
+                "geodesics": s.geodesics,
+                "mds": s.mds,
+                "lsmesh": s.lsmesh,
+                "quality": s.quality,
+            },
+            "load_seconds": load_seconds,
+            "save_seconds": save_seconds,
+            "landmarks": report.landmarks,
+            "dim": report.dim,
+            "stress": report.stress,
+            "initial_stress": report.initial_stress,
+            "mds_iterations": report.mds_iterations,
+            "mds_converged": report.mds_converged,
+            "geodesic_rel_err_p50": finite_or_null(report.geodesic_rel_err_p50),
+            "geodesic_rel_err_p90": finite_or_null(report.geodesic_rel_err_p90),
+            "quality_pairs": report.quality_pairs,
+            "vertices": report.vertices,
+            "faces": report.faces,
+            "removed_by_largest_component": removed.map(|(v, f)| json!({"vertices": v, "faces": f})),
+        });
+        println!("{v}");
+    } else {
+        println!(
+            "mesh          {} ({} vertices, {} faces)",
+            args.mesh, report.vertices, report.faces
+        );
+        if let Some((v, f)) = removed {
+            println!("repaired      --largest-component removed {v} vertices, {f} faces");
+        }
+        println!("output        {}", args.output.display());
+        println!("landmarks     {}  dim {}", report.landmarks, report.dim);
+        println!(
+            "stress        {:.4} (classical start {:.4}, {} SMACOF iterations{})",
+            report.stress,
+            report.initial_stress,
+            report.mds_iterations,
+            if report.mds_converged {
+                ""
+            } else {
+                ", limit reached"
+            }
+        );
+        println!(
+            "geodesic rel. error  p50 {:.4}  p90 {:.4}  ({} pairs)",
+            report.geodesic_rel_err_p50, report.geodesic_rel_err_p90, report.quality_pairs
+        );
+        println!(
+            "seconds       {:.2} = decimate {:.2} + geodesics {:.2} + mds {:.2} + lsmesh {:.2} + quality {:.2}  (load {:.2}, save {:.2})",
+            report.seconds,
+            s.decimate,
+            s.geodesics,
+            s.mds,
+            s.lsmesh,
+            s.quality,
+            load_seconds,
+            save_seconds
+        );
+    }
+    if removed.is_some_and(|(v, _)| v > 0) && args.repaired_mesh.is_none() {
+        eprintln!(
+            "note: the embedding belongs to the mesh after --largest-component; pass \
+             --repaired-mesh FILE to save that mesh for later use"
+        );
+    }
+    Ok(())
+}
+
+fn finite_or_null(x: f64) -> serde_json::Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        serde_json::Value::Null
+    }
+}
+
+/// Validates with a message naming the problems and the repair options.
+fn validate(name: &str, mesh: wavg_mesh::TriMesh) -> Result<ValidMesh, CliError> {
+    let components = wavg_mesh::analyze(&mesh).stats.components;
+    match ValidMesh::new(mesh) {
+        Ok(m) => {
+            if m.topology().n_components() != 1 {
+                return Err(CliError::input(format!(
+                    "{name}: the mesh has {} connected components; the embedding needs one \
+                     (rerun with --largest-component to keep the largest)",
+                    m.topology().n_components()
+                )));
+            }
+            Ok(m)
+        }
+        Err(MeshError::Invalid(report)) => {
+            let mut hint = String::from("run `wavg info` for details");
+            if components > 1 {
+                hint.push_str(&format!(
+                    "; the mesh has {components} components: --largest-component keeps the \
+                     largest"
+                ));
+            }
+            Err(CliError::input(format!(
+                "{name}: not a valid oriented manifold mesh: {} ({hint})",
+                report.lines().join("; ")
+            )))
+        }
+        Err(e) => Err(CliError::input(one_line(&e))),
+    }
+}
+
+/// One progress bar per stage on stderr (hidden when stderr is not a terminal).
+struct Bars {
+    multi: MultiProgress,
+    bars: Mutex<HashMap<Stage, ProgressBar>>,
+}
+
+const TICKS: u64 = 1000;
+
+impl Bars {
+    fn new(visible: bool) -> Self {
+        let target = if visible {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        };
+        Self {
+            multi: MultiProgress::with_draw_target(target),
+            bars: Mutex::new(HashMap::new()),
+        }
+    }
+
+    fn clear(&self) {
+        let _ = self.multi.clear();
+    }
+}
+
+impl Progress for Bars {
+    fn report(&self, stage: Stage, fraction: f64) {
+        let Ok(mut bars) = self.bars.lock() else {
+            return;
+        };
+        let bar = bars.entry(stage).or_insert_with(|| {
+            let b = self.multi.add(ProgressBar::new(TICKS));
+            b.set_style(
+                ProgressStyle::with_template("{prefix:>10} [{bar:40}] {percent:>3}% {elapsed:>4}")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar())
+                    .progress_chars("=> "),
+            );
+            b.set_prefix(stage.name());
+            b
+        });
+        bar.set_position((fraction.clamp(0.0, 1.0) * TICKS as f64) as u64);
+        if fraction >= 1.0 {
+            bar.finish();
+        }
+    }
 }

@@ -84,7 +84,7 @@ impl Default for EmbeddingParams {
             landmarks_requested: 1000,
             seed: 0,
             mds_max_iterations: 300,
-            mds_tolerance: 1e-6,
+            mds_tolerance: 1e-4,
             geodesic_mesh_vertices: 0,
         }
     }

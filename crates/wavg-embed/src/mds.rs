@@ -44,7 +44,7 @@ impl Default for MdsOptions {
         Self {
             dim: MAX_DIM,
             max_iterations: 300,
-            tolerance: 1e-6,
+            tolerance: 1e-4,
         }
     }
 }

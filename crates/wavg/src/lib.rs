@@ -9,6 +9,7 @@
 //! assert_eq!(m.n_vertices(), 162);
 //! ```
 
+pub use wavg_embed as embed;
 pub use wavg_mesh as mesh;
 pub use wavg_project as project;
 pub use wavg_solve as solve;

@@ -1,0 +1,192 @@
+//! `wavg precompute` run as a process: JSON keys, the written file, error messages.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use wavg_mesh::{TriMesh, ValidMesh, io, procedural};
+
+fn wavg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(args)
+        .output()
+        .expect("run wavg")
+}
+
+fn write(dir: &Path, name: &str, mesh: &TriMesh) -> String {
+    let path = dir.join(name);
+    io::save(&path, mesh).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn json_report_and_loadable_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = procedural::torus(48, 24, 1.0, 0.4);
+    let mesh_path = write(dir.path(), "torus.off", &mesh);
+    let out_path = dir.path().join("torus.wavg");
+    let out = wavg(&[
+        "precompute",
+        &mesh_path,
+        "-o",
+        out_path.to_str().unwrap(),
+        "--landmarks",
+        "100",
+        "--seed",
+        "7",
+        "--json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Not a terminal: no progress output at all.
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    for key in [
+        "seconds",
+        "landmarks",
+        "dim",
+        "stress",
+        "geodesic_rel_err_p50",
+        "geodesic_rel_err_p90",
+        "vertices",
+        "faces",
+    ] {
+        assert!(v[key].is_number(), "{key}: {v}");
+    }
+    for stage in ["decimate", "geodesics", "mds", "lsmesh"] {
+        assert!(v["stages"][stage].as_f64().unwrap() >= 0.0, "{stage}");
+    }
+    assert_eq!(v["landmarks"], 100);
+    assert_eq!(v["dim"], 8);
+    assert_eq!(v["vertices"], mesh.n_vertices());
+    assert_eq!(v["faces"], mesh.n_faces());
+    assert!(v["geodesic_rel_err_p50"].as_f64().unwrap() < 0.1);
+
+    // The file loads against the mesh as read back from disk, and only against it.
+    let disk = ValidMesh::new(io::load(Path::new(&mesh_path)).unwrap()).unwrap();
+    let emb = wavg::embed::file::load(&out_path, &disk).unwrap();
+    assert_eq!(emb.landmarks.len(), 100);
+    assert_eq!(emb.params.seed, 7);
+    assert_eq!(emb.stress, v["stress"].as_f64().unwrap());
+    let other = procedural::torus(48, 24, 1.0, 0.41);
+    assert!(matches!(
+        wavg::embed::file::load(&out_path, &other),
+        Err(wavg::embed::EmbedError::MeshMismatch { .. })
+    ));
+
+    // Text mode works too and overwrites atomically.
+    let out = wavg(&[
+        "precompute",
+        &mesh_path,
+        "-o",
+        out_path.to_str().unwrap(),
+        "--landmarks",
+        "50",
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("landmarks     50"), "{text}");
+    assert_eq!(
+        wavg::embed::file::load(&out_path, &disk)
+            .unwrap()
+            .landmarks
+            .len(),
+        50
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}
+
+#[test]
+fn two_components_need_largest_component() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = procedural::icosphere(3);
+    let small = procedural::icosphere(1).map_positions(|p| (p * 0.3).add_scalar(3.0));
+    let mut m = big.clone();
+    let nb = big.n_vertices() as u32;
+    m.positions.extend(&small.positions);
+    m.triangles
+        .extend(small.triangles.iter().map(|t| t.map(|v| v + nb)));
+    let mesh_path = write(dir.path(), "two.obj", &m);
+    let out_path = dir.path().join("two.wavg");
+    let out = wavg(&[
+        "precompute",
+        &mesh_path,
+        "-o",
+        out_path.to_str().unwrap(),
+        "--landmarks",
+        "60",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("2 connected components") && err.contains("--largest-component"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!out_path.exists());
+
+    let repaired = dir.path().join("big.off");
+    let out = wavg(&[
+        "precompute",
+        &mesh_path,
+        "-o",
+        out_path.to_str().unwrap(),
+        "--landmarks",
+        "60",
+        "--largest-component",
+        "--repaired-mesh",
+        repaired.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["vertices"], big.n_vertices());
+    assert_eq!(
+        v["removed_by_largest_component"]["vertices"],
+        small.n_vertices()
+    );
+    let disk = io::load(&repaired).unwrap();
+    assert!(wavg::embed::file::load(&out_path, &disk).is_ok());
+}
+
+#[test]
+fn invalid_and_unreadable_meshes_are_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    // A non-manifold edge: three triangles on one edge.
+    let mut m = procedural::grid(4, 4, 1.0, 1.0);
+    let extra = m.positions.len() as u32;
+    let mut apex = m.positions[0];
+    apex.z = 1.0;
+    m.positions.push(apex);
+    let t = m.triangles[0];
+    m.triangles.push([t[0], t[1], extra]);
+    let mesh_path = write(dir.path(), "bad.obj", &m);
+    let out_path = dir.path().join("bad.wavg");
+    let out = wavg(&["precompute", &mesh_path, "-o", out_path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("not a valid oriented manifold"), "{err}");
+    assert!(!out_path.exists());
+
+    let out = wavg(&[
+        "precompute",
+        "/nonexistent/x.off",
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
+}
