@@ -15,7 +15,9 @@ use wavg_mesh::geometry::mean_edge_length;
 use wavg_solve::sampling::{
     FpsMetric, farthest_point_vertices, spatial_order, uniform_surface_points,
 };
-use wavg_solve::{Anchor, ForwardOptions, ForwardResult, ProjectionPath, SolveError, Solver};
+use wavg_solve::{
+    Anchor, ForwardOptions, ForwardResult, ProjectionPath, SearchMode, SolveError, Solver,
+};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
@@ -70,9 +72,24 @@ pub struct Args {
     /// Timed runs of each batch; the best is reported.
     #[arg(long, default_value_t = 3)]
     pub repeat: usize,
+    /// Forward search: the paper's local search (fast), the projector's certified closest
+    /// projection, or the exhaustive search.
+    #[arg(long, value_enum, default_value_t = Search::Fast)]
+    pub search: Search,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--search` values.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Search {
+    /// Walk + breadth-first triangle search (paper), certified fallback.
+    Fast,
+    /// Closest valid projection, certified against the bounding volume hierarchy.
+    Certified,
+    /// Exhaustive search.
+    Exact,
 }
 
 /// The JSON report (keys as documented).
@@ -149,7 +166,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let k = solver.n_anchors();
     // Failed inverses get a placeholder that fails validation, so forward reports it.
     let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
-    let opts = ForwardOptions::default();
+    let opts = ForwardOptions {
+        mode: match args.search {
+            Search::Fast => SearchMode::Fast,
+            Search::Certified => SearchMode::Certified,
+            Search::Exact => SearchMode::Exact,
+        },
+        ..Default::default()
+    };
     let (t_fwd, fwd) = textio::with_threads(Some(threads), || {
         best_of(args.repeat, || solver.forward_batch(&rows, &opts))
     })?;

@@ -33,6 +33,7 @@ pub mod error;
 pub mod kernel;
 pub mod points;
 pub mod sampling;
+pub mod search;
 pub mod solver;
 pub mod weights;
 

@@ -6,22 +6,28 @@ use std::sync::Arc;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use wavg_mesh::{SurfacePoint, VertexId};
-use wavg_project::{ProjectError, ProjectionPath};
+use wavg_project::{ProjectError, Projection, ProjectionPath};
 
 use crate::anchors::AnchorSet;
 use crate::error::SolveError;
 use crate::kernel::{DEFAULT_GAMMA, InverseScratch, inverse_weights};
 use crate::points::{check_point, nearest_corner};
+use crate::search::local_search;
 use crate::weights::{Normalization, validate};
 use crate::{Projector, Vec8};
 
 /// How the forward problem searches for the projection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SearchMode {
-    /// Greedy walk from a start vertex, then local triangle search (the paper's method),
-    /// certified by the projector (falls back to the global search when needed).
+    /// The paper's method ([`crate::search`]): greedy walk from a start vertex, then a
+    /// breadth-first search over triangles; the first ring holding a valid projection wins.
+    /// When none is found within [`crate::search::LOCAL_BUDGET`] triangles, the projector's
+    /// certified search is used (reported as [`ProjectionPath::Fallback`]).
     #[default]
     Fast,
+    /// The projector's fast path certified against its bounding volume hierarchy: always
+    /// the closest valid projection (slower when the average lies far off the surface).
+    Certified,
     /// Exhaustive search over all triangles for the closest valid projection.
     Exact,
 }
@@ -192,7 +198,7 @@ impl Solver {
         let mesh = self.mesh();
         let (proj, start) = match opts.mode {
             SearchMode::Exact => (self.projector.project_exhaustive(&ybar), Start::Exhaustive),
-            SearchMode::Fast => {
+            SearchMode::Fast | SearchMode::Certified => {
                 let start = match opts.warm_start {
                     Some(p) => Start::Warm(nearest_corner(mesh, &check_point(mesh, &p)?)),
                     None => {
@@ -213,7 +219,26 @@ impl Solver {
                     Start::Warm(v) | Start::HighestWeight { vertex: v, .. } => v,
                     Start::Exhaustive => unreachable!("fast mode always has a start vertex"),
                 };
-                (self.projector.project(&ybar, v), start)
+                let found = match opts.mode {
+                    SearchMode::Fast => {
+                        local_search(&self.projector, &ybar, v).map(|h| Projection {
+                            point: h.point,
+                            distance: h.distance,
+                            path: ProjectionPath::Local,
+                        })
+                    }
+                    _ => None,
+                };
+                let proj = match found {
+                    Some(p) => Ok(p),
+                    None => self.projector.project(&ybar, v).map(|mut p| {
+                        if opts.mode == SearchMode::Fast {
+                            p.path = ProjectionPath::Fallback;
+                        }
+                        p
+                    }),
+                };
+                (proj, start)
             }
         };
         let p = proj.map_err(|e| match e {

@@ -19,9 +19,10 @@ fn solver_on(mesh: TriMesh, k: usize, seed: u64) -> Solver {
 }
 
 /// Inverse then forward on `n` random points; returns the fraction back within 1e-3 mean
-/// edge lengths, after checking partition of unity on every query and that a point that
-/// does not come back was replaced by a closer valid projection (the forward problem is the
-/// closest Phong projection; the original point is always a valid one by construction).
+/// edge lengths, after checking partition of unity on every query and, for the certified
+/// searches, that a point that does not come back was replaced by a closer valid projection
+/// (they return the closest Phong projection; the original point is a valid one by
+/// construction). The paper's local search (`Fast`) is not certified.
 fn round_trip_fraction(s: &Solver, n: usize, seed: u64, mode: SearchMode) -> f64 {
     let mel = mean_edge_length(s.mesh());
     let pts = uniform_surface_points(s.mesh(), n, seed).unwrap();
@@ -36,7 +37,7 @@ fn round_trip_fraction(s: &Solver, n: usize, seed: u64, mode: SearchMode) -> f64
         let r = s.forward(&w, &opts).unwrap();
         if (r.position - p.position(s.mesh())).norm() < 1e-3 * mel {
             ok += 1;
-        } else {
+        } else if mode != SearchMode::Fast {
             let ybar = s.average(&w, Normalization::Reject).unwrap();
             let own = (ybar - s.projector().embedded().point(p)).norm();
             assert!(
@@ -66,6 +67,8 @@ fn round_trips_on_procedural_meshes() {
         assert!(f >= 0.99, "{name}: round trip fraction {f}");
         let f = round_trip_fraction(&s, 50, 3, SearchMode::Exact);
         assert!(f >= 0.98, "{name} (exact): round trip fraction {f}");
+        let f = round_trip_fraction(&s, 100, 4, SearchMode::Certified);
+        assert!(f >= 0.98, "{name} (certified): round trip fraction {f}");
     }
 }
 
@@ -82,6 +85,8 @@ fn round_trips_on_a_real_mesh() {
     let s = solver_on(mesh, 27, 0);
     let f = round_trip_fraction(&s, 1000, 4, SearchMode::Fast);
     assert!(f >= 0.9, "pig: round trip fraction {f}");
+    let f = round_trip_fraction(&s, 300, 5, SearchMode::Certified);
+    assert!(f >= 0.9, "pig (certified): round trip fraction {f}");
 }
 
 #[test]
@@ -433,4 +438,31 @@ fn no_weighted_average_is_a_typed_outcome() {
     // Inside, it works and matches bilinear intuition: the centre.
     let r = s.forward(&[0.25; 4], &ForwardOptions::default()).unwrap();
     assert!((r.position - nalgebra::Vector3::new(0.5, 0.5, 0.0)).norm() < 1e-9);
+}
+
+/// The local search returns any point of the surface itself, from any start vertex.
+#[test]
+fn local_search_finds_points_on_the_surface_from_anywhere() {
+    let s = solver_on(procedural::bump_sphere(3, 0.4), 4, 1);
+    let proj = s.projector();
+    let pts = uniform_surface_points(s.mesh(), 200, 9).unwrap();
+    let mut n_near = 0;
+    for (i, p) in pts.iter().enumerate() {
+        let y = proj.embedded().point(p);
+        let start = (i * 37 % s.mesh().n_vertices()) as u32;
+        let v = wavg_solve::search::walk(proj, &y, start);
+        let near = s.mesh().triangles[p.face as usize].contains(&v);
+        let hit = wavg_solve::search::local_search(proj, &y, start);
+        // On a convex-ish sphere the walk reaches a corner of the face (or a neighbour).
+        if near {
+            n_near += 1;
+            let h = hit.expect("a point on the surface has a projection next to it");
+            assert!(h.distance < 1e-6, "{}", h.distance);
+            assert!((h.point.position(s.mesh()) - p.position(s.mesh())).norm() < 1e-6);
+        }
+    }
+    assert!(
+        n_near >= 180,
+        "the walk ended next to the point only {n_near} times of 200"
+    );
 }
