@@ -164,6 +164,8 @@ pub fn to_json(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
         "vertices": s.vertices,
         "faces": s.faces,
         "polygons": notes.map_or(s.faces, |n| n.polygons),
+        "skipped_faces": notes.map_or(0, |n| n.skipped_faces),
+        "uv_dropped": notes.is_some_and(|n| n.uv_dropped),
         "edges": s.edges,
         "components": s.components,
         "boundary_loops": s.boundary_loops,

@@ -114,7 +114,7 @@ pub(crate) fn bucket_sorted(items: impl Iterator<Item = (u64, u32)> + Clone) -> 
     out
 }
 
-/// Vertex to incident faces (CSR), in face order.
+/// Vertex to incident faces (CSR), in ascending face order (binary-searchable).
 pub(crate) struct VertexFaces {
     offsets: Vec<u32>,
     faces: Vec<u32>,
@@ -191,7 +191,9 @@ pub(crate) fn count_fans(
                 let h = adj[f as usize * 3 + e];
                 if h != NONE {
                     let g = h / 3;
-                    if let Some(i) = faces.iter().position(|&x| x == g) {
+                    // `faces` is in ascending face order (see VertexFaces): O(log k) lookup
+                    // keeps a vertex of huge valence (a cone apex) from taking O(k^2).
+                    if let Ok(i) = faces.binary_search(&g) {
                         if !seen[i] {
                             seen[i] = true;
                             stack.push(g);

@@ -149,3 +149,24 @@ proptest! {
         }
     }
 }
+
+/// A closed double cone whose two apexes have 200k faces each: fan counting must not be
+/// quadratic in the valence (it was: minutes instead of a fraction of a second).
+#[test]
+fn huge_valence_vertex_does_not_hang() {
+    let k = 200_000u32;
+    let mut positions = vec![Vector3::new(0.0, 0.0, 1.0), Vector3::new(0.0, 0.0, 0.0)];
+    for i in 0..k {
+        let a = i as f64 / k as f64 * std::f64::consts::TAU;
+        positions.push(Vector3::new(a.cos(), a.sin(), 0.0));
+    }
+    let mut faces = Vec::new();
+    for i in 0..k {
+        let (p, q) = (2 + i, 2 + (i + 1) % k);
+        faces.push([0, p, q]);
+        faces.push([1, q, p]);
+    }
+    let v = ValidMesh::new(TriMesh::new(positions, faces)).unwrap();
+    assert_eq!(v.topology().genus(), 0);
+    assert_eq!(v.topology().ring(0).len(), k as usize);
+}

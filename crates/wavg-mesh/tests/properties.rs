@@ -249,3 +249,25 @@ fn unknown_extension_and_missing_file_are_typed_errors() {
         Err(wavg_mesh::MeshError::Parse { .. })
     ));
 }
+
+#[test]
+fn empty_and_non_finite_meshes_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut odd = procedural::icosphere(0);
+    odd.positions[0] = Vector3::new(f64::NAN, f64::INFINITY, f64::NEG_INFINITY);
+    for ext in ["obj", "off", "ply", "off.gz"] {
+        let path = dir.path().join(format!("e.{ext}"));
+        io::save(&path, &TriMesh::default()).unwrap();
+        let back = io::load(&path).unwrap();
+        assert_eq!((back.n_vertices(), back.n_faces()), (0, 0), "{ext}");
+        io::save(&path, &odd).unwrap();
+        let back = io::load(&path).unwrap();
+        let p = back.positions[0];
+        assert!(
+            p.x.is_nan() && p.y == f64::INFINITY && p.z == f64::NEG_INFINITY,
+            "{ext}"
+        );
+        assert_eq!(back.positions[1..], odd.positions[1..]);
+        assert_eq!(back.triangles, odd.triangles);
+    }
+}

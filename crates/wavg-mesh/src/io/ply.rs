@@ -60,7 +60,13 @@ fn read(bytes: &[u8]) -> Result<Ply<DefaultElement>> {
         Ok(Ok(ply)) => Ok(ply),
         Ok(Err(e)) => Err(ParseError::new(
             e.line().unwrap_or(0),
-            format!("PLY: {}", strip_line_prefix(&e.to_string())),
+            format!(
+                "PLY: {}",
+                strip_line_prefix(&e.to_string())
+                    .split_whitespace()
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            ),
         )),
         Err(_) => Err(ParseError::new(
             0,
