@@ -49,9 +49,6 @@
 //! * Quadric areas: OpenMesh leaves the normal unnormalised for faces of area below
 //!   `FLT_MIN`; valid meshes have no such faces, so this never matters here.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-
 use nalgebra::Vector3;
 use wavg_mesh::{TriMesh, ValidMesh};
 
@@ -358,16 +355,15 @@ struct Decimator<'a> {
     min_cos: f64,
     cone_deg: Option<f64>,
     relaxations: Vec<(f64, Option<f64>)>,
-    // Heap of (priority key, vertex, stamp); a vertex's stamp invalidates old entries.
-    heap: BinaryHeap<Reverse<(u64, u64, u32, u32)>>,
-    stamp: Vec<u32>,
+    /// Vertices by their best collapse (OpenMesh's updatable `HeapT`).
+    heap: IndexedHeap,
     best: Vec<u32>,
     mark: Vec<u32>,
     mark_stamp: u32,
     scratch_out: Vec<u32>,
-    scratch_ring: Vec<u32>,
     scratch_hs: Vec<u32>,
     scratch_support: Vec<u32>,
+    scratch_cands: Vec<(f64, f64, u32, u32)>,
 }
 
 impl<'a> Decimator<'a> {
@@ -442,15 +438,14 @@ impl<'a> Decimator<'a> {
             min_cos: flip_deg.to_radians().cos(),
             cone_deg: opts.max_normal_cone_deg,
             relaxations: Vec::new(),
-            heap: BinaryHeap::new(),
-            stamp: vec![0; n],
+            heap: IndexedHeap::new(n),
             best: vec![NONE; n],
             mark: vec![0; n],
             mark_stamp: 0,
             scratch_out: Vec::with_capacity(32),
-            scratch_ring: Vec::with_capacity(32),
             scratch_hs: Vec::with_capacity(32),
             scratch_support: Vec::with_capacity(32),
+            scratch_cands: Vec::with_capacity(32),
         }
     }
 
@@ -485,8 +480,40 @@ impl<'a> Decimator<'a> {
         }
     }
 
+    /// Marks the one-ring of the vertex whose outgoing halfedges are `out` (for the link
+    /// condition); returns its size.
+    fn mark_ring(&mut self, out: &[u32]) -> usize {
+        self.mark_stamp = self.mark_stamp.wrapping_add(1);
+        if self.mark_stamp == 0 {
+            self.mark.fill(0);
+            self.mark_stamp = 1;
+        }
+        let st = self.mark_stamp;
+        for &g in out {
+            let w = self.to(g);
+            self.mark[w as usize] = st;
+        }
+        let last = *out.last().expect("live vertex has a face");
+        if self.opp[prev(last) as usize] == NONE {
+            let w = self.corner[prev(last) as usize];
+            self.mark[w as usize] = st;
+            out.len() + 1
+        } else {
+            out.len()
+        }
+    }
+
     /// Topological legality of collapsing halfedge `h` (see the module docs).
     fn topo_legal(&mut self, h: u32) -> bool {
+        let mut out = std::mem::take(&mut self.scratch_out);
+        self.outgoing(self.corner[h as usize], &mut out);
+        let deg_u = self.mark_ring(&out);
+        self.scratch_out = out;
+        self.topo_legal_marked(h, deg_u)
+    }
+
+    /// [`Self::topo_legal`] with the one-ring of `u` already marked by [`Self::mark_ring`].
+    fn topo_legal_marked(&mut self, h: u32, deg_u: usize) -> bool {
         let hu = h as usize;
         let (u, v) = (self.corner[hu], self.to(h));
         let (ui, vi) = (u as usize, v as usize);
@@ -514,37 +541,46 @@ impl<'a> Decimator<'a> {
             }
         }
         // Link condition: ring(u) and ring(v) share exactly {wl, wr}.
-        let mut ring = std::mem::take(&mut self.scratch_ring);
-        let mut scratch = std::mem::take(&mut self.scratch_out);
-        self.mark_stamp = self.mark_stamp.wrapping_add(1);
-        if self.mark_stamp == 0 {
-            self.mark.fill(0);
-            self.mark_stamp = 1;
+        let st = self.mark_stamp;
+        let start = self.vh[vi];
+        let mut g = start;
+        let mut deg_v = 0usize;
+        loop {
+            let w = self.to(g);
+            deg_v += 1;
+            if w != u && w != wl && w != wr && self.mark[w as usize] == st {
+                return false;
+            }
+            let pg = prev(g);
+            let og = self.opp[pg as usize];
+            if og == NONE {
+                let w = self.corner[pg as usize];
+                deg_v += 1;
+                if w != u && w != wl && w != wr && self.mark[w as usize] == st {
+                    return false;
+                }
+                break;
+            }
+            if og == start || deg_v > 4096 {
+                break;
+            }
+            g = og;
         }
-        self.ring(u, &mut ring, &mut scratch);
-        let deg_u = ring.len();
-        for &w in &ring {
-            self.mark[w as usize] = self.mark_stamp;
-        }
-        self.ring(v, &mut ring, &mut scratch);
-        let mut ok = ring
-            .iter()
-            .all(|&w| w == u || w == wl || w == wr || self.mark[w as usize] != self.mark_stamp);
         // A closed tetrahedron has no legal collapse.
-        if ok && o != NONE && !self.boundary[vi] && deg_u == 3 && ring.len() == 3 {
-            ok = false;
-        }
-        self.scratch_ring = ring;
-        self.scratch_out = scratch;
-        ok
+        !(o != NONE && !self.boundary[vi] && deg_u == 3 && deg_v == 3)
     }
 
-    /// Priority of collapsing `h` if legal (topology and the binary modules).
-    fn evaluate(&mut self, h: u32) -> Option<f64> {
-        if !self.topo_legal(h) {
-            return None;
-        }
+    /// Quadric priority of collapsing `h` (ModQuadricT::collapse_priority).
+    #[inline]
+    fn priority(&self, h: u32) -> f64 {
         let (u, v) = (self.corner[h as usize], self.to(h));
+        self.quadric[u as usize].eval_sum(&self.quadric[v as usize], &self.pos[v as usize])
+    }
+
+    /// The binary modules (normal flipping, normal cone) for `h`, given the outgoing
+    /// halfedges `out` of `u`.
+    fn geometry_legal(&self, h: u32, out: &[u32]) -> bool {
+        let v = self.to(h);
         let pv = self.pos[v as usize];
         let fl = h / 3;
         let o = self.opp[h as usize];
@@ -558,10 +594,7 @@ impl<'a> Decimator<'a> {
             self.opp[next(o) as usize]
         };
         let fc = if c == NONE { NONE } else { c / 3 };
-        let mut out = std::mem::take(&mut self.scratch_out);
-        self.outgoing(u, &mut out);
-        let mut ok = true;
-        for &g in &out {
+        for &g in out {
             let f = g / 3;
             if f == fl || f == fr {
                 continue;
@@ -571,14 +604,15 @@ impl<'a> Decimator<'a> {
             let (e1, e2) = (p1 - pv, p2 - pv);
             let cr = e1.cross(&e2);
             let len = cr.norm();
-            if !(len > 1e-12 * e1.norm() * e2.norm()) {
-                ok = false;
-                break;
+            // Degenerate (or NaN) result: illegal.
+            if len.partial_cmp(&(1e-12 * e1.norm() * e2.norm()))
+                != Some(std::cmp::Ordering::Greater)
+            {
+                return false;
             }
             let nn = cr / len;
             if nn.dot(&self.normal[f as usize]) < self.min_cos {
-                ok = false;
-                break;
+                return false;
             }
             if let Some(max_cone) = self.cone_deg {
                 let mut cone = self.cone[f as usize].merged(&Cone { n: nn, angle: 0.0 });
@@ -589,42 +623,54 @@ impl<'a> Decimator<'a> {
                     cone = cone.merged(&self.cone[fr as usize]);
                 }
                 if cone.angle > 0.5 * max_cone.to_radians() {
-                    ok = false;
-                    break;
+                    return false;
                 }
             }
         }
-        self.scratch_out = out;
-        if !ok {
-            return None;
-        }
-        let u_q = self.quadric[u as usize];
-        Some(u_q.eval_sum(&self.quadric[v as usize], &pv))
+        true
     }
 
     /// Recomputes vertex `x`'s best collapse and (re)inserts it in the heap.
     fn heap_vertex(&mut self, x: u32) {
         let xi = x as usize;
-        self.stamp[xi] = self.stamp[xi].wrapping_add(1);
         if !self.alive[xi] || self.locked[xi] {
+            self.heap.remove(x);
             return;
         }
         let mut hs = std::mem::take(&mut self.scratch_hs);
         self.outgoing(x, &mut hs);
-        let mut best: Option<(f64, f64, u32, u32)> = None;
+        // Candidates by (priority, squared length, target); the first legal one wins.
+        // Checking legality in that order gives the same answer as checking all, but
+        // usually stops at the first.
+        let mut cands = std::mem::take(&mut self.scratch_cands);
+        cands.clear();
         for &h in &hs {
-            if let Some(p) = self.evaluate(h) {
-                let t = self.to(h);
-                let l = (self.pos[t as usize] - self.pos[xi]).norm_squared();
-                if best.is_none_or(|b| (p, l, t) < (b.0, b.1, b.2)) {
-                    best = Some((p, l, t, h));
-                }
+            let t = self.to(h);
+            let l = (self.pos[t as usize] - self.pos[xi]).norm_squared();
+            cands.push((self.priority(h), l, t, h));
+        }
+        cands.sort_unstable_by(|a, b| {
+            (a.0, a.1, a.2)
+                .partial_cmp(&(b.0, b.1, b.2))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        let mut best = None;
+        let mut deg = None;
+        for &c in &cands {
+            let d = *deg.get_or_insert_with(|| self.mark_ring(&hs));
+            if self.topo_legal_marked(c.3, d) && self.geometry_legal(c.3, &hs) {
+                best = Some(c);
+                break;
             }
         }
+        self.scratch_cands = cands;
         self.scratch_hs = hs;
-        if let Some((p, l, _, h)) = best {
-            self.best[xi] = h;
-            self.heap.push(Reverse((key(p), key(l), x, self.stamp[xi])));
+        match best {
+            Some((p, l, _, h)) => {
+                self.best[xi] = h;
+                self.heap.set(x, (key(p), key(l), x));
+            }
+            None => self.heap.remove(x),
         }
     }
 
@@ -637,17 +683,12 @@ impl<'a> Decimator<'a> {
 
     /// Pops one heap entry and performs its collapse if still legal; true if collapsed.
     fn step(&mut self) -> bool {
-        let Some(Reverse((_, _, x, st))) = self.heap.pop() else {
+        let Some(x) = self.heap.pop() else {
             return false;
         };
-        let xi = x as usize;
-        if st != self.stamp[xi] || !self.alive[xi] {
-            return false;
-        }
-        let h = self.best[xi];
-        // DecimaterT re-checks topological legality only.
+        let h = self.best[x as usize];
+        // DecimaterT re-checks topological legality only (the vertex leaves the heap).
         if !self.topo_legal(h) {
-            self.stamp[xi] = self.stamp[xi].wrapping_add(1);
             return false;
         }
         let mut support = std::mem::take(&mut self.scratch_support);
@@ -793,9 +834,9 @@ impl<'a> Decimator<'a> {
         let mut new_id = vec![NONE; n];
         let mut landmarks = Vec::with_capacity(self.n_alive);
         let mut positions = Vec::with_capacity(self.n_alive);
-        for v in 0..n {
+        for (v, id) in new_id.iter_mut().enumerate() {
             if self.alive[v] {
-                new_id[v] = landmarks.len() as u32;
+                *id = landmarks.len() as u32;
                 landmarks.push(v as u32);
                 positions.push(self.pos[v]);
             }
@@ -808,6 +849,113 @@ impl<'a> Decimator<'a> {
             mesh: TriMesh::new(positions, triangles),
             landmarks,
             relaxations: self.relaxations.clone(),
+        }
+    }
+}
+
+/// Binary min-heap of vertices with updatable keys (each vertex at most once).
+struct IndexedHeap {
+    items: Vec<u32>,
+    /// Position of each vertex in `items`, or `NONE`.
+    at: Vec<u32>,
+    key: Vec<(u64, u64, u32)>,
+}
+
+impl IndexedHeap {
+    fn new(n: usize) -> Self {
+        Self {
+            items: Vec::with_capacity(n),
+            at: vec![NONE; n],
+            key: vec![(0, 0, 0); n],
+        }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    fn clear(&mut self) {
+        for &v in &self.items {
+            self.at[v as usize] = NONE;
+        }
+        self.items.clear();
+    }
+
+    /// Inserts `v` or changes its key.
+    fn set(&mut self, v: u32, k: (u64, u64, u32)) {
+        let vi = v as usize;
+        self.key[vi] = k;
+        let i = self.at[vi];
+        if i == NONE {
+            self.items.push(v);
+            self.at[vi] = (self.items.len() - 1) as u32;
+            self.up(self.items.len() - 1);
+        } else {
+            let i = i as usize;
+            self.up(i);
+            self.down(self.at[vi] as usize);
+        }
+    }
+
+    fn remove(&mut self, v: u32) {
+        let i = self.at[v as usize];
+        if i == NONE {
+            return;
+        }
+        let i = i as usize;
+        let last = self.items.pop().expect("non-empty");
+        self.at[v as usize] = NONE;
+        if i < self.items.len() {
+            self.items[i] = last;
+            self.at[last as usize] = i as u32;
+            self.up(i);
+            self.down(self.at[last as usize] as usize);
+        }
+    }
+
+    fn pop(&mut self) -> Option<u32> {
+        let v = *self.items.first()?;
+        self.remove(v);
+        Some(v)
+    }
+
+    #[inline]
+    fn less(&self, a: usize, b: usize) -> bool {
+        self.key[self.items[a] as usize] < self.key[self.items[b] as usize]
+    }
+
+    fn swap(&mut self, a: usize, b: usize) {
+        self.items.swap(a, b);
+        self.at[self.items[a] as usize] = a as u32;
+        self.at[self.items[b] as usize] = b as u32;
+    }
+
+    fn up(&mut self, mut i: usize) {
+        while i > 0 {
+            let p = (i - 1) / 2;
+            if !self.less(i, p) {
+                break;
+            }
+            self.swap(i, p);
+            i = p;
+        }
+    }
+
+    fn down(&mut self, mut i: usize) {
+        loop {
+            let (l, r) = (2 * i + 1, 2 * i + 2);
+            let mut m = i;
+            if l < self.items.len() && self.less(l, m) {
+                m = l;
+            }
+            if r < self.items.len() && self.less(r, m) {
+                m = r;
+            }
+            if m == i {
+                break;
+            }
+            self.swap(i, m);
+            i = m;
         }
     }
 }
@@ -1129,6 +1277,30 @@ mod tests {
                 mesh.topology().boundary_loops().len(),
                 d.relaxations
             );
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn indexed_heap_pops_in_key_order(ops in proptest::collection::vec((0u32..50, 0u64..20, any::<bool>()), 0..300)) {
+            let mut h = IndexedHeap::new(50);
+            let mut model = std::collections::BTreeMap::new();
+            for (v, k, set) in ops {
+                if set {
+                    h.set(v, (k, 0, v));
+                    model.insert(v, (k, 0, v));
+                } else {
+                    h.remove(v);
+                    model.remove(&v);
+                }
+            }
+            let mut want: Vec<_> = model.into_values().collect();
+            want.sort();
+            let mut got = Vec::new();
+            while let Some(v) = h.pop() {
+                got.push(h.key[v as usize]);
+            }
+            prop_assert_eq!(got, want);
         }
     }
 

@@ -3,7 +3,7 @@
 //! # Method
 //!
 //! The classic first-order scheme: vertices are frozen in order of increasing distance
-//! (a binary heap with lazy deletion); when a vertex `v` freezes, every unfrozen neighbour
+//! (an indexed binary heap with decrease-key); when a vertex `v` freezes, every unfrozen neighbour
 //! `x` is updated
 //! * along each edge: `u(x) <= u(v) + |xv|` (Dijkstra), and
 //! * across each *update stencil* `(x; v, w)` whose other vertex `w` is frozen: the planar
@@ -30,13 +30,11 @@
 //! distance array, the heap and that list. [`Workspace`] holds the per-run buffers so that
 //! repeated runs do not allocate.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-
 use nalgebra::Vector2;
 use rayon::prelude::*;
 use wavg_mesh::{NONE, ValidMesh};
 
+use crate::decimate::{DecimateOptions, Decimated, decimate};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 
 /// How many triangles the obtuse-angle unfolding may cross before giving up.
@@ -84,8 +82,10 @@ pub struct FastMarching {
 #[derive(Clone, Debug)]
 pub struct Workspace {
     dist: Vec<f64>,
-    frozen: Vec<bool>,
-    heap: BinaryHeap<Reverse<(u64, u32)>>,
+    /// `FAR`, `FROZEN`, or the vertex's position in `heap`.
+    state: Vec<u32>,
+    /// Binary min-heap of vertices by `dist` (each vertex at most once).
+    heap: Vec<u32>,
 }
 
 /// A stencil `(x; A, B)` with the 2-D (or 3-D, only dot products matter) edge vectors.
@@ -241,8 +241,8 @@ impl FastMarching {
     pub fn workspace(&self) -> Workspace {
         Workspace {
             dist: vec![f64::INFINITY; self.n],
-            frozen: vec![false; self.n],
-            heap: BinaryHeap::with_capacity(1024),
+            state: vec![FAR; self.n],
+            heap: Vec::with_capacity(1024),
         }
     }
 
@@ -268,26 +268,21 @@ impl FastMarching {
     }
 
     fn run_until(&self, ws: &mut Workspace, sources: &[u32], stop: Option<(&[bool], usize)>) {
-        let Workspace { dist, frozen, heap } = ws;
-        dist.fill(f64::INFINITY);
-        frozen.fill(false);
-        heap.clear();
+        ws.dist.fill(f64::INFINITY);
+        ws.state.fill(FAR);
+        ws.heap.clear();
         for &s in sources {
-            if (s as usize) < self.n {
-                dist[s as usize] = 0.0;
-                heap.push(Reverse((0, s)));
+            if (s as usize) < self.n && ws.dist[s as usize] != 0.0 {
+                ws.dist[s as usize] = 0.0;
+                ws.push_or_decrease(s);
             }
         }
         let mut remaining = stop.map_or(usize::MAX, |(_, k)| k);
         if remaining == 0 {
             return;
         }
-        while let Some(Reverse((key, v))) = heap.pop() {
+        while let Some(v) = ws.pop() {
             let vi = v as usize;
-            if frozen[vi] || key != dist[vi].to_bits() {
-                continue;
-            }
-            frozen[vi] = true;
             if let Some((targets, _)) = stop {
                 if targets[vi] {
                     remaining -= 1;
@@ -296,26 +291,95 @@ impl FastMarching {
                     }
                 }
             }
-            let uv = dist[vi];
+            let uv = ws.dist[vi];
             let range = self.offsets[vi] as usize..self.offsets[vi + 1] as usize;
             for e in &self.entries[range] {
                 let xi = e.x as usize;
-                if frozen[xi] {
+                if ws.state[xi] == FROZEN {
                     continue;
                 }
                 let mut cand = uv + e.len as f64;
                 let oi = e.other as usize;
-                if e.q_vv > 0.0 && frozen[oi] {
-                    if let Some(t) = triangle_update(uv, dist[oi], e) {
+                if e.q_vv > 0.0 && ws.state[oi] == FROZEN {
+                    if let Some(t) = triangle_update(uv, ws.dist[oi], e) {
                         cand = cand.min(t);
                     }
                 }
-                if cand < dist[xi] {
-                    dist[xi] = cand;
-                    heap.push(Reverse((cand.to_bits(), e.x)));
+                if cand < ws.dist[xi] {
+                    ws.dist[xi] = cand;
+                    ws.push_or_decrease(e.x);
                 }
             }
         }
+    }
+}
+
+/// `Workspace::state` of a vertex not yet reached.
+const FAR: u32 = u32::MAX;
+/// `Workspace::state` of a frozen vertex (otherwise: its position in the heap).
+const FROZEN: u32 = u32::MAX - 1;
+
+impl Workspace {
+    /// Inserts `v` into the heap or moves it up after its distance decreased.
+    #[inline]
+    fn push_or_decrease(&mut self, v: u32) {
+        let mut i = match self.state[v as usize] {
+            FAR => {
+                self.heap.push(v);
+                self.heap.len() - 1
+            }
+            p => p as usize,
+        };
+        let d = self.dist[v as usize];
+        while i > 0 {
+            let p = (i - 1) / 2;
+            let pv = self.heap[p];
+            if self.dist[pv as usize] <= d {
+                break;
+            }
+            self.heap[i] = pv;
+            self.state[pv as usize] = i as u32;
+            i = p;
+        }
+        self.heap[i] = v;
+        self.state[v as usize] = i as u32;
+    }
+
+    /// Removes the vertex of smallest distance and marks it frozen.
+    #[inline]
+    fn pop(&mut self) -> Option<u32> {
+        let top = *self.heap.first()?;
+        self.state[top as usize] = FROZEN;
+        let last = self.heap.pop().expect("non-empty");
+        let n = self.heap.len();
+        if n > 0 {
+            let d = self.dist[last as usize];
+            let mut i = 0;
+            loop {
+                let l = 2 * i + 1;
+                if l >= n {
+                    break;
+                }
+                let r = l + 1;
+                let c = if r < n
+                    && self.dist[self.heap[r] as usize] < self.dist[self.heap[l] as usize]
+                {
+                    r
+                } else {
+                    l
+                };
+                let cv = self.heap[c];
+                if self.dist[cv as usize] >= d {
+                    break;
+                }
+                self.heap[i] = cv;
+                self.state[cv as usize] = i as u32;
+                i = c;
+            }
+            self.heap[i] = last;
+            self.state[last as usize] = i as u32;
+        }
+        Some(top)
     }
 }
 
@@ -344,14 +408,12 @@ fn triangle_update(uv: f64, uo: f64, e: &Entry) -> Option<f64> {
     }
 }
 
+/// The vertex `W` found by unfolding, and the 2-D vectors from `x` to `A`, `W`, `B`.
+type Split = (u32, Vector2<f64>, Vector2<f64>, Vector2<f64>);
+
 /// Splits the obtuse corner `k` of face `f` (Kimmel & Sethian's unfolding). Returns the
 /// vertex `W` found and the 2-D vectors from `x` to `A`, `W`, `B` in the unfolded plane.
-fn unfold(
-    mesh: &ValidMesh,
-    f: u32,
-    k: usize,
-    topo: &wavg_mesh::Topology,
-) -> Option<(u32, Vector2<f64>, Vector2<f64>, Vector2<f64>)> {
+fn unfold(mesh: &ValidMesh, f: u32, k: usize, topo: &wavg_mesh::Topology) -> Option<Split> {
     let pos = &mesh.positions;
     let t = mesh.triangles[f as usize];
     let x = t[k];
@@ -523,12 +585,71 @@ pub fn landmark_distances_with(
     Ok(q)
 }
 
+/// [`landmark_distances`] computed on a coarser mesh, to save time on large meshes: the
+/// mesh is first decimated (with the landmarks locked, so they all survive) down to
+/// `intermediate_vertices`, and fast marching runs there. Geodesics on the coarse mesh are
+/// slightly shorter (its faces cut corners) and its triangles are less regular; the cost in
+/// accuracy is measured in the crate's timing example. With `intermediate_vertices >=`
+/// the vertex count this is exactly [`landmark_distances`].
+pub fn landmark_distances_coarse(
+    mesh: &ValidMesh,
+    landmarks: &[u32],
+    intermediate_vertices: usize,
+    progress: &dyn Progress,
+) -> Result<Vec<f64>, EmbedError> {
+    if intermediate_vertices >= mesh.n_vertices() {
+        return landmark_distances(mesh, landmarks, progress);
+    }
+    let opts = DecimateOptions {
+        target: intermediate_vertices.max(landmarks.len()),
+        locked: landmarks.to_vec(),
+        ..DecimateOptions::default()
+    };
+    let coarse = decimate(mesh, &opts, &CancelOnly(progress))?;
+    landmark_distances_decimated(&coarse, landmarks, progress)
+}
+
+/// [`landmark_distances`] on an already decimated mesh (for example a snapshot of the
+/// landmark decimation, see [`crate::decimate::decimate_with_snapshots`]); `landmarks` are
+/// original vertex ids and must all be vertices of `coarse`.
+pub fn landmark_distances_decimated(
+    coarse: &Decimated,
+    landmarks: &[u32],
+    progress: &dyn Progress,
+) -> Result<Vec<f64>, EmbedError> {
+    let ids = landmarks
+        .iter()
+        .map(|&l| {
+            coarse.coarse_index(l).ok_or_else(|| {
+                EmbedError::InvalidArgument(format!(
+                    "landmark {l} is not a vertex of the decimated mesh"
+                ))
+            })
+        })
+        .collect::<Result<Vec<u32>, _>>()?;
+    let mesh = ValidMesh::new(coarse.mesh.clone())
+        .map_err(|e| EmbedError::Numerical(format!("the decimated mesh is not valid: {e}")))?;
+    landmark_distances(&mesh, &ids, progress)
+}
+
+/// Forwards cancellation but not progress (for a sub-step reported as part of another stage).
+struct CancelOnly<'a>(&'a dyn Progress);
+
+impl Progress for CancelOnly<'_> {
+    fn report(&self, _stage: Stage, _fraction: f64) {}
+    fn cancelled(&self) -> bool {
+        self.0.cancelled()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::error::NoProgress;
     use nalgebra::Vector3;
     use proptest::prelude::*;
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
     use wavg_mesh::{TriMesh, procedural};
 
     fn valid(m: TriMesh) -> ValidMesh {
@@ -798,6 +919,7 @@ mod tests {
             .collect();
         let h = wavg_mesh::geometry::mean_edge_length(&mesh);
         let (mut worst, mut worst_far, mut sum) = (0.0f64, 0.0f64, 0.0);
+        #[allow(clippy::needless_range_loop)]
         for i in 0..n {
             for j in 0..i {
                 let q = 0.5 * (d[i][j] + d[j][i]);
@@ -870,6 +992,81 @@ mod tests {
         let p = Last(std::sync::Mutex::new(0.0));
         landmark_distances(&mesh, &[0, 10, 20, 30], &p).unwrap();
         assert_eq!(*p.0.lock().unwrap(), 1.0);
+    }
+
+    #[test]
+    fn coarse_landmark_distances_stay_close_to_the_truth() {
+        let mesh = valid(procedural::icosphere(5));
+        let n_v = mesh.n_vertices() as u32;
+        let lm: Vec<u32> = (0..60).map(|i| i * (n_v / 60) + 3).collect();
+        let n = lm.len();
+        let full = landmark_distances(&mesh, &lm, &NoProgress).unwrap();
+        // Not coarser than the mesh: identical.
+        let same = landmark_distances_coarse(&mesh, &lm, n_v as usize, &NoProgress).unwrap();
+        assert_eq!(same, full);
+        let coarse = landmark_distances_coarse(&mesh, &lm, 2000, &NoProgress).unwrap();
+        let (mut e_full, mut e_coarse, mut diff) = (0.0, 0.0, 0.0);
+        for i in 0..n {
+            for j in 0..n {
+                if i == j {
+                    continue;
+                }
+                let (a, b) = (
+                    mesh.positions[lm[i] as usize],
+                    mesh.positions[lm[j] as usize],
+                );
+                let exact = a.dot(&b).clamp(-1.0, 1.0).acos();
+                let k = i * n + j;
+                e_full += (full[k] - exact).abs() / exact;
+                e_coarse += (coarse[k] - exact).abs() / exact;
+                diff += (coarse[k] - full[k]).abs() / full[k];
+            }
+        }
+        let m = (n * (n - 1)) as f64;
+        eprintln!(
+            "icosphere(5) {n_v} v, 60 landmarks: mean rel err full {:.3}%, on 2000 v {:.3}%, coarse vs full {:.3}%",
+            100.0 * e_full / m,
+            100.0 * e_coarse / m,
+            100.0 * diff / m
+        );
+        assert!(e_full / m < 0.01 && e_coarse / m < 0.02 && diff / m < 0.02);
+    }
+
+    #[test]
+    fn distances_on_a_snapshot_of_the_landmark_decimation() {
+        use crate::decimate::decimate_with_snapshots;
+        let mesh = valid(procedural::with_noise(
+            procedural::torus(80, 30, 1.0, 0.35),
+            0.2,
+            2,
+        ));
+        let opts = DecimateOptions {
+            target: 40,
+            ..Default::default()
+        };
+        let (fin, snaps) = decimate_with_snapshots(&mesh, &opts, &[800], &NoProgress).unwrap();
+        let q = landmark_distances_decimated(&snaps[0], &fin.landmarks, &NoProgress).unwrap();
+        let full = landmark_distances(&mesh, &fin.landmarks, &NoProgress).unwrap();
+        let mut diff = 0.0;
+        for k in 0..q.len() {
+            if full[k] > 0.0 {
+                diff += (q[k] - full[k]).abs() / full[k];
+            }
+        }
+        let mean = diff / (40.0 * 39.0);
+        eprintln!(
+            "torus 2400 v -> snapshot 800 v: mean rel diff of 40x40 landmark distances {:.3}%",
+            100.0 * mean
+        );
+        assert!(mean < 0.03, "{mean}");
+        // A landmark that is not in the coarse mesh is refused.
+        let missing = (0..mesh.n_vertices() as u32)
+            .find(|&v| snaps[0].coarse_index(v).is_none())
+            .unwrap();
+        assert!(matches!(
+            landmark_distances_decimated(&snaps[0], &[fin.landmarks[0], missing], &NoProgress),
+            Err(EmbedError::InvalidArgument(_))
+        ));
     }
 
     proptest! {

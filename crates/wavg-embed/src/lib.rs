@@ -23,6 +23,8 @@ pub mod lsmesh;
 pub mod mds;
 pub mod pipeline;
 pub mod quality;
+pub use decimate::{DecimateOptions, Decimated, decimate, select_landmarks};
 pub use error::{EmbedError, NoProgress, Progress, Stage};
 pub use file::{Embedding, EmbeddingParams};
+pub use geodesic::{FastMarching, distances_from, landmark_distances};
 pub use pipeline::{PrecomputeOptions, Report, StageSeconds, precompute};

@@ -1,0 +1,198 @@
+//! Times landmark selection (decimation) and the landmark geodesics on real meshes.
+//!
+//! `cargo run --release -p wavg-embed --example landmark_timing -- [MESH...] [--landmarks N]`
+//! (default meshes: pig, armadillo, horse, igea from the shared data folder).
+
+use std::time::Instant;
+
+use wavg_embed::NoProgress;
+use wavg_embed::decimate::{DecimateOptions, select_landmarks};
+use wavg_embed::geodesic::{FastMarching, landmark_distances_coarse, landmark_distances_with};
+use wavg_mesh::ValidMesh;
+
+fn main() {
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let mut n_landmarks = 1000usize;
+    if let Some(i) = args.iter().position(|a| a == "--landmarks") {
+        n_landmarks = args[i + 1].parse().expect("--landmarks N");
+        args.drain(i..i + 2);
+    }
+    let mut coarse_sizes: Vec<usize> = Vec::new();
+    if let Some(i) = args.iter().position(|a| a == "--coarse") {
+        coarse_sizes = args[i + 1]
+            .split(',')
+            .map(|x| x.parse().expect("--coarse N,M"))
+            .collect();
+        args.drain(i..i + 2);
+    }
+    let decimate_only = args.iter().any(|a| a == "--decimate-only");
+    args.retain(|a| a != "--decimate-only");
+    let paths: Vec<std::path::PathBuf> = if args.is_empty() {
+        let Some(dir) = wavg_mesh::data::require_data_dir("landmark_timing") else {
+            return;
+        };
+        ["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"]
+            .iter()
+            .map(|m| dir.join("meshes").join(m))
+            .collect()
+    } else {
+        args.iter().map(Into::into).collect()
+    };
+    println!(
+        "| mesh | vertices | decimate (s) | fm build (s) | one run (ms) | {n_landmarks} runs, {} threads (s) | max asym. % |",
+        rayon::current_num_threads()
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|");
+    for p in paths {
+        let mut mesh = ValidMesh::new(wavg_mesh::io::load(&p).expect("load")).expect("valid");
+        if std::env::var_os("BFS").is_some() {
+            mesh = bfs(&mesh);
+        }
+        let name = p.file_name().unwrap().to_string_lossy().to_string();
+        let (t, c) = (Instant::now(), cpu_seconds());
+        let landmarks = landmarks(&mesh, n_landmarks);
+        let t_dec = t.elapsed().as_secs_f64();
+        let c_dec = cpu_seconds() - c;
+        if decimate_only {
+            println!(
+                "| {name} | {} | {t_dec:.3} (cpu {c_dec:.2}) |",
+                mesh.n_vertices()
+            );
+            continue;
+        }
+        let t = Instant::now();
+        let fm = FastMarching::new(&mesh);
+        let t_build = t.elapsed().as_secs_f64();
+        let mut ws = fm.workspace();
+        let t = Instant::now();
+        let reps = 5;
+        for i in 0..reps {
+            std::hint::black_box(fm.run(&mut ws, &landmarks[i..i + 1]));
+        }
+        let t_run = t.elapsed().as_secs_f64() / reps as f64;
+        let (t, c) = (Instant::now(), cpu_seconds());
+        let q = landmark_distances_with(&fm, &landmarks, &NoProgress).expect("distances");
+        let t_all = t.elapsed().as_secs_f64();
+        let c_all = cpu_seconds() - c;
+        // Asymmetry of the raw rows for a few landmarks.
+        let n = landmarks.len();
+        let mut asym = 0.0f64;
+        for i in 0..8.min(n) {
+            let row: Vec<f64> = {
+                let d = fm.run(&mut ws, &landmarks[i..i + 1]);
+                landmarks.iter().map(|&l| d[l as usize]).collect()
+            };
+            for j in 0..n {
+                if j != i {
+                    // q = (d_ij + d_ji)/2, so |d_ij - d_ji| / q = 2 |d_ij - q| / q.
+                    asym = asym.max(2.0 * (row[j] - q[i * n + j]).abs() / q[i * n + j]);
+                }
+            }
+        }
+        println!(
+            "| {name} | {} | {t_dec:.3} (cpu {c_dec:.2}) | {t_build:.3} | {:.1} | {t_all:.2} (cpu {c_all:.2}) | {:.2} |",
+            mesh.n_vertices(),
+            t_run * 1e3,
+            asym * 100.0
+        );
+        for &m in &coarse_sizes {
+            if m >= mesh.n_vertices() {
+                continue;
+            }
+            let (t, c) = (Instant::now(), cpu_seconds());
+            let qc = landmark_distances_coarse(&mesh, &landmarks, m, &NoProgress).expect("coarse");
+            let (tc, cc) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
+            let mut rel: Vec<f64> = (0..n * n)
+                .filter(|k| k / n != k % n)
+                .map(|k| (qc[k] - q[k]) / q[k])
+                .collect();
+            let mean = rel.iter().sum::<f64>() / rel.len() as f64;
+            if std::env::var_os("WORST").is_some() {
+                let h = wavg_mesh::geometry::mean_edge_length(&mesh);
+                let mut idx: Vec<usize> = (0..n * n).filter(|k| k / n < k % n).collect();
+                idx.sort_by(|&a, &b| {
+                    ((qc[b] - q[b]) / q[b])
+                        .abs()
+                        .total_cmp(&((qc[a] - q[a]) / q[a]).abs())
+                });
+                for &k in idx.iter().take(8) {
+                    eprintln!(
+                        "pair {} {}: full {:.4} ({:.1} h) coarse {:.4}",
+                        landmarks[k / n],
+                        landmarks[k % n],
+                        q[k],
+                        q[k] / h,
+                        qc[k]
+                    );
+                }
+            }
+            rel.iter_mut().for_each(|r| *r = r.abs());
+            rel.sort_by(f64::total_cmp);
+            println!(
+                "|   coarse {m} | | | | | {tc:.2} (cpu {cc:.2}) | rel. diff to full: mean {:+.2}%, |.| p50 {:.2}% p90 {:.2}% max {:.2}% |",
+                mean * 100.0,
+                rel[rel.len() / 2] * 100.0,
+                rel[rel.len() * 9 / 10] * 100.0,
+                rel[rel.len() - 1] * 100.0
+            );
+        }
+    }
+}
+
+/// Landmarks by decimation.
+fn landmarks(mesh: &ValidMesh, n: usize) -> Vec<u32> {
+    let opts = DecimateOptions {
+        target: n,
+        ..Default::default()
+    };
+    select_landmarks(mesh, &opts, &NoProgress).expect("decimation")
+}
+
+/// User + system CPU time of this process so far (Linux; 0 elsewhere). The machine is
+/// shared, so wall-clock times alone are noisy.
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = &stat[stat.rfind(')').map_or(0, |i| i + 2)..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f[11].parse::<f64>().unwrap_or(0.0) + f[12].parse::<f64>().unwrap_or(0.0);
+    ticks / 100.0
+}
+
+fn bfs(mesh: &ValidMesh) -> ValidMesh {
+    let n = mesh.n_vertices();
+    let mut order = Vec::with_capacity(n);
+    let mut seen = vec![false; n];
+    for s in 0..n {
+        if seen[s] {
+            continue;
+        }
+        seen[s] = true;
+        order.push(s as u32);
+        let mut i = order.len() - 1;
+        while i < order.len() {
+            let v = order[i];
+            for &w in mesh.topology().ring(v) {
+                if !seen[w as usize] {
+                    seen[w as usize] = true;
+                    order.push(w);
+                }
+            }
+            i += 1;
+        }
+    }
+    let mut new_id = vec![0u32; n];
+    for (i, &v) in order.iter().enumerate() {
+        new_id[v as usize] = i as u32;
+    }
+    let pos = order.iter().map(|&v| mesh.positions[v as usize]).collect();
+    let mut tris: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| new_id[v as usize]))
+        .collect();
+    tris.sort_by_key(|t| *t.iter().min().unwrap());
+    ValidMesh::new(wavg_mesh::TriMesh::new(pos, tris)).unwrap()
+}
