@@ -9,6 +9,25 @@
 //! let mesh = ValidMesh::new(procedural::torus(32, 16, 1.0, 0.3)).unwrap();
 //! assert_eq!(mesh.topology().genus(), 1);
 //! ```
+//!
+//! A file from a scanner, end to end ([`io::load`] reads OBJ/OFF/PLY, optionally `.gz`):
+//!
+//! ```
+//! use wavg_mesh::{ValidMesh, analyze, io, repair};
+//! # let dir = tempfile::tempdir().unwrap();
+//! # let path = dir.path().join("scan.off");
+//! # std::fs::write(&path, "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n9 9 9\n\
+//! #     3 0 1 2\n3 1 3 2\n3 2 1 3\n").unwrap();
+//! let raw = io::load(&path)?;
+//! let report = analyze(&raw).report;
+//! if !report.is_valid() {
+//!     eprintln!("{report}"); // duplicate face 2, unreferenced vertex 4
+//! }
+//! let fixed = repair::repair_all(&raw, &repair::RepairOptions::default());
+//! let mesh = ValidMesh::new(fixed.mesh)?;
+//! assert_eq!((mesh.n_vertices(), mesh.n_faces()), (4, 2));
+//! # Ok::<(), wavg_mesh::MeshError>(())
+//! ```
 
 pub mod analyze;
 pub mod data;
