@@ -1,0 +1,369 @@
+//! `wavg forward`, `wavg inverse` and `wavg bench roundtrip` run as a user would.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn wavg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(args)
+        .output()
+        .expect("run wavg")
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// 12 anchors spread over the small sphere (its icosahedron vertices), one as a face point.
+const ANCHORS: &str = "# the icosahedron's vertices\nv 0\nv 1\nv 2\nv 3\n\nv 4\nv 5\nv 6\nv 7\nv 8\nv 9\nv 10\nf 0 0.2 0.3 0.5  # a face point\n";
+const MESH: &str = "builtin:sphere-small";
+
+fn parse_floats(line: &str) -> Vec<f64> {
+    line.split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn inverse_then_forward_returns_the_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = write(dir.path(), "anchors.txt", ANCHORS);
+    let points = write(
+        dir.path(),
+        "points.txt",
+        "f 10 0.2 0.3 0.5\n# comment\n\nv 40\nf 100 0.6 0.2 0.2\nf 7 1 0 0\n",
+    );
+    let weights = dir.path().join("weights.txt");
+    let out = wavg(&[
+        "inverse",
+        "--mesh",
+        MESH,
+        "--anchors",
+        s(&anchors),
+        "--points",
+        s(&points),
+        "-o",
+        s(&weights),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let wtext = std::fs::read_to_string(&weights).unwrap();
+    let rows: Vec<Vec<f64>> = wtext.lines().map(parse_floats).collect();
+    assert_eq!(rows.len(), 4);
+    for r in &rows {
+        assert_eq!(r.len(), 12);
+        assert!((r.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+    }
+    let result = dir.path().join("points_back.txt");
+    let out = wavg(&[
+        "forward",
+        "--mesh",
+        MESH,
+        "--anchors",
+        s(&anchors),
+        "--weights",
+        s(&weights),
+        "-o",
+        s(&result),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let back: Vec<Vec<f64>> = std::fs::read_to_string(&result)
+        .unwrap()
+        .lines()
+        .map(parse_floats)
+        .collect();
+    assert_eq!(back.len(), 4);
+    // Compare 3-D positions with the library's positions of the original points.
+    let mesh = wavg_mesh::procedural::builtin("sphere-small").unwrap();
+    let originals = [
+        wavg_mesh::SurfacePoint::new(10, [0.2, 0.3, 0.5]).position(&mesh),
+        mesh.positions[40],
+        wavg_mesh::SurfacePoint::new(100, [0.6, 0.2, 0.2]).position(&mesh),
+        mesh.corners(7)[0],
+    ];
+    for (b, o) in back.iter().zip(&originals) {
+        assert_eq!(b.len(), 7, "FACE B0 B1 B2 X Y Z");
+        let d = ((b[4] - o.x).powi(2) + (b[5] - o.y).powi(2) + (b[6] - o.z).powi(2)).sqrt();
+        assert!(d < 1e-6, "{b:?} vs {o:?}");
+        assert!((b[1] + b[2] + b[3] - 1.0).abs() < 1e-9);
+    }
+    // The exact search and stdout output agree.
+    let out = wavg(&[
+        "forward",
+        "--mesh",
+        MESH,
+        "--anchors",
+        s(&anchors),
+        "--weights",
+        s(&weights),
+        "-o",
+        "-",
+        "--exact",
+        "--threads",
+        "1",
+    ]);
+    assert!(out.status.success());
+    let exact: Vec<Vec<f64>> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(parse_floats)
+        .collect();
+    for (a, b) in exact.iter().zip(&back) {
+        assert!((a[4] - b[4]).abs() + (a[5] - b[5]).abs() + (a[6] - b[6]).abs() < 1e-6);
+    }
+}
+
+/// Runs a failing command; checks exit status 2, the `file:line` in the message, and that
+/// the pre-existing output file is untouched.
+fn expect_input_error(args: &[&str], out_file: &Path, needle: &str) {
+    std::fs::write(out_file, "previous contents\n").unwrap();
+    let out = wavg(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(
+        err.contains(needle),
+        "{args:?}: expected {needle:?} in {err:?}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out_file).unwrap(),
+        "previous contents\n"
+    );
+    let leftovers = std::fs::read_dir(out_file.parent().unwrap())
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with(".tmp")
+        })
+        .count();
+    assert_eq!(leftovers, 0, "temporary file left behind");
+}
+
+#[test]
+fn malformed_weights_are_reported_with_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = write(dir.path(), "anchors.txt", "v 0\nv 10\nv 20\n");
+    let out = dir.path().join("out.txt");
+    for (text, needle) in [
+        ("0.2 0.3 0.5\n0.2 zz 0.5\n", "w.txt:2:"),
+        (
+            "# c\n0.2 0.3 0.5\n\n0.5 0.5\n",
+            "w.txt:4: expected 3 weights",
+        ),
+        ("0.2 0.3 0.5\n0.2 NaN 0.8\n", "w.txt:2:"),
+        ("0.2 0.3 0.5\n0.2 0.3 0.6\n", "w.txt:2: weights sum to"),
+        ("0.2 0.3 0.5\n0.2 inf 0.5\n", "not finite"),
+    ] {
+        let w = write(dir.path(), "w.txt", text);
+        expect_input_error(
+            &[
+                "forward",
+                "--mesh",
+                MESH,
+                "--anchors",
+                s(&anchors),
+                "--weights",
+                s(&w),
+                "-o",
+                s(&out),
+            ],
+            &out,
+            needle,
+        );
+    }
+    // --normalize accepts a wrong sum.
+    let w = write(dir.path(), "w.txt", "2 3 5\n");
+    let r = wavg(&[
+        "forward",
+        "--mesh",
+        MESH,
+        "--anchors",
+        s(&anchors),
+        "--weights",
+        s(&w),
+        "-o",
+        s(&out),
+        "--normalize",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert_eq!(std::fs::read_to_string(&out).unwrap().lines().count(), 1);
+}
+
+#[test]
+fn malformed_points_and_anchors_are_reported_with_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = write(dir.path(), "good.txt", "v 0\nv 10\nv 20\nv 30\n");
+    let out = dir.path().join("out.txt");
+    for (text, needle) in [
+        ("v 1\nv 99999\n", "p.txt:2: vertex 99999 is out of range"),
+        (
+            "v 1\n\nf 5000 0.2 0.3 0.5\n",
+            "p.txt:3: face 5000 is out of range",
+        ),
+        ("f 3 0.5 0.5 0.5\n", "p.txt:1: bad barycentric"),
+        ("f 3 -0.5 0.5 1.0\n", "p.txt:1: bad barycentric"),
+        ("x 3\n", "p.txt:1: expected 'v VERTEX'"),
+        ("f 3 0.5 0.5\n", "p.txt:1: 'f' takes 4 values"),
+        ("v -3\n", "p.txt:1:"),
+    ] {
+        let p = write(dir.path(), "p.txt", text);
+        expect_input_error(
+            &[
+                "inverse",
+                "--mesh",
+                MESH,
+                "--anchors",
+                s(&good),
+                "--points",
+                s(&p),
+                "-o",
+                s(&out),
+            ],
+            &out,
+            needle,
+        );
+        // The same file as anchors is rejected with its line too.
+        let w = write(dir.path(), "w.txt", "1\n");
+        expect_input_error(
+            &[
+                "forward",
+                "--mesh",
+                MESH,
+                "--anchors",
+                s(&p),
+                "--weights",
+                s(&w),
+                "-o",
+                s(&out),
+            ],
+            &out,
+            needle,
+        );
+    }
+    let missing = dir.path().join("missing.txt");
+    expect_input_error(
+        &[
+            "inverse",
+            "--mesh",
+            MESH,
+            "--anchors",
+            s(&good),
+            "--points",
+            s(&missing),
+            "-o",
+            s(&out),
+        ],
+        &out,
+        "missing.txt",
+    );
+}
+
+#[test]
+fn no_weighted_average_is_a_per_line_marker() {
+    let dir = tempfile::tempdir().unwrap();
+    // Corners of the flat builtin grid (41 x 21 vertices): extrapolating weights leave it.
+    let anchors = write(dir.path(), "a.txt", "v 0\nv 40\nv 860\nv 820\n");
+    let w = write(dir.path(), "w.txt", "0.25 0.25 0.25 0.25\n2 -1 0 0\n");
+    let out = dir.path().join("out.txt");
+    let r = wavg(&[
+        "forward",
+        "--mesh",
+        "builtin:grid",
+        "--anchors",
+        s(&anchors),
+        "--weights",
+        s(&w),
+        "-o",
+        s(&out),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2);
+    let first = parse_floats(lines[0]);
+    assert!(
+        (first[4] - 1.0).abs() < 1e-9 && (first[5] - 0.5).abs() < 1e-9,
+        "{text}"
+    );
+    assert!(lines[1].starts_with("none "), "{text}");
+}
+
+#[test]
+fn bench_roundtrip_reports_the_documented_json() {
+    let out = wavg(&[
+        "bench",
+        "roundtrip",
+        "--mesh",
+        "builtin:sphere-small",
+        "--anchors",
+        "12",
+        "--queries",
+        "300",
+        "--threads",
+        "2",
+        "--seed",
+        "3",
+        "--repeat",
+        "1",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let obj = v.as_object().unwrap();
+    let mut keys: Vec<&str> = obj.keys().map(|k| k.as_str()).collect();
+    keys.sort();
+    assert_eq!(
+        keys,
+        [
+            "anchors",
+            "faces",
+            "forward_us",
+            "forward_warm_us",
+            "inverse_us",
+            "mesh",
+            "negative_weight_fraction",
+            "queries",
+            "roundtrip_err_p50",
+            "roundtrip_err_p99",
+            "roundtrip_ok_fraction",
+            "threads",
+            "vertices",
+        ]
+    );
+    assert_eq!(obj["anchors"], 12);
+    assert_eq!(obj["queries"], 300);
+    assert_eq!(obj["threads"], 2);
+    assert_eq!(obj["vertices"], 162);
+    assert!(obj["roundtrip_ok_fraction"].as_f64().unwrap() > 0.95);
+    assert!(obj["inverse_us"].as_f64().unwrap() > 0.0);
+    let bad = wavg(&[
+        "bench",
+        "roundtrip",
+        "--mesh",
+        "builtin:sphere-small",
+        "--anchors",
+        "1000",
+        "--queries",
+        "10",
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+}
