@@ -116,8 +116,18 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
             let _ = writeln!(o, "  - {line}");
         }
         let remedies = remedies(a);
+        let all_fixable = a.report.summary().iter().all(|s| s.kind.remedy().is_some());
         if !remedies.is_empty() {
-            let _ = writeln!(o, "repairable (wavg_mesh::repair): {}", remedies.join(", "));
+            let _ = writeln!(
+                o,
+                "fixable with wavg_mesh::repair: {}{}",
+                remedies.join(", "),
+                if all_fixable {
+                    ""
+                } else {
+                    " (the other problems need editing the mesh)"
+                }
+            );
         }
     }
     o
