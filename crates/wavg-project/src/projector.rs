@@ -17,7 +17,7 @@ use wavg_mesh::{FaceId, NONE, SurfacePoint, VertexId};
 use crate::bvh::Bvh;
 use crate::euclid::closest_point_barycentric;
 use crate::frames::FrameKind;
-use crate::triangle::{Frame32, TriData, frame_apply_diff, frame_to_f32, frame_to_f64};
+use crate::triangle::{Frame32, TriData, frame_to_f32, frame_to_f64};
 use crate::{EmbeddedMesh, Mat2x8, ProjectError, Vec8};
 
 /// A distance below this fraction of the triangle's longest edge counts as zero: such a
@@ -135,12 +135,7 @@ impl Projector {
             .triangles
             .par_iter()
             .with_min_len(chunk)
-            .map(|t| {
-                TriData::new(
-                    t.map(|v| &frames[v as usize]),
-                    t.map(|v| coords[v as usize]),
-                )
-            })
+            .map(|t| TriData::new(t.map(|v| &frames[v as usize])))
             .collect();
         let boxes: Vec<(Vec8, Vec8)> = (0..mesh.n_faces())
             .map(|f| {
@@ -228,12 +223,12 @@ impl Projector {
         let t = self.emb.mesh().triangles[f as usize];
         let c = self.emb.coords();
         let (v0, v1, v2) = (&c[t[0] as usize], &c[t[1] as usize], &c[t[2] as usize]);
-        let h = [
-            frame_apply_diff(&self.frames[t[0] as usize], y, v0),
-            frame_apply_diff(&self.frames[t[1] as usize], y, v1),
-            frame_apply_diff(&self.frames[t[2] as usize], y, v2),
+        let fr = [
+            &self.frames[t[0] as usize],
+            &self.frames[t[1] as usize],
+            &self.frames[t[2] as usize],
         ];
-        let xi = self.tris[f as usize].solve(&h)?;
+        let xi = self.tris[f as usize].solve(fr, [v0, v1, v2], y)?;
         let (a, b, cc) = (&v0.data.0[0], &v1.data.0[0], &v2.data.0[0]);
         let yy = &y.data.0[0];
         let mut d2 = 0.0;

@@ -77,14 +77,16 @@ pub fn frame_apply_diff(f: &Frame32, y: &Vec8, v: &Vec8) -> [f64; 2] {
     [a, b]
 }
 
-/// Precomputed data of one triangle (192 bytes, three cache lines).
+/// Precomputed data of one triangle: the six 2x2 blend matrices `X_e` (row-major), 96
+/// bytes. The tangent coordinates of the corners are recomputed per query from the
+/// (stored) frames and the (f64) corners, so a point on the triangle satisfies the
+/// tangent equations to f64 rounding: the f32 storage perturbs `Psi`, never the
+/// zero of `p(xi) - y`.
 #[derive(Clone, Copy, Debug, Default)]
-#[repr(C, align(64))]
+#[repr(C, align(32))]
 pub struct TriData {
     /// The six 2x2 blend matrices `X_e` (row-major).
     pub x: [[f32; 4]; 6],
-    /// `G_e`: `X_e T_i (v_{i+1} - v_i)` then `X_e T_i (v_{i+2} - v_i)`, `i` = [`TERM_VERTEX`]`[e]`.
-    pub g: [[f32; 4]; 6],
 }
 
 /// Gram blocks `T_i T_j^T` of the three corner frames (`[C01, C12, C20]`).
@@ -196,7 +198,7 @@ fn from_m2(m: &M2) -> nalgebra::Matrix2<f64> {
 
 impl TriData {
     /// Precomputes a triangle from its stored corner frames and embedded corners.
-    pub fn new(frames: [&Frame32; 3], corners: [Vec8; 3]) -> Self {
+    pub fn new(frames: [&Frame32; 3]) -> Self {
         let t = frames.map(frame_to_f64);
         let (r, e) = alignments(&t);
         let mut d = TriData::default();
@@ -204,16 +206,6 @@ impl TriData {
             let a = ort::mul(&e[k], &r[k]);
             d.x[2 * k] = a.map(|v| v as f32);
             d.x[2 * k + 1] = e[k].map(|v| v as f32);
-        }
-        for term in 0..6 {
-            let i = TERM_VERTEX[term];
-            let xe = d.x[term].map(|v| v as f64);
-            for (s, k) in [(i + 1) % 3, (i + 2) % 3].into_iter().enumerate() {
-                let g = frame_apply(frames[i], &(corners[k] - corners[i]));
-                let xg = [xe[0] * g[0] + xe[1] * g[1], xe[2] * g[0] + xe[3] * g[1]];
-                d.g[term][2 * s] = xg[0] as f32;
-                d.g[term][2 * s + 1] = xg[1] as f32;
-            }
         }
         d
     }
@@ -244,15 +236,15 @@ impl TriData {
     }
 
     /// Newton's method for `Psi(xi) (p(xi) - y) = 0`, `sum xi = 1`, from the centroid,
-    /// kept inside the triangle; `h[i] = T_i (y - v_i)`. Returns the barycentrics of a
+    /// kept inside the triangle (`frames` and `corners` are the triangle's). Returns the barycentrics of a
     /// projection, or `None` when Newton finds none (the root lies outside the triangle,
     /// the Jacobian is singular, or it does not converge in [`MAX_NEWTON`] steps).
     ///
     /// Convergence is tested relative to the triangle's size and the query's distance
     /// (`|F| <= 1e-11 (|G| + |h|)`), so it does not depend on the mesh's scale or position.
     #[inline]
-    pub fn solve(&self, h: &[[f64; 2]; 3]) -> Option<[f64; 3]> {
-        let sys = System::new(self, h);
+    pub fn solve(&self, frames: [&Frame32; 3], corners: [&Vec8; 3], y: &Vec8) -> Option<[f64; 3]> {
+        let sys = System::new(self, frames, corners, y);
         let ftol = 1e-11 * sys.fscale;
         let mut xi = sys.initial_guess();
         let mut stuck = 0;
@@ -277,6 +269,11 @@ impl TriData {
                     t = t.min(xi[k] / -d[k]);
                 }
             }
+            if t < 1.0 && d[0].abs().max(d[1].abs()).max(d[2].abs()) <= BARY_EPS {
+                // The root is within BARY_EPS outside the triangle (on an edge, up to the
+                // rounding of the f32 data): a valid projection, clamped onto the triangle.
+                return renormalize([xi[0] + d[0], xi[1] + d[1], xi[2] + d[2]]);
+            }
             if t < 1e-9 {
                 // On the boundary and pushing out: slide (clamp the full step); twice in
                 // a row means the root is outside.
@@ -298,8 +295,14 @@ impl TriData {
     }
 
     /// `F(xi) = Psi(xi) (p(xi) - y)` given `h[i] = T_i (y - v_i)` (for tests).
-    pub fn tangent_residual(&self, h: &[[f64; 2]; 3], xi: &[f64; 3]) -> [f64; 2] {
-        System::new(self, h).eval(xi).0
+    pub fn tangent_residual(
+        &self,
+        frames: [&Frame32; 3],
+        corners: [&Vec8; 3],
+        y: &Vec8,
+        xi: &[f64; 3],
+    ) -> [f64; 2] {
+        System::new(self, frames, corners, y).eval(xi).0
     }
 }
 
@@ -315,26 +318,53 @@ struct System {
 
 impl System {
     #[inline(always)]
-    fn new(d: &TriData, h: &[[f64; 2]; 3]) -> Self {
+    fn new(d: &TriData, frames: [&Frame32; 3], corners: [&Vec8; 3], y: &Vec8) -> Self {
+        // a[i][j]: T_i (v_{i+1+j} - v_i); h[i] = T_i (y - v_i).
+        let mut a = [[[0.0f64; 2]; 2]; 3];
+        let mut h = [[0.0f64; 2]; 3];
+        let yv: &[f64; 8] = &y.data.0[0];
+        let cv = [
+            &corners[0].data.0[0],
+            &corners[1].data.0[0],
+            &corners[2].data.0[0],
+        ];
+        for i in 0..3 {
+            let f = frames[i];
+            let (k1, k2) = ((i + 1) % 3, (i + 2) % 3);
+            let mut acc = [0.0f64; 6];
+            for c in 0..8 {
+                let (t0, t1) = (f[c] as f64, f[8 + c] as f64);
+                let o = cv[i][c];
+                let (d1, d2, dy) = (cv[k1][c] - o, cv[k2][c] - o, yv[c] - o);
+                acc[0] += t0 * d1;
+                acc[1] += t1 * d1;
+                acc[2] += t0 * d2;
+                acc[3] += t1 * d2;
+                acc[4] += t0 * dy;
+                acc[5] += t1 * dy;
+            }
+            a[i] = [[acc[0], acc[1]], [acc[2], acc[3]]];
+            h[i] = [acc[4], acc[5]];
+        }
         let mut q = [[0.0f64; 2]; 6];
         let mut g = [[0.0f64; 4]; 6];
         let mut m: f64 = 0.0;
         for e in 0..6 {
             let x = d.x[e];
-            let hi = h[TERM_VERTEX[e]];
-            q[e] = [
-                x[0] as f64 * hi[0] + x[1] as f64 * hi[1],
-                x[2] as f64 * hi[0] + x[3] as f64 * hi[1],
-            ];
+            let x = [x[0] as f64, x[1] as f64, x[2] as f64, x[3] as f64];
+            let i = TERM_VERTEX[e];
+            let mv = |v: &[f64; 2]| [x[0] * v[0] + x[1] * v[1], x[2] * v[0] + x[3] * v[1]];
+            q[e] = mv(&h[i]);
+            let (g1, g2) = (mv(&a[i][0]), mv(&a[i][1]));
+            g[e] = [g1[0], g1[1], g2[0], g2[1]];
             for k in 0..4 {
-                g[e][k] = d.g[e][k] as f64;
-                let a = g[e][k].abs();
-                if a > m {
-                    m = a;
+                let v = g[e][k].abs();
+                if v > m {
+                    m = v;
                 }
             }
         }
-        for hi in h {
+        for hi in &h {
             for &v in hi {
                 if v.abs() > m {
                     m = v.abs();
@@ -559,6 +589,36 @@ mod tests {
                     let fd = (ca[e] - cb[e]) / (2.0 * h);
                     prop_assert!((fd - dc[e][k]).abs() < 1e-5 * (1.0 + fd.abs() / s), "{e} {k} {fd} {}", dc[e][k]);
                 }
+            }
+        }
+    }
+
+    fn frame(seed: u64) -> Mat2x8 {
+        // A deterministic pseudo-random orthonormal 2x8 frame.
+        let mut x = seed.wrapping_mul(0x9E3779B97F4A7C15) | 1;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let a = Vec8::from_fn(|_, _| next());
+        let b = Vec8::from_fn(|_, _| next());
+        let e1 = a.normalize();
+        let e2 = (b - e1 * e1.dot(&b)).normalize();
+        let mut m = Mat2x8::zeros();
+        m.row_mut(0).copy_from(&e1.transpose());
+        m.row_mut(1).copy_from(&e2.transpose());
+        m
+    }
+
+    proptest! {
+        /// Each block-descent sweep cannot increase the Procrustes energy.
+        #[test]
+        fn procrustes_energy_never_increases(s in 0u64..100_000) {
+            let e = procrustes_energies(&[frame(s), frame(s + 1), frame(s + 2)]);
+            for w in e.windows(2) {
+                prop_assert!(w[1] <= w[0] + 1e-9 * (1.0 + w[0]), "{e:?}");
             }
         }
     }
