@@ -5,7 +5,7 @@
 
 use serde_json::{Value, json};
 use wavg_mesh::io::{self, LoadNotes};
-use wavg_mesh::{Analysis, ProblemKind, TriMesh, analyze, procedural};
+use wavg_mesh::{Analysis, ProblemKind, TriMesh, analyze, procedural, repair};
 
 use crate::CliError;
 use crate::common::one_line;
@@ -115,34 +115,47 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
         for line in a.report.lines() {
             let _ = writeln!(o, "  - {line}");
         }
-        let remedies = remedies(a);
-        let all_fixable = a.report.summary().iter().all(|s| s.kind.remedy().is_some());
-        if !remedies.is_empty() {
+        let r = repair_outcome(mesh);
+        if r.remaining.is_empty() {
             let _ = writeln!(
                 o,
-                "fixable with wavg_mesh::repair: {}{}",
-                remedies.join(", "),
-                if all_fixable {
-                    ""
-                } else {
-                    " (the other problems need editing the mesh)"
-                }
+                "repair:               wavg_mesh::repair::repair_all fixes every problem \
+                 (removes {} vertices, {} faces)",
+                r.removed_vertices, r.removed_faces
+            );
+        } else {
+            let _ = writeln!(
+                o,
+                "repair:               wavg_mesh::repair::repair_all leaves: {}",
+                r.remaining.join("; ")
             );
         }
     }
     o
 }
 
-/// Distinct remedies for the problems found.
-fn remedies(a: &Analysis) -> Vec<&'static str> {
-    let mut r: Vec<&'static str> = a
-        .report
-        .summary()
-        .iter()
-        .filter_map(|s| s.kind.remedy())
-        .collect();
-    r.dedup();
-    r
+/// What the default repairs would do to an invalid mesh (tried, not guessed: a duplicate
+/// face also makes non-manifold edges that disappear with it).
+struct RepairOutcome {
+    removed_vertices: usize,
+    removed_faces: usize,
+    /// Problem lines left after repair (empty: the repaired mesh is valid).
+    remaining: Vec<String>,
+}
+
+fn repair_outcome(mesh: &TriMesh) -> RepairOutcome {
+    let r = repair::repair_all(mesh, &repair::RepairOptions::default());
+    let after = analyze(&r.mesh);
+    RepairOutcome {
+        removed_vertices: r.removed_vertices(),
+        removed_faces: r.removed_faces(mesh.n_faces()),
+        remaining: after
+            .report
+            .summary()
+            .iter()
+            .map(|s| format!("{} {}", s.count, s.kind.describe()))
+            .collect(),
+    }
 }
 
 /// The `--json` object.
@@ -169,6 +182,15 @@ pub fn to_json(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
             "diagonal": (hi - lo).norm(),
         })
     });
+    let repair = (!a.report.is_valid()).then(|| {
+        let r = repair_outcome(mesh);
+        json!({
+            "fixes_all": r.remaining.is_empty(),
+            "removed_vertices": r.removed_vertices,
+            "removed_faces": r.removed_faces,
+            "remaining_problems": r.remaining,
+        })
+    });
     json!({
         "mesh": name,
         "vertices": s.vertices,
@@ -189,6 +211,7 @@ pub fn to_json(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
         "bounding_box": bbox,
         "problems": a.report.lines(),
         "problem_summary": summary,
+        "repair": repair,
     })
 }
 

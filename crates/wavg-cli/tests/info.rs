@@ -118,7 +118,23 @@ fn invalid_but_parseable_file_exits_zero_and_lists_problems() {
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("valid:                no"), "{text}");
     assert!(
-        text.contains("fixable with") && text.contains("drop unreferenced vertices"),
+        text.contains("repair_all leaves: 1 non-manifold edges"),
+        "{text}"
+    );
+    assert_eq!(j["repair"]["fixes_all"], false);
+    assert_eq!(j["repair"]["removed_vertices"], 1);
+    // A problem the repairs do fix: an unreferenced vertex on a valid torus.
+    let mut torus = procedural::torus(8, 5, 1.0, 0.3);
+    torus.positions.push(torus.positions[0] * 5.0);
+    let tpath = dir.path().join("t.obj");
+    io::save(&tpath, &torus).unwrap();
+    let j = info_json(&tpath);
+    assert_eq!(j["valid"], false);
+    assert_eq!(j["repair"]["fixes_all"], true);
+    let out = wavg(&["info", tpath.to_str().unwrap()]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("fixes every problem (removes 1 vertices, 0 faces)"),
         "{text}"
     );
 }

@@ -142,10 +142,15 @@ impl ProblemKind {
         }
     }
 
-    /// The repair (or CLI flag family) that fixes this kind, if any.
+    /// The repair in [`crate::repair`] that fixes this kind, if any.
     pub fn remedy(self) -> Option<&'static str> {
         match self {
-            Self::RepeatedIndex | Self::ZeroAreaFace => Some("drop degenerate faces"),
+            // repair::drop_degenerate_faces also drops faces with out-of-range indices or
+            // non-finite corners (the vertices left unused go with the unreferenced ones).
+            Self::RepeatedIndex
+            | Self::ZeroAreaFace
+            | Self::IndexOutOfRange
+            | Self::NonFiniteCoordinate => Some("drop degenerate faces"),
             Self::DuplicateFace => Some("drop duplicate faces"),
             Self::UnreferencedVertex => Some("drop unreferenced vertices"),
             _ => None,

@@ -243,3 +243,38 @@ proptest! {
         prop_assert_eq!(v.n_faces(), 20 * 4usize.pow(level));
     }
 }
+
+/// Every kind that names a remedy is actually fixed by `repair_all`'s default options.
+#[test]
+fn remedies_named_by_problem_kinds_are_real() {
+    let base = procedural::icosphere(1);
+    let n = base.n_vertices() as u32;
+    let mut cases: Vec<(TriMesh, ProblemKind)> = Vec::new();
+    let mut m = base.clone();
+    m.triangles.push([0, 0, 1]);
+    cases.push((m, ProblemKind::RepeatedIndex));
+    let mut m = base.clone();
+    m.triangles.push([0, 1, n + 3]);
+    cases.push((m, ProblemKind::IndexOutOfRange));
+    let mut m = base.clone();
+    m.positions[5] = Vector3::new(f64::NAN, 0.0, 0.0);
+    cases.push((m, ProblemKind::NonFiniteCoordinate));
+    let mut m = base.clone();
+    m.triangles.push(m.triangles[4]); // also makes 3 non-manifold edges
+    cases.push((m, ProblemKind::DuplicateFace));
+    let mut m = base.clone();
+    m.positions.push(Vector3::zeros());
+    cases.push((m, ProblemKind::UnreferencedVertex));
+    let mut m = base.clone();
+    let mid = (m.positions[0] + m.positions[11]) / 2.0;
+    m.positions.push(mid);
+    m.triangles.push([0, 11, n]);
+    cases.push((m, ProblemKind::ZeroAreaFace));
+    for (m, kind) in cases {
+        let a = analyze(&m);
+        assert!(a.report.count(kind) > 0, "{kind:?}: {}", a.report);
+        assert!(kind.remedy().is_some(), "{kind:?}");
+        let r = repair::repair_all(&m, &RepairOptions::default());
+        assert!(ValidMesh::new(r.mesh).is_ok(), "{}", a.report);
+    }
+}
