@@ -244,9 +244,9 @@ mod tests {
     fn apply(a: &SparseColMat<usize, f64>, x: &[[f64; MAX_DIM]], c: usize) -> Vec<f64> {
         let (sym, vals) = a.parts();
         let mut y = vec![0.0; x.len()];
-        for j in 0..sym.ncols() {
+        for (j, xj) in x.iter().enumerate() {
             for k in sym.col_range(j) {
-                y[sym.row_idx()[k]] += vals[k] * x[j][c];
+                y[sym.row_idx()[k]] += vals[k] * xj[c];
             }
         }
         y
