@@ -1,5 +1,9 @@
 //! Geometric quantities: areas, normals, edge lengths, the cotangent stiffness and lumped
 //! mass matrices, and surface points.
+//!
+//! These take a `&TriMesh` so that they also serve repairs and diagnostics, but they assume
+//! face indices are in range (they index positions directly and panic otherwise): pass a
+//! [`crate::ValidMesh`] (it derefs to `TriMesh`) unless the mesh is known to be sound.
 
 use faer::sparse::{SparseColMat, Triplet};
 use nalgebra::Vector3;
