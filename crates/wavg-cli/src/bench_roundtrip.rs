@@ -274,10 +274,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
 /// `--precompute`: the embedding pipeline with default parameters.
 fn precompute_embedding(
-    _mesh: &std::sync::Arc<wavg_mesh::ValidMesh>,
+    mesh: &std::sync::Arc<wavg_mesh::ValidMesh>,
 ) -> Result<std::sync::Arc<wavg_solve::EmbeddedMesh>, CliError> {
-    Err(CliError::failure(
-        "--precompute is not available yet (wavg_embed::pipeline::precompute is not written); \
-         run `wavg precompute` and pass --embedding",
-    ))
+    let opts = wavg_embed::pipeline::PrecomputeOptions::default();
+    let (emb, _) = wavg_embed::pipeline::precompute(mesh, &opts, &wavg_embed::NoProgress)
+        .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))?;
+    let coords = emb.coords.iter().map(|c| wavg_solve::Vec8::from(*c)).collect();
+    wavg_solve::EmbeddedMesh::new(mesh.clone(), coords)
+        .map(std::sync::Arc::new)
+        .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))
 }
