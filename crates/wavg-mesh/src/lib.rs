@@ -1,7 +1,7 @@
 //! Triangle meshes for wavg: storage, connectivity, validation, repair, I/O and geometry.
 //!
 //! The flow is: load or generate a [`TriMesh`] (any file can be parsed into one, however
-//! broken), [`analyze`] it to see its problems and statistics, optionally repair it, then
+//! broken), [`analyze()`] it to see its problems and statistics, optionally [`repair`] it, then
 //! make a [`ValidMesh`] (oriented manifold plus [`Topology`]), the only type later stages take.
 //!
 //! ```
