@@ -25,6 +25,8 @@ fn main() {
             .collect();
         args.drain(i..i + 2);
     }
+    let runs_only = args.iter().any(|a| a == "--runs-only");
+    args.retain(|a| a != "--runs-only");
     let decimate_only = args.iter().any(|a| a == "--decimate-only");
     args.retain(|a| a != "--decimate-only");
     let paths: Vec<std::path::PathBuf> = if args.is_empty() {
@@ -64,6 +66,39 @@ fn main() {
         let fm = FastMarching::new(&mesh);
         let t_build = t.elapsed().as_secs_f64();
         let mut ws = fm.workspace();
+        if runs_only {
+            let per_run = |fm: &FastMarching, ws: &mut wavg_embed::geodesic::Workspace| {
+                // Best on-CPU time of 5 batches of 10 runs (the machine is shared).
+                let mut best = f64::INFINITY;
+                for b in 0..5 {
+                    let t = thread_cpu_ns();
+                    for i in 0..10 {
+                        std::hint::black_box(fm.run(ws, &landmarks[b * 10 + i..b * 10 + i + 1]));
+                    }
+                    best = best.min((thread_cpu_ns() - t) as f64 / 10.0 * 1e-6);
+                }
+                best
+            };
+            print!(
+                "| {name} | {} | {:.2} ms/run",
+                mesh.n_vertices(),
+                per_run(&fm, &mut ws)
+            );
+            for &m in coarse_sizes.iter().filter(|&&m| m < mesh.n_vertices()) {
+                let opts = DecimateOptions {
+                    target: m,
+                    locked: landmarks.clone(),
+                    ..Default::default()
+                };
+                let d = wavg_embed::decimate(&mesh, &opts, &NoProgress).unwrap();
+                let cm = ValidMesh::new(d.mesh).unwrap();
+                let cfm = FastMarching::new(&cm);
+                let mut cws = cfm.workspace();
+                print!(" | coarse {m}: {:.2} ms/run", per_run(&cfm, &mut cws));
+            }
+            println!();
+            continue;
+        }
         let t = Instant::now();
         let reps = 5;
         for i in 0..reps {
@@ -195,4 +230,12 @@ fn bfs(mesh: &ValidMesh) -> ValidMesh {
         .collect();
     tris.sort_by_key(|t| *t.iter().min().unwrap());
     ValidMesh::new(wavg_mesh::TriMesh::new(pos, tris)).unwrap()
+}
+
+/// Nanoseconds this thread has spent on a CPU (Linux schedstat; 0 elsewhere).
+fn thread_cpu_ns() -> u64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0)
 }

@@ -175,8 +175,14 @@ pub fn decimate_with_snapshots(
     d.init_heap();
     let total = (n - opts.target).max(1) as f64;
     let mut since_report = 0usize;
+    // Whether a collapse happened since the heap was last filled from scratch. Vertices
+    // whose popped collapse turned out illegal leave the heap (as in OpenMesh), so an empty
+    // heap first triggers a full re-evaluation; only if that finds nothing are the bounds
+    // relaxed.
+    let mut collapsed_since_fill = false;
     while d.n_alive > opts.target {
         if d.step() {
+            collapsed_since_fill = true;
             take(&d, &mut snaps);
             since_report += 1;
             if since_report == 2048 {
@@ -185,6 +191,11 @@ pub fn decimate_with_snapshots(
                 progress.report(Stage::Decimate, (n - d.n_alive) as f64 / total);
             }
         } else if d.heap.is_empty() {
+            if collapsed_since_fill {
+                collapsed_since_fill = false;
+                d.init_heap();
+                continue;
+            }
             if !opts.relax || !d.relax() {
                 return Err(EmbedError::InvalidArgument(format!(
                     "cannot decimate to {} vertices: no legal collapse left at {} vertices \
@@ -462,7 +473,7 @@ impl<'a> Decimator<'a> {
         loop {
             out.push(h);
             let o = self.opp[prev(h) as usize];
-            if o == NONE || o == start || out.len() > 4096 {
+            if o == NONE || o == start || out.len() > self.corner.len() {
                 break;
             }
             h = o;
@@ -561,7 +572,7 @@ impl<'a> Decimator<'a> {
                 }
                 break;
             }
-            if og == start || deg_v > 4096 {
+            if og == start || deg_v > self.corner.len() {
                 break;
             }
             g = og;
@@ -789,7 +800,7 @@ impl<'a> Decimator<'a> {
             .expect("a live vertex keeps a live outgoing halfedge");
         let start = h;
         let mut h = h;
-        for _ in 0..4096 {
+        for _ in 0..self.corner.len() {
             let o = self.opp[h as usize];
             if o == NONE {
                 break;
@@ -1008,6 +1019,18 @@ mod tests {
         coarse
     }
 
+    /// A disk: one centre vertex of valence `k` and a boundary ring of `k` vertices,
+    /// slightly domed so that the quadrics are not all zero.
+    fn fan(k: u32) -> TriMesh {
+        let mut pos = vec![Vector3::new(0.0, 0.0, 0.3)];
+        for i in 0..k {
+            let a = std::f64::consts::TAU * i as f64 / k as f64;
+            pos.push(Vector3::new(a.cos(), a.sin(), 0.0));
+        }
+        let tris = (0..k).map(|i| [0, 1 + i, 1 + (i + 1) % k]).collect();
+        TriMesh::new(pos, tris)
+    }
+
     fn grid_with_hole() -> TriMesh {
         let g = procedural::grid(30, 30, 1.0, 1.0);
         let tris = g
@@ -1061,6 +1084,7 @@ mod tests {
             ("grid", procedural::grid(40, 30, 2.0, 1.0), 50),
             ("grid with hole", grid_with_hole(), 60),
             ("bump", procedural::bump_sphere(4, 0.5), 30),
+            ("fan of 4500 triangles", fan(4500), 4200),
         ];
         for (name, m, target) in cases {
             let mesh = valid(m);
