@@ -77,6 +77,22 @@ fn obj_errors_name_the_line() {
 }
 
 #[test]
+fn byte_order_mark_and_crlf_are_accepted() {
+    let (m, _) = parse(
+        &format!("\u{feff}{}f 1 2 3\r\n", SQUARE.replace('\n', "\r\n")),
+        Format::Obj,
+    )
+    .unwrap();
+    assert_eq!((m.n_vertices(), m.n_faces()), (4, 1));
+    let (m, _) = parse(
+        "\u{feff}OFF\r\n3 1 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2\r\n",
+        Format::Off,
+    )
+    .unwrap();
+    assert_eq!(m.n_faces(), 1);
+}
+
+#[test]
 fn obj_out_of_range_is_kept_for_validation() {
     let (m, _) = parse(&format!("{SQUARE}f 1 2 9\n"), Format::Obj).unwrap();
     assert_eq!(m.triangles, vec![[0, 1, 8]]);

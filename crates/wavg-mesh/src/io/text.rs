@@ -18,8 +18,10 @@ impl ParseError {
 
 pub(crate) type Result<T> = std::result::Result<T, ParseError>;
 
-/// The bytes as text, or an error naming the line of the first invalid UTF-8 byte.
+/// The bytes as text (without a UTF-8 byte-order mark, which would otherwise hide the first
+/// statement), or an error naming the line of the first invalid UTF-8 byte.
 pub(crate) fn as_text(bytes: &[u8]) -> Result<&str> {
+    let bytes = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes);
     std::str::from_utf8(bytes).map_err(|e| {
         let at = e.valid_up_to();
         let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
