@@ -279,7 +279,11 @@ fn precompute_embedding(
     let opts = wavg_embed::pipeline::PrecomputeOptions::default();
     let (emb, _) = wavg_embed::pipeline::precompute(mesh, &opts, &wavg_embed::NoProgress)
         .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))?;
-    let coords = emb.coords.iter().map(|c| wavg_solve::Vec8::from(*c)).collect();
+    let coords = emb
+        .coords
+        .iter()
+        .map(|c| wavg_solve::Vec8::from(*c))
+        .collect();
     wavg_solve::EmbeddedMesh::new(mesh.clone(), coords)
         .map(std::sync::Arc::new)
         .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))

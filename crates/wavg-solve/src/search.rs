@@ -9,6 +9,8 @@
 //! [`crate::SearchMode::Certified`] and [`crate::SearchMode::Exact`] are the guaranteed
 //! alternatives.
 
+use std::sync::Arc;
+
 use wavg_mesh::{FaceId, NONE, SurfacePoint, VertexId};
 
 use crate::{Projector, Vec8};
@@ -17,38 +19,77 @@ use crate::{Projector, Vec8};
 /// back to the projector's certified search).
 pub const LOCAL_BUDGET: usize = 96;
 
-/// Squared distance in R^8.
-#[inline]
-fn dist2(a: &Vec8, b: &Vec8) -> f64 {
-    let mut s = 0.0;
-    for k in 0..8 {
-        let d = a[k] - b[k];
-        s += d * d;
+/// A vertex's embedded coordinates in f32, half a cache line, for the walk.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(32))]
+struct Coord32([f32; 8]);
+
+impl Coord32 {
+    fn new(y: &Vec8) -> Self {
+        Self(std::array::from_fn(|k| y[k] as f32))
     }
-    s
+
+    #[inline]
+    fn dist2(&self, y: &Coord32) -> f32 {
+        let mut s = 0.0;
+        for k in 0..8 {
+            let d = self.0[k] - y.0[k];
+            s += d * d;
+        }
+        s
+    }
 }
 
-/// Greedy walk from `start`: move to the neighbour closest to `y` while one is closer
-/// than the current vertex (steepest descent; ends at a local minimum of the distance).
-pub fn walk(proj: &Projector, y: &Vec8, start: VertexId) -> VertexId {
-    let emb = proj.embedded();
-    let topo = emb.mesh().topology();
-    let c = emb.coords();
-    let mut v = start;
-    let mut dv = dist2(&c[v as usize], y);
-    loop {
-        let mut next = v;
-        for &u in topo.ring(v) {
-            let d = dist2(&c[u as usize], y);
-            if d < dv {
-                dv = d;
-                next = u;
+/// The forward problem's local search over one projector, with compact f32 copies of the
+/// embedded coordinates so the walk touches little memory (it is bound by cache misses on
+/// large meshes).
+pub struct LocalSearch {
+    proj: Arc<Projector>,
+    coords: Vec<Coord32>,
+}
+
+impl LocalSearch {
+    /// Prepares the search (copies the coordinates to f32).
+    pub fn new(proj: Arc<Projector>) -> Self {
+        let coords = proj.embedded().coords().iter().map(Coord32::new).collect();
+        Self { proj, coords }
+    }
+
+    /// The projector.
+    pub fn projector(&self) -> &Arc<Projector> {
+        &self.proj
+    }
+
+    /// Greedy walk from `start`: move to the neighbour closest to `y` while one is closer
+    /// than the current vertex (steepest descent; ends at a local minimum of the distance,
+    /// measured in f32).
+    pub fn walk(&self, y: &Vec8, start: VertexId) -> VertexId {
+        let topo = self.proj.embedded().mesh().topology();
+        let c = &self.coords;
+        let y = Coord32::new(y);
+        let mut v = start;
+        let mut dv = c[v as usize].dist2(&y);
+        loop {
+            let mut next = v;
+            for &u in topo.ring(v) {
+                let d = c[u as usize].dist2(&y);
+                if d < dv {
+                    dv = d;
+                    next = u;
+                }
             }
+            if next == v {
+                return v;
+            }
+            v = next;
         }
-        if next == v {
-            return v;
-        }
-        v = next;
+    }
+
+    /// The local search from `start` (see the module docs); `None` when no triangle within
+    /// [`LOCAL_BUDGET`] has a valid Phong projection of `y`.
+    pub fn search(&self, y: &Vec8, start: VertexId) -> Option<LocalHit> {
+        let v = self.walk(y, start);
+        self.search_from(y, v)
     }
 }
 
@@ -73,20 +114,16 @@ impl FaceSet {
     }
 }
 
-/// How far outside triangle `f` the Euclidean projection of `y` onto the triangle's plane
-/// in R^8 falls: the most negative barycentric coordinate, negated (0 inside; infinite for
-/// a degenerate triangle).
+/// How far outside the triangle `(p0, p1, p2)` the Euclidean projection of `y` onto its
+/// plane falls: the most negative barycentric coordinate, negated (0 inside; infinite for a
+/// degenerate triangle). In f32: it only orders the candidates.
 #[inline]
-fn outside(proj: &Projector, y: &Vec8, f: FaceId) -> f64 {
-    let emb = proj.embedded();
-    let t = emb.mesh().triangles[f as usize];
-    let c = emb.coords();
-    let (p0, p1, p2) = (&c[t[0] as usize], &c[t[1] as usize], &c[t[2] as usize]);
-    let (mut a, mut b, mut cc, mut d, mut e) = (0.0, 0.0, 0.0, 0.0, 0.0);
+fn outside(p0: &Coord32, p1: &Coord32, p2: &Coord32, y: &Coord32) -> f32 {
+    let (mut a, mut b, mut cc, mut d, mut e) = (0.0f32, 0.0, 0.0, 0.0, 0.0);
     for k in 0..8 {
-        let e1 = p1[k] - p0[k];
-        let e2 = p2[k] - p0[k];
-        let r = y[k] - p0[k];
+        let e1 = p1.0[k] - p0.0[k];
+        let e2 = p2.0[k] - p0.0[k];
+        let r = y.0[k] - p0.0[k];
         a += e1 * e1;
         b += e1 * e2;
         cc += e2 * e2;
@@ -95,7 +132,7 @@ fn outside(proj: &Projector, y: &Vec8, f: FaceId) -> f64 {
     }
     let det = a * cc - b * b;
     if det.is_nan() || det <= 0.0 {
-        return f64::INFINITY;
+        return f32::INFINITY;
     }
     let l1 = (cc * d - b * e) / det;
     let l2 = (a * e - b * d) / det;
@@ -103,61 +140,69 @@ fn outside(proj: &Projector, y: &Vec8, f: FaceId) -> f64 {
     (-l0).max(-l1).max(-l2).max(0.0)
 }
 
-/// The local search from `start` (see the module docs); `None` when no triangle within
-/// [`LOCAL_BUDGET`] has a valid Phong projection of `y`.
-pub fn local_search(proj: &Projector, y: &Vec8, start: VertexId) -> Option<LocalHit> {
-    let emb = proj.embedded();
-    let topo = emb.mesh().topology();
-    let v = walk(proj, y, start);
-    let mut seen = FaceSet {
-        ids: [0; LOCAL_BUDGET],
-        n: 0,
-    };
-    for &f in topo.ring_faces(v) {
-        if seen.n == LOCAL_BUDGET {
-            break;
+impl LocalSearch {
+    /// Breadth-first search over triangles from vertex `v` (the walk's end).
+    fn search_from(&self, y: &Vec8, v: VertexId) -> Option<LocalHit> {
+        let proj = &*self.proj;
+        let emb = proj.embedded();
+        let mesh = emb.mesh();
+        let topo = mesh.topology();
+        let c = &self.coords;
+        let y32 = Coord32::new(y);
+        let mut seen = FaceSet {
+            ids: [0; LOCAL_BUDGET],
+            n: 0,
+        };
+        let mut order = [(0.0f32, 0 as FaceId); LOCAL_BUDGET];
+        // First ring: the faces around v; their corners are v and consecutive ring
+        // vertices, whose coordinates the walk has just read (no lookup of the triangles).
+        let ring = topo.ring(v);
+        for (j, &f) in topo.ring_faces(v).iter().enumerate().take(LOCAL_BUDGET) {
+            let (a, b) = (ring[j], ring[(j + 1) % ring.len()]);
+            let score = outside(&c[v as usize], &c[a as usize], &c[b as usize], &y32);
+            seen.ids[seen.n] = f;
+            order[seen.n] = (score, f);
+            seen.n += 1;
         }
-        seen.ids[seen.n] = f;
-        seen.n += 1;
-    }
-    let mut level = 0..seen.n;
-    let mut order = [(0.0f64, 0 as FaceId); LOCAL_BUDGET];
-    loop {
-        // Try the ring's triangles in order of how far outside each one the Euclidean
-        // projection of `y` onto its plane falls: the face holding the Phong projection is
-        // almost always first, so usually a single Newton solve is needed.
-        let m = level.len();
-        for (o, i) in order.iter_mut().zip(level.clone()) {
-            let f = seen.ids[i];
-            *o = (outside(proj, y, f), f);
-        }
-        order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        for &(_, f) in &order[..m] {
-            if let Some(xi) = proj.project_onto_face(y, f) {
-                let p = SurfacePoint::new(f, xi);
-                return Some(LocalHit {
-                    point: p,
-                    distance: (emb.point(&p) - y).norm(),
-                });
+        let mut level = 0..seen.n;
+        loop {
+            // Try the ring's triangles in order of how far outside each one the Euclidean
+            // projection of `y` onto its plane falls: the face holding the Phong projection
+            // is almost always first, so usually a single Newton solve is needed.
+            let m = level.len();
+            order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for &(_, f) in &order[..m] {
+                if let Some(xi) = proj.project_onto_face(y, f) {
+                    let p = SurfacePoint::new(f, xi);
+                    return Some(LocalHit {
+                        point: p,
+                        distance: (emb.point(&p) - y).norm(),
+                    });
+                }
+            }
+            // Next ring of triangles: unseen neighbours across edges, in order.
+            let start_next = seen.n;
+            'fill: for i in level {
+                for g in topo.face_neighbors(seen.ids[i]) {
+                    if g == NONE || seen.contains(g) {
+                        continue;
+                    }
+                    if seen.n == LOCAL_BUDGET {
+                        break 'fill;
+                    }
+                    seen.ids[seen.n] = g;
+                    seen.n += 1;
+                }
+            }
+            if seen.n == start_next {
+                return None;
+            }
+            level = start_next..seen.n;
+            for (o, i) in order.iter_mut().zip(level.clone()) {
+                let f = seen.ids[i];
+                let t = mesh.triangles[f as usize].map(|u| &c[u as usize]);
+                *o = (outside(t[0], t[1], t[2], &y32), f);
             }
         }
-        // Next ring of triangles: unseen neighbours across edges, in order.
-        let start_next = seen.n;
-        'fill: for i in level {
-            for g in topo.face_neighbors(seen.ids[i]) {
-                if g == NONE || seen.contains(g) {
-                    continue;
-                }
-                if seen.n == LOCAL_BUDGET {
-                    break 'fill;
-                }
-                seen.ids[seen.n] = g;
-                seen.n += 1;
-            }
-        }
-        if seen.n == start_next {
-            return None;
-        }
-        level = start_next..seen.n;
     }
 }

@@ -12,7 +12,7 @@ use crate::anchors::AnchorSet;
 use crate::error::SolveError;
 use crate::kernel::{DEFAULT_GAMMA, InverseScratch, inverse_weights};
 use crate::points::{check_point, nearest_corner};
-use crate::search::local_search;
+use crate::search::LocalSearch;
 use crate::weights::{Normalization, validate};
 use crate::{Projector, Vec8};
 
@@ -104,6 +104,7 @@ pub struct ForwardResult {
 #[derive(Clone)]
 pub struct Solver {
     projector: Arc<Projector>,
+    local: Arc<LocalSearch>,
     anchors: AnchorSet,
     gamma: f64,
 }
@@ -116,6 +117,7 @@ impl Solver {
     ) -> Result<Self, SolveError> {
         let set = AnchorSet::with_anchors(projector.embedded().clone(), anchors)?;
         Ok(Self {
+            local: Arc::new(LocalSearch::new(projector.clone())),
             projector,
             anchors: set,
             gamma: DEFAULT_GAMMA,
@@ -133,6 +135,7 @@ impl Solver {
             ));
         }
         Ok(Self {
+            local: Arc::new(LocalSearch::new(projector.clone())),
             projector,
             anchors,
             gamma: DEFAULT_GAMMA,
@@ -158,6 +161,11 @@ impl Solver {
     /// The projector.
     pub fn projector(&self) -> &Arc<Projector> {
         &self.projector
+    }
+
+    /// The local search used by [`SearchMode::Fast`].
+    pub fn local_search(&self) -> &LocalSearch {
+        &self.local
     }
 
     /// The mesh.
@@ -220,13 +228,11 @@ impl Solver {
                     Start::Exhaustive => unreachable!("fast mode always has a start vertex"),
                 };
                 let found = match opts.mode {
-                    SearchMode::Fast => {
-                        local_search(&self.projector, &ybar, v).map(|h| Projection {
-                            point: h.point,
-                            distance: h.distance,
-                            path: ProjectionPath::Local,
-                        })
-                    }
+                    SearchMode::Fast => self.local.search(&ybar, v).map(|h| Projection {
+                        point: h.point,
+                        distance: h.distance,
+                        path: ProjectionPath::Local,
+                    }),
                     _ => None,
                 };
                 let proj = match found {

@@ -450,9 +450,9 @@ fn local_search_finds_points_on_the_surface_from_anywhere() {
     for (i, p) in pts.iter().enumerate() {
         let y = proj.embedded().point(p);
         let start = (i * 37 % s.mesh().n_vertices()) as u32;
-        let v = wavg_solve::search::walk(proj, &y, start);
+        let v = s.local_search().walk(&y, start);
         let near = s.mesh().triangles[p.face as usize].contains(&v);
-        let hit = wavg_solve::search::local_search(proj, &y, start);
+        let hit = s.local_search().search(&y, start);
         // On a convex-ish sphere the walk reaches a corner of the face (or a neighbour).
         if near {
             n_near += 1;
