@@ -979,6 +979,61 @@ mod tests {
     }
 
     #[test]
+    fn real_mesh_landmark_matrix_symmetry() {
+        for file in [
+            "meshes/pig.off",
+            "meshes/camelhead.off",
+            "meshes/fertility.off",
+        ] {
+            let Some(path) =
+                wavg_mesh::data::require_data_file("geodesic::real_mesh_symmetry", file)
+            else {
+                return;
+            };
+            let mesh = valid(wavg_mesh::io::load(&path).unwrap());
+            let opts = DecimateOptions {
+                target: 300,
+                ..Default::default()
+            };
+            let lm = crate::decimate::select_landmarks(&mesh, &opts, &NoProgress).unwrap();
+            let fm = FastMarching::new(&mesh);
+            let n = lm.len();
+            let rows: Vec<Vec<f64>> = lm
+                .par_iter()
+                .map_init(
+                    || fm.workspace(),
+                    |ws, &s| {
+                        let d = fm.run(ws, &[s]);
+                        lm.iter().map(|&l| d[l as usize]).collect()
+                    },
+                )
+                .collect();
+            let (mut sum, mut over, mut worst) = (0.0, 0usize, 0.0f64);
+            for i in 0..n {
+                for j in 0..i {
+                    let q = 0.5 * (rows[i][j] + rows[j][i]);
+                    let a = (rows[i][j] - rows[j][i]).abs() / q;
+                    sum += a;
+                    worst = worst.max(a);
+                    over += usize::from(a > 0.02);
+                }
+            }
+            let pairs = (n * (n - 1) / 2) as f64;
+            eprintln!(
+                "{file}: 300 decimation landmarks, asymmetry mean {:.3}%, max {:.2}%, pairs above 2%: {:.2}%",
+                100.0 * sum / pairs,
+                100.0 * worst,
+                100.0 * over as f64 / pairs
+            );
+            // First-order fast marching is not symmetric for close pairs (a few edges apart).
+            assert!(
+                sum / pairs < 0.005 && (over as f64) < 0.02 * pairs,
+                "{file}"
+            );
+        }
+    }
+
+    #[test]
     fn landmark_distances_rejects_bad_ids_and_honours_cancellation() {
         let mesh = valid(procedural::icosphere(2));
         let n = mesh.n_vertices() as u32;
