@@ -37,7 +37,7 @@ pub fn load_valid(path_or_builtin: &str) -> Result<Arc<ValidMesh>, CliError> {
             eprintln!(
                 "hint: run `wavg info {path_or_builtin}` for details; duplicate vertices, \
                  degenerate/duplicate faces, unreferenced vertices and extra components can \
-                 be removed with wavg_mesh::repair (repair_all)"
+                 be removed with `wavg repair {path_or_builtin} -o FIXED.obj [--largest-component]`"
             );
             Err(CliError::input(format!(
                 "{path_or_builtin}: invalid mesh ({} problem{})",

@@ -119,14 +119,14 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
         if r.remaining.is_empty() {
             let _ = writeln!(
                 o,
-                "repair:               wavg_mesh::repair::repair_all fixes every problem \
+                "repair:               `wavg repair` fixes every problem \
                  (removes {} vertices, {} faces)",
                 r.removed_vertices, r.removed_faces
             );
         } else {
             let _ = writeln!(
                 o,
-                "repair:               wavg_mesh::repair::repair_all leaves: {}",
+                "repair:               `wavg repair` leaves: {} (try --largest-component)",
                 r.remaining.join("; ")
             );
         }

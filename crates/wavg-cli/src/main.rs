@@ -9,6 +9,7 @@ mod forward;
 mod info;
 mod inverse;
 mod precompute;
+mod repair;
 mod textio;
 
 use std::process::ExitCode;
@@ -29,6 +30,8 @@ struct Cli {
 enum Command {
     /// Describe a mesh: counts, topology, and every validation problem.
     Info(info::Args),
+    /// Repair a mesh (weld, drop degenerate/duplicate faces, ...) and write it.
+    Repair(repair::Args),
     /// Compute the 8-D embedding of a mesh and write it as a .wavg file.
     Precompute(precompute::Args),
     /// Forward problem: anchors + weights -> points on the surface.
@@ -54,6 +57,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(a) => info::run(a),
+        Command::Repair(a) => repair::run(a),
         Command::Precompute(a) => precompute::run(a),
         Command::Forward(a) => forward::run(a),
         Command::Inverse(a) => inverse::run(a),

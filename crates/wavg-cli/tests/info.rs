@@ -118,7 +118,7 @@ fn invalid_but_parseable_file_exits_zero_and_lists_problems() {
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("valid:                no"), "{text}");
     assert!(
-        text.contains("repair_all leaves: 1 non-manifold edges"),
+        text.contains("`wavg repair` leaves: 1 non-manifold edges"),
         "{text}"
     );
     assert_eq!(j["repair"]["fixes_all"], false);

@@ -1,0 +1,148 @@
+//! `wavg repair IN -o OUT`: the opt-in repairs scans need, from the command line, with the
+//! new-to-original vertex map so callers can translate their vertex ids.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use wavg_mesh::repair::{RepairOptions, repair_all};
+use wavg_mesh::{analyze, io};
+
+use crate::CliError;
+use crate::common::{load_mesh, one_line};
+
+/// Arguments of `wavg repair`.
+#[derive(clap::Args)]
+#[command(
+    long_about = "Repair a mesh so that wavg can use it, and write the result.\n\n\
+    By default: weld vertices with identical positions, drop degenerate faces (repeated \
+    index, zero area, out-of-range index, NaN/inf corner), drop duplicate faces and drop \
+    unreferenced vertices. Components are kept unless --largest-component is given.\n\n\
+    --map FILE writes one line per output vertex: the 0-based index of the input vertex it \
+    came from (after welding, the lowest such index).\n\n\
+    Exit status: 0 when the output is a valid mesh, 1 when problems remain (the output is \
+    still written, and the remaining problems are listed), 2 for unreadable input."
+)]
+pub struct Args {
+    /// Input mesh (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    pub input: String,
+    /// Output mesh; the format follows the extension.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Weld vertices closer than this distance (0 = identical positions only).
+    #[arg(long, default_value_t = 0.0, conflicts_with = "no_weld")]
+    pub weld: f64,
+    /// Do not weld vertices.
+    #[arg(long)]
+    pub no_weld: bool,
+    /// Keep only the largest connected component (by face count).
+    #[arg(long)]
+    pub largest_component: bool,
+    /// Write the new-to-original vertex map here (one index per line).
+    #[arg(long)]
+    pub map: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `wavg repair`.
+pub fn run(args: Args) -> Result<(), CliError> {
+    if !(args.weld >= 0.0 && args.weld.is_finite()) {
+        return Err(CliError::input(format!(
+            "--weld must be a finite distance >= 0, got {}",
+            args.weld
+        )));
+    }
+    let mesh = load_mesh(&args.input)?;
+    let options = RepairOptions {
+        weld: (!args.no_weld).then_some(args.weld),
+        keep_largest_component: args.largest_component,
+        ..RepairOptions::default()
+    };
+    let r = repair_all(&mesh, &options);
+    let after = analyze(&r.mesh);
+    write_atomically(&args.output, |tmp| {
+        io::save(tmp, &r.mesh).map_err(|e| one_line(&e))
+    })?;
+    if let Some(map) = &args.map {
+        let mut text = String::with_capacity(r.vertex_map.len() * 7);
+        for v in &r.vertex_map {
+            let _ = writeln!(text, "{v}");
+        }
+        write_atomically(map, |tmp| {
+            std::fs::write(tmp, &text).map_err(|e| format!("{}: {e}", tmp.display()))
+        })?;
+    }
+    let problems = after.report.lines();
+    if args.json {
+        let j = serde_json::json!({
+            "input": args.input,
+            "output": args.output,
+            "vertices_before": mesh.n_vertices(),
+            "faces_before": mesh.n_faces(),
+            "vertices": r.mesh.n_vertices(),
+            "faces": r.mesh.n_faces(),
+            "removed_vertices": r.removed_vertices(),
+            "removed_faces": r.removed_faces(mesh.n_faces()),
+            "components": after.stats.components,
+            "valid": after.report.is_valid(),
+            "problems": problems,
+        });
+        println!("{j}");
+    } else {
+        println!(
+            "{} -> {}: {} -> {} vertices, {} -> {} faces, {} component(s)",
+            args.input,
+            args.output.display(),
+            mesh.n_vertices(),
+            r.mesh.n_vertices(),
+            mesh.n_faces(),
+            r.mesh.n_faces(),
+            after.stats.components
+        );
+        if after.report.is_valid() {
+            println!("valid: yes");
+        } else {
+            println!("valid: no; remaining problems:");
+            for p in &problems {
+                println!("  - {p}");
+            }
+        }
+    }
+    if after.report.is_valid() {
+        Ok(())
+    } else {
+        let hint = if after.stats.components > 1 && !args.largest_component {
+            " (several components: try --largest-component)"
+        } else {
+            ""
+        };
+        Err(CliError::failure(format!(
+            "{}: written, but {} problem(s) remain{hint}",
+            args.output.display(),
+            after.report.problems.len()
+        )))
+    }
+}
+
+/// Writes through a temporary file beside `path`, then renames: an interrupted or failed
+/// run never leaves a half-written file under the final name.
+fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), CliError> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    // Keep the extension(s) last so format detection by extension still works.
+    let tmp = path.with_file_name(format!(".tmp-{}-{name}", std::process::id()));
+    if let Err(e) = write(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(CliError::failure(e));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        CliError::failure(format!("{}: {e}", path.display()))
+    })
+}

@@ -1,0 +1,131 @@
+//! `wavg repair` run as a process: repaired output is valid, the vertex map points back to
+//! the input, remaining problems give exit 1, unreadable input exit 2.
+
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use wavg_mesh::{ValidMesh, io, procedural};
+
+fn wavg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(args)
+        .output()
+        .expect("run wavg")
+}
+
+#[test]
+fn repairs_unwelded_mesh_and_writes_vertex_map() {
+    let dir = tempfile::tempdir().unwrap();
+    // A torus whose faces are split into a soup: every face gets its own three vertices.
+    let torus = procedural::torus(10, 6, 1.0, 0.3);
+    let mut soup = torus.clone();
+    soup.positions.clear();
+    soup.triangles.clear();
+    for t in &torus.triangles {
+        let base = soup.positions.len() as u32;
+        soup.positions
+            .extend(t.iter().map(|&v| torus.positions[v as usize]));
+        soup.triangles.push([base, base + 1, base + 2]);
+    }
+    let input = dir.path().join("soup.obj");
+    io::save(&input, &soup).unwrap();
+    let output = dir.path().join("fixed.off");
+    let map = dir.path().join("map.txt");
+    let out = wavg(&[
+        "repair",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+        "--map",
+        map.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let j: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["valid"], true);
+    assert_eq!(j["vertices"], torus.n_vertices());
+    assert_eq!(j["faces"], torus.n_faces());
+    let fixed = ValidMesh::new(io::load(&output).unwrap()).expect("repaired mesh is valid");
+    assert_eq!(fixed.topology().genus(), 1);
+    let lines: Vec<u32> = std::fs::read_to_string(&map)
+        .unwrap()
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect();
+    assert_eq!(lines.len(), fixed.n_vertices());
+    for (new, &old) in lines.iter().enumerate() {
+        assert_eq!(fixed.positions[new], soup.positions[old as usize]);
+    }
+    // No temporary files are left beside the outputs.
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+}
+
+#[test]
+fn remaining_problems_exit_1_and_components_need_opt_in() {
+    let dir = tempfile::tempdir().unwrap();
+    // Two disjoint spheres: valid per component, but two components are fine for info;
+    // a pinched vertex (two cones sharing an apex) is not repairable.
+    let a = procedural::icosphere(1);
+    let mut two = a.clone();
+    let n = a.n_vertices() as u32;
+    two.positions.extend(
+        a.positions
+            .iter()
+            .map(|p| p + nalgebra::Vector3::new(5.0, 0.0, 0.0)),
+    );
+    two.triangles
+        .extend(a.triangles.iter().map(|t| t.map(|v| v + n)));
+    let input = dir.path().join("two.obj");
+    io::save(&input, &two).unwrap();
+    let output = dir.path().join("one.obj");
+    let out = wavg(&[
+        "repair",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+        "--largest-component",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(io::load(&output).unwrap().n_vertices(), a.n_vertices());
+
+    // A fin (three faces on one edge) cannot be repaired: output written, exit 1.
+    let fin = wavg_mesh::TriMesh::new(
+        vec![
+            nalgebra::Vector3::new(0.0, 0.0, 0.0),
+            nalgebra::Vector3::new(1.0, 0.0, 0.0),
+            nalgebra::Vector3::new(0.5, 1.0, 0.0),
+            nalgebra::Vector3::new(0.5, -1.0, 0.0),
+            nalgebra::Vector3::new(0.5, 0.0, 1.0),
+        ],
+        vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
+    );
+    let input = dir.path().join("fin.obj");
+    io::save(&input, &fin).unwrap();
+    let output = dir.path().join("fin-out.obj");
+    let out = wavg(&[
+        "repair",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("non-manifold edges"));
+    assert!(output.exists());
+
+    let out = wavg(&["repair", "/nonexistent.obj", "-o", output.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+}
