@@ -115,8 +115,9 @@ impl FaceSet {
 }
 
 /// How far outside the triangle `(p0, p1, p2)` the Euclidean projection of `y` onto its
-/// plane falls: the most negative barycentric coordinate, negated (0 inside; infinite for a
-/// degenerate triangle). In f32: it only orders the candidates.
+/// plane falls: the smallest barycentric coordinate, negated (negative inside, the more so
+/// the deeper inside; infinite for a degenerate triangle). In f32: it only orders the
+/// candidates.
 #[inline]
 fn outside(p0: &Coord32, p1: &Coord32, p2: &Coord32, y: &Coord32) -> f32 {
     let (mut a, mut b, mut cc, mut d, mut e) = (0.0f32, 0.0, 0.0, 0.0, 0.0);
@@ -137,7 +138,7 @@ fn outside(p0: &Coord32, p1: &Coord32, p2: &Coord32, y: &Coord32) -> f32 {
     let l1 = (cc * d - b * e) / det;
     let l2 = (a * e - b * d) / det;
     let l0 = 1.0 - l1 - l2;
-    (-l0).max(-l1).max(-l2).max(0.0)
+    (-l0).max(-l1).max(-l2)
 }
 
 impl LocalSearch {
