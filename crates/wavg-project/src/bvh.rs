@@ -10,7 +10,7 @@ const LEAF: usize = 4;
 /// Traversal stack size; the median split keeps the depth near log2(faces / LEAF).
 const STACK: usize = 96;
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 struct Node {
     lo: [f32; 8],
     hi: [f32; 8],
@@ -54,13 +54,28 @@ fn step(f: f32, up: bool) -> f32 {
 }
 
 impl Bvh {
-    /// Builds the hierarchy over boxes `(lo, hi)`, one per face.
-    pub fn new(boxes: &[(Vec8, Vec8)]) -> Self {
-        let mut items: Vec<u32> = (0..boxes.len() as u32).collect();
-        let centers: Vec<Vec8> = boxes.iter().map(|(l, h)| (l + h) * 0.5).collect();
-        let mut nodes = Vec::with_capacity(2 * boxes.len() / LEAF + 1);
-        if !boxes.is_empty() {
-            build(&mut nodes, &mut items, 0, boxes, &centers);
+    /// Builds the hierarchy over the triangles `tris` with corners `coords` (median
+    /// splits along the widest axis of the centroids; large subtrees in parallel).
+    pub fn new(tris: &[[u32; 3]], coords: &[Vec8]) -> Self {
+        use rayon::prelude::*;
+        let mut items: Vec<u32> = (0..tris.len() as u32).collect();
+        let centers: Vec<[f32; 8]> = tris
+            .par_iter()
+            .with_min_len(4096)
+            .map(|t| {
+                let c =
+                    (coords[t[0] as usize] + coords[t[1] as usize] + coords[t[2] as usize]) / 3.0;
+                std::array::from_fn(|k| c[k] as f32)
+            })
+            .collect();
+        let mut nodes = vec![Node::default(); node_count(tris.len())];
+        if !tris.is_empty() {
+            let geo = Geometry {
+                tris,
+                coords,
+                centers: &centers,
+            };
+            build(&mut nodes, 0, &mut items, 0, &geo);
         }
         Self { nodes, items }
     }
@@ -146,43 +161,98 @@ fn box_dist2(n: &Node, y: &Vec8) -> f64 {
     s
 }
 
+/// Subtrees of at least this many faces are built in parallel.
+const PARALLEL_BUILD: usize = 8192;
+
+/// Nodes of the tree over `n` faces (median splits down to `LEAF`).
+fn node_count(n: usize) -> usize {
+    if n == 0 {
+        0
+    } else if n <= LEAF {
+        1
+    } else {
+        1 + node_count(n / 2) + node_count(n - n / 2)
+    }
+}
+
+struct Geometry<'a> {
+    tris: &'a [[u32; 3]],
+    coords: &'a [Vec8],
+    centers: &'a [[f32; 8]],
+}
+
+/// Builds the subtree over `items` (at `offset` in the item list) into `nodes`, whose
+/// first entry has absolute index `base`; returns its bounding box.
 fn build(
-    nodes: &mut Vec<Node>,
+    nodes: &mut [Node],
+    base: usize,
     items: &mut [u32],
     offset: usize,
-    boxes: &[(Vec8, Vec8)],
-    centers: &[Vec8],
-) {
-    let mut lo = Vec8::repeat(f64::INFINITY);
-    let mut hi = Vec8::repeat(f64::NEG_INFINITY);
-    let mut clo = Vec8::repeat(f64::INFINITY);
-    let mut chi = Vec8::repeat(f64::NEG_INFINITY);
-    for &f in items.iter() {
-        let (l, h) = &boxes[f as usize];
-        lo = lo.inf(l);
-        hi = hi.sup(h);
-        clo = clo.inf(&centers[f as usize]);
-        chi = chi.sup(&centers[f as usize]);
-    }
-    let me = nodes.len();
-    nodes.push(Node {
-        lo: std::array::from_fn(|k| down(lo[k])),
-        hi: std::array::from_fn(|k| up(hi[k])),
-        a: offset as u32,
-        n: items.len() as u32,
-    });
+    g: &Geometry,
+) -> ([f64; 8], [f64; 8]) {
     if items.len() <= LEAF {
-        return;
+        let mut lo = [f64::INFINITY; 8];
+        let mut hi = [f64::NEG_INFINITY; 8];
+        for &f in items.iter() {
+            for &v in &g.tris[f as usize] {
+                let c = &g.coords[v as usize];
+                for k in 0..8 {
+                    lo[k] = lo[k].min(c[k]);
+                    hi[k] = hi[k].max(c[k]);
+                }
+            }
+        }
+        nodes[0] = Node {
+            lo: std::array::from_fn(|k| down(lo[k])),
+            hi: std::array::from_fn(|k| up(hi[k])),
+            a: offset as u32,
+            n: items.len() as u32,
+        };
+        return (lo, hi);
     }
-    let axis = (chi - clo).imax();
+    let mut clo = [f32::INFINITY; 8];
+    let mut chi = [f32::NEG_INFINITY; 8];
+    for &f in items.iter() {
+        let c = &g.centers[f as usize];
+        for k in 0..8 {
+            clo[k] = clo[k].min(c[k]);
+            chi[k] = chi[k].max(c[k]);
+        }
+    }
+    let mut axis = 0;
+    for k in 1..8 {
+        if chi[k] - clo[k] > chi[axis] - clo[axis] {
+            axis = k;
+        }
+    }
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |&a, &b| {
-        centers[a as usize][axis].total_cmp(&centers[b as usize][axis])
+        g.centers[a as usize][axis].total_cmp(&g.centers[b as usize][axis])
     });
+    let parallel = items.len() >= PARALLEL_BUILD;
     let (left, right) = items.split_at_mut(mid);
-    build(nodes, left, offset, boxes, centers);
-    let r = nodes.len();
-    build(nodes, right, offset + mid, boxes, centers);
-    nodes[me].a = r as u32;
-    nodes[me].n = 0;
+    let nl = node_count(left.len());
+    let (me, rest) = nodes.split_at_mut(1);
+    let (ln, rn) = rest.split_at_mut(nl);
+    let right_base = base + 1 + nl;
+    let ((llo, lhi), (rlo, rhi)) = if parallel {
+        rayon::join(
+            || build(ln, base + 1, left, offset, g),
+            || build(rn, right_base, right, offset + mid, g),
+        )
+    } else {
+        (
+            build(ln, base + 1, left, offset, g),
+            build(rn, right_base, right, offset + mid, g),
+        )
+    };
+    let lo: [f64; 8] = std::array::from_fn(|k| llo[k].min(rlo[k]));
+    let hi: [f64; 8] = std::array::from_fn(|k| lhi[k].max(rhi[k]));
+    me[0] = Node {
+        lo: std::array::from_fn(|k| down(lo[k])),
+        hi: std::array::from_fn(|k| up(hi[k])),
+        a: right_base as u32,
+        n: 0,
+    };
+    (lo, hi)
 }

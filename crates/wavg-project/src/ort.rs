@@ -20,36 +20,26 @@ pub const I2: M2 = [1.0, 0.0, 0.0, 1.0];
 /// ```
 pub fn ort(m: &M2) -> M2 {
     let [a, b, c, d] = *m;
-    let scale = a.abs().max(b.abs()).max(c.abs()).max(d.abs());
-    if !(scale > 1e-300) || !scale.is_finite() {
-        return I2;
-    }
-    let (a, b, c, d) = (a / scale, b / scale, c / scale, d / scale);
+    // Rotation [[p, -q], [q, p]] from (a + d, c - b); reflection [[p, q], [q, -p]] from
+    // (a - d, b + c). The branch matches the sign of det(m); when its vector vanishes
+    // (m is a scaled orthogonal matrix of the other kind, or zero) try the other one.
+    let rot = (a + d, c - b);
+    let refl = (a - d, b + c);
     let det = a * d - b * c;
-    // Rotation: [[a+d, b-c], [c-b, a+d]]; reflection: [[a-d, b+c], [c+b, d-a]].
-    let (p, q, r, s) = if det >= 0.0 {
-        (a + d, b - c, c - b, a + d)
+    let order = if det >= 0.0 {
+        [true, false]
     } else {
-        (a - d, b + c, c + b, d - a)
+        [false, true]
     };
-    let n0 = (p * p + r * r).sqrt();
-    let n1 = (q * q + s * s).sqrt();
-    if n0 < 1e-150 || n1 < 1e-150 {
-        // a is (numerically) rank deficient in a way that makes both choices degenerate:
-        // any orthogonal matrix is equally close; fall back to the other branch or I.
-        let (p, q, r, s) = if det >= 0.0 {
-            (a - d, b + c, c + b, d - a)
-        } else {
-            (a + d, b - c, c - b, a + d)
-        };
-        let n0 = (p * p + r * r).sqrt();
-        let n1 = (q * q + s * s).sqrt();
-        if n0 < 1e-150 || n1 < 1e-150 {
-            return I2;
+    for is_rot in order {
+        let (x, y) = if is_rot { rot } else { refl };
+        let n = (x * x + y * y).sqrt();
+        if n > 1e-300 && n.is_finite() {
+            let (p, q) = (x / n, y / n);
+            return if is_rot { [p, -q, q, p] } else { [p, q, q, -p] };
         }
-        return [p / n0, q / n1, r / n0, s / n1];
     }
-    [p / n0, q / n1, r / n0, s / n1]
+    I2
 }
 
 /// Product `a b`.

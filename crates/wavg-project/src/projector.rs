@@ -21,11 +21,12 @@ use crate::triangle::{Frame32, TriData, frame_to_f32, frame_to_f64};
 use crate::{EmbeddedMesh, Mat2x8, ProjectError, Vec8};
 
 /// A distance below this fraction of the triangle's longest edge counts as zero: such a
-/// projection is a global minimum up to the f32 precision of the per-triangle data.
-pub const ZERO_DISTANCE: f64 = 1e-5;
+/// projection is a global minimum up to rounding (the tangent equations of a point on a
+/// triangle hold to f64 precision), so the fast path returns it without certification.
+pub const ZERO_DISTANCE: f64 = 1e-10;
 
 /// Faces the local search may test before certifying or falling back.
-const LOCAL_BUDGET: usize = 128;
+const LOCAL_BUDGET: usize = 64;
 
 /// Which search produced a projection.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -118,32 +119,35 @@ impl Projector {
         }
         let coords = emb.coords();
         let chunk = 4096;
-        let framed: Vec<(Mat2x8, FrameKind)> = (0..mesh.n_vertices())
+        let (frames, kinds): (Vec<Frame32>, Vec<FrameKind>) = (0..mesh.n_vertices())
             .into_par_iter()
             .with_min_len(chunk)
-            .map(|v| crate::frames::vertex_frame(mesh, coords, v as u32))
-            .collect();
+            .map(|v| {
+                let (t, k) = crate::frames::vertex_frame(mesh, coords, v as u32);
+                (frame_to_f32(&t), k)
+            })
+            .unzip();
         let mut frame_kinds = [0; 4];
-        let frames: Vec<Frame32> = framed
-            .iter()
-            .map(|(t, k)| {
-                frame_kinds[*k as usize] += 1;
-                frame_to_f32(t)
-            })
-            .collect();
-        let tris: Vec<TriData> = mesh
-            .triangles
-            .par_iter()
-            .with_min_len(chunk)
-            .map(|t| TriData::new(t.map(|v| &frames[v as usize])))
-            .collect();
-        let boxes: Vec<(Vec8, Vec8)> = (0..mesh.n_faces())
-            .map(|f| {
-                let [a, b, c] = emb.corners(f);
-                (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
-            })
-            .collect();
-        let bvh = Bvh::new(&boxes);
+        for k in kinds {
+            frame_kinds[k as usize] += 1;
+        }
+        const BATCH: usize = 4;
+        let mut tris = vec![TriData::default(); mesh.n_faces()];
+        tris.par_chunks_mut(BATCH)
+            .zip(mesh.triangles.par_chunks(BATCH))
+            .with_min_len(chunk / BATCH)
+            .for_each(|(out, ts)| {
+                let fr = |t: &[u32; 3]| t.map(|v| &frames[v as usize]);
+                if ts.len() == BATCH {
+                    let d = TriData::new_batch([fr(&ts[0]), fr(&ts[1]), fr(&ts[2]), fr(&ts[3])]);
+                    out.copy_from_slice(&d);
+                } else {
+                    for (o, t) in out.iter_mut().zip(ts) {
+                        *o = TriData::new(fr(t));
+                    }
+                }
+            });
+        let bvh = Bvh::new(&mesh.triangles, coords);
         let (lo, hi) = coords.iter().fold(
             (Vec8::repeat(f64::INFINITY), Vec8::repeat(f64::NEG_INFINITY)),
             |(l, h), c| (l.inf(c), h.sup(c)),
@@ -274,22 +278,67 @@ impl Projector {
         // 1. Greedy walk.
         let mut ring_d = [0.0f32; 64];
         let v = self.walk_inner(y, start, &mut ring_d);
-        // 2. Faces around v, most promising first (nearest opposite corners).
+        // 2. Faces around v, most promising first: by how far inside each face's plane
+        // the query's orthogonal projection falls (walk coordinates, already cached).
         let ring = topo.ring(v);
         let faces = topo.ring_faces(v);
-        let yw = self.walk_point(y);
-        let dist = |j: usize| {
-            if j < 64 {
-                ring_d[j]
-            } else {
-                dist2(&self.walk_coords[ring[j] as usize], &yw)
-            }
-        };
-        let mut order = [(0.0f32, 0u32); 64];
         let m = faces.len().min(64);
-        for j in 0..m {
-            let score = dist(j) + dist((j + 1) % ring.len());
-            order[j] = (score, faces[j]);
+        let mut order = [(0.0f32, 0u32); 64];
+        if ring.len() <= 64 {
+            let yw = self.walk_point(y);
+            let wv = &self.walk_coords[v as usize];
+            let mut dy = [0.0f32; 8];
+            for k in 0..8 {
+                dy[k] = yw.0[k] - wv.0[k];
+            }
+            // Per neighbour j: |e_j|^2, e_j . (y - v) and e_j . e_{j+1}, e_j = u_j - v.
+            let mut ee = [0.0f32; 64];
+            let mut de = [0.0f32; 64];
+            let mut ee1 = [0.0f32; 64];
+            let edge = |u: u32| {
+                let wu = &self.walk_coords[u as usize];
+                let mut d = [0.0f32; 8];
+                for k in 0..8 {
+                    d[k] = wu.0[k] - wv.0[k];
+                }
+                d
+            };
+            let first = edge(ring[0]);
+            let mut cur = first;
+            for j in 0..ring.len() {
+                let next = if j + 1 < ring.len() {
+                    edge(ring[j + 1])
+                } else {
+                    first
+                };
+                let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
+                for k in 0..8 {
+                    a += cur[k] * cur[k];
+                    b += cur[k] * dy[k];
+                    c += cur[k] * next[k];
+                }
+                ee[j] = a;
+                de[j] = b;
+                ee1[j] = c;
+                cur = next;
+            }
+            for j in 0..m {
+                let l = if j + 1 == ring.len() { 0 } else { j + 1 };
+                let ab = ee1[j];
+                let det = ee[j] * ee[l] - ab * ab;
+                let score = if det > 0.0 {
+                    let s = (ee[l] * de[j] - ab * de[l]) / det;
+                    let t = (ee[j] * de[l] - ab * de[j]) / det;
+                    -(s.min(t).min(1.0 - s - t))
+                } else {
+                    f32::INFINITY
+                };
+                order[j] = (if score.is_nan() { f32::INFINITY } else { score }, faces[j]);
+            }
+        } else {
+            for j in 0..m {
+                order[j] = (ring_d[j] + ring_d[(j + 1) % 64], faces[j]);
+            }
         }
         order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         let mut tested = Tested::new();
