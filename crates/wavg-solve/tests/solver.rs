@@ -466,3 +466,33 @@ fn local_search_finds_points_on_the_surface_from_anywhere() {
         "the walk ended next to the point only {n_near} times of 200"
     );
 }
+
+/// With a real geodesic embedding (the precomputation pipeline) instead of 3-D positions.
+#[test]
+fn round_trips_with_a_geodesic_embedding() {
+    for (name, mesh, k) in [
+        ("bump sphere", procedural::bump_sphere(4, 0.5), 40),
+        ("torus", procedural::torus(64, 24, 1.0, 0.35), 60),
+    ] {
+        let mesh = Arc::new(ValidMesh::new(mesh).unwrap());
+        let opts = wavg_embed::pipeline::PrecomputeOptions {
+            landmarks: 300,
+            ..Default::default()
+        };
+        let (e, _) =
+            wavg_embed::pipeline::precompute(&mesh, &opts, &wavg_embed::NoProgress).unwrap();
+        let coords = e
+            .coords
+            .iter()
+            .map(|c| wavg_solve::Vec8::from(*c))
+            .collect();
+        let emb = Arc::new(EmbeddedMesh::new(mesh.clone(), coords).unwrap());
+        let proj = Arc::new(Projector::new(emb).unwrap());
+        let a = farthest_point_vertices(&mesh, k, 1, FpsMetric::EdgeGraph).unwrap();
+        let s = Solver::new(proj, a.into_iter().map(Anchor::Vertex)).unwrap();
+        let f = round_trip_fraction(&s, 500, 2, SearchMode::Fast);
+        assert!(f >= 0.99, "{name}: round trip fraction {f}");
+        let f = round_trip_fraction(&s, 100, 3, SearchMode::Certified);
+        assert!(f >= 0.99, "{name} (certified): round trip fraction {f}");
+    }
+}
