@@ -35,6 +35,10 @@ pub struct Args {
     /// Seed of the quality-check pairs (every other stage is deterministic).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Run the landmark geodesics on an intermediate decimated mesh with this many vertices
+    /// when the mesh has more (0: always on the full mesh).
+    #[arg(long, value_name = "N")]
+    pub geodesic_vertices: Option<usize>,
     /// Vertex pairs of the quality check (0 skips it).
     #[arg(long, default_value_t = 1024)]
     pub quality_pairs: usize,
@@ -66,11 +70,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let load_seconds = t_load.elapsed().as_secs_f64();
 
+    let defaults = PrecomputeOptions::default();
     let opts = PrecomputeOptions {
+        geodesic_vertices: args.geodesic_vertices.unwrap_or(defaults.geodesic_vertices),
         landmarks: args.landmarks,
         seed: args.seed,
         quality_pairs: args.quality_pairs,
-        ..Default::default()
+        ..defaults
     };
     let bars = Bars::new(std::io::stderr().is_terminal());
     let result = embed::precompute(&mesh, &opts, &bars);
@@ -101,6 +107,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "load_seconds": load_seconds,
             "save_seconds": save_seconds,
             "landmarks": report.landmarks,
+            "geodesic_mesh_vertices": report.geodesic_mesh_vertices,
             "dim": report.dim,
             "stress": report.stress,
             "initial_stress": report.initial_stress,
@@ -124,6 +131,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
         println!("output        {}", args.output.display());
         println!("landmarks     {}  dim {}", report.landmarks, report.dim);
+        if report.geodesic_mesh_vertices != report.vertices {
+            println!(
+                "geodesics     on an intermediate mesh of {} vertices",
+                report.geodesic_mesh_vertices
+            );
+        }
         println!(
             "stress        {:.4} (classical start {:.4}, {} SMACOF iterations{})",
             report.stress,

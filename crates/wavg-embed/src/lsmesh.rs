@@ -9,7 +9,9 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
+use faer::sparse::linalg::cholesky::{
+    LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+};
 use faer::sparse::linalg::matmul::sparse_sparse_matmul;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Conj, Mat, Par, Side};
@@ -64,19 +66,208 @@ fn fixed_mask(n: usize, landmarks: &[u32]) -> Result<Vec<bool>, EmbedError> {
     Ok(fixed)
 }
 
+/// The factored least-squares-mesh system of a mesh and a landmark set; [`Self::solve`]
+/// then extends any landmark values. The factorisation depends only on the mesh and the
+/// landmarks, so it can run before (or while) the landmark values are computed.
+pub struct LsMeshSolver {
+    n: usize,
+    landmarks: Vec<u32>,
+    /// Free vertex ids, in system order.
+    free: Vec<u32>,
+    /// Coupling `A_FS`: `(free row, landmark index, value)`.
+    coupling: Vec<(u32, u32, f64)>,
+    symbolic: SymbolicCholesky<usize>,
+    l_values: Vec<f64>,
+}
+
+impl LsMeshSolver {
+    /// Assembles and factors `A_FF` for `landmarks` (distinct vertex ids, at least one).
+    ///
+    /// The mesh should be connected (otherwise a component without landmarks makes the
+    /// system singular, reported as [`EmbedError::Numerical`]). Progress is reported as
+    /// [`Stage::LsMesh`] up to 0.9.
+    pub fn new(
+        mesh: &ValidMesh,
+        landmarks: &[u32],
+        progress: &dyn Progress,
+    ) -> Result<Self, EmbedError> {
+        let n = mesh.n_vertices();
+        let fixed = fixed_mask(n, landmarks)?;
+        progress.report(Stage::LsMesh, 0.0);
+        check_cancel(progress)?;
+        let mut landmark_index = vec![u32::MAX; n];
+        for (k, &s) in landmarks.iter().enumerate() {
+            landmark_index[s as usize] = k as u32;
+        }
+        let mut free_id = vec![usize::MAX; n];
+        let mut free = Vec::with_capacity(n - landmarks.len());
+        for v in 0..n {
+            if !fixed[v] {
+                free_id[v] = free.len();
+                free.push(v as u32);
+            }
+        }
+        let nf = free.len();
+
+        let a = bilaplacian(mesh)?;
+        progress.report(Stage::LsMesh, 0.15);
+        check_cancel(progress)?;
+
+        // A_FF (lower triangle only, which is all the factorisation reads) and the coupling
+        // A_FS, in one sweep over the columns of the symmetric A.
+        let (sym, vals) = a.parts();
+        let mut col_ptr = Vec::with_capacity(nf + 1);
+        let mut row_idx = Vec::new();
+        let mut ff_vals = Vec::new();
+        let mut coupling = Vec::new();
+        let mut entries: Vec<(usize, f64)> = Vec::new();
+        col_ptr.push(0usize);
+        for &j in &free {
+            let j = j as usize;
+            let jf = free_id[j];
+            entries.clear();
+            for k in sym.col_range(j) {
+                let i = sym.row_idx()[k];
+                if fixed[i] {
+                    // A symmetric: A_FS[jf, i] = A[i, j].
+                    coupling.push((jf as u32, landmark_index[i], vals[k]));
+                } else if free_id[i] >= jf {
+                    entries.push((free_id[i], vals[k]));
+                }
+            }
+            entries.sort_unstable_by_key(|e| e.0);
+            for &(i, x) in &entries {
+                row_idx.push(i);
+                ff_vals.push(x);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        drop(a);
+        let a_ff = SparseColMat::new(
+            SymbolicSparseColMat::new_checked(nf, nf, col_ptr, None, row_idx),
+            ff_vals,
+        );
+        check_cancel(progress)?;
+
+        let par = Par::Seq;
+        let symbolic = factorize_symbolic_cholesky(
+            a_ff.symbolic(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            Default::default(),
+        )
+        .map_err(|e| {
+            EmbedError::Numerical(format!("least-squares mesh symbolic Cholesky: {e:?}"))
+        })?;
+        progress.report(Stage::LsMesh, 0.3);
+        check_cancel(progress)?;
+        let mut l_values = vec![0.0; symbolic.len_val()];
+        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+        symbolic
+            .factorize_numeric_llt(
+                &mut l_values,
+                a_ff.as_ref(),
+                Side::Lower,
+                LltRegularization::default(),
+                par,
+                MemStack::new(&mut MemBuffer::new(scratch)),
+                Default::default(),
+            )
+            .map_err(|e| {
+                EmbedError::Numerical(format!(
+                    "least-squares mesh system is not positive definite ({e:?}); \
+                     is every connected component given a landmark?"
+                ))
+            })?;
+        progress.report(Stage::LsMesh, 0.9);
+        Ok(Self {
+            n,
+            landmarks: landmarks.to_vec(),
+            free,
+            coupling,
+            symbolic,
+            l_values,
+        })
+    }
+
+    /// One point per vertex, equal to `values[k]` at vertex `landmarks[k]` and minimising the
+    /// bi-Laplacian energy elsewhere. Only the first `dim` entries of each value are used;
+    /// the rest of the output is zero.
+    pub fn solve(
+        &self,
+        values: &[[f64; MAX_DIM]],
+        dim: usize,
+    ) -> Result<Vec<[f64; MAX_DIM]>, EmbedError> {
+        if dim == 0 || dim > MAX_DIM {
+            return Err(EmbedError::InvalidArgument(format!(
+                "embedding dimension {dim} not in 1..={MAX_DIM}"
+            )));
+        }
+        if values.len() != self.landmarks.len() {
+            return Err(EmbedError::InvalidArgument(format!(
+                "{} values for {} landmarks",
+                values.len(),
+                self.landmarks.len()
+            )));
+        }
+        if values
+            .iter()
+            .any(|v| v[..dim].iter().any(|c| !c.is_finite()))
+        {
+            return Err(EmbedError::InvalidArgument(
+                "landmark values must be finite".into(),
+            ));
+        }
+        let mut out = vec![[0.0; MAX_DIM]; self.n];
+        for (&s, v) in self.landmarks.iter().zip(values) {
+            out[s as usize][..dim].copy_from_slice(&v[..dim]);
+        }
+        let nf = self.free.len();
+        if nf == 0 {
+            return Ok(out);
+        }
+        let mut rhs = Mat::<f64>::zeros(nf, dim);
+        for &(jf, k, a) in &self.coupling {
+            for c in 0..dim {
+                rhs[(jf as usize, c)] -= a * values[k as usize][c];
+            }
+        }
+        let par = Par::Seq;
+        let scratch = self.symbolic.solve_in_place_scratch::<f64>(dim, par);
+        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
+            Conj::No,
+            rhs.as_mut(),
+            par,
+            MemStack::new(&mut MemBuffer::new(scratch)),
+        );
+        for (jf, &v) in self.free.iter().enumerate() {
+            for c in 0..dim {
+                out[v as usize][c] = rhs[(jf, c)];
+            }
+        }
+        if out.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(EmbedError::Numerical(
+                "least-squares mesh produced non-finite coordinates".into(),
+            ));
+        }
+        Ok(out)
+    }
+}
+
 /// Solves the least-squares mesh: returns one point per vertex, equal to `values[k]` at
 /// vertex `landmarks[k]` and minimising the bi-Laplacian energy elsewhere. Only the first
 /// `dim` entries of each value are used; the rest of the output is zero.
 ///
 /// The mesh should be connected (otherwise a component without landmarks makes the system
-/// singular, reported as [`EmbedError::Numerical`]).
+/// singular, reported as [`EmbedError::Numerical`]). See [`LsMeshSolver`] to factor once
+/// and solve several times.
 ///
 /// ```
 /// use wavg_embed::lsmesh::least_squares_mesh;
 /// use wavg_embed::NoProgress;
 /// use wavg_mesh::{ValidMesh, procedural};
 /// let mesh = ValidMesh::new(procedural::icosphere(2)).unwrap();
-/// // Fixing every vertex to a constant extends to the constant.
+/// // Constant landmark values extend to the constant.
 /// let landmarks = vec![0, 10, 20];
 /// let values = vec![[1.0; 8]; 3];
 /// let x = least_squares_mesh(&mesh, &landmarks, &values, 8, &NoProgress).unwrap();
@@ -89,7 +280,6 @@ pub fn least_squares_mesh(
     dim: usize,
     progress: &dyn Progress,
 ) -> Result<Vec<[f64; MAX_DIM]>, EmbedError> {
-    let n = mesh.n_vertices();
     if dim == 0 || dim > MAX_DIM {
         return Err(EmbedError::InvalidArgument(format!(
             "embedding dimension {dim} not in 1..={MAX_DIM}"
@@ -102,124 +292,9 @@ pub fn least_squares_mesh(
             landmarks.len()
         )));
     }
-    if values
-        .iter()
-        .any(|v| v[..dim].iter().any(|c| !c.is_finite()))
-    {
-        return Err(EmbedError::InvalidArgument(
-            "landmark values must be finite".into(),
-        ));
-    }
-    let fixed = fixed_mask(n, landmarks)?;
-    progress.report(Stage::LsMesh, 0.0);
+    let solver = LsMeshSolver::new(mesh, landmarks, progress)?;
     check_cancel(progress)?;
-
-    let mut out = vec![[0.0; MAX_DIM]; n];
-    for (&s, v) in landmarks.iter().zip(values) {
-        out[s as usize][..dim].copy_from_slice(&v[..dim]);
-    }
-    // Free-vertex numbering.
-    let mut free_id = vec![usize::MAX; n];
-    let mut free = Vec::with_capacity(n - landmarks.len());
-    for v in 0..n {
-        if !fixed[v] {
-            free_id[v] = free.len();
-            free.push(v);
-        }
-    }
-    let nf = free.len();
-    if nf == 0 {
-        progress.report(Stage::LsMesh, 1.0);
-        return Ok(out);
-    }
-
-    let a = bilaplacian(mesh)?;
-    progress.report(Stage::LsMesh, 0.15);
-    check_cancel(progress)?;
-
-    // A_FF (lower triangle only, which is all the factorisation reads) and the right-hand
-    // side -A_FS v_S, in one sweep over the columns of the symmetric A.
-    let (sym, vals) = a.parts();
-    let mut col_ptr = Vec::with_capacity(nf + 1);
-    let mut row_idx = Vec::new();
-    let mut ff_vals = Vec::new();
-    let mut rhs = Mat::<f64>::zeros(nf, dim);
-    col_ptr.push(0usize);
-    for &j in &free {
-        let jf = free_id[j];
-        let mut entries: Vec<(usize, f64)> = Vec::new();
-        for k in sym.col_range(j) {
-            let i = sym.row_idx()[k];
-            let x = vals[k];
-            if fixed[i] {
-                // A symmetric: A_FS[jf, i] = A[i, j].
-                for c in 0..dim {
-                    rhs[(jf, c)] -= x * out[i][c];
-                }
-            } else if free_id[i] >= jf {
-                entries.push((free_id[i], x));
-            }
-        }
-        entries.sort_unstable_by_key(|e| e.0);
-        for (i, x) in entries {
-            row_idx.push(i);
-            ff_vals.push(x);
-        }
-        col_ptr.push(row_idx.len());
-    }
-    let a_ff = SparseColMat::new(
-        SymbolicSparseColMat::new_checked(nf, nf, col_ptr, None, row_idx),
-        ff_vals,
-    );
-    check_cancel(progress)?;
-
-    let par = Par::Seq;
-    let symbolic = factorize_symbolic_cholesky(
-        a_ff.symbolic(),
-        Side::Lower,
-        SymmetricOrdering::Amd,
-        Default::default(),
-    )
-    .map_err(|e| EmbedError::Numerical(format!("least-squares mesh symbolic Cholesky: {e:?}")))?;
-    progress.report(Stage::LsMesh, 0.3);
-    check_cancel(progress)?;
-    let mut l_values = vec![0.0; symbolic.len_val()];
-    let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
-    let llt = symbolic
-        .factorize_numeric_llt(
-            &mut l_values,
-            a_ff.as_ref(),
-            Side::Lower,
-            LltRegularization::default(),
-            par,
-            MemStack::new(&mut MemBuffer::new(scratch)),
-            Default::default(),
-        )
-        .map_err(|e| {
-            EmbedError::Numerical(format!(
-                "least-squares mesh system is not positive definite ({e:?}); \
-                 is every connected component given a landmark?"
-            ))
-        })?;
-    progress.report(Stage::LsMesh, 0.9);
-    check_cancel(progress)?;
-    let scratch = symbolic.solve_in_place_scratch::<f64>(dim, par);
-    llt.solve_in_place_with_conj(
-        Conj::No,
-        rhs.as_mut(),
-        par,
-        MemStack::new(&mut MemBuffer::new(scratch)),
-    );
-    for (jf, &v) in free.iter().enumerate() {
-        for c in 0..dim {
-            out[v][c] = rhs[(jf, c)];
-        }
-    }
-    if out.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
-        return Err(EmbedError::Numerical(
-            "least-squares mesh produced non-finite coordinates".into(),
-        ));
-    }
+    let out = solver.solve(values, dim)?;
     progress.report(Stage::LsMesh, 1.0);
     Ok(out)
 }
@@ -294,6 +369,40 @@ mod tests {
                 }
                 let rel = (r2 / b2).sqrt();
                 assert!(rel < 1e-8, "relative residual {rel}");
+            }
+        }
+    }
+
+    #[test]
+    fn one_factorisation_serves_several_value_sets_linearly() {
+        let mesh = ValidMesh::new(procedural::torus(30, 15, 1.0, 0.4)).unwrap();
+        let lm = random_landmarks(mesh.n_vertices(), 30, 2);
+        let solver = LsMeshSolver::new(&mesh, &lm, &NoProgress).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut draw = || -> Vec<[f64; MAX_DIM]> {
+            lm.iter()
+                .map(|_| std::array::from_fn(|_| rng.random_range(-1.0..1.0)))
+                .collect()
+        };
+        let (u, v) = (draw(), draw());
+        let w: Vec<[f64; MAX_DIM]> = u
+            .iter()
+            .zip(&v)
+            .map(|(a, b)| std::array::from_fn(|k| 2.0 * a[k] - 3.0 * b[k]))
+            .collect();
+        let (xu, xv, xw) = (
+            solver.solve(&u, 8).unwrap(),
+            solver.solve(&v, 8).unwrap(),
+            solver.solve(&w, 8).unwrap(),
+        );
+        assert_eq!(
+            xu,
+            least_squares_mesh(&mesh, &lm, &u, 8, &NoProgress).unwrap()
+        );
+        for i in 0..mesh.n_vertices() {
+            for k in 0..MAX_DIM {
+                let lin = 2.0 * xu[i][k] - 3.0 * xv[i][k];
+                assert!((xw[i][k] - lin).abs() < 1e-9, "{} vs {lin}", xw[i][k]);
             }
         }
     }

@@ -64,7 +64,150 @@ pub fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[lo] + (pos - lo as f64) * (sorted[hi] - sorted[lo])
 }
 
-/// Relative error of embedding distance vs fast-marching geodesic distance on random pairs.
+/// Seeded random vertex pairs with their fast-marching distances: computed once (they do
+/// not depend on the embedding), then [`Self::evaluate`] scores any embedding.
+#[derive(Clone, Debug)]
+pub struct QualityPairs {
+    n: usize,
+    /// `(a, b, geodesic distance)`.
+    pairs: Vec<(u32, u32, f64)>,
+}
+
+impl QualityPairs {
+    /// Draws the pairs and runs fast marching (`fm` must be built from `mesh`).
+    pub fn compute(
+        mesh: &ValidMesh,
+        fm: &FastMarching,
+        opts: &QualityOptions,
+        progress: &dyn Progress,
+    ) -> Result<Self, EmbedError> {
+        let n = mesh.n_vertices();
+        if fm.n_vertices() != n {
+            return Err(EmbedError::InvalidArgument(format!(
+                "quality check: a {}-vertex fast-marching structure for a {n}-vertex mesh",
+                fm.n_vertices()
+            )));
+        }
+        if n < 2 || opts.sources == 0 || opts.pairs < opts.sources {
+            return Err(EmbedError::InvalidArgument(format!(
+                "quality check needs >= 2 vertices and pairs >= sources >= 1 (got {n} \
+                 vertices, {} pairs, {} sources)",
+                opts.pairs, opts.sources
+            )));
+        }
+        let n_sources = opts.sources.min(n);
+        let per_source = (opts.pairs / opts.sources).min(n - 1);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(opts.seed);
+        let sources: Vec<u32> = sample(&mut rng, n, n_sources)
+            .into_iter()
+            .map(|v| v as u32)
+            .collect();
+        // Targets per source: distinct, never the source itself.
+        let targets: Vec<Vec<u32>> = sources
+            .iter()
+            .map(|&s| {
+                let mut t: Vec<u32> = sample(&mut rng, n - 1, per_source)
+                    .into_iter()
+                    .map(|v| {
+                        if v as u32 >= s {
+                            v as u32 + 1
+                        } else {
+                            v as u32
+                        }
+                    })
+                    .collect();
+                t.sort_unstable();
+                t
+            })
+            .collect();
+        progress.report(Stage::Quality, 0.0);
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let runs: Vec<Vec<(u32, u32, f64)>> = sources
+            .par_iter()
+            .zip(&targets)
+            .map_init(
+                || (fm.workspace(), vec![false; n]),
+                |(ws, is_target), (&s, ts)| {
+                    check_cancel(progress)?;
+                    for &t in ts {
+                        is_target[t as usize] = true;
+                    }
+                    let d = fm.run_until_targets(ws, &[s], is_target, ts.len());
+                    let mut out = Vec::with_capacity(ts.len());
+                    for &t in ts {
+                        is_target[t as usize] = false;
+                        let g = d[t as usize];
+                        if !(g.is_finite() && g > 0.0) {
+                            return Err(EmbedError::InvalidArgument(format!(
+                                "quality check: vertices {s} and {t} have geodesic distance \
+                                 {g} (is the mesh connected?)"
+                            )));
+                        }
+                        out.push((s, t, g));
+                    }
+                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    progress.report(Stage::Quality, 0.99 * k as f64 / n_sources as f64);
+                    Ok(out)
+                },
+            )
+            .collect::<Result<_, EmbedError>>()?;
+        Ok(Self {
+            n,
+            pairs: runs.into_iter().flatten().collect(),
+        })
+    }
+
+    /// Number of pairs.
+    pub fn len(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// True if there are no pairs.
+    pub fn is_empty(&self) -> bool {
+        self.pairs.is_empty()
+    }
+
+    /// Relative distance errors of `coords` (one point per vertex, all 8 entries used).
+    pub fn evaluate(&self, coords: &[[f64; MAX_DIM]]) -> Result<Quality, EmbedError> {
+        if coords.len() != self.n {
+            return Err(EmbedError::InvalidArgument(format!(
+                "quality check: {} coordinates for a {}-vertex mesh",
+                coords.len(),
+                self.n
+            )));
+        }
+        let mut all: Vec<f64> = self
+            .pairs
+            .iter()
+            .map(|&(s, t, g)| {
+                let (a, b) = (&coords[s as usize], &coords[t as usize]);
+                let e = a
+                    .iter()
+                    .zip(b)
+                    .map(|(x, y)| (x - y) * (x - y))
+                    .sum::<f64>()
+                    .sqrt();
+                (e - g).abs() / g
+            })
+            .collect();
+        if all.iter().any(|e| !e.is_finite()) {
+            return Err(EmbedError::InvalidArgument(
+                "quality check: non-finite embedding coordinates".into(),
+            ));
+        }
+        all.sort_unstable_by(f64::total_cmp);
+        Ok(Quality {
+            pairs: all.len(),
+            rel_err_p50: percentile(&all, 0.5),
+            rel_err_p90: percentile(&all, 0.9),
+            rel_err_mean: all.iter().sum::<f64>() / all.len().max(1) as f64,
+            rel_err_max: *all.last().unwrap_or(&f64::NAN),
+        })
+    }
+}
+
+/// Relative error of embedding distance vs fast-marching geodesic distance on random pairs
+/// ([`QualityPairs::compute`] then [`QualityPairs::evaluate`]).
 ///
 /// `fm` must be built from `mesh`; `coords` holds one embedded point per vertex (all 8
 /// entries are used; unused dimensions must be zero).
@@ -89,99 +232,16 @@ pub fn geodesic_quality(
     opts: &QualityOptions,
     progress: &dyn Progress,
 ) -> Result<Quality, EmbedError> {
-    let n = mesh.n_vertices();
-    if coords.len() != n || fm.n_vertices() != n {
+    if coords.len() != mesh.n_vertices() {
         return Err(EmbedError::InvalidArgument(format!(
-            "quality check: {} coordinates and a {}-vertex fast-marching structure for a \
-             {n}-vertex mesh",
+            "quality check: {} coordinates for a {}-vertex mesh",
             coords.len(),
-            fm.n_vertices()
+            mesh.n_vertices()
         )));
     }
-    if n < 2 || opts.sources == 0 || opts.pairs < opts.sources {
-        return Err(EmbedError::InvalidArgument(format!(
-            "quality check needs >= 2 vertices and pairs >= sources >= 1 (got {n} vertices, \
-             {} pairs, {} sources)",
-            opts.pairs, opts.sources
-        )));
-    }
-    let n_sources = opts.sources.min(n);
-    let per_source = (opts.pairs / opts.sources).min(n - 1);
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(opts.seed);
-    let sources: Vec<u32> = sample(&mut rng, n, n_sources)
-        .into_iter()
-        .map(|v| v as u32)
-        .collect();
-    // Targets per source: distinct, never the source itself.
-    let targets: Vec<Vec<u32>> = sources
-        .iter()
-        .map(|&s| {
-            let mut t: Vec<u32> = sample(&mut rng, n - 1, per_source)
-                .into_iter()
-                .map(|v| {
-                    if v as u32 >= s {
-                        v as u32 + 1
-                    } else {
-                        v as u32
-                    }
-                })
-                .collect();
-            t.sort_unstable();
-            t
-        })
-        .collect();
-    progress.report(Stage::Quality, 0.0);
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    let errors: Vec<Vec<f64>> = sources
-        .par_iter()
-        .zip(&targets)
-        .map_init(
-            || (fm.workspace(), vec![false; n]),
-            |(ws, is_target), (&s, ts)| {
-                check_cancel(progress)?;
-                for &t in ts {
-                    is_target[t as usize] = true;
-                }
-                let d = fm.run_until_targets(ws, &[s], is_target, ts.len());
-                let mut errs = Vec::with_capacity(ts.len());
-                for &t in ts {
-                    is_target[t as usize] = false;
-                    let g = d[t as usize];
-                    if !(g.is_finite() && g > 0.0) {
-                        return Err(EmbedError::InvalidArgument(format!(
-                            "quality check: vertices {s} and {t} have geodesic distance {g} \
-                             (is the mesh connected?)"
-                        )));
-                    }
-                    let (a, b) = (&coords[s as usize], &coords[t as usize]);
-                    let e = a
-                        .iter()
-                        .zip(b)
-                        .map(|(x, y)| (x - y) * (x - y))
-                        .sum::<f64>()
-                        .sqrt();
-                    errs.push((e - g).abs() / g);
-                }
-                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress.report(Stage::Quality, k as f64 / n_sources as f64);
-                Ok(errs)
-            },
-        )
-        .collect::<Result<_, EmbedError>>()?;
-    let mut all: Vec<f64> = errors.into_iter().flatten().collect();
-    if all.iter().any(|e| !e.is_finite()) {
-        return Err(EmbedError::InvalidArgument(
-            "quality check: non-finite embedding coordinates".into(),
-        ));
-    }
-    all.sort_unstable_by(f64::total_cmp);
-    Ok(Quality {
-        pairs: all.len(),
-        rel_err_p50: percentile(&all, 0.5),
-        rel_err_p90: percentile(&all, 0.9),
-        rel_err_mean: all.iter().sum::<f64>() / all.len() as f64,
-        rel_err_max: *all.last().unwrap_or(&f64::NAN),
-    })
+    let q = QualityPairs::compute(mesh, fm, opts, progress)?.evaluate(coords)?;
+    progress.report(Stage::Quality, 1.0);
+    Ok(q)
 }
 
 #[cfg(test)]
