@@ -1,0 +1,65 @@
+//! The pipeline on real meshes from the shared data folder: genus 0, genus > 0 and open
+//! surfaces embed, the result survives the file round trip, and on the pig the quality
+//! meets the targets (geodesic relative error p50 <= 0.05, p90 <= 0.15).
+
+use wavg_embed::{NoProgress, PrecomputeOptions, file, precompute};
+use wavg_mesh::{ValidMesh, data, io};
+
+fn load(test: &str, rel: &str) -> Option<ValidMesh> {
+    let path = data::require_data_file(test, rel)?;
+    Some(ValidMesh::new(io::load(&path).unwrap()).unwrap())
+}
+
+fn embed(mesh: &ValidMesh, landmarks: usize) -> wavg_embed::Report {
+    let opts = PrecomputeOptions {
+        landmarks,
+        quality_pairs: 512,
+        ..Default::default()
+    };
+    let (emb, report) = precompute(mesh, &opts, &NoProgress).unwrap();
+    assert_eq!(emb.landmarks.len(), landmarks);
+    emb.validate(mesh.n_vertices()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.wavg");
+    file::save(&path, &emb, mesh).unwrap();
+    assert_eq!(file::load(&path, mesh).unwrap().coords, emb.coords);
+    report
+}
+
+#[test]
+fn genus_zero_higher_genus_and_open_meshes_embed() {
+    for (rel, genus, open) in [
+        ("meshes/decimated-knight.off", 0, false),
+        ("meshes/torus.obj", 1, false),
+        ("meshes/3holes.off", 3, false),
+        ("meshes/camelhead.off", 0, true),
+    ] {
+        let Some(mesh) = load("genus_zero_higher_genus_and_open_meshes_embed", rel) else {
+            return;
+        };
+        assert_eq!(mesh.topology().genus(), genus, "{rel}");
+        assert_eq!(!mesh.topology().boundary_loops().is_empty(), open, "{rel}");
+        let landmarks = 200.min(mesh.n_vertices() / 2);
+        let r = embed(&mesh, landmarks);
+        eprintln!(
+            "{rel}: {} vertices, {landmarks} landmarks, stress {:.4}, p50 {:.4}, p90 {:.4}",
+            r.vertices, r.stress, r.geodesic_rel_err_p50, r.geodesic_rel_err_p90
+        );
+        assert!(
+            r.geodesic_rel_err_p50 < 0.1 && r.geodesic_rel_err_p90 < 0.25,
+            "{rel}: {r:?}"
+        );
+    }
+}
+
+#[test]
+fn pig_meets_the_quality_targets() {
+    let Some(mesh) = load("pig_meets_the_quality_targets", "meshes/pig.off") else {
+        return;
+    };
+    let r = embed(&mesh, 1000);
+    eprintln!("pig: {r:?}");
+    assert!(r.geodesic_rel_err_p50 <= 0.05, "{r:?}");
+    assert!(r.geodesic_rel_err_p90 <= 0.15, "{r:?}");
+    assert!(r.stress < 0.1);
+}
