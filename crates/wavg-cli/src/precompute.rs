@@ -153,7 +153,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             report.geodesic_rel_err_p50, report.geodesic_rel_err_p90, report.quality_pairs
         );
         println!(
-            "seconds       {:.2} = decimate {:.2} + geodesics {:.2} + mds {:.2} + lsmesh {:.2} + quality {:.2}  (load {:.2}, save {:.2})",
+            "seconds       {:.2}  (stages, some overlapping: decimate {:.2}, geodesics {:.2}, mds {:.2}, lsmesh {:.2}, quality {:.2}; load {:.2}, save {:.2})",
             report.seconds,
             s.decimate,
             s.geodesics,
