@@ -63,3 +63,47 @@ fn pig_meets_the_quality_targets() {
     assert!(r.geodesic_rel_err_p90 <= 0.15, "{r:?}");
     assert!(r.stress < 0.1);
 }
+
+#[test]
+fn least_squares_mesh_of_own_positions_stays_close_on_real_meshes() {
+    use wavg_embed::decimate::{DecimateOptions, select_landmarks};
+    use wavg_embed::lsmesh::least_squares_mesh;
+    for rel in [
+        "meshes/pig.off",
+        "meshes/3holes.off",
+        "meshes/camelhead.off",
+    ] {
+        let Some(mesh) = load("least_squares_mesh_of_own_positions_stays_close", rel) else {
+            return;
+        };
+        let opts = DecimateOptions {
+            target: 1000,
+            ..Default::default()
+        };
+        let lm = select_landmarks(&mesh, &opts, &NoProgress).unwrap();
+        let values: Vec<[f64; 8]> = lm
+            .iter()
+            .map(|&s| {
+                let p = mesh.positions[s as usize];
+                [p.x, p.y, p.z, 0.0, 0.0, 0.0, 0.0, 0.0]
+            })
+            .collect();
+        let x = least_squares_mesh(&mesh, &lm, &values, 3, &NoProgress).unwrap();
+        let diag = mesh.bounding_box_diagonal();
+        let dev: Vec<f64> = mesh
+            .positions
+            .iter()
+            .zip(&x)
+            .map(|(p, q)| {
+                ((p.x - q[0]).powi(2) + (p.y - q[1]).powi(2) + (p.z - q[2]).powi(2)).sqrt() / diag
+            })
+            .collect();
+        let mean = dev.iter().sum::<f64>() / dev.len() as f64;
+        let max = dev.iter().fold(0.0f64, |m, &d| m.max(d));
+        eprintln!(
+            "{rel}: LS mesh of the 1000 landmarks' own positions deviates from the surface by \
+             {mean:.2e} (mean) / {max:.2e} (max) of the bounding-box diagonal"
+        );
+        assert!(mean < 0.005 && max < 0.05, "{rel}: mean {mean}, max {max}");
+    }
+}
