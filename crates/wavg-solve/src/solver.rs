@@ -283,17 +283,27 @@ impl Solver {
 
     /// Forward problem for many weight vectors in parallel; result `i` belongs to
     /// `weights[i]`. Every query is independent, so the results do not depend on the
-    /// number of threads.
+    /// number of threads. Queries are processed grouped by their two highest-weight anchors
+    /// (nearby queries together, so their walks share cached memory); each still starts
+    /// from its own highest-weight anchor, so the results equal [`Solver::forward`]'s.
     pub fn forward_batch<W: AsRef<[f64]> + Sync>(
         &self,
         weights: &[W],
         opts: &ForwardOptions,
     ) -> Vec<Result<ForwardResult, SolveError>> {
-        weights
+        let keys: Vec<(u64, u32)> = weights
+            .par_iter()
+            .with_min_len(1024)
+            .enumerate()
+            .map(|(i, w)| (top_two(w.as_ref()), i as u32))
+            .collect();
+        let order = sorted_order(keys);
+        let done: Vec<(u32, Result<ForwardResult, SolveError>)> = order
             .par_iter()
             .with_min_len(64)
-            .map(|w| self.forward(w.as_ref(), opts))
-            .collect()
+            .map(|&i| (i, self.forward(weights[i as usize].as_ref(), opts)))
+            .collect();
+        scatter(done)
     }
 
     /// Forward problem for a sequence of nearby queries (e.g. samples along a curve):
@@ -323,7 +333,8 @@ impl Solver {
             .collect()
     }
 
-    /// Inverse problem for many points in parallel (see [`BatchWeights`]).
+    /// Inverse problem for many points in parallel (see [`BatchWeights`]); each point is
+    /// independent, so the results equal [`Solver::inverse`]'s for any thread count.
     pub fn inverse_batch(&self, points: &[SurfacePoint]) -> BatchWeights {
         let n = self.n_anchors();
         let mut data = vec![0.0; points.len() * n.max(1)];
@@ -344,6 +355,37 @@ impl Solver {
             .collect();
         BatchWeights { n, data, status }
     }
+}
+
+/// Indices sorted by key (ties by index, so the order is deterministic).
+fn sorted_order(mut keys: Vec<(u64, u32)>) -> Vec<u32> {
+    keys.par_sort_unstable();
+    keys.into_iter().map(|(_, i)| i).collect()
+}
+
+/// Results computed out of order, put back in input order.
+fn scatter<T>(done: Vec<(u32, T)>) -> Vec<T> {
+    let mut out: Vec<Option<T>> = std::iter::repeat_with(|| None).take(done.len()).collect();
+    for (i, r) in done {
+        out[i as usize] = Some(r);
+    }
+    out.into_iter()
+        .map(|r| r.expect("every index is processed once"))
+        .collect()
+}
+
+/// Sort key grouping weight vectors by their highest and second-highest entries' indices.
+fn top_two(w: &[f64]) -> u64 {
+    let (mut a, mut b) = (0usize, usize::MAX);
+    for (i, &x) in w.iter().enumerate().skip(1) {
+        if x > w[a] {
+            b = a;
+            a = i;
+        } else if b == usize::MAX || x > w[b] {
+            b = i;
+        }
+    }
+    ((a as u64) << 32) | (b as u32 as u64)
 }
 
 /// Weights of a batch of inverse problems: one row of `n_anchors` weights per point.
@@ -376,5 +418,28 @@ impl BatchWeights {
     /// All rows in order.
     pub fn iter(&self) -> impl Iterator<Item = Result<&[f64], &SolveError>> {
         (0..self.len()).map(|i| self.get(i))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn batch_ordering_helpers() {
+        let key = |a: u64, b: u32| (a << 32) | b as u64;
+        assert_eq!(top_two(&[0.1, 0.7, 0.2]), key(1, 2));
+        assert_eq!(top_two(&[0.5, 0.5]), key(0, 1));
+        assert_eq!(top_two(&[0.9, 0.05, 0.05]), key(0, 1));
+        assert_eq!(top_two(&[1.0]), key(0, u32::MAX));
+        assert_eq!(top_two(&[]), key(0, u32::MAX));
+        assert_eq!(
+            sorted_order(vec![(3, 0), (1, 1), (3, 2), (0, 3)]),
+            vec![3, 1, 0, 2]
+        );
+        assert_eq!(
+            scatter(vec![(2, 'c'), (0, 'a'), (1, 'b')]),
+            vec!['a', 'b', 'c']
+        );
     }
 }
