@@ -6,7 +6,7 @@
 use std::time::Instant;
 
 use wavg_embed::NoProgress;
-use wavg_embed::decimate::{DecimateOptions, select_landmarks};
+use wavg_embed::decimate::DecimateOptions;
 use wavg_embed::geodesic::{FastMarching, landmark_distances_coarse, landmark_distances_with};
 use wavg_mesh::ValidMesh;
 
@@ -184,13 +184,17 @@ fn main() {
     }
 }
 
-/// Landmarks by decimation.
+/// Landmarks by decimation (prints any relaxation of the normal bounds that was needed).
 fn landmarks(mesh: &ValidMesh, n: usize) -> Vec<u32> {
     let opts = DecimateOptions {
         target: n,
         ..Default::default()
     };
-    select_landmarks(mesh, &opts, &NoProgress).expect("decimation")
+    let d = wavg_embed::decimate(mesh, &opts, &NoProgress).expect("decimation");
+    if !d.relaxations.is_empty() {
+        eprintln!("relaxations: {:?}", d.relaxations);
+    }
+    d.landmarks
 }
 
 /// User + system CPU time of this process so far (Linux; 0 elsewhere). The machine is
