@@ -9,7 +9,8 @@
 //!
 //! Modules: [`anchors`] (editable anchor sets), [`points`] (validating user locations),
 //! [`weights`] (validating weights), [`solver`] (single and batched problems),
-//! [`sampling`] (seeded anchors and query points for benchmarks and tests).
+//! [`search`] (the paper's local search for the forward problem), [`sampling`] (seeded
+//! anchors and query points for benchmarks and tests).
 //!
 //! ```
 //! use std::sync::Arc;
