@@ -1,7 +1,17 @@
 //! Times landmark selection (decimation) and the landmark geodesics on real meshes.
 //!
-//! `cargo run --release -p wavg-embed --example landmark_timing -- [MESH...] [--landmarks N]`
-//! (default meshes: pig, armadillo, horse, igea from the shared data folder).
+//! `cargo run --release -p wavg-embed --example landmark_timing -- [MESH...] [--landmarks N]
+//! [--coarse N,M,...] [--decimate-only] [--runs-only]` (default meshes: pig, armadillo,
+//! horse, igea from the shared data folder).
+//!
+//! Columns: decimation wall time (and process CPU time), `FastMarching` build, one
+//! single-threaded run, all landmark runs in parallel, and the asymmetry of the raw
+//! distance rows. `--coarse N` adds the two-level landmark distances on an N-vertex
+//! intermediate mesh with their relative difference to full resolution; `--runs-only`
+//! prints the on-CPU time per run (best of 5 batches); `--decimate-only` only decimates.
+//! The machine is shared, so CPU times are the more reliable numbers. Set `BFS=1` to
+//! reorder the mesh breadth-first first (a locality experiment), `WORST=1` to list the
+//! pairs with the largest coarse-vs-full differences.
 
 use std::time::Instant;
 
