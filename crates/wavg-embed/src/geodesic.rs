@@ -255,6 +255,9 @@ impl FastMarching {
                 },
             );
         }
+        for v in 0..n {
+            entries[offsets[v] as usize..offsets[v + 1] as usize].sort_by_key(|e| e.x);
+        }
         let (near_offsets, near) = exact_second_ring(mesh);
         Self {
             n,
@@ -405,23 +408,34 @@ impl FastMarching {
                     std::hint::black_box(e.x);
                 }
             }
-            let range = self.offsets[vi] as usize..self.offsets[vi + 1] as usize;
-            for e in &self.entries[range] {
-                let xi = e.x as usize;
-                if ws.state[xi] == FROZEN {
-                    continue;
+            // Entries are grouped by neighbour `x`: one frozen check and one heap update per
+            // neighbour.
+            let end = self.offsets[vi + 1] as usize;
+            let mut i = self.offsets[vi] as usize;
+            while i < end {
+                let x = self.entries[i].x;
+                let xi = x as usize;
+                let mut j = i + 1;
+                while j < end && self.entries[j].x == x {
+                    j += 1;
                 }
-                let mut cand = uv + e.len as f64;
-                let oi = e.other as usize;
-                if e.q_vv > 0.0 && ws.state[oi] == FROZEN {
-                    if let Some(t) = triangle_update(uv, ws.dist[oi], e) {
-                        cand = cand.min(t);
+                if ws.state[xi] != FROZEN {
+                    let mut cand = f64::INFINITY;
+                    for e in &self.entries[i..j] {
+                        cand = cand.min(uv + e.len as f64);
+                        let oi = e.other as usize;
+                        if e.q_vv > 0.0 && ws.state[oi] == FROZEN {
+                            if let Some(t) = triangle_update(uv, ws.dist[oi], e) {
+                                cand = cand.min(t);
+                            }
+                        }
+                    }
+                    if cand < ws.dist[xi] {
+                        ws.dist[xi] = cand;
+                        ws.push_or_decrease(x);
                     }
                 }
-                if cand < ws.dist[xi] {
-                    ws.dist[xi] = cand;
-                    ws.push_or_decrease(e.x);
-                }
+                i = j;
             }
         }
     }
