@@ -160,8 +160,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map_err(|e| CliError::input(one_line(&e)))?;
     let n = points.len();
 
-    let (t_inv, weights) = textio::with_threads(Some(threads), || {
-        best_of(args.repeat, || solver.inverse_batch(&points))
+    // The result buffers are reused across the repeats, as an application would.
+    let mut weights = wavg_solve::BatchWeights::default();
+    let t_inv = textio::with_threads(Some(threads), || {
+        best_of(args.repeat, || {
+            solver.inverse_batch_into(&points, &mut weights)
+        })
+        .0
     })?;
     let k = solver.n_anchors();
     // Failed inverses get a placeholder that fails validation, so forward reports it.

@@ -336,9 +336,19 @@ impl Solver {
     /// Inverse problem for many points in parallel (see [`BatchWeights`]); each point is
     /// independent, so the results equal [`Solver::inverse`]'s for any thread count.
     pub fn inverse_batch(&self, points: &[SurfacePoint]) -> BatchWeights {
+        let mut out = BatchWeights::default();
+        self.inverse_batch_into(points, &mut out);
+        out
+    }
+
+    /// [`Solver::inverse_batch`] into an existing result, reusing its memory (repeated
+    /// batches then neither allocate nor page-fault).
+    pub fn inverse_batch_into(&self, points: &[SurfacePoint], out: &mut BatchWeights) {
         let n = self.n_anchors();
-        let mut data = vec![0.0; points.len() * n.max(1)];
-        let status = data
+        out.n = n;
+        out.data.resize(points.len() * n.max(1), 0.0);
+        out.status.clear();
+        out.data
             .par_chunks_mut(n.max(1))
             .zip(points.par_iter())
             .with_min_len(64)
@@ -352,8 +362,7 @@ impl Solver {
                     r
                 },
             )
-            .collect();
-        BatchWeights { n, data, status }
+            .collect_into_vec(&mut out.status);
     }
 }
 
@@ -389,7 +398,7 @@ fn top_two(w: &[f64]) -> u64 {
 }
 
 /// Weights of a batch of inverse problems: one row of `n_anchors` weights per point.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct BatchWeights {
     n: usize,
     data: Vec<f64>,
