@@ -55,27 +55,46 @@ pub struct Projection {
 /// Precomputed frames and per-triangle data of an embedded mesh; `Send + Sync`.
 pub struct Projector {
     emb: Arc<EmbeddedMesh>,
-    frames: Vec<Frame32>,
+    verts: Vec<VertexRec>,
     frame_kinds: [usize; 4],
-    tris: Vec<TriData>,
+    faces: Vec<Face>,
     bvh: Bvh,
     walk_origin: Vec8,
     walk_coords: Vec<WalkPoint>,
 }
 
-/// A vertex in the walk's compact coordinates (f32, relative to the bounding box centre).
+/// A vertex in the walk's compact coordinates (f32, relative to the bounding box
+/// centre): half a cache line, so the walk, which reads many vertices once, waits for
+/// half as many lines. Only the walk and the ordering of candidate faces use them.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
 struct WalkPoint([f32; 8]);
 
 #[inline(always)]
-fn dist2(a: &WalkPoint, b: &WalkPoint) -> f32 {
+fn wdist2(a: &WalkPoint, b: &WalkPoint) -> f32 {
     let mut s = 0.0;
     for k in 0..8 {
         let d = a.0[k] - b.0[k];
         s += d * d;
     }
     s
+}
+
+/// What a query reads of a vertex, in two adjacent cache lines: its embedded point (f64,
+/// for the walk and the tangent equations) and its frame (f32).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct VertexRec {
+    x: Vec8,
+    t: Frame32,
+}
+
+/// What a query reads of a face, in two cache lines: its blend matrices and corners.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
+struct Face {
+    d: TriData,
+    v: [u32; 3],
 }
 
 /// Small fixed set of face ids (no allocation per query).
@@ -119,12 +138,16 @@ impl Projector {
         }
         let coords = emb.coords();
         let chunk = 4096;
-        let (frames, kinds): (Vec<Frame32>, Vec<FrameKind>) = (0..mesh.n_vertices())
+        let (verts, kinds): (Vec<VertexRec>, Vec<FrameKind>) = (0..mesh.n_vertices())
             .into_par_iter()
             .with_min_len(chunk)
             .map(|v| {
                 let (t, k) = crate::frames::vertex_frame(mesh, coords, v as u32);
-                (frame_to_f32(&t), k)
+                let rec = VertexRec {
+                    x: coords[v],
+                    t: frame_to_f32(&t),
+                };
+                (rec, k)
             })
             .unzip();
         let mut frame_kinds = [0; 4];
@@ -132,18 +155,24 @@ impl Projector {
             frame_kinds[k as usize] += 1;
         }
         const BATCH: usize = 4;
-        let mut tris = vec![TriData::default(); mesh.n_faces()];
-        tris.par_chunks_mut(BATCH)
+        let mut faces = vec![Face::default(); mesh.n_faces()];
+        faces
+            .par_chunks_mut(BATCH)
             .zip(mesh.triangles.par_chunks(BATCH))
             .with_min_len(chunk / BATCH)
             .for_each(|(out, ts)| {
-                let fr = |t: &[u32; 3]| t.map(|v| &frames[v as usize]);
+                let fr = |t: &[u32; 3]| t.map(|v| &verts[v as usize].t);
                 if ts.len() == BATCH {
                     let d = TriData::new_batch([fr(&ts[0]), fr(&ts[1]), fr(&ts[2]), fr(&ts[3])]);
-                    out.copy_from_slice(&d);
+                    for i in 0..BATCH {
+                        out[i] = Face { d: d[i], v: ts[i] };
+                    }
                 } else {
                     for (o, t) in out.iter_mut().zip(ts) {
-                        *o = TriData::new(fr(t));
+                        *o = Face {
+                            d: TriData::new(fr(t)),
+                            v: *t,
+                        };
                     }
                 }
             });
@@ -159,9 +188,9 @@ impl Projector {
             .collect();
         Ok(Self {
             emb,
-            frames,
+            verts,
             frame_kinds,
-            tris,
+            faces,
             bvh,
             walk_origin,
             walk_coords,
@@ -175,7 +204,7 @@ impl Projector {
 
     /// Tangent frame of vertex `v` (orthonormal rows, as stored in f32).
     pub fn frame(&self, v: VertexId) -> Mat2x8 {
-        frame_to_f64(&self.frames[v as usize])
+        frame_to_f64(&self.verts[v as usize].t)
     }
 
     /// How many vertex frames came from each rule: interior stencil, boundary rules,
@@ -186,15 +215,15 @@ impl Projector {
 
     /// Bytes of the projector's own data plus the embedded coordinates.
     pub fn bytes(&self) -> usize {
-        self.frames.len() * std::mem::size_of::<Frame32>()
-            + self.tris.len() * std::mem::size_of::<TriData>()
+        std::mem::size_of_val(&self.verts[..])
+            + std::mem::size_of_val(&self.faces[..])
             + self.bvh.bytes()
-            + self.walk_coords.len() * std::mem::size_of::<WalkPoint>()
+            + std::mem::size_of_val(&self.walk_coords[..])
             + std::mem::size_of_val(self.emb.coords())
     }
 
     fn face_frames(&self, f: FaceId) -> [&Frame32; 3] {
-        self.emb.mesh().triangles[f as usize].map(|v| &self.frames[v as usize])
+        self.faces[f as usize].v.map(|v| &self.verts[v as usize].t)
     }
 
     /// Interpolated tangent plane at a surface point (rows span it; near-orthonormal).
@@ -209,12 +238,16 @@ impl Projector {
     /// assert!(psi.column(2).norm() < 1e-6); // the grid lies in the z = 0 plane
     /// ```
     pub fn psi(&self, p: &SurfacePoint) -> Mat2x8 {
-        self.tris[p.face as usize].psi(self.face_frames(p.face), &p.bary)
+        self.faces[p.face as usize]
+            .d
+            .psi(self.face_frames(p.face), &p.bary)
     }
 
     /// Partial derivatives of `Psi` with respect to the three barycentrics at `p`.
     pub fn psi_derivatives(&self, p: &SurfacePoint) -> [Mat2x8; 3] {
-        self.tris[p.face as usize].psi_derivatives(self.face_frames(p.face), &p.bary)
+        self.faces[p.face as usize]
+            .d
+            .psi_derivatives(self.face_frames(p.face), &p.bary)
     }
 
     /// Phong projection of `y` onto face `f` alone (barycentrics), if Newton finds one.
@@ -224,16 +257,16 @@ impl Projector {
 
     #[inline]
     fn try_face(&self, f: FaceId, y: &Vec8) -> Option<Best> {
-        let t = self.emb.mesh().triangles[f as usize];
-        let c = self.emb.coords();
-        let (v0, v1, v2) = (&c[t[0] as usize], &c[t[1] as usize], &c[t[2] as usize]);
-        let fr = [
-            &self.frames[t[0] as usize],
-            &self.frames[t[1] as usize],
-            &self.frames[t[2] as usize],
+        let face = &self.faces[f as usize];
+        let r = [
+            &self.verts[face.v[0] as usize],
+            &self.verts[face.v[1] as usize],
+            &self.verts[face.v[2] as usize],
         ];
-        let xi = self.tris[f as usize].solve(fr, [v0, v1, v2], y)?;
-        let (a, b, cc) = (&v0.data.0[0], &v1.data.0[0], &v2.data.0[0]);
+        let xi = face
+            .d
+            .solve([&r[0].t, &r[1].t, &r[2].t], [&r[0].x, &r[1].x, &r[2].x], y)?;
+        let (a, b, cc) = (&r[0].x.data.0[0], &r[1].x.data.0[0], &r[2].x.data.0[0]);
         let yy = &y.data.0[0];
         let mut d2 = 0.0;
         for k in 0..8 {
@@ -244,12 +277,17 @@ impl Projector {
     }
 
     fn is_zero(&self, b: &Best) -> bool {
-        let [p, q, r] = self.emb.corners(b.face as usize);
+        let [p, q, r] = self.corners(b.face);
         let scale2 = (q - p)
             .norm_squared()
             .max((r - q).norm_squared())
             .max((p - r).norm_squared());
         b.d2 <= ZERO_DISTANCE * ZERO_DISTANCE * scale2
+    }
+
+    #[inline]
+    fn corners(&self, f: FaceId) -> [Vec8; 3] {
+        self.faces[f as usize].v.map(|v| self.verts[v as usize].x)
     }
 
     fn finish(b: Best, path: ProjectionPath) -> Projection {
@@ -280,26 +318,27 @@ impl Projector {
         let v = self.walk_inner(y, start, &mut ring_d);
         // 2. Faces around v, most promising first: by how far inside each face's plane
         // the query's orthogonal projection falls (walk coordinates, already cached).
+        // The face list is fetched first but only used after the scores, so its memory
+        // access overlaps the arithmetic.
         let ring = topo.ring(v);
         let faces = topo.ring_faces(v);
-        let m = faces.len().min(64);
-        let mut order = [(0.0f32, 0u32); 64];
+        let mut scores = [f32::INFINITY; 64];
         if ring.len() <= 64 {
             let yw = self.walk_point(y);
-            let wv = &self.walk_coords[v as usize];
+            let wv = &self.walk_coords[v as usize].0;
             let mut dy = [0.0f32; 8];
             for k in 0..8 {
-                dy[k] = yw.0[k] - wv.0[k];
+                dy[k] = yw.0[k] - wv[k];
             }
             // Per neighbour j: |e_j|^2, e_j . (y - v) and e_j . e_{j+1}, e_j = u_j - v.
             let mut ee = [0.0f32; 64];
             let mut de = [0.0f32; 64];
             let mut ee1 = [0.0f32; 64];
             let edge = |u: u32| {
-                let wu = &self.walk_coords[u as usize];
+                let wu = &self.walk_coords[u as usize].0;
                 let mut d = [0.0f32; 8];
                 for k in 0..8 {
-                    d[k] = wu.0[k] - wv.0[k];
+                    d[k] = wu[k] - wv[k];
                 }
                 d
             };
@@ -322,23 +361,29 @@ impl Projector {
                 ee1[j] = c;
                 cur = next;
             }
-            for j in 0..m {
+            // Face j lies between ring[j] and ring[j + 1] (cyclically when interior).
+            for j in 0..ring.len() {
                 let l = if j + 1 == ring.len() { 0 } else { j + 1 };
                 let ab = ee1[j];
                 let det = ee[j] * ee[l] - ab * ab;
-                let score = if det > 0.0 {
+                if det > 0.0 {
                     let s = (ee[l] * de[j] - ab * de[l]) / det;
                     let t = (ee[j] * de[l] - ab * de[j]) / det;
-                    -(s.min(t).min(1.0 - s - t))
-                } else {
-                    f32::INFINITY
-                };
-                order[j] = (if score.is_nan() { f32::INFINITY } else { score }, faces[j]);
+                    let score = -(s.min(t).min(1.0 - s - t));
+                    if !score.is_nan() {
+                        scores[j] = score;
+                    }
+                }
             }
         } else {
-            for j in 0..m {
-                order[j] = (ring_d[j] + ring_d[(j + 1) % 64], faces[j]);
+            for j in 0..64 {
+                scores[j] = ring_d[j] + ring_d[(j + 1) % 64];
             }
+        }
+        let m = faces.len().min(64);
+        let mut order = [(0.0f32, 0u32); 64];
+        for j in 0..m {
+            order[j] = (scores[j], faces[j]);
         }
         order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         let mut tested = Tested::new();
@@ -422,7 +467,7 @@ impl Projector {
     /// is strictly closer than that.
     #[inline]
     fn try_face_bounded(&self, f: FaceId, y: &Vec8, bound: f64) -> Option<Best> {
-        let [a, b, c] = self.emb.corners(f as usize);
+        let [a, b, c] = self.corners(f);
         let lo = a.inf(&b).inf(&c);
         let hi = a.sup(&b).sup(&c);
         let mut s = 0.0;
@@ -467,7 +512,7 @@ impl Projector {
             return Err(ProjectError::NonFiniteQuery);
         }
         let mut best: Option<Best> = None;
-        for f in 0..self.tris.len() as u32 {
+        for f in 0..self.faces.len() as u32 {
             let bound = best.map_or(f64::INFINITY, |b| b.d2);
             if let Some(b) = self.try_face_bounded(f, y, bound) {
                 best = Some(b);
@@ -488,7 +533,7 @@ impl Projector {
         if y.iter().all(|v| v.is_finite()) {
             let mut bound = f64::INFINITY;
             self.bvh.search(y, &mut bound, |f, bound| {
-                let [a, b, c] = self.emb.corners(f as usize);
+                let [a, b, c] = self.corners(f);
                 let xi = closest_point_barycentric(y, &a, &b, &c);
                 let d2 = (a * xi[0] + b * xi[1] + c * xi[2] - y).norm_squared();
                 if d2 < *bound {
@@ -505,17 +550,13 @@ impl Projector {
     /// distance to `y`, a good start for the next query near `y`).
     pub fn walk(&self, y: &Vec8, start: VertexId) -> VertexId {
         let mut ring_d = [0.0f32; 64];
-        self.walk_inner(y, start.min(self.walk_coords.len() as u32 - 1), &mut ring_d)
+        self.walk_inner(y, start.min(self.verts.len() as u32 - 1), &mut ring_d)
     }
 
     /// The query in the walk's compact coordinates.
     #[inline]
     fn walk_point(&self, y: &Vec8) -> WalkPoint {
-        let mut p = WalkPoint([0.0; 8]);
-        for k in 0..8 {
-            p.0[k] = (y[k] - self.walk_origin[k]) as f32;
-        }
-        p
+        WalkPoint(std::array::from_fn(|k| (y[k] - self.walk_origin[k]) as f32))
     }
 
     /// The walk; leaves the squared distances of the final vertex's ring in `ring_d`.
@@ -525,11 +566,11 @@ impl Projector {
         let w = &self.walk_coords;
         let yw = self.walk_point(y);
         let mut v = start;
-        let mut dv = dist2(&w[v as usize], &yw);
+        let mut dv = wdist2(&w[v as usize], &yw);
         loop {
             let mut next = v;
             for (j, &u) in topo.ring(v).iter().enumerate() {
-                let d = dist2(&w[u as usize], &yw);
+                let d = wdist2(&w[u as usize], &yw);
                 if j < 64 {
                     ring_d[j] = d;
                 }
