@@ -1,13 +1,15 @@
 //! Times landmark selection (decimation) and the landmark geodesics on real meshes.
 //!
 //! `cargo run --release -p wavg-embed --example landmark_timing -- [MESH...] [--landmarks N]
-//! [--coarse N,M,...] [--decimate-only] [--runs-only]` (default meshes: pig, armadillo,
+//! [--coarse N,M,...] [--snapshot] [--decimate-only] [--runs-only]` (default meshes: pig, armadillo,
 //! horse, igea from the shared data folder).
 //!
 //! Columns: decimation wall time (and process CPU time), `FastMarching` build, one
 //! single-threaded run, all landmark runs in parallel, and the asymmetry of the raw
 //! distance rows. `--coarse N` adds the two-level landmark distances on an N-vertex
-//! intermediate mesh with their relative difference to full resolution; `--runs-only`
+//! intermediate mesh with their relative difference to full resolution (with `--snapshot`
+//! the intermediate mesh is a snapshot of the landmark decimation, as a pipeline would do
+//! it, and the two steps are timed separately); `--runs-only`
 //! prints the on-CPU time per run (best of 5 batches); `--decimate-only` only decimates.
 //! The machine is shared, so CPU times are the more reliable numbers. Set `BFS=1` to
 //! reorder the mesh breadth-first first (a locality experiment), `WORST=1` to list the
@@ -16,8 +18,10 @@
 use std::time::Instant;
 
 use wavg_embed::NoProgress;
-use wavg_embed::decimate::DecimateOptions;
-use wavg_embed::geodesic::{FastMarching, landmark_distances_coarse, landmark_distances_with};
+use wavg_embed::decimate::{DecimateOptions, decimate_with_snapshots};
+use wavg_embed::geodesic::{
+    FastMarching, landmark_distances_coarse, landmark_distances_two_level, landmark_distances_with,
+};
 use wavg_mesh::ValidMesh;
 
 fn main() {
@@ -35,6 +39,8 @@ fn main() {
             .collect();
         args.drain(i..i + 2);
     }
+    let snapshot = args.iter().any(|a| a == "--snapshot");
+    args.retain(|a| a != "--snapshot");
     let runs_only = args.iter().any(|a| a == "--runs-only");
     args.retain(|a| a != "--runs-only");
     let decimate_only = args.iter().any(|a| a == "--decimate-only");
@@ -104,7 +110,12 @@ fn main() {
                 let cm = ValidMesh::new(d.mesh).unwrap();
                 let cfm = FastMarching::new(&cm);
                 let mut cws = cfm.workspace();
-                print!(" | coarse {m}: {:.2} ms/run", per_run(&cfm, &mut cws));
+                print!(
+                    " | coarse {m}: {:.2} ms/run, obtuse corners/split {:?} of {}",
+                    per_run(&cfm, &mut cws),
+                    cfm.obtuse_corners(),
+                    3 * cm.n_faces()
+                );
             }
             println!();
             continue;
@@ -155,7 +166,27 @@ fn main() {
                 continue;
             }
             let (t, c) = (Instant::now(), cpu_seconds());
-            let qc = landmark_distances_coarse(&mesh, &landmarks, m, &NoProgress).expect("coarse");
+            let mut label = format!("coarse {m}");
+            let qc = if snapshot {
+                // The recommended pipeline: one decimation with a snapshot, two-level distances.
+                let opts = DecimateOptions {
+                    target: n_landmarks,
+                    ..Default::default()
+                };
+                let (fin, snaps) =
+                    decimate_with_snapshots(&mesh, &opts, &[m], &NoProgress).expect("decimation");
+                assert_eq!(fin.landmarks, landmarks);
+                let (td, cd) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
+                label = format!("snapshot {m} (decimate+snapshot {td:.2} s, cpu {cd:.2}; then)");
+                let (t, c) = (Instant::now(), cpu_seconds());
+                let q = landmark_distances_two_level(&fm, &snaps[0], &landmarks, &NoProgress)
+                    .expect("two-level");
+                let (tc, cc) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
+                label = format!("{label} geodesics {tc:.2} s (cpu {cc:.2})");
+                q
+            } else {
+                landmark_distances_coarse(&mesh, &landmarks, m, &NoProgress).expect("coarse")
+            };
             let (tc, cc) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
             let mut rel: Vec<f64> = (0..n * n)
                 .filter(|k| k / n != k % n)
@@ -184,7 +215,7 @@ fn main() {
             rel.iter_mut().for_each(|r| *r = r.abs());
             rel.sort_by(f64::total_cmp);
             println!(
-                "|   coarse {m} | | | | | {tc:.2} (cpu {cc:.2}) | rel. diff to full: mean {:+.2}%, |.| p50 {:.2}% p90 {:.2}% max {:.2}% |",
+                "|   {label} | | | | | {tc:.2} (cpu {cc:.2}) | rel. diff to full: mean {:+.2}%, |.| p50 {:.2}% p90 {:.2}% max {:.2}% |",
                 mean * 100.0,
                 rel[rel.len() / 2] * 100.0,
                 rel[rel.len() * 9 / 10] * 100.0,
