@@ -91,6 +91,25 @@ impl LocalSearch {
         let v = self.walk(y, start);
         self.search_from(y, v)
     }
+
+    /// The vertex nearest to `y` (brute force over the f32 coordinates): the second chance
+    /// when the walk ends in a local minimum of the distance with no projection nearby.
+    pub fn nearest_vertex(&self, y: &Vec8) -> VertexId {
+        let y = Coord32::new(y);
+        let mut best = (f32::INFINITY, 0);
+        for (v, c) in self.coords.iter().enumerate() {
+            let d = c.dist2(&y);
+            if d < best.0 {
+                best = (d, v as VertexId);
+            }
+        }
+        best.1
+    }
+
+    /// The breadth-first triangle search from vertex `v` itself (no walk).
+    pub fn search_at(&self, y: &Vec8, v: VertexId) -> Option<LocalHit> {
+        self.search_from(y, v)
+    }
 }
 
 /// A found projection: the point and its squared distance to the query.

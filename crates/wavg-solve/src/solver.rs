@@ -20,9 +20,10 @@ use crate::{Projector, Vec8};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SearchMode {
     /// The paper's method ([`crate::search`]): greedy walk from a start vertex, then a
-    /// breadth-first search over triangles; the first ring holding a valid projection wins.
-    /// When none is found within [`crate::search::LOCAL_BUDGET`] triangles, the projector's
-    /// certified search is used (reported as [`ProjectionPath::Fallback`]).
+    /// breadth-first search over triangles; the first triangle holding a valid projection
+    /// wins. When none is found within [`crate::search::LOCAL_BUDGET`] triangles, the same
+    /// search runs once more from the vertex nearest to the average; if that fails too, the
+    /// projector's certified search is used (reported as [`ProjectionPath::Fallback`]).
     #[default]
     Fast,
     /// The projector's fast path certified against its bounding volume hierarchy: always
@@ -228,11 +229,21 @@ impl Solver {
                     Start::Exhaustive => unreachable!("fast mode always has a start vertex"),
                 };
                 let found = match opts.mode {
-                    SearchMode::Fast => self.local.search(&ybar, v).map(|h| Projection {
-                        point: h.point,
-                        distance: h.distance,
-                        path: ProjectionPath::Local,
-                    }),
+                    // The paper's search; when the walk ends in a local minimum with no
+                    // projection nearby, once more from the nearest vertex (much cheaper than
+                    // the certified global search, and usually its answer).
+                    SearchMode::Fast => self
+                        .local
+                        .search(&ybar, v)
+                        .or_else(|| {
+                            let u = self.local.nearest_vertex(&ybar);
+                            self.local.search_at(&ybar, u)
+                        })
+                        .map(|h| Projection {
+                            point: h.point,
+                            distance: h.distance,
+                            path: ProjectionPath::Local,
+                        }),
                     _ => None,
                 };
                 let proj = match found {

@@ -496,3 +496,29 @@ fn round_trips_with_a_geodesic_embedding() {
         assert!(f >= 0.99, "{name} (certified): round trip fraction {f}");
     }
 }
+
+/// The second chance of the fast search: the nearest vertex (f32 brute force) agrees with
+/// the projector's, and the search from it finds points on the surface.
+#[test]
+fn nearest_vertex_second_chance() {
+    let s = solver_on(procedural::torus(48, 24, 1.0, 0.35), 4, 1);
+    let proj = s.projector();
+    let c = proj.embedded().coords();
+    for (i, p) in uniform_surface_points(s.mesh(), 100, 3)
+        .unwrap()
+        .iter()
+        .enumerate()
+    {
+        let y = proj.embedded().point(p)
+            + wavg_solve::Vec8::from_fn(|k, _| ((i + k) % 3) as f64 * 0.01);
+        let a = s.local_search().nearest_vertex(&y);
+        let b = proj.nearest_vertex(&y);
+        assert!(((c[a as usize] - y).norm() - (c[b as usize] - y).norm()).abs() < 1e-5);
+        let yhat = proj.embedded().point(p);
+        let h = s
+            .local_search()
+            .search_at(&yhat, s.local_search().nearest_vertex(&yhat))
+            .unwrap();
+        assert!(h.distance < 1e-6);
+    }
+}
