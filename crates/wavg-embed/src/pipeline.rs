@@ -7,7 +7,10 @@ use wavg_mesh::ValidMesh;
 use crate::decimate::{DecimateOptions, decimate_with_snapshots, select_landmarks};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::{Embedding, EmbeddingParams, MAX_DIM};
-use crate::geodesic::{FastMarching, landmark_distances_decimated, landmark_distances_with};
+use crate::geodesic::{
+    FastMarching, landmark_distances_decimated, landmark_distances_two_level,
+    landmark_distances_with,
+};
 use crate::lsmesh::LsMeshSolver;
 use crate::mds::{MdsOptions, metric_mds};
 use crate::quality::{QualityOptions, QualityPairs};
@@ -32,6 +35,13 @@ pub struct PrecomputeOptions {
     /// geodesic relative errors (p50, p90) change by at most 0.003 against full-resolution
     /// geodesics, for 4-10x less geodesic time.
     pub geodesic_vertices: usize,
+    /// With an intermediate mesh, replace the distances of close landmark pairs by
+    /// full-mesh values from short radius-limited runs
+    /// ([`crate::geodesic::landmark_distances_two_level`]). Measured on the horse (48k
+    /// vertices, 10k intermediate): the median relative error of vertex pairs closer than
+    /// 3% of the bounding-box diagonal drops from 0.097 to 0.091 (full-mesh geodesics:
+    /// 0.087); random-pair errors are unchanged.
+    pub refine_near_pairs: bool,
     /// MDS settings (`mds.dim` is the embedding dimension, 8 in wavg).
     pub mds: MdsOptions,
     /// Vertex pairs for the quality check; 0 skips it (errors are then NaN).
@@ -47,6 +57,7 @@ impl Default for PrecomputeOptions {
             seed: 0,
             decimate: DecimateOptions::default(),
             geodesic_vertices: 10_000,
+            refine_near_pairs: true,
             mds: MdsOptions::default(),
             quality_pairs: 1024,
             quality_sources: 16,
@@ -197,17 +208,21 @@ pub fn precompute(
         },
     );
     let (landmarks, coarse, t_decimate) = landmark_result?;
-    let (fm, quality_pairs, t_quality) = quality_result?;
+    let (mut fm, quality_pairs, t_quality) = quality_result?;
     stages.decimate = t_decimate;
     stages.quality = t_quality;
     check_cancel(progress)?;
 
     // 2. Geodesic distances between landmarks.
     let t = Instant::now();
-    let q = match (&coarse, &fm) {
-        (Some(c), _) => landmark_distances_decimated(c, &landmarks, progress)?,
-        (None, Some(full)) => landmark_distances_with(full, &landmarks, progress)?,
-        (None, None) => landmark_distances_with(&FastMarching::new(mesh), &landmarks, progress)?,
+    let fine = fm.get_or_insert_with(|| FastMarching::new(mesh));
+    let q = match &coarse {
+        // All pairs on the intermediate mesh, close pairs corrected on the full mesh.
+        Some(c) if opts.refine_near_pairs => {
+            landmark_distances_two_level(fine, c, &landmarks, progress)?
+        }
+        Some(c) => landmark_distances_decimated(c, &landmarks, progress)?,
+        None => landmark_distances_with(fine, &landmarks, progress)?,
     };
     drop(fm);
     let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
