@@ -492,10 +492,16 @@ pub fn save(path: &Path, emb: &Embedding, mesh: &TriMesh) -> Result<(), EmbedErr
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".wavg-tmp-")
-        .tempfile_in(&dir)
-        .map_err(io)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".wavg-tmp-");
+    // Temporary files are private (0600) by default; the result should get the usual
+    // permissions of a new file (0666 minus the umask), as `File::create` would give it.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut tmp = builder.tempfile_in(&dir).map_err(io)?;
     tmp.write_all(&bytes).map_err(io)?;
     tmp.as_file().sync_all().map_err(io)?;
     tmp.persist(path).map_err(|e| io(e.error))?;
@@ -828,6 +834,20 @@ mod tests {
         assert!(save(&path, &bad, &mesh).is_err());
         assert_eq!(bits(&load(&path, &mesh).unwrap()), bits(&good));
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn saved_file_gets_the_permissions_of_a_new_file() {
+        use std::os::unix::fs::PermissionsExt;
+        let mesh = procedural::icosphere(0);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.wavg");
+        save(&path, &sample(&mesh, 8, 2, 3), &mesh).unwrap();
+        let plain = dir.path().join("plain");
+        std::fs::File::create(&plain).unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&path), mode(&plain));
     }
 
     #[test]
