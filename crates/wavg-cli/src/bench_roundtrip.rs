@@ -123,6 +123,37 @@ fn best_of<T>(repeat: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     (best, out.expect("at least one run"))
 }
 
+/// CPU time (user + system, all threads) of this process in seconds, where the platform
+/// reports it (Linux `/proc/self/stat`, 10 ms resolution); `None` elsewhere. On a shared
+/// machine it shows how much work a batch took, independently of waiting for a core.
+fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+/// The 1-minute load average (Linux), to judge how busy the machine was.
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// Runs `f` and returns its result with the CPU seconds it used (NaN when unknown).
+fn with_cpu<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    let c0 = process_cpu_seconds();
+    let r = f();
+    let dt = match (c0, process_cpu_seconds()) {
+        (Some(a), Some(b)) => b - a,
+        _ => f64::NAN,
+    };
+    (r, dt)
+}
+
 /// Value at quantile `q` of sorted `xs` (nearest rank).
 fn quantile(xs: &[f64], q: f64) -> f64 {
     if xs.is_empty() {
@@ -162,12 +193,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
     // The result buffers are reused across the repeats, as an application would.
     let mut weights = wavg_solve::BatchWeights::default();
-    let t_inv = textio::with_threads(Some(threads), || {
-        best_of(args.repeat, || {
-            solver.inverse_batch_into(&points, &mut weights)
+    let (t_inv, cpu_inv) = with_cpu(|| {
+        textio::with_threads(Some(threads), || {
+            best_of(args.repeat, || {
+                solver.inverse_batch_into(&points, &mut weights)
+            })
+            .0
         })
-        .0
-    })?;
+    });
+    let t_inv = t_inv?;
     let k = solver.n_anchors();
     // Failed inverses get a placeholder that fails validation, so forward reports it.
     let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
@@ -179,16 +213,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
         },
         ..Default::default()
     };
-    let (t_fwd, fwd) = textio::with_threads(Some(threads), || {
-        best_of(args.repeat, || solver.forward_batch(&rows, &opts))
-    })?;
+    let (r, cpu_fwd) = with_cpu(|| {
+        textio::with_threads(Some(threads), || {
+            best_of(args.repeat, || solver.forward_batch(&rows, &opts))
+        })
+    });
+    let (t_fwd, fwd) = r?;
     let order = spatial_order(&points.iter().map(|p| p.position(&mesh)).collect::<Vec<_>>());
     let ordered: Vec<&[f64]> = order.iter().map(|&i| rows[i]).collect();
-    let (t_warm, warm) = textio::with_threads(Some(threads), || {
-        best_of(args.repeat, || {
-            solver.forward_batch_warm(&ordered, &opts, WARM_CHUNK)
+    let (r, cpu_warm) = with_cpu(|| {
+        textio::with_threads(Some(threads), || {
+            best_of(args.repeat, || {
+                solver.forward_batch_warm(&ordered, &opts, WARM_CHUNK)
+            })
         })
-    })?;
+    });
+    let (t_warm, warm) = r?;
+    // CPU microseconds per query (mean over the repeats, summed over threads).
+    let cpu_us = |c: f64| c / (n * args.repeat.max(1)) as f64 * 1e6;
 
     let mel = mean_edge_length(&mesh);
     let err = |p: &wavg_mesh::SurfacePoint, r: &Result<ForwardResult, SolveError>| match r {
@@ -251,9 +293,22 @@ pub fn run(args: Args) -> Result<(), CliError> {
         threads,
         args.repeat.max(1)
     );
-    println!("inverse_us                {:.3}", report.inverse_us);
-    println!("forward_us                {:.3}", report.forward_us);
-    println!("forward_warm_us           {:.3}", report.forward_warm_us);
+    println!(
+        "inverse_us                {:.3}  (CPU per query {:.3})",
+        report.inverse_us,
+        cpu_us(cpu_inv)
+    );
+    println!(
+        "forward_us                {:.3}  (CPU per query {:.3})",
+        report.forward_us,
+        cpu_us(cpu_fwd)
+    );
+    println!(
+        "forward_warm_us           {:.3}  (CPU per query {:.3})",
+        report.forward_warm_us,
+        cpu_us(cpu_warm)
+    );
+    println!("load average              {}", load_average());
     println!(
         "roundtrip_ok_fraction     {:.5}  (warm: {:.5})",
         report.roundtrip_ok_fraction,
