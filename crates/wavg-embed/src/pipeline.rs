@@ -86,8 +86,8 @@ pub struct Report {
     /// Total wall-clock seconds.
     pub seconds: f64,
     /// Per stage. Some stages overlap (the decimation with the quality check's fast
-    /// marching, the MDS with the least-squares factorisation), so these can add up to
-    /// more than `seconds`.
+    /// marching, the geodesics with the least-squares factorisation), so these can add up
+    /// to more than `seconds`.
     pub stages: StageSeconds,
     /// Landmarks used.
     pub landmarks: usize,
@@ -213,39 +213,41 @@ pub fn precompute(
     stages.quality = t_quality;
     check_cancel(progress)?;
 
-    // 2. Geodesic distances between landmarks.
-    let t = Instant::now();
+    // 2. Geodesic distances between landmarks (parallel), while the least-squares system,
+    //    which depends only on the mesh and the landmarks, is factored alongside
+    //    (sequential): this fills the second core during the geodesics' tail.
     let fine = fm.get_or_insert_with(|| FastMarching::new(mesh));
-    let q = match &coarse {
-        // All pairs on the intermediate mesh, close pairs corrected on the full mesh.
-        Some(c) if opts.refine_near_pairs => {
-            landmark_distances_two_level(fine, c, &landmarks, progress)?
-        }
-        Some(c) => landmark_distances_decimated(c, &landmarks, progress)?,
-        None => landmark_distances_with(fine, &landmarks, progress)?,
-    };
-    drop(fm);
-    let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
-    drop(coarse);
-    stages.geodesics = secs(t);
-    check_cancel(progress)?;
-
-    // 3. MDS of the landmarks, while the least-squares system (which depends only on the
-    //    mesh and the landmarks) is factored alongside.
-    let (mds, solver) = rayon::join(
-        || {
+    let (q, solver) = rayon::join(
+        || -> Result<_, EmbedError> {
             let t = Instant::now();
-            metric_mds(&q, landmarks.len(), &opts.mds, progress).map(|r| (r, secs(t)))
+            let q = match &coarse {
+                // All pairs on the intermediate mesh, close pairs corrected on the full mesh.
+                Some(c) if opts.refine_near_pairs => {
+                    landmark_distances_two_level(fine, c, &landmarks, progress)?
+                }
+                Some(c) => landmark_distances_decimated(c, &landmarks, progress)?,
+                None => landmark_distances_with(fine, &landmarks, progress)?,
+            };
+            Ok((q, secs(t)))
         },
         || {
             let t = Instant::now();
             LsMeshSolver::new(mesh, &landmarks, progress).map(|s| (s, secs(t)))
         },
     );
-    let (mds, t_mds) = mds?;
+    let (q, t_geodesics) = q?;
     let (solver, t_factor) = solver?;
+    drop(fm);
+    let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
+    drop(coarse);
+    stages.geodesics = t_geodesics;
+    check_cancel(progress)?;
+
+    // 3. MDS of the landmarks.
+    let t = Instant::now();
+    let mds = metric_mds(&q, landmarks.len(), &opts.mds, progress)?;
     drop(q);
-    stages.mds = t_mds;
+    stages.mds = secs(t);
     check_cancel(progress)?;
 
     // 4. Least-squares mesh: the landmarks' MDS positions extended to every vertex.
@@ -478,11 +480,11 @@ mod tests {
             let seen = p.seen.lock().unwrap().clone();
             // Stages that run strictly after the cancelled one never start (the quality
             // check's fast marching runs alongside the decimation, the least-squares
-            // factorisation alongside the MDS), and the final solve never happens.
+            // factorisation alongside the geodesics), and the final solve never happens.
             let never: &[Stage] = match stage {
                 Stage::Decimate | Stage::Quality => &[Stage::Geodesics, Stage::Mds, Stage::LsMesh],
-                Stage::Geodesics => &[Stage::Mds, Stage::LsMesh],
-                Stage::Mds | Stage::LsMesh => &[],
+                Stage::Geodesics | Stage::LsMesh => &[Stage::Mds],
+                Stage::Mds => &[],
             };
             for (s, f) in &seen {
                 assert!(
