@@ -1,0 +1,48 @@
+//! Runs the whole precomputation on meshes and prints the per-stage table (markdown).
+//!
+//! `cargo run --release -p wavg-embed --example precompute_table -- [MESH...]`
+//! (default: pig, armadillo, horse, igea from the shared data folder).
+
+use std::path::PathBuf;
+
+use wavg_embed::{NoProgress, PrecomputeOptions, precompute};
+use wavg_mesh::ValidMesh;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let paths: Vec<PathBuf> = if args.is_empty() {
+        let Some(dir) = wavg_mesh::data::require_data_dir("precompute_table") else {
+            return;
+        };
+        ["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"]
+            .iter()
+            .map(|m| dir.join("meshes").join(m))
+            .collect()
+    } else {
+        args.iter().map(PathBuf::from).collect()
+    };
+    println!(
+        "| mesh | vertices | geodesic mesh | seconds | decimate | geodesics | mds | lsmesh | quality | stress | p50 | p90 |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for path in paths {
+        let mesh = ValidMesh::new(wavg_mesh::io::load(&path).unwrap()).unwrap();
+        let (_, r) = precompute(&mesh, &PrecomputeOptions::default(), &NoProgress).unwrap();
+        let s = &r.stages;
+        println!(
+            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.4} | {:.4} | {:.4} |",
+            path.file_name().unwrap().to_string_lossy(),
+            r.vertices,
+            r.geodesic_mesh_vertices,
+            r.seconds,
+            s.decimate,
+            s.geodesics,
+            s.mds,
+            s.lsmesh,
+            s.quality,
+            r.stress,
+            r.geodesic_rel_err_p50,
+            r.geodesic_rel_err_p90
+        );
+    }
+}
