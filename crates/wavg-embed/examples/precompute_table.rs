@@ -1,6 +1,7 @@
 //! Runs the whole precomputation on meshes and prints the per-stage table (markdown).
 //!
-//! `cargo run --release -p wavg-embed --example precompute_table -- [MESH...]`
+//! `cargo run --release -p wavg-embed --example precompute_table -- [MESH...]
+//! [--no-refine] [--geodesic-vertices N]`
 //! (default: pig, armadillo, horse, igea from the shared data folder).
 
 use std::path::PathBuf;
@@ -9,7 +10,16 @@ use wavg_embed::{NoProgress, PrecomputeOptions, precompute};
 use wavg_mesh::ValidMesh;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let mut opts = PrecomputeOptions::default();
+    if let Some(i) = args.iter().position(|a| a == "--no-refine") {
+        opts.refine_near_pairs = false;
+        args.remove(i);
+    }
+    if let Some(i) = args.iter().position(|a| a == "--geodesic-vertices") {
+        opts.geodesic_vertices = args[i + 1].parse().expect("--geodesic-vertices N");
+        args.drain(i..i + 2);
+    }
     let paths: Vec<PathBuf> = if args.is_empty() {
         let Some(dir) = wavg_mesh::data::require_data_dir("precompute_table") else {
             return;
@@ -27,7 +37,7 @@ fn main() {
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for path in paths {
         let mesh = ValidMesh::new(wavg_mesh::io::load(&path).unwrap()).unwrap();
-        let (_, r) = precompute(&mesh, &PrecomputeOptions::default(), &NoProgress).unwrap();
+        let (_, r) = precompute(&mesh, &opts, &NoProgress).unwrap();
         let s = &r.stages;
         println!(
             "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.4} | {:.4} | {:.4} |",
