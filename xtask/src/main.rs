@@ -19,7 +19,10 @@ fn main() -> ExitCode {
 }
 
 fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask lives in the workspace").to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace")
+        .to_path_buf()
 }
 
 /// One check: a name and a command line.
@@ -30,13 +33,28 @@ struct Step {
 }
 
 const STEPS: &[Step] = &[
-    Step { name: "format", program: "cargo", args: &["fmt", "--all", "--check"] },
+    Step {
+        name: "format",
+        program: "cargo",
+        args: &["fmt", "--all", "--check"],
+    },
     Step {
         name: "clippy",
         program: "cargo",
-        args: &["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"],
+        args: &[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ],
     },
-    Step { name: "tests", program: "cargo", args: &["test", "--workspace"] },
+    Step {
+        name: "tests",
+        program: "cargo",
+        args: &["test", "--workspace"],
+    },
 ];
 
 fn run_all(root: &Path) -> ExitCode {
@@ -47,11 +65,21 @@ fn run_all(root: &Path) -> ExitCode {
     report_data_dir(root);
     let total = Instant::now();
     for step in STEPS {
-        eprintln!("==> {} ({} {})", step.name, step.program, step.args.join(" "));
+        eprintln!(
+            "==> {} ({} {})",
+            step.name,
+            step.program,
+            step.args.join(" ")
+        );
         let t = Instant::now();
-        let status = Command::new(step.program).args(step.args).current_dir(root).status();
+        let status = Command::new(step.program)
+            .args(step.args)
+            .current_dir(root)
+            .status();
         match status {
-            Ok(s) if s.success() => eprintln!("==> {} ok in {:.1} s", step.name, t.elapsed().as_secs_f64()),
+            Ok(s) if s.success() => {
+                eprintln!("==> {} ok in {:.1} s", step.name, t.elapsed().as_secs_f64())
+            }
             Ok(s) => {
                 eprintln!("==> {} FAILED ({s})", step.name);
                 return ExitCode::FAILURE;
@@ -62,7 +90,10 @@ fn run_all(root: &Path) -> ExitCode {
             }
         }
     }
-    eprintln!("==> all checks passed in {:.1} s", total.elapsed().as_secs_f64());
+    eprintln!(
+        "==> all checks passed in {:.1} s",
+        total.elapsed().as_secs_f64()
+    );
     ExitCode::SUCCESS
 }
 
@@ -70,9 +101,14 @@ fn run_all(root: &Path) -> ExitCode {
 /// say exactly what is missing and how to add it.
 fn check_tools() -> Result<(), String> {
     for (tool, component) in [("rustfmt", "rustfmt"), ("cargo-clippy", "clippy")] {
-        let ok = Command::new(tool).arg("--version").output().is_ok_and(|o| o.status.success());
+        let ok = Command::new(tool)
+            .arg("--version")
+            .output()
+            .is_ok_and(|o| o.status.success());
         if !ok {
-            return Err(format!("{tool} is missing: install it with `rustup component add {component}`"));
+            return Err(format!(
+                "{tool} is missing: install it with `rustup component add {component}`"
+            ));
         }
     }
     Ok(())

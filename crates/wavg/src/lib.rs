@@ -11,6 +11,6 @@
 
 pub use wavg_embed as embed;
 pub use wavg_mesh as mesh;
+pub use wavg_mesh::{MeshError, SurfacePoint, TriMesh, ValidMesh};
 pub use wavg_project as project;
 pub use wavg_solve as solve;
-pub use wavg_mesh::{MeshError, SurfacePoint, TriMesh, ValidMesh};
