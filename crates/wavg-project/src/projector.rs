@@ -60,28 +60,38 @@ pub struct Projector {
     faces: Vec<Face>,
     bvh: Bvh,
     walk_origin: Vec8,
+    walk_inv_step: f64,
     walk_coords: Vec<WalkPoint>,
 }
 
-/// A vertex in the walk's compact coordinates (f32, relative to the bounding box
-/// centre): half a cache line, so the walk, which reads many vertices once, waits for
-/// half as many lines. Only the walk and the ordering of candidate faces use them.
+/// A vertex in the walk's compact coordinates: 16-bit integers on a uniform grid over the
+/// bounding box (65535 steps along its longest side), a quarter of a cache line, so the
+/// walk, which reads many vertices once, waits for few lines. Only the greedy walk and
+/// the ordering of candidate faces use them (heuristics; every answer is computed and
+/// certified in f64).
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(32))]
-struct WalkPoint([f32; 8]);
+#[repr(C, align(16))]
+struct WalkPoint([u16; 8]);
+
+impl WalkPoint {
+    #[inline(always)]
+    fn unpack(&self) -> [f32; 8] {
+        std::array::from_fn(|k| self.0[k] as f32)
+    }
+}
 
 #[inline(always)]
-fn wdist2(a: &WalkPoint, b: &WalkPoint) -> f32 {
+fn wdist2(a: &[f32; 8], b: &[f32; 8]) -> f32 {
     let mut s = 0.0;
     for k in 0..8 {
-        let d = a.0[k] - b.0[k];
+        let d = a[k] - b[k];
         s += d * d;
     }
     s
 }
 
 /// What a query reads of a vertex, in two adjacent cache lines: its embedded point (f64,
-/// for the walk and the tangent equations) and its frame (f32).
+/// for the tangent equations) and its frame (f32).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct VertexRec {
@@ -181,10 +191,22 @@ impl Projector {
             (Vec8::repeat(f64::INFINITY), Vec8::repeat(f64::NEG_INFINITY)),
             |(l, h), c| (l.inf(c), h.sup(c)),
         );
-        let walk_origin = (lo + hi) * 0.5;
+        let walk_origin = lo;
+        let extent = (hi - lo).max();
+        let walk_inv_step = if extent > 0.0 && extent.is_finite() {
+            65535.0 / extent
+        } else {
+            1.0
+        };
         let walk_coords = coords
             .iter()
-            .map(|c| WalkPoint(std::array::from_fn(|k| (c[k] - walk_origin[k]) as f32)))
+            .map(|c| {
+                WalkPoint(std::array::from_fn(|k| {
+                    ((c[k] - walk_origin[k]) * walk_inv_step)
+                        .round()
+                        .clamp(0.0, 65535.0) as u16
+                }))
+            })
             .collect();
         Ok(Self {
             emb,
@@ -193,6 +215,7 @@ impl Projector {
             faces,
             bvh,
             walk_origin,
+            walk_inv_step,
             walk_coords,
         })
     }
@@ -325,17 +348,17 @@ impl Projector {
         let mut scores = [f32::INFINITY; 64];
         if ring.len() <= 64 {
             let yw = self.walk_point(y);
-            let wv = &self.walk_coords[v as usize].0;
+            let wv = self.walk_coords[v as usize].unpack();
             let mut dy = [0.0f32; 8];
             for k in 0..8 {
-                dy[k] = yw.0[k] - wv[k];
+                dy[k] = yw[k] - wv[k];
             }
             // Per neighbour j: |e_j|^2, e_j . (y - v) and e_j . e_{j+1}, e_j = u_j - v.
             let mut ee = [0.0f32; 64];
             let mut de = [0.0f32; 64];
             let mut ee1 = [0.0f32; 64];
             let edge = |u: u32| {
-                let wu = &self.walk_coords[u as usize].0;
+                let wu = self.walk_coords[u as usize].unpack();
                 let mut d = [0.0f32; 8];
                 for k in 0..8 {
                     d[k] = wu[k] - wv[k];
@@ -555,8 +578,8 @@ impl Projector {
 
     /// The query in the walk's compact coordinates.
     #[inline]
-    fn walk_point(&self, y: &Vec8) -> WalkPoint {
-        WalkPoint(std::array::from_fn(|k| (y[k] - self.walk_origin[k]) as f32))
+    fn walk_point(&self, y: &Vec8) -> [f32; 8] {
+        std::array::from_fn(|k| ((y[k] - self.walk_origin[k]) * self.walk_inv_step) as f32)
     }
 
     /// The walk; leaves the squared distances of the final vertex's ring in `ring_d`.
@@ -566,11 +589,11 @@ impl Projector {
         let w = &self.walk_coords;
         let yw = self.walk_point(y);
         let mut v = start;
-        let mut dv = wdist2(&w[v as usize], &yw);
+        let mut dv = wdist2(&w[v as usize].unpack(), &yw);
         loop {
             let mut next = v;
             for (j, &u) in topo.ring(v).iter().enumerate() {
-                let d = wdist2(&w[u as usize], &yw);
+                let d = wdist2(&w[u as usize].unpack(), &yw);
                 if j < 64 {
                     ring_d[j] = d;
                 }
