@@ -413,10 +413,14 @@ impl Projector {
         let mut best: Option<Best> = None;
         let consider = |f: u32, tested: &mut Tested, best: &mut Option<Best>| -> bool {
             tested.push(f);
-            if let Some(b) = self.try_face(f, y) {
-                if best.is_none_or(|x| b.d2 < x.d2) {
-                    *best = Some(b);
-                }
+            // Once something is found, only a strictly closer answer matters: the cheap
+            // lower bounds of `try_face_bounded` skip most of the remaining faces.
+            let found = match best {
+                None => self.try_face(f, y),
+                Some(x) => self.try_face_bounded(f, y, x.d2),
+            };
+            if let Some(b) = found {
+                *best = Some(b);
                 return self.is_zero(&b);
             }
             false
@@ -499,6 +503,12 @@ impl Projector {
             s += d * d;
         }
         if s >= bound {
+            return None;
+        }
+        // The (clamped) Phong point lies in the triangle, so the Euclidean distance is a
+        // lower bound too, tighter than the box and cheaper than Newton.
+        let w = closest_point_barycentric(y, &a, &b, &c);
+        if (a * w[0] + b * w[1] + c * w[2] - y).norm_squared() >= bound {
             return None;
         }
         self.try_face(f, y).filter(|r| r.d2 < bound)
