@@ -49,34 +49,6 @@ pub fn frame_to_f64(f: &Frame32) -> Mat2x8 {
     Mat2x8::from_fn(|r, c| f[r * 8 + c] as f64)
 }
 
-/// `T (d)` for a stored frame: the 2-D tangent coordinates of `d`.
-#[inline(always)]
-pub fn frame_apply(f: &Frame32, d: &Vec8) -> [f64; 2] {
-    let d: &[f64; 8] = &d.data.0[0];
-    let mut a = 0.0;
-    let mut b = 0.0;
-    for c in 0..8 {
-        a += f[c] as f64 * d[c];
-        b += f[8 + c] as f64 * d[c];
-    }
-    [a, b]
-}
-
-/// `T (y - v)` for a stored frame, without forming `y - v`.
-#[inline(always)]
-pub fn frame_apply_diff(f: &Frame32, y: &Vec8, v: &Vec8) -> [f64; 2] {
-    let y: &[f64; 8] = &y.data.0[0];
-    let v: &[f64; 8] = &v.data.0[0];
-    let mut a = 0.0;
-    let mut b = 0.0;
-    for c in 0..8 {
-        let d = y[c] - v[c];
-        a += f[c] as f64 * d;
-        b += f[8 + c] as f64 * d;
-    }
-    [a, b]
-}
-
 /// Precomputed data of one triangle: the six 2x2 blend matrices `X_e` (row-major), 96
 /// bytes. The tangent coordinates of the corners are recomputed per query from the
 /// (stored) frames and the (f64) corners, so a point on the triangle satisfies the
