@@ -168,11 +168,14 @@ fn main() {
         thick: Vec<f64>,         // inward ray thickness / mel3
         resid: Vec<f64>,         // |Psi (ybar - yhat)| / |ybar - yhat|
         off_rel_thick: Vec<f64>, // |ybar - yhat| (R^8) / thickness in R^8 units (approx)
+        min_bary: Vec<f64>,      // smallest barycentric of the query (near an edge/vertex)
     }
     let (mut ok, mut bad) = (Stats::default(), Stats::default());
     let (mut n_fail_fast, mut n_fail_exact, mut n_fail_paper, mut n_orig_invalid) = (0, 0, 0, 0);
     let mut boundary_fail = 0;
     let mut fast_fail_exact_ok = 0;
+    // Failures per nearest anchor (are they clustered?).
+    let mut by_anchor = vec![0usize; anchors.len()];
     let exact_opts = ForwardOptions {
         mode: SearchMode::Exact,
         ..Default::default()
@@ -214,6 +217,10 @@ fn main() {
 
         let s = if fast_ok { &mut ok } else { &mut bad };
         if !fast_ok {
+            let nearest = (0..apos.len())
+                .min_by(|&i, &j| (apos[i] - x3).norm().total_cmp(&(apos[j] - x3).norm()))
+                .unwrap_or(0);
+            by_anchor[nearest] += 1;
             let q = fast.point;
             s.other.push((emb.point(&q) - ybar).norm() / mel8);
             s.jump3.push((q.position(&mesh) - x3).norm() / mel3);
@@ -229,6 +236,8 @@ fn main() {
         }
         let off = (ybar - yhat).norm();
         s.off.push(off / mel8);
+        s.min_bary
+            .push(p.bary.iter().copied().fold(f64::INFINITY, f64::min));
         let psi = proj.psi(p);
         s.resid.push((psi * (ybar - yhat)).norm() / off.max(1e-300));
         let mut aw: Vec<f64> = w.iter().map(|x| x.abs()).collect();
@@ -269,6 +278,18 @@ fn main() {
     println!(
         "original face's Newton does not return the point: {n_orig_invalid}; failures on boundary faces {boundary_fail}; fast fails but exact ok {fast_fail_exact_ok}"
     );
+    let mut ranked: Vec<(usize, usize)> = by_anchor.iter().copied().zip(0..).collect();
+    ranked.sort_by(|a, b| b.cmp(a));
+    let top: usize = ranked.iter().take(5).map(|r| r.0).sum();
+    println!(
+        "failures by nearest anchor: top 5 anchors hold {top} of {}: {:?}",
+        bad.off.len(),
+        ranked
+            .iter()
+            .take(5)
+            .map(|&(c, i)| (c, anchors[i], apos[i].map(|x| (x * 100.0).round() / 100.0)))
+            .collect::<Vec<_>>()
+    );
     for (name, s) in [("FAILED (fast)", &bad), ("ok", &ok)] {
         println!("{name}:");
         summary("|ybar-yhat| / mean edge (R^8)", &s.off);
@@ -284,6 +305,7 @@ fn main() {
         summary("inward thickness / mean edge (3-D)", &s.thick);
         summary("|ybar-yhat| / thickness (scaled)", &s.off_rel_thick);
         summary("|Psi(ybar-yhat)| / |ybar-yhat|", &s.resid);
+        summary("smallest barycentric of the query", &s.min_bary);
     }
 }
 
