@@ -174,6 +174,7 @@ fn main() {
     let (mut n_fail_fast, mut n_fail_exact, mut n_fail_paper, mut n_orig_invalid) = (0, 0, 0, 0);
     let mut boundary_fail = 0;
     let mut fast_fail_exact_ok = 0;
+    let mut n_agree = 0;
     // Failures per nearest anchor (are they clustered?).
     let mut by_anchor = vec![0usize; anchors.len()];
     let exact_opts = ForwardOptions {
@@ -199,6 +200,10 @@ fn main() {
         let paper = paper_search(&proj, &ybar, v0);
         let paper_ok = paper.is_some_and(|q| okf(&q));
         n_fail_fast += !fast_ok as usize;
+        n_agree += exact
+            .as_ref()
+            .is_ok_and(|r| (r.position - fast.position).norm() < 1e-3 * mel3)
+            as usize;
         n_fail_exact += !exact_ok as usize;
         n_fail_paper += !paper_ok as usize;
         // Does Newton on the original face give back the original point?
@@ -274,6 +279,10 @@ fn main() {
         1.0 - n_fail_fast as f64 / n,
         1.0 - n_fail_exact as f64 / n,
         1.0 - n_fail_paper as f64 / n
+    );
+    println!(
+        "fast search agrees with the closest projection (paper's own check): {:.4}",
+        n_agree as f64 / n
     );
     println!(
         "original face's Newton does not return the point: {n_orig_invalid}; failures on boundary faces {boundary_fail}; fast fails but exact ok {fast_fail_exact_ok}"
