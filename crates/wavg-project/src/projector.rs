@@ -64,19 +64,36 @@ pub struct Projector {
     walk_coords: Vec<WalkPoint>,
 }
 
-/// A vertex in the walk's compact coordinates: 16-bit integers on a uniform grid over the
-/// bounding box (65535 steps along its longest side), a quarter of a cache line, so the
-/// walk, which reads many vertices once, waits for few lines. Only the greedy walk and
-/// the ordering of candidate faces use them (heuristics; every answer is computed and
-/// certified in f64).
+/// Neighbours stored in a vertex's walk record (larger rings come from the topology).
+const WALK_RING: usize = 11;
+
+/// A vertex as the walk sees it, in one cache line: its coordinates as 16-bit integers on
+/// a uniform grid over the bounding box (65535 steps along its longest side) and its
+/// one-ring. Reading a neighbour's distance brings in its ring too, so a walk step waits
+/// for one round of (parallel) memory accesses. Only the greedy walk and the ordering of
+/// candidate faces use these (heuristics; every answer is computed and certified in f64).
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(16))]
-struct WalkPoint([u16; 8]);
+#[repr(C, align(64))]
+struct WalkPoint {
+    c: [u16; 8],
+    ring: [u32; WALK_RING],
+    /// Ring length, or `u32::MAX` if it does not fit.
+    n: u32,
+}
 
 impl WalkPoint {
     #[inline(always)]
     fn unpack(&self) -> [f32; 8] {
-        std::array::from_fn(|k| self.0[k] as f32)
+        std::array::from_fn(|k| self.c[k] as f32)
+    }
+
+    #[inline(always)]
+    fn ring<'a>(&'a self, topo: &'a wavg_mesh::Topology, v: VertexId) -> &'a [u32] {
+        if (self.n as usize) <= WALK_RING {
+            &self.ring[..self.n as usize]
+        } else {
+            topo.ring(v)
+        }
     }
 }
 
@@ -200,12 +217,25 @@ impl Projector {
         };
         let walk_coords = coords
             .iter()
-            .map(|c| {
-                WalkPoint(std::array::from_fn(|k| {
-                    ((c[k] - walk_origin[k]) * walk_inv_step)
-                        .round()
-                        .clamp(0.0, 65535.0) as u16
-                }))
+            .enumerate()
+            .map(|(v, c)| {
+                let r = mesh.topology().ring(v as u32);
+                let mut ring = [0u32; WALK_RING];
+                let n = if r.len() <= WALK_RING {
+                    ring[..r.len()].copy_from_slice(r);
+                    r.len() as u32
+                } else {
+                    u32::MAX
+                };
+                WalkPoint {
+                    c: std::array::from_fn(|k| {
+                        ((c[k] - walk_origin[k]) * walk_inv_step)
+                            .round()
+                            .clamp(0.0, 65535.0) as u16
+                    }),
+                    ring,
+                    n,
+                }
             })
             .collect();
         Ok(Self {
@@ -343,7 +373,7 @@ impl Projector {
         // the query's orthogonal projection falls (walk coordinates, already cached).
         // The face list is fetched first but only used after the scores, so its memory
         // access overlaps the arithmetic.
-        let ring = topo.ring(v);
+        let ring = self.walk_coords[v as usize].ring(topo, v);
         let faces = topo.ring_faces(v);
         let mut scores = [f32::INFINITY; 64];
         if ring.len() <= 64 {
@@ -602,7 +632,7 @@ impl Projector {
         let mut dv = wdist2(&w[v as usize].unpack(), &yw);
         loop {
             let mut next = v;
-            for (j, &u) in topo.ring(v).iter().enumerate() {
+            for (j, &u) in w[v as usize].ring(topo, v).iter().enumerate() {
                 let d = wdist2(&w[u as usize].unpack(), &yw);
                 if j < 64 {
                     ring_d[j] = d;
