@@ -13,15 +13,16 @@
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Instant;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use wavg::mesh::{SurfacePoint, ValidMesh, VertexId, io};
+use wavg::mesh::{SurfacePoint, ValidMesh, VertexId};
 use wavg::project::{EmbeddedMesh, Projection, Projector, Vec8};
 
 use crate::CliError;
+use crate::common::load_valid;
+use crate::textio;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -57,27 +58,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.queries == 0 {
         return Err(CliError::input("--queries must be at least 1"));
     }
-    let tri = io::load(&args.mesh)
-        .map_err(|e| CliError::input(format!("{}: {e}", args.mesh.display())))?;
-    let mesh = Arc::new(
-        ValidMesh::new(tri)
-            .map_err(|e| CliError::input(format!("{}: {e}", args.mesh.display())))?,
-    );
-    let emb = match &args.embedding {
-        None => EmbeddedMesh::from_positions(mesh.clone()),
-        Some(p) => {
-            let e = wavg_embed::file::load(p, &mesh)
-                .map_err(|e| CliError::input(format!("{}: {e}", p.display())))?;
-            let coords = e
-                .coords
-                .iter()
-                .map(|c| Vec8::from_column_slice(c))
-                .collect();
-            EmbeddedMesh::new(mesh.clone(), coords)
-                .map_err(|e| CliError::input(format!("{}: {e}", p.display())))?
-        }
-    };
-    let emb = Arc::new(emb);
+    let mesh = load_valid(&args.mesh.to_string_lossy())?;
+    let emb = textio::load_embedded(mesh.clone(), args.embedding.as_deref())?;
     let t0 = Instant::now();
     let projector = Projector::new(emb.clone()).map_err(CliError::failure)?;
     let init_s = t0.elapsed().as_secs_f64();

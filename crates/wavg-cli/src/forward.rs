@@ -28,21 +28,11 @@ starts each line from the previous line's answer (for sequences of nearby querie
 #[derive(clap::Args)]
 #[command(after_long_help = format!("{LONG_ABOUT}\n\n{}", textio::FORMAT_HELP))]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
-    /// Embedding (.wavg from `wavg precompute`); default: the mesh's 3-D positions.
-    #[arg(long)]
-    pub embedding: Option<PathBuf>,
-    /// Anchors file ('v VERTEX' or 'f FACE B0 B1 B2' per line).
-    #[arg(long)]
-    pub anchors: PathBuf,
+    #[command(flatten)]
+    pub problem: textio::ProblemArgs,
     /// Weights file (one line of numbers per query, one number per anchor).
     #[arg(long)]
     pub weights: PathBuf,
-    /// Output file ('-' for stdout).
-    #[arg(short, long)]
-    pub output: PathBuf,
     /// Divide each weight line by its sum instead of rejecting lines that do not sum to 1.
     #[arg(long)]
     pub normalize: bool,
@@ -52,9 +42,6 @@ pub struct Args {
     /// Start each query from the previous line's answer.
     #[arg(long)]
     pub warm: bool,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
 }
 
 /// Runs the command.
@@ -62,7 +49,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let text = textio::read_text(&args.weights)?;
     let lines =
         textio::parse_weights(&text).map_err(|e| located(&args.weights, e.line, &e.message))?;
-    let solver = textio::load_solver(&args.mesh, args.embedding.as_deref(), &args.anchors)?;
+    let solver = textio::load_solver(
+        &args.problem.mesh,
+        args.problem.embedding.as_deref(),
+        &args.problem.anchors,
+    )?;
     let normalization = if args.normalize {
         Normalization::Normalize
     } else {
@@ -83,7 +74,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         warm_start: None,
     };
     let weights: Vec<&[f64]> = lines.iter().map(|(_, w)| &w[..]).collect();
-    let results = textio::with_threads(args.threads, || {
+    let results = textio::with_threads(args.problem.threads, || {
         if args.warm {
             solver.forward_batch_warm(&weights, &opts, 256)
         } else {
@@ -101,7 +92,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             )));
         }
     }
-    textio::write_atomic(&args.output, |w: &mut dyn Write| {
+    textio::write_atomic(&args.problem.output, |w: &mut dyn Write| {
         for r in &results {
             match r {
                 Ok(r) => {

@@ -22,39 +22,30 @@ bad barycentrics) are input errors: exit status 2 naming the line, and nothing i
 #[derive(clap::Args)]
 #[command(after_long_help = format!("{LONG_ABOUT}\n\n{}", textio::FORMAT_HELP))]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
-    /// Embedding (.wavg from `wavg precompute`); default: the mesh's 3-D positions.
-    #[arg(long)]
-    pub embedding: Option<PathBuf>,
-    /// Anchors file ('v VERTEX' or 'f FACE B0 B1 B2' per line).
-    #[arg(long)]
-    pub anchors: PathBuf,
+    #[command(flatten)]
+    pub problem: textio::ProblemArgs,
     /// Points file ('v VERTEX' or 'f FACE B0 B1 B2' per line).
     #[arg(long)]
     pub points: PathBuf,
-    /// Output file ('-' for stdout).
-    #[arg(short, long)]
-    pub output: PathBuf,
     /// How much more distance off the tangent plane counts than distance along it.
     #[arg(long, default_value_t = wavg_solve::kernel::DEFAULT_GAMMA)]
     pub gamma: f64,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let specs = textio::read_points(&args.points)?;
-    let mut solver = textio::load_solver(&args.mesh, args.embedding.as_deref(), &args.anchors)?;
+    let mut solver = textio::load_solver(
+        &args.problem.mesh,
+        args.problem.embedding.as_deref(),
+        &args.problem.anchors,
+    )?;
     solver
         .set_gamma(args.gamma)
         .map_err(|e| CliError::input(format!("--gamma: {e}")))?;
     let points = textio::resolve_points(solver.mesh(), &specs, &args.points)?;
-    let batch = textio::with_threads(args.threads, || solver.inverse_batch(&points))?;
-    textio::write_atomic(&args.output, |w: &mut dyn Write| {
+    let batch = textio::with_threads(args.problem.threads, || solver.inverse_batch(&points))?;
+    textio::write_atomic(&args.problem.output, |w: &mut dyn Write| {
         for r in batch.iter() {
             match r {
                 Ok(ws) => write_numbers(w, ws.iter().copied())?,

@@ -10,7 +10,7 @@
 
 use std::fmt;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use wavg_mesh::{SurfacePoint, ValidMesh};
@@ -181,6 +181,27 @@ pub fn write_atomic(
     }
     tmp.persist(path).map_err(|e| fail(&e.error))?;
     Ok(())
+}
+
+/// Arguments shared by `wavg forward` and `wavg inverse`: the mesh, its embedding, the
+/// anchors, the output and the thread count.
+#[derive(clap::Args)]
+pub struct ProblemArgs {
+    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    #[arg(long)]
+    pub mesh: String,
+    /// Embedding (.wavg from `wavg precompute`); default: the mesh's 3-D positions.
+    #[arg(long)]
+    pub embedding: Option<PathBuf>,
+    /// Anchors file ('v VERTEX' or 'f FACE B0 B1 B2' per line).
+    #[arg(long)]
+    pub anchors: PathBuf,
+    /// Output file ('-' for stdout).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
 }
 
 /// The embedded mesh: the `.wavg` embedding when given, else the 3-D positions.
