@@ -56,7 +56,7 @@ impl Default for PrecomputeOptions {
             landmarks: 1000,
             seed: 0,
             decimate: DecimateOptions::default(),
-            geodesic_vertices: 10_000,
+            geodesic_vertices: crate::geodesic::DEFAULT_GEODESIC_VERTICES,
             refine_near_pairs: true,
             mds: MdsOptions::default(),
             quality_pairs: 1024,
