@@ -10,7 +10,8 @@
 use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -56,6 +57,11 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
+    // Ctrl-C asks the pipeline to stop at its next check; the output is only written after
+    // success, so an interrupted run leaves no file behind.
+    let interrupted = Arc::new(AtomicBool::new(false));
+    let flag = interrupted.clone();
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
     let t_load = Instant::now();
     let mut mesh = load_mesh(&args.mesh)?;
     let mut removed = None;
@@ -78,11 +84,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         quality_pairs: args.quality_pairs,
         ..defaults
     };
-    let bars = Bars::new(std::io::stderr().is_terminal());
+    let bars = Bars::new(std::io::stderr().is_terminal(), interrupted);
     let result = embed::precompute(&mesh, &opts, &bars);
     bars.clear();
     let (embedding, report) = result.map_err(|e| match e {
         embed::EmbedError::InvalidArgument(m) => CliError::input(format!("{}: {m}", args.mesh)),
+        embed::EmbedError::Cancelled => CliError {
+            code: 130,
+            message: format!("interrupted; {} was not written", args.output.display()),
+        },
         e => CliError::failure(format!("{}: {}", args.mesh, one_line(&e))),
     })?;
 
@@ -212,16 +222,18 @@ fn validate(name: &str, mesh: wavg_mesh::TriMesh) -> Result<ValidMesh, CliError>
     }
 }
 
-/// One progress bar per stage on stderr (hidden when stderr is not a terminal).
+/// One progress bar per stage on stderr (hidden when stderr is not a terminal); also
+/// carries the Ctrl-C flag to the pipeline's cancellation checks.
 struct Bars {
     multi: MultiProgress,
     bars: Mutex<HashMap<Stage, ProgressBar>>,
+    interrupted: Arc<AtomicBool>,
 }
 
 const TICKS: u64 = 1000;
 
 impl Bars {
-    fn new(visible: bool) -> Self {
+    fn new(visible: bool, interrupted: Arc<AtomicBool>) -> Self {
         let target = if visible {
             ProgressDrawTarget::stderr()
         } else {
@@ -230,6 +242,7 @@ impl Bars {
         Self {
             multi: MultiProgress::with_draw_target(target),
             bars: Mutex::new(HashMap::new()),
+            interrupted,
         }
     }
 
@@ -239,6 +252,10 @@ impl Bars {
 }
 
 impl Progress for Bars {
+    fn cancelled(&self) -> bool {
+        self.interrupted.load(Ordering::Relaxed)
+    }
+
     fn report(&self, stage: Stage, fraction: f64) {
         let Ok(mut bars) = self.bars.lock() else {
             return;

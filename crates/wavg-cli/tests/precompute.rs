@@ -190,3 +190,49 @@ fn invalid_and_unreadable_meshes_are_clear_errors() {
     assert_eq!(out.status.code(), Some(2));
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
 }
+
+/// Ctrl-C (SIGINT) stops the pipeline cleanly: exit status 130, a one-line message, and no
+/// output file (not even a temporary one).
+#[cfg(unix)]
+#[test]
+fn interrupt_stops_cleanly_without_output() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    // Full-resolution geodesics on a 41k-vertex sphere: several seconds of work.
+    let mesh_path = write(dir.path(), "sphere.off", &procedural::icosphere(6));
+    let out_path = dir.path().join("sphere.wavg");
+    let child = Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(["precompute", &mesh_path, "-o", out_path.to_str().unwrap()])
+        .args(["--geodesic-vertices", "0"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(700));
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let start = Instant::now();
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        start.elapsed() < Duration::from_secs(20),
+        "cancellation took too long"
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("interrupted"));
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(
+        names,
+        vec![std::ffi::OsString::from("sphere.off")],
+        "{names:?}"
+    );
+}
