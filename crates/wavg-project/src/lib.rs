@@ -39,7 +39,7 @@ pub mod triangle;
 
 pub use embedded::EmbeddedMesh;
 pub use error::ProjectError;
-pub use projector::{Projection, ProjectionPath, Projector};
+pub use projector::{FaceOrder, Projection, ProjectionPath, Projector};
 
 /// Dimension of the embedding space.
 pub const DIM: usize = 8;

@@ -140,6 +140,20 @@ struct Face {
     v: [u32; 3],
 }
 
+/// Faces around a vertex in the order [`Projector::faces_by_promise`] gives them.
+#[derive(Clone, Copy, Debug)]
+pub struct FaceOrder {
+    faces: [FaceId; 64],
+    n: usize,
+}
+
+impl FaceOrder {
+    /// The faces, most promising first.
+    pub fn as_slice(&self) -> &[FaceId] {
+        &self.faces[..self.n]
+    }
+}
+
 /// Small fixed set of face ids (no allocation per query).
 struct Tested {
     ids: [u32; LOCAL_BUDGET],
@@ -391,8 +405,115 @@ impl Projector {
         // 1. Greedy walk.
         let mut ring_d = [0.0f32; 64];
         let v = self.walk_inner(y, start, &mut ring_d);
-        // 2. Faces around v, most promising first: by how far inside each face's plane
-        // the query's orthogonal projection falls (walk coordinates, already cached).
+        // 2. Faces around v, most promising first.
+        let cands = self.order_faces(y, v, &ring_d);
+        let (order, m) = (&cands.faces, cands.n);
+        let faces = self.walk_coords[v as usize].faces(topo, v);
+        let mut tested = Tested::new();
+        let mut best: Option<Best> = None;
+        let consider = |f: u32, tested: &mut Tested, best: &mut Option<Best>| -> bool {
+            tested.push(f);
+            // Once something is found, only a strictly closer answer matters: the cheap
+            // lower bounds of `try_face_bounded` skip most of the remaining faces.
+            let found = match best {
+                None => self.try_face(f, y),
+                Some(x) => self.try_face_bounded(f, y, x.d2),
+            };
+            if let Some(b) = found {
+                *best = Some(b);
+                return self.is_zero(&b);
+            }
+            false
+        };
+        for &f in &order[..m] {
+            if consider(f, &mut tested, &mut best) {
+                return Ok(Self::finish(
+                    best.unwrap_or_else(|| unreachable!()),
+                    ProjectionPath::Local,
+                ));
+            }
+        }
+        for &f in faces.iter().skip(m) {
+            if tested.full() {
+                break;
+            }
+            if consider(f, &mut tested, &mut best) {
+                return Ok(Self::finish(
+                    best.unwrap_or_else(|| unreachable!()),
+                    ProjectionPath::Local,
+                ));
+            }
+        }
+        // 3. Their neighbours across edges.
+        if best.is_none() {
+            let n_ring = tested.n;
+            'outer: for i in 0..n_ring {
+                for g in topo.face_neighbors(tested.ids[i]) {
+                    if g == NONE || tested.contains(g) {
+                        continue;
+                    }
+                    if tested.full() {
+                        break 'outer;
+                    }
+                    if consider(g, &mut tested, &mut best) {
+                        return Ok(Self::finish(
+                            best.unwrap_or_else(|| unreachable!()),
+                            ProjectionPath::Local,
+                        ));
+                    }
+                }
+            }
+        }
+        // 4. Certify (or search globally).
+        match best {
+            Some(local) => {
+                let mut improved = None;
+                let mut bound = local.d2;
+                self.bvh.search(y, &mut bound, |f, bound| {
+                    if tested.contains(f) {
+                        return;
+                    }
+                    if let Some(b) = self.try_face_bounded(f, y, *bound) {
+                        *bound = b.d2;
+                        improved = Some(b);
+                    }
+                });
+                Ok(match improved {
+                    Some(b) => Self::finish(b, ProjectionPath::Fallback),
+                    None => Self::finish(local, ProjectionPath::Local),
+                })
+            }
+            None => self
+                .exhaustive(y)
+                .map(|b| Self::finish(b, ProjectionPath::Fallback))
+                .ok_or(ProjectError::NoProjection),
+        }
+    }
+
+    /// The faces around vertex `v` (at most 64), most promising first for a projection of
+    /// `y`: by how far inside each face's plane the orthogonal projection of `y` falls
+    /// (walk coordinates, in cache right after a walk ending at `v`). Starts loading the
+    /// first face's data. The order is a heuristic; it never changes which answers exist.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// let m = Arc::new(ValidMesh::new(procedural::icosphere(2)).unwrap());
+    /// let emb = Arc::new(EmbeddedMesh::from_positions(m.clone()));
+    /// let p = Projector::new(emb.clone()).unwrap();
+    /// let f = m.topology().ring_faces(5)[2];
+    /// let y = emb.point(&SurfacePoint::new(f, [0.4, 0.3, 0.3]));
+    /// assert_eq!(p.faces_by_promise(&y, 5).as_slice()[0], f);
+    /// ```
+    pub fn faces_by_promise(&self, y: &Vec8, v: VertexId) -> FaceOrder {
+        self.order_faces(y, v, &[f32::INFINITY; 64])
+    }
+
+    /// [`Projector::faces_by_promise`]; `ring_d` (squared walk distances of `v`'s
+    /// neighbours) orders the faces of rings too long for the exact score.
+    fn order_faces(&self, y: &Vec8, v: VertexId, ring_d: &[f32; 64]) -> FaceOrder {
+        let topo = self.emb.mesh().topology();
         let ring = self.walk_coords[v as usize].ring(topo, v);
         let faces = self.walk_coords[v as usize].faces(topo, v);
         let mut scores = [f32::INFINITY; 64];
@@ -458,91 +579,17 @@ impl Projector {
         for j in 0..m {
             order[j] = (scores[j], faces[j]);
         }
-        order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        // Ties (and unscored faces) by id, so the order never depends on the sort.
+        order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         if m > 0 {
             // The first candidate nearly always holds the answer: request its record and
             // its corners' records together rather than one after the other.
             let f = order[0].1;
             self.prefetch_face(f, v, ring, faces);
         }
-        let mut tested = Tested::new();
-        let mut best: Option<Best> = None;
-        let consider = |f: u32, tested: &mut Tested, best: &mut Option<Best>| -> bool {
-            tested.push(f);
-            // Once something is found, only a strictly closer answer matters: the cheap
-            // lower bounds of `try_face_bounded` skip most of the remaining faces.
-            let found = match best {
-                None => self.try_face(f, y),
-                Some(x) => self.try_face_bounded(f, y, x.d2),
-            };
-            if let Some(b) = found {
-                *best = Some(b);
-                return self.is_zero(&b);
-            }
-            false
-        };
-        for &(_, f) in &order[..m] {
-            if consider(f, &mut tested, &mut best) {
-                return Ok(Self::finish(
-                    best.unwrap_or_else(|| unreachable!()),
-                    ProjectionPath::Local,
-                ));
-            }
-        }
-        for &f in faces.iter().skip(m) {
-            if tested.full() {
-                break;
-            }
-            if consider(f, &mut tested, &mut best) {
-                return Ok(Self::finish(
-                    best.unwrap_or_else(|| unreachable!()),
-                    ProjectionPath::Local,
-                ));
-            }
-        }
-        // 3. Their neighbours across edges.
-        if best.is_none() {
-            let n_ring = tested.n;
-            'outer: for i in 0..n_ring {
-                for g in topo.face_neighbors(tested.ids[i]) {
-                    if g == NONE || tested.contains(g) {
-                        continue;
-                    }
-                    if tested.full() {
-                        break 'outer;
-                    }
-                    if consider(g, &mut tested, &mut best) {
-                        return Ok(Self::finish(
-                            best.unwrap_or_else(|| unreachable!()),
-                            ProjectionPath::Local,
-                        ));
-                    }
-                }
-            }
-        }
-        // 4. Certify (or search globally).
-        match best {
-            Some(local) => {
-                let mut improved = None;
-                let mut bound = local.d2;
-                self.bvh.search(y, &mut bound, |f, bound| {
-                    if tested.contains(f) {
-                        return;
-                    }
-                    if let Some(b) = self.try_face_bounded(f, y, *bound) {
-                        *bound = b.d2;
-                        improved = Some(b);
-                    }
-                });
-                Ok(match improved {
-                    Some(b) => Self::finish(b, ProjectionPath::Fallback),
-                    None => Self::finish(local, ProjectionPath::Local),
-                })
-            }
-            None => self
-                .exhaustive(y)
-                .map(|b| Self::finish(b, ProjectionPath::Fallback))
-                .ok_or(ProjectError::NoProjection),
+        FaceOrder {
+            faces: std::array::from_fn(|j| order[j].1),
+            n: m,
         }
     }
 

@@ -129,6 +129,25 @@ impl AnchorCoords {
     }
 }
 
+/// Hints the processor to load the first lines (up to 1 KiB) of `v`; results are
+/// unaffected, and it is a no-op off x86-64.
+#[inline]
+pub fn prefetch_slice(v: &[f64]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let bytes = std::mem::size_of_val(v).min(1024);
+        let p = v.as_ptr() as *const i8;
+        for off in (0..bytes).step_by(64) {
+            // SAFETY: SSE is part of the x86-64 baseline and a prefetch never faults; the
+            // addresses lie inside `v` anyway.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(off)) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = v;
+}
+
 /// Reusable buffers for [`inverse_weights`] (so batches do not allocate per query).
 #[derive(Clone, Debug, Default)]
 pub struct InverseScratch {

@@ -61,28 +61,10 @@ impl LocalSearch {
     }
 
     /// Greedy walk from `start`: move to the neighbour closest to `y` while one is closer
-    /// than the current vertex (steepest descent; ends at a local minimum of the distance,
-    /// measured in f32).
+    /// than the current vertex (steepest descent; ends at a local minimum of the distance).
+    /// This is [`Projector::walk`], over its compact walk records.
     pub fn walk(&self, y: &Vec8, start: VertexId) -> VertexId {
-        let topo = self.proj.embedded().mesh().topology();
-        let c = &self.coords;
-        let y = Coord32::new(y);
-        let mut v = start;
-        let mut dv = c[v as usize].dist2(&y);
-        loop {
-            let mut next = v;
-            for &u in topo.ring(v) {
-                let d = c[u as usize].dist2(&y);
-                if d < dv {
-                    dv = d;
-                    next = u;
-                }
-            }
-            if next == v {
-                return v;
-            }
-            v = next;
-        }
+        self.proj.walk(y, start)
     }
 
     /// The local search from `start` (see the module docs); `None` when no triangle within
@@ -174,14 +156,12 @@ impl LocalSearch {
             n: 0,
         };
         let mut order = [(0.0f32, 0 as FaceId); LOCAL_BUDGET];
-        // First ring: the faces around v; their corners are v and consecutive ring
-        // vertices, whose coordinates the walk has just read (no lookup of the triangles).
-        let ring = topo.ring(v);
-        for (j, &f) in topo.ring_faces(v).iter().enumerate().take(LOCAL_BUDGET) {
-            let (a, b) = (ring[j], ring[(j + 1) % ring.len()]);
-            let score = outside(&c[v as usize], &c[a as usize], &c[b as usize], &y32);
+        // First ring: the faces around v, ordered by the projector from the walk records
+        // the walk has just read (the same score as below).
+        let first = proj.faces_by_promise(y, v);
+        for (j, &f) in first.as_slice().iter().enumerate().take(LOCAL_BUDGET) {
             seen.ids[seen.n] = f;
-            order[seen.n] = (score, f);
+            order[j] = (j as f32, f);
             seen.n += 1;
         }
         let mut level = 0..seen.n;

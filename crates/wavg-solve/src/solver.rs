@@ -309,10 +309,19 @@ impl Solver {
             .map(|(i, w)| (top_two(w.as_ref()), i as u32))
             .collect();
         let order = sorted_order(keys);
+        // In this order the weight rows are read at random: each query first waits for its
+        // row, so the rows two queries ahead are requested early.
+        const AHEAD: usize = 2;
         let done: Vec<(u32, Result<ForwardResult, SolveError>)> = order
-            .par_iter()
-            .with_min_len(64)
-            .map(|&i| (i, self.forward(weights[i as usize].as_ref(), opts)))
+            .par_chunks(64)
+            .flat_map_iter(|c| {
+                c.iter().enumerate().map(move |(k, &i)| {
+                    if let Some(&j) = c.get(k + AHEAD) {
+                        crate::kernel::prefetch_slice(weights[j as usize].as_ref());
+                    }
+                    (i, self.forward(weights[i as usize].as_ref(), opts))
+                })
+            })
             .collect();
         scatter(done)
     }
