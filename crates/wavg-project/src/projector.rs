@@ -332,6 +332,48 @@ impl Projector {
             .psi(self.face_frames(p.face), &p.bary)
     }
 
+    /// `Psi` and the embedded point at `p` together, from the projector's own records
+    /// (one face record and its corners': half the dependent memory reads of
+    /// [`Projector::psi`] plus [`EmbeddedMesh::point`]).
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// let m = Arc::new(ValidMesh::new(procedural::icosphere(1)).unwrap());
+    /// let emb = Arc::new(EmbeddedMesh::from_positions(m));
+    /// let p = Projector::new(emb.clone()).unwrap();
+    /// let q = SurfacePoint::new(3, [0.2, 0.3, 0.5]);
+    /// let (psi, y) = p.psi_and_point(&q);
+    /// assert_eq!(psi, p.psi(&q));
+    /// assert!((y - emb.point(&q)).norm() < 1e-15);
+    /// ```
+    pub fn psi_and_point(&self, p: &SurfacePoint) -> (Mat2x8, Vec8) {
+        let face = &self.faces[p.face as usize];
+        let r = face.v.map(|v| &self.verts[v as usize]);
+        let psi = face.d.psi([&r[0].t, &r[1].t, &r[2].t], &p.bary);
+        let y = r[0].x * p.bary[0] + r[1].x * p.bary[1] + r[2].x * p.bary[2];
+        (psi, y)
+    }
+
+    /// Starts loading what [`Projector::psi_and_point`] reads of face `f`: its record
+    /// (`corners == false`), or its corners' records, reading the face record for their
+    /// ids (`corners == true`; request the record a few queries earlier). For software
+    /// pipelining over batches; no effect on results.
+    #[inline]
+    pub fn prefetch_point_data(&self, f: FaceId, corners: bool) {
+        let Some(face) = self.faces.get(f as usize) else {
+            return;
+        };
+        if corners {
+            for v in face.v {
+                prefetch(&self.verts[v as usize]);
+            }
+        } else {
+            prefetch(face);
+        }
+    }
+
     /// Partial derivatives of `Psi` with respect to the three barycentrics at `p`.
     pub fn psi_derivatives(&self, p: &SurfacePoint) -> [Mat2x8; 3] {
         self.faces[p.face as usize]

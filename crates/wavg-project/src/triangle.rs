@@ -245,9 +245,23 @@ impl TriData {
     /// `Psi(xi)` for corner frames `frames` (2x8; rows span the interpolated tangent plane).
     pub fn psi(&self, frames: [&Frame32; 3], xi: &[f64; 3]) -> Mat2x8 {
         let (c, _) = coefficients(xi);
-        let mut m = Mat2x8::zeros();
+        // Two terms share each corner's frame: sum their weighted blends first, then one
+        // 2x2-by-2x8 product per corner.
+        let mut b = [[0.0f64; 4]; 3];
         for (e, &ce) in c.iter().enumerate() {
-            m += from_m2(&self.x[e].map(|v| v as f64)) * frame_to_f64(frames[TERM_VERTEX[e]]) * ce;
+            let i = TERM_VERTEX[e];
+            for k in 0..4 {
+                b[i][k] += ce * self.x[e][k] as f64;
+            }
+        }
+        let mut m = Mat2x8::zeros();
+        for (i, f) in frames.iter().enumerate() {
+            let b = &b[i];
+            for col in 0..8 {
+                let (t0, t1) = (f[col] as f64, f[8 + col] as f64);
+                m[(0, col)] += b[0] * t0 + b[1] * t1;
+                m[(1, col)] += b[2] * t0 + b[3] * t1;
+            }
         }
         m
     }

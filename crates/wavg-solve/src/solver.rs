@@ -287,8 +287,7 @@ impl Solver {
         out: &mut Vec<f64>,
     ) -> Result<(), SolveError> {
         let p = check_point(self.mesh(), point)?;
-        let psi = self.projector.psi(&p);
-        let yhat = self.projector.embedded().point(&p);
+        let (psi, yhat) = self.projector.psi_and_point(&p);
         inverse_weights(&psi, &yhat, self.anchors.coords(), self.gamma, scratch, out)
     }
 
@@ -368,21 +367,39 @@ impl Solver {
         out.n = n;
         out.data.resize(points.len() * n.max(1), 0.0);
         out.status.clear();
-        out.data
-            .par_chunks_mut(n.max(1))
-            .zip(points.par_iter())
-            .with_min_len(64)
-            .map_init(
-                || (InverseScratch::default(), Vec::with_capacity(n)),
-                |(scratch, buf), (row, p)| {
-                    let r = self.inverse_into(p, scratch, buf);
-                    if r.is_ok() {
-                        row.copy_from_slice(buf);
+        // Random points read random face records and then their corners' records: request
+        // both a few points ahead (software pipelining), so the waits overlap.
+        const CHUNK: usize = 64;
+        let proj = &self.projector;
+        let status = out
+            .data
+            .par_chunks_mut(n.max(1) * CHUNK)
+            .zip(points.par_chunks(CHUNK))
+            .flat_map_iter(|(rows, pts)| {
+                let mut scratch = InverseScratch::default();
+                let mut buf = Vec::with_capacity(n);
+                let ahead = |k: usize| pts.get(k).map(|p| p.face);
+                for f in (0..4).filter_map(ahead) {
+                    proj.prefetch_point_data(f, false);
+                }
+                let mut status = Vec::with_capacity(pts.len());
+                for (k, (row, p)) in rows.chunks_mut(n.max(1)).zip(pts).enumerate() {
+                    if let Some(f) = ahead(k + 4) {
+                        proj.prefetch_point_data(f, false);
                     }
-                    r
-                },
-            )
-            .collect_into_vec(&mut out.status);
+                    if let Some(f) = ahead(k + 2) {
+                        proj.prefetch_point_data(f, true);
+                    }
+                    let r = self.inverse_into(p, &mut scratch, &mut buf);
+                    if r.is_ok() {
+                        row.copy_from_slice(&buf);
+                    }
+                    status.push(r);
+                }
+                status
+            });
+        // In order (`par_extend` keeps the order of an ordered iterator).
+        out.status.par_extend(status);
     }
 }
 
