@@ -46,6 +46,13 @@ roundtrip_err_p50 / roundtrip_err_p99 (that distance in mean edge lengths; null 
 when infinite, i.e. more failures than the percentile), negative_weight_fraction (queries
 with some weight below -0.1), and mesh, vertices, faces, anchors, queries, threads.
 
+With --verified it also runs the verified inverse (Solver::inverse_verified: the paper's
+weights where the forward problem returns them to the point, else the smallest offset
+penalty of the ladder 10, 100, 1000, 10000 that does) and adds verified_inverse_us (one
+run, including its forward checks), verified_roundtrip_ok_fraction and
+verified_negative_weight_fraction (the same protocol on those weights),
+verified_penalized_fraction and verified_not_reached_fraction.
+
 Without --embedding or --precompute the 3-D positions are the embedding.")]
 pub struct Args {
     /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
@@ -76,6 +83,9 @@ pub struct Args {
     /// projection, or the exhaustive search.
     #[arg(long, value_enum, default_value_t = Search::Fast)]
     pub search: Search,
+    /// Also run the verified inverse (round trip checked, offset penalty where needed).
+    #[arg(long)]
+    pub verified: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -108,6 +118,18 @@ struct Report {
     anchors: usize,
     queries: usize,
     threads: usize,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    verified: Option<VerifiedReport>,
+}
+
+/// The `--verified` keys.
+#[derive(Serialize)]
+struct VerifiedReport {
+    verified_inverse_us: f64,
+    verified_roundtrip_ok_fraction: f64,
+    verified_negative_weight_fraction: f64,
+    verified_penalized_fraction: f64,
+    verified_not_reached_fraction: f64,
 }
 
 /// Best wall time of `repeat` runs of `f`, and the last result.
@@ -255,6 +277,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .filter(|r| r.as_ref().is_ok_and(|r| r.path == p))
             .count()
     };
+    let verified = if args.verified {
+        Some(run_verified(&solver, &points, threads, &opts, mel)?)
+    } else {
+        None
+    };
     let report = Report {
         inverse_us: t_inv / n as f64 * 1e6,
         forward_us: t_fwd / n as f64 * 1e6,
@@ -269,6 +296,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         anchors: k,
         queries: n,
         threads,
+        verified,
     };
     if args.json {
         let s = serde_json::to_string(&report).map_err(CliError::failure)?;
@@ -329,7 +357,61 @@ pub fn run(args: Args) -> Result<(), CliError> {
         fwd.iter().filter(|r| r.is_err()).count(),
         inverse_failed
     );
+    if let Some(v) = &report.verified {
+        println!(
+            "verified_inverse_us       {:.3}  (one run, forward checks included)",
+            v.verified_inverse_us
+        );
+        println!(
+            "verified round trip       ok {:.5}  negative weights {:.5}  penalized {:.5}  not reached {:.5}",
+            v.verified_roundtrip_ok_fraction,
+            v.verified_negative_weight_fraction,
+            v.verified_penalized_fraction,
+            v.verified_not_reached_fraction
+        );
+    }
     Ok(())
+}
+
+/// `--verified`: the checked inverse, then the same forward protocol on its weights.
+fn run_verified(
+    solver: &Solver,
+    points: &[wavg_mesh::SurfacePoint],
+    threads: usize,
+    opts: &ForwardOptions,
+    mel: f64,
+) -> Result<VerifiedReport, CliError> {
+    use wavg_solve::RoundTrip;
+    let n = points.len() as f64;
+    let t0 = Instant::now();
+    let ver = textio::with_threads(Some(threads), || {
+        solver.inverse_verified_batch(points, OK_TOLERANCE)
+    })?;
+    let t = t0.elapsed().as_secs_f64();
+    let rows: Vec<&[f64]> = ver
+        .iter()
+        .map(|r| r.as_ref().map_or(&[][..], |v| &v.weights[..]))
+        .collect();
+    let fwd = textio::with_threads(Some(threads), || solver.forward_batch(&rows, opts))?;
+    let mesh = solver.mesh();
+    let ok = points
+        .iter()
+        .zip(&fwd)
+        .filter(|(p, r)| {
+            r.as_ref()
+                .is_ok_and(|r| (r.position - p.position(mesh)).norm() / mel < OK_TOLERANCE)
+        })
+        .count();
+    let count = |f: &dyn Fn(&wavg_solve::Verified) -> bool| {
+        ver.iter().filter(|r| r.as_ref().is_ok_and(f)).count() as f64 / n
+    };
+    Ok(VerifiedReport {
+        verified_inverse_us: t / n * 1e6,
+        verified_roundtrip_ok_fraction: ok as f64 / n,
+        verified_negative_weight_fraction: count(&|v| v.weights.iter().any(|&x| x < NEGATIVE)),
+        verified_penalized_fraction: count(&|v| matches!(v.round_trip, RoundTrip::Penalized(_))),
+        verified_not_reached_fraction: count(&|v| v.round_trip == RoundTrip::NotReached),
+    })
 }
 
 /// `--precompute`: the embedding pipeline with default parameters.

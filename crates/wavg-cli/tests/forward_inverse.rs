@@ -367,3 +367,116 @@ fn bench_roundtrip_reports_the_documented_json() {
     ]);
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// `wavg inverse --verified`: same format; the weights lead back (forward), and the
+/// summary on standard error is printed.
+#[test]
+fn verified_inverse_keeps_the_format_and_returns() {
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = write(dir.path(), "anchors.txt", ANCHORS);
+    let points = write(
+        dir.path(),
+        "points.txt",
+        "f 10 0.2 0.3 0.5\nv 40\nf 100 0.6 0.2 0.2\n",
+    );
+    let weights = dir.path().join("weights.txt");
+    let out = wavg(&[
+        "inverse",
+        "--mesh",
+        MESH,
+        "--anchors",
+        s(&anchors),
+        "--points",
+        s(&points),
+        "-o",
+        s(&weights),
+        "--verified",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("verified: 3 points"), "{err}");
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&weights)
+        .unwrap()
+        .lines()
+        .map(parse_floats)
+        .collect();
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        assert_eq!(r.len(), 12);
+        assert!((r.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+    }
+    let back = dir.path().join("back.txt");
+    let out = wavg(&[
+        "forward",
+        "--mesh",
+        MESH,
+        "--anchors",
+        s(&anchors),
+        "--weights",
+        s(&weights),
+        "-o",
+        s(&back),
+    ]);
+    assert!(out.status.success());
+    let mesh = wavg_mesh::procedural::builtin("sphere-small").unwrap();
+    let originals = [
+        wavg_mesh::SurfacePoint::new(10, [0.2, 0.3, 0.5]).position(&mesh),
+        mesh.positions[40],
+        wavg_mesh::SurfacePoint::new(100, [0.6, 0.2, 0.2]).position(&mesh),
+    ];
+    let back: Vec<Vec<f64>> = std::fs::read_to_string(&back)
+        .unwrap()
+        .lines()
+        .map(parse_floats)
+        .collect();
+    for (b, o) in back.iter().zip(&originals) {
+        let d = ((b[4] - o.x).powi(2) + (b[5] - o.y).powi(2) + (b[6] - o.z).powi(2)).sqrt();
+        assert!(d < 1e-6, "{b:?} vs {o:?}");
+    }
+}
+
+/// `wavg bench roundtrip --verified` adds exactly the documented keys.
+#[test]
+fn bench_roundtrip_verified_adds_its_keys() {
+    let out = wavg(&[
+        "bench",
+        "roundtrip",
+        "--mesh",
+        "builtin:torus",
+        "--anchors",
+        "10",
+        "--queries",
+        "300",
+        "--repeat",
+        "1",
+        "--verified",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let obj = v.as_object().unwrap();
+    assert_eq!(obj.len(), 13 + 5);
+    for k in [
+        "verified_inverse_us",
+        "verified_roundtrip_ok_fraction",
+        "verified_negative_weight_fraction",
+        "verified_penalized_fraction",
+        "verified_not_reached_fraction",
+    ] {
+        let x = obj[k].as_f64().unwrap_or_else(|| panic!("{k}"));
+        assert!(x.is_finite() && x >= 0.0, "{k} = {x}");
+    }
+    let paper = obj["roundtrip_ok_fraction"].as_f64().unwrap();
+    let verified = obj["verified_roundtrip_ok_fraction"].as_f64().unwrap();
+    assert!(verified >= paper, "verified {verified} < paper {paper}");
+    let reached = 1.0 - obj["verified_not_reached_fraction"].as_f64().unwrap();
+    assert!((verified - reached).abs() < 1e-9, "{verified} vs {reached}");
+}

@@ -36,11 +36,13 @@ pub mod points;
 pub mod sampling;
 pub mod search;
 pub mod solver;
+pub mod verified;
 pub mod weights;
 
 pub use anchors::AnchorSet;
 pub use error::SolveError;
 pub use points::Anchor;
 pub use solver::{BatchWeights, ForwardOptions, ForwardResult, SearchMode, Solver, Start};
+pub use verified::{RoundTrip, Verified};
 pub use wavg_project::{DIM, EmbeddedMesh, Mat2x8, ProjectError, ProjectionPath, Projector, Vec8};
 pub use weights::Normalization;

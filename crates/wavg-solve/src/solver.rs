@@ -108,6 +108,8 @@ pub struct Solver {
     local: Arc<LocalSearch>,
     anchors: AnchorSet,
     gamma: f64,
+    /// Mean 3-D edge length of the mesh (the unit of round-trip tolerances).
+    mean_edge: f64,
 }
 
 impl Solver {
@@ -119,6 +121,7 @@ impl Solver {
         let set = AnchorSet::with_anchors(projector.embedded().clone(), anchors)?;
         Ok(Self {
             local: Arc::new(LocalSearch::new(projector.clone())),
+            mean_edge: wavg_mesh::geometry::mean_edge_length(projector.embedded().mesh()),
             projector,
             anchors: set,
             gamma: DEFAULT_GAMMA,
@@ -137,6 +140,7 @@ impl Solver {
         }
         Ok(Self {
             local: Arc::new(LocalSearch::new(projector.clone())),
+            mean_edge: wavg_mesh::geometry::mean_edge_length(projector.embedded().mesh()),
             projector,
             anchors,
             gamma: DEFAULT_GAMMA,
@@ -157,6 +161,11 @@ impl Solver {
     /// The inverse problem's `gamma`.
     pub fn gamma(&self) -> f64 {
         self.gamma
+    }
+
+    /// Mean 3-D edge length of the mesh (the unit of round-trip tolerances).
+    pub fn mean_edge_length(&self) -> f64 {
+        self.mean_edge
     }
 
     /// The projector.
