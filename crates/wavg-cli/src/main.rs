@@ -4,6 +4,7 @@ mod bench_load;
 mod bench_project;
 mod bench_roundtrip;
 mod common;
+mod demo;
 mod error;
 mod forward;
 mod info;
@@ -28,6 +29,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Run the whole method on a generated mesh: embedding, a spline, round trips.
+    Demo(demo::Args),
     /// Describe a mesh: counts, topology, and every validation problem.
     Info(info::Args),
     /// Repair a mesh (weld, drop degenerate/duplicate faces, ...) and write it.
@@ -56,6 +59,7 @@ enum BenchCommand {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Demo(a) => demo::run(a),
         Command::Info(a) => info::run(a),
         Command::Repair(a) => repair::run(a),
         Command::Precompute(a) => precompute::run(a),

@@ -1,0 +1,297 @@
+//! `wavg demo`: the whole method on one mesh, end to end, in a few seconds.
+//!
+//! Precomputes the 8-D embedding, places anchors by farthest-point sampling, draws a
+//! closed cubic B-spline on the surface through them (forward problems, warm-started
+//! along the curve), and runs inverse-then-forward round trips on random points, with the
+//! paper's and the verified inverse. Optionally writes every artefact to a folder.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use wavg_mesh::{SurfacePoint, ValidMesh};
+use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
+use wavg_solve::verified::DEFAULT_TOLERANCE;
+use wavg_solve::{Anchor, EmbeddedMesh, ForwardOptions, Solver, Vec8};
+
+use crate::CliError;
+use crate::common::{load_valid, one_line};
+use crate::textio::{self, write_numbers};
+
+/// Arguments.
+#[derive(clap::Args)]
+#[command(after_long_help = "\
+Runs the method end to end on a mesh the project generates itself (default builtin:bump,
+an icosphere with a bump) or on your own: precomputes the 8-D embedding, places anchors
+by farthest-point sampling, evaluates a closed cubic B-spline on the surface whose control
+points are the anchors (ordered around the z axis), and runs inverse-then-forward round
+trips on random surface points with the paper's and the verified inverse.
+
+With --out DIR it writes DIR/mesh.obj, DIR/mesh.wavg, DIR/anchors.txt, DIR/curve.txt
+(FACE B0 B1 B2 X Y Z per sample, as `wavg forward` writes) and DIR/curve.obj (the curve
+as an OBJ polyline, to view over mesh.obj).
+
+--json prints one object: mesh, vertices, faces, landmarks, precompute_s, stress,
+geodesic_rel_err_p50, geodesic_rel_err_p90, anchors, curve_points, curve_ok, curve_us,
+roundtrip_queries, inverse_us, forward_us, roundtrip_ok_fraction,
+verified_roundtrip_ok_fraction.")]
+pub struct Args {
+    /// Mesh file or builtin:NAME.
+    #[arg(long, default_value = "builtin:bump")]
+    pub mesh: String,
+    /// Landmarks of the embedding (default: a tenth of the vertices, 50 to 1000).
+    #[arg(long)]
+    pub landmarks: Option<usize>,
+    /// Anchors (spline control points).
+    #[arg(long, default_value_t = 8)]
+    pub anchors: usize,
+    /// Samples along the spline.
+    #[arg(long, default_value_t = 400)]
+    pub samples: usize,
+    /// Random points for the round trips.
+    #[arg(long, default_value_t = 2000)]
+    pub queries: usize,
+    /// Seed of the anchors and the random points.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Folder to write the mesh, embedding, anchors and curve to (created if missing).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object instead of the report.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Uniform cubic B-spline basis at `u` in [0, 1).
+fn bspline(u: f64) -> [f64; 4] {
+    let (u2, u3) = (u * u, u * u * u);
+    [
+        (1.0 - u).powi(3) / 6.0,
+        (3.0 * u3 - 6.0 * u2 + 4.0) / 6.0,
+        (-3.0 * u3 + 3.0 * u2 + 3.0 * u + 1.0) / 6.0,
+        u3 / 6.0,
+    ]
+}
+
+/// Weights (one per anchor) of `samples` points along the closed B-spline whose control
+/// points are the anchors in the order `order`.
+fn spline_weights(order: &[usize], samples: usize) -> Vec<Vec<f64>> {
+    let n = order.len();
+    (0..samples)
+        .map(|s| {
+            let t = s as f64 * n as f64 / samples as f64;
+            let i = t.floor() as usize;
+            let b = bspline(t - i as f64);
+            let mut w = vec![0.0; n];
+            for (k, bk) in b.iter().enumerate() {
+                w[order[(i + n + k - 1) % n]] += bk;
+            }
+            w
+        })
+        .collect()
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    if args.anchors < 4 {
+        return Err(CliError::input(
+            "--anchors must be at least 4 (a cubic spline)",
+        ));
+    }
+    if args.samples == 0 || args.queries == 0 {
+        return Err(CliError::input(
+            "--samples and --queries must be at least 1",
+        ));
+    }
+    let say = |s: &str| {
+        if !args.json {
+            eprintln!("{s}");
+        }
+    };
+    let mesh = load_valid(&args.mesh)?;
+    let landmarks = args
+        .landmarks
+        .unwrap_or((mesh.n_vertices() / 10).clamp(50, 1000))
+        .min(mesh.n_vertices());
+    say(&format!(
+        "mesh {}: {} vertices, {} faces; precomputing the embedding ({landmarks} landmarks)...",
+        args.mesh,
+        mesh.n_vertices(),
+        mesh.n_faces()
+    ));
+    let t0 = Instant::now();
+    let opts = wavg_embed::pipeline::PrecomputeOptions {
+        landmarks,
+        seed: args.seed,
+        ..Default::default()
+    };
+    let (emb, _) = wavg_embed::pipeline::precompute(&mesh, &opts, &wavg_embed::NoProgress)
+        .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))?;
+    let precompute_s = t0.elapsed().as_secs_f64();
+    let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
+    let embedded = EmbeddedMesh::new(mesh.clone(), coords)
+        .map(Arc::new)
+        .map_err(|e| CliError::failure(one_line(&e)))?;
+    let proj = textio::build_projector(embedded)?;
+    let anchor_ids = farthest_point_vertices(&mesh, args.anchors, args.seed, FpsMetric::EdgeGraph)
+        .map_err(|e| CliError::input(one_line(&e)))?;
+    let solver = Solver::new(proj, anchor_ids.iter().map(|&v| Anchor::Vertex(v)))
+        .map_err(|e| CliError::failure(one_line(&e)))?;
+
+    // The spline: control points ordered by their angle around the z axis.
+    let mut order: Vec<usize> = (0..anchor_ids.len()).collect();
+    let angle = |i: usize| {
+        let p = mesh.positions[anchor_ids[i] as usize];
+        p.y.atan2(p.x)
+    };
+    order.sort_by(|&a, &b| angle(a).total_cmp(&angle(b)));
+    let weights = spline_weights(&order, args.samples);
+    let t0 = Instant::now();
+    let curve = solver.forward_batch_warm(&weights, &ForwardOptions::default(), args.samples);
+    let curve_us = t0.elapsed().as_secs_f64() / args.samples as f64 * 1e6;
+    let curve_ok = curve.iter().filter(|r| r.is_ok()).count();
+
+    // Round trips.
+    let points = uniform_surface_points(&mesh, args.queries, args.seed.wrapping_add(1))
+        .map_err(|e| CliError::input(one_line(&e)))?;
+    let t0 = Instant::now();
+    let inv = solver.inverse_batch(&points);
+    let inverse_us = t0.elapsed().as_secs_f64() / points.len() as f64 * 1e6;
+    let rows: Vec<&[f64]> = inv.iter().map(|r| r.unwrap_or(&[])).collect();
+    let t0 = Instant::now();
+    let fwd = solver.forward_batch(&rows, &ForwardOptions::default());
+    let forward_us = t0.elapsed().as_secs_f64() / points.len() as f64 * 1e6;
+    let tol = DEFAULT_TOLERANCE * solver.mean_edge_length();
+    let back = |p: &SurfacePoint, r: &Result<wavg_solve::ForwardResult, _>| {
+        r.as_ref()
+            .is_ok_and(|r| (r.position - p.position(&mesh)).norm() <= tol)
+    };
+    let ok = points.iter().zip(&fwd).filter(|(p, r)| back(p, r)).count();
+    let verified = solver.inverse_verified_batch(&points, DEFAULT_TOLERANCE);
+    let vrows: Vec<&[f64]> = verified
+        .iter()
+        .map(|r| r.as_ref().map_or(&[][..], |v| &v.weights[..]))
+        .collect();
+    let vfwd = solver.forward_batch(&vrows, &ForwardOptions::default());
+    let vok = points.iter().zip(&vfwd).filter(|(p, r)| back(p, r)).count();
+    let n = points.len() as f64;
+
+    if let Some(dir) = &args.out {
+        write_outputs(dir, &mesh, &emb, &anchor_ids, &curve)?;
+    }
+    if args.json {
+        let j = serde_json::json!({
+            "mesh": args.mesh,
+            "vertices": mesh.n_vertices(),
+            "faces": mesh.n_faces(),
+            "landmarks": landmarks,
+            "precompute_s": precompute_s,
+            "stress": emb.stress,
+            "geodesic_rel_err_p50": emb.geodesic_rel_err_p50,
+            "geodesic_rel_err_p90": emb.geodesic_rel_err_p90,
+            "anchors": anchor_ids.len(),
+            "curve_points": args.samples,
+            "curve_ok": curve_ok,
+            "curve_us": curve_us,
+            "roundtrip_queries": points.len(),
+            "inverse_us": inverse_us,
+            "forward_us": forward_us,
+            "roundtrip_ok_fraction": ok as f64 / n,
+            "verified_roundtrip_ok_fraction": vok as f64 / n,
+        });
+        println!("{j}");
+        return Ok(());
+    }
+    println!(
+        "embedding      {landmarks} landmarks in {precompute_s:.2} s; stress {:.3}, geodesic \
+         error p50 {:.3} p90 {:.3}",
+        emb.stress, emb.geodesic_rel_err_p50, emb.geodesic_rel_err_p90
+    );
+    println!(
+        "spline         {} anchors, {curve_ok} of {} samples on the surface, {curve_us:.2} us \
+         each (warm-started)",
+        anchor_ids.len(),
+        args.samples
+    );
+    println!(
+        "round trips    {} random points: inverse {inverse_us:.2} us, forward {forward_us:.2} \
+         us; back to the point: paper {:.4}, verified {:.4}",
+        points.len(),
+        ok as f64 / n,
+        vok as f64 / n
+    );
+    match &args.out {
+        Some(d) => println!(
+            "written        {0}/mesh.obj, mesh.wavg, anchors.txt, curve.txt, curve.obj",
+            d.display()
+        ),
+        None => println!("(pass --out DIR to keep the mesh, embedding, anchors and curve)"),
+    }
+    Ok(())
+}
+
+/// `--out`: the mesh, embedding, anchors and curve.
+fn write_outputs(
+    dir: &Path,
+    mesh: &ValidMesh,
+    emb: &wavg_embed::Embedding,
+    anchors: &[u32],
+    curve: &[Result<wavg_solve::ForwardResult, wavg_solve::SolveError>],
+) -> Result<(), CliError> {
+    let fail = |what: &str, e: &dyn std::fmt::Display| {
+        CliError::failure(format!("{}: {what}: {e}", dir.display()))
+    };
+    std::fs::create_dir_all(dir).map_err(|e| fail("cannot create", &e))?;
+    wavg_mesh::io::save(&dir.join("mesh.obj"), mesh).map_err(|e| fail("mesh.obj", &e))?;
+    wavg_embed::file::save(&dir.join("mesh.wavg"), emb, mesh).map_err(|e| fail("mesh.wavg", &e))?;
+    textio::write_atomic(&dir.join("anchors.txt"), |w: &mut dyn Write| {
+        anchors.iter().try_for_each(|v| writeln!(w, "v {v}"))
+    })?;
+    textio::write_atomic(&dir.join("curve.txt"), |w: &mut dyn Write| {
+        for r in curve {
+            match r {
+                Ok(r) => {
+                    write!(w, "{} ", r.point.face)?;
+                    write_numbers(w, r.point.bary.iter().chain(r.position.iter()).copied())?;
+                }
+                Err(e) => write!(w, "none {}", one_line(e))?,
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    })?;
+    textio::write_atomic(&dir.join("curve.obj"), |w: &mut dyn Write| {
+        let pts: Vec<_> = curve.iter().flatten().map(|r| r.position).collect();
+        for p in &pts {
+            writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
+        }
+        if !pts.is_empty() {
+            write!(w, "l")?;
+            for i in (1..=pts.len()).chain([1]) {
+                write!(w, " {i}")?;
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spline_weights_sum_to_one_and_are_local() {
+        let order = [3, 0, 4, 1, 5, 2];
+        for w in spline_weights(&order, 97) {
+            assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+            assert!(w.iter().all(|&x| x >= 0.0));
+            assert!(w.iter().filter(|&&x| x > 0.0).count() <= 4);
+        }
+        // At a knot the curve sits at (1/6, 4/6, 1/6) of three consecutive controls.
+        let w = &spline_weights(&order, 6)[1];
+        assert!((w[0] - 4.0 / 6.0).abs() < 1e-12);
+        assert!((w[3] - 1.0 / 6.0).abs() < 1e-12 && (w[4] - 1.0 / 6.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,89 @@
+//! `wavg demo` runs the method end to end on a generated mesh and writes what it says.
+
+use std::process::Command;
+
+#[test]
+fn demo_reports_and_writes_its_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("demo");
+    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(["demo", "--json", "--queries", "300", "--out"])
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let o = v.as_object().unwrap();
+    let mut keys: Vec<&str> = o.keys().map(|k| k.as_str()).collect();
+    keys.sort();
+    assert_eq!(
+        keys,
+        [
+            "anchors",
+            "curve_ok",
+            "curve_points",
+            "curve_us",
+            "faces",
+            "forward_us",
+            "geodesic_rel_err_p50",
+            "geodesic_rel_err_p90",
+            "inverse_us",
+            "landmarks",
+            "mesh",
+            "precompute_s",
+            "roundtrip_ok_fraction",
+            "roundtrip_queries",
+            "stress",
+            "verified_roundtrip_ok_fraction",
+            "vertices",
+        ]
+    );
+    assert_eq!(o["vertices"], 2562);
+    assert_eq!(o["curve_ok"], o["curve_points"]);
+    assert!(o["verified_roundtrip_ok_fraction"].as_f64().unwrap() >= 0.99);
+    // The outputs: a mesh that loads, an embedding that matches it, a curve on it.
+    let mesh = wavg_mesh::io::load(&out_dir.join("mesh.obj")).unwrap();
+    assert_eq!(mesh.n_vertices(), 2562);
+    let emb = wavg_embed::file::load(&out_dir.join("mesh.wavg"), &mesh).unwrap();
+    assert_eq!(emb.coords.len(), 2562);
+    let curve = std::fs::read_to_string(out_dir.join("curve.txt")).unwrap();
+    assert_eq!(curve.lines().count(), 400);
+    for line in curve.lines() {
+        let t: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert_eq!(t.len(), 7);
+        assert!((t[1] + t[2] + t[3] - 1.0).abs() < 1e-9);
+        let p = wavg_mesh::SurfacePoint::new(t[0] as u32, [t[1], t[2], t[3]]).position(&mesh);
+        assert!((p.x - t[4]).abs() + (p.y - t[5]).abs() + (p.z - t[6]).abs() < 1e-6);
+    }
+    let obj = std::fs::read_to_string(out_dir.join("curve.obj")).unwrap();
+    assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), 400);
+    assert_eq!(
+        std::fs::read_to_string(out_dir.join("anchors.txt"))
+            .unwrap()
+            .lines()
+            .count(),
+        8
+    );
+}
+
+#[test]
+fn demo_rejects_bad_arguments() {
+    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(["demo", "--anchors", "2"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--anchors"));
+    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(["demo", "--mesh", "builtin:teapot"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
