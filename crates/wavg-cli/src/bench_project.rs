@@ -5,7 +5,9 @@
 //! rings away, on one thread: mean time and the fraction that return to themselves
 //! (same face within 1e-5 in barycentrics, or the same position within 1e-5 mean edge
 //! lengths on a face sharing a vertex; times are the thread's CPU time per query, best
-//! of three passes, as the machine may be shared); (b) the
+//! of three passes, as the machine may be shared; the queries go through
+//! `Projector::project_batch`, one thread, which interleaves the walks of 8 queries;
+//! the text output also shows one `project` call at a time); (b) the
 //! same with the points offset from the
 //! surface by 0.1 mean edge length along the face normal (with `--embedding`: a seeded
 //! random direction of R^8 orthogonal to the embedded face), timed, and on the first
@@ -79,7 +81,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
     // (a) on-surface points.
     let ys: Vec<Vec8> = points.iter().map(|p| emb.point(p)).collect();
-    let (on, on_time) = timed(&projector, &ys, &starts);
+    let (on, on_time) = timed(&projector, &ys, &starts, true);
+    let (single, single_time) = timed(&projector, &ys, &starts, false);
+    if single != on {
+        return Err(CliError::failure(
+            "project_batch and project disagree (a bug: please report it)",
+        ));
+    }
     let onsurface_us = on_time.cpu_us;
     let mut back = 0usize;
     for ((p, r), y) in points.iter().zip(&on).zip(&ys) {
@@ -100,7 +108,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             y + offset_direction(&mesh, &emb, p.face, padded, &mut rng) * (0.1 * mean_edge)
         })
         .collect();
-    let (off, off_time) = timed(&projector, &offset, &starts);
+    let (off, off_time) = timed(&projector, &offset, &starts, true);
     let offset_us = off_time.cpu_us;
     let n_check = BRUTE_FORCE_CHECKS.min(offset.len());
     let agree = brute_force_agreement(&projector, &offset[..n_check], &off[..n_check], mean_edge);
@@ -142,6 +150,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         println!(
             "onsurface_us                      {onsurface_us:.3} (thread CPU time; wall {:.3})",
             on_time.wall_us
+        );
+        println!(
+            "  one query at a time              {:.3} (thread CPU time; wall {:.3})",
+            single_time.cpu_us, single_time.wall_us
         );
         println!("onsurface_self_fraction           {onsurface_self_fraction:.6}");
         println!(
@@ -190,7 +202,7 @@ fn thread_cpu_seconds() -> Option<f64> {
 /// [`REPEATS`] passes. The machine may be shared, so the figure reported is the thread's
 /// CPU time (time it actually ran), which other processes do not inflate; wall time is
 /// shown alongside in the table.
-fn timed(p: &Projector, ys: &[Vec8], starts: &[VertexId]) -> (Vec<Answer>, Timing) {
+fn timed(p: &Projector, ys: &[Vec8], starts: &[VertexId], batch: bool) -> (Vec<Answer>, Timing) {
     let mut out = Vec::with_capacity(ys.len());
     let mut best = Timing {
         cpu_us: f64::INFINITY,
@@ -201,8 +213,12 @@ fn timed(p: &Projector, ys: &[Vec8], starts: &[VertexId]) -> (Vec<Answer>, Timin
         out.clear();
         let c0 = thread_cpu_seconds();
         let t = Instant::now();
-        for (y, &s) in ys.iter().zip(starts) {
-            out.push(p.project(y, s));
+        if batch {
+            out = p.project_batch(ys, starts);
+        } else {
+            for (y, &s) in ys.iter().zip(starts) {
+                out.push(p.project(y, s));
+            }
         }
         let wall = t.elapsed().as_secs_f64();
         let cpu = match (c0, thread_cpu_seconds()) {

@@ -64,6 +64,9 @@ pub struct Projector {
     walk_coords: Vec<WalkPoint>,
 }
 
+/// Queries whose walks [`Projector::project_batch`] interleaves.
+pub const WALK_GROUP: usize = 8;
+
 /// Neighbours (and faces) stored in a vertex's walk record; larger rings come from the
 /// topology.
 const WALK_RING: usize = 12;
@@ -443,12 +446,23 @@ impl Projector {
                 n_vertices: mesh.n_vertices(),
             });
         }
-        let topo = mesh.topology();
         // 1. Greedy walk.
         let mut ring_d = [0.0f32; 64];
         let v = self.walk_inner(y, start, &mut ring_d);
         // 2. Faces around v, most promising first.
         let cands = self.order_faces(y, v, &ring_d);
+        self.search_around(y, v, &cands)
+    }
+
+    /// Steps 2-4 of [`Projector::project`]: the faces around the walk's end `v` in the
+    /// order `cands`, their neighbours, then certification or the global search.
+    fn search_around(
+        &self,
+        y: &Vec8,
+        v: VertexId,
+        cands: &FaceOrder,
+    ) -> Result<Projection, ProjectError> {
+        let topo = self.emb.mesh().topology();
         let (order, m) = (&cands.faces, cands.n);
         let faces = self.walk_coords[v as usize].faces(topo, v);
         let mut tested = Tested::new();
@@ -530,6 +544,117 @@ impl Projector {
                 .map(|b| Self::finish(b, ProjectionPath::Fallback))
                 .ok_or(ProjectError::NoProjection),
         }
+    }
+
+    /// [`Projector::project`] for many queries on the calling thread, with the same
+    /// results: the greedy walks of [`WALK_GROUP`] queries advance in turn, each step
+    /// requesting the records the next step reads, so their memory waits overlap instead
+    /// of adding up; then the first candidate face of every query in the group is
+    /// requested before any is solved. Parallelise over chunks of queries.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// let m = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
+    /// let emb = Arc::new(EmbeddedMesh::from_positions(m));
+    /// let p = Projector::new(emb.clone()).unwrap();
+    /// let ys: Vec<_> = (0..20).map(|f| emb.point(&SurfacePoint::new(f * 30, [0.2, 0.3, 0.5]))).collect();
+    /// let starts = vec![0; ys.len()];
+    /// let batch = p.project_batch(&ys, &starts);
+    /// for ((y, s), b) in ys.iter().zip(&starts).zip(&batch) {
+    ///     assert_eq!(b, &p.project(y, *s));
+    /// }
+    /// ```
+    pub fn project_batch(
+        &self,
+        ys: &[Vec8],
+        starts: &[VertexId],
+    ) -> Vec<Result<Projection, ProjectError>> {
+        let mut out = Vec::with_capacity(ys.len());
+        let mut ends = [0 as VertexId; WALK_GROUP];
+        for (yc, sc) in ys.chunks(WALK_GROUP).zip(starts.chunks(WALK_GROUP)) {
+            let valid = yc.len() == sc.len()
+                && yc.iter().all(|y| y.iter().all(|v| v.is_finite()))
+                && sc.iter().all(|&s| (s as usize) < self.verts.len());
+            if !valid {
+                // The per-query path reports each error.
+                out.extend(yc.iter().zip(sc).map(|(y, &s)| self.project(y, s)));
+                continue;
+            }
+            let ends = &mut ends[..yc.len()];
+            self.walk_group(yc, sc, ends);
+            let cands: Vec<FaceOrder> = yc
+                .iter()
+                .zip(ends.iter())
+                .map(|(y, &v)| self.order_faces(y, v, &self.ring_dists(y, v)))
+                .collect();
+            for ((y, &v), c) in yc.iter().zip(ends.iter()).zip(&cands) {
+                out.push(self.search_around(y, v, c));
+            }
+        }
+        out
+    }
+
+    /// Interleaved greedy walks (up to [`WALK_GROUP`]); `starts` must be in range.
+    fn walk_group(&self, ys: &[Vec8], starts: &[VertexId], ends: &mut [VertexId]) {
+        let topo = self.emb.mesh().topology();
+        let w = &self.walk_coords;
+        let m = ends.len();
+        let mut yw = [[0.0f32; 8]; WALK_GROUP];
+        let mut dv = [0.0f32; WALK_GROUP];
+        let mut active = [false; WALK_GROUP];
+        for q in 0..m {
+            yw[q] = self.walk_point(&ys[q]);
+            ends[q] = starts[q];
+            dv[q] = wdist2(&w[starts[q] as usize].unpack(), &yw[q]);
+            active[q] = true;
+            for &u in w[starts[q] as usize].ring(topo, starts[q]) {
+                prefetch_line(&w[u as usize]);
+            }
+        }
+        let mut left = m;
+        while left > 0 {
+            for q in 0..m {
+                if !active[q] {
+                    continue;
+                }
+                // One step of `walk_inner`, in the same order (so the same path).
+                let v = ends[q];
+                let mut next = v;
+                for &u in w[v as usize].ring(topo, v) {
+                    let d = wdist2(&w[u as usize].unpack(), &yw[q]);
+                    if d < dv[q] {
+                        dv[q] = d;
+                        next = u;
+                    }
+                }
+                if next == v {
+                    active[q] = false;
+                    left -= 1;
+                    continue;
+                }
+                ends[q] = next;
+                // The next step reads these; the other walks' steps hide the wait.
+                for &u in w[next as usize].ring(topo, next) {
+                    prefetch_line(&w[u as usize]);
+                }
+            }
+        }
+    }
+
+    /// Squared walk distances from `y` to `v`'s neighbours, as `walk_inner` leaves them
+    /// (only rings over 64 use them, see [`Projector::order_faces`]).
+    fn ring_dists(&self, y: &Vec8, v: VertexId) -> [f32; 64] {
+        let mut d = [f32::INFINITY; 64];
+        let ring = self.walk_coords[v as usize].ring(self.emb.mesh().topology(), v);
+        if ring.len() > 64 {
+            let yw = self.walk_point(y);
+            for (j, &u) in ring.iter().take(64).enumerate() {
+                d[j] = wdist2(&self.walk_coords[u as usize].unpack(), &yw);
+            }
+        }
+        d
     }
 
     /// The faces around vertex `v` (at most 64), most promising first for a projection of
@@ -815,6 +940,19 @@ fn prefetch<T>(r: &T) {
             _mm_prefetch::<_MM_HINT_T0>(p);
             _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
         }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = r;
+}
+
+/// Hints the processor to load the cache line holding the start of `r`.
+#[inline(always)]
+fn prefetch_line<T>(r: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        // SAFETY: as in `prefetch`.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(r as *const T as *const i8) };
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = r;

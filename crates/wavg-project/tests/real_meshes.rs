@@ -66,6 +66,49 @@ fn check(rel: &str, queries: usize, brute: usize) {
     }
 }
 
+/// `project_batch` gives exactly `project`'s answers, on- and off-surface, including
+/// per-query errors (a NaN query, a start out of range) inside a group.
+fn batch_equals_single(rel: &str, queries: usize) {
+    let Some(path) = data::require_data_file("wavg-project batches", rel) else {
+        return;
+    };
+    let mesh = Arc::new(ValidMesh::new(io::load(&path).unwrap()).unwrap());
+    let emb = Arc::new(EmbeddedMesh::from_positions(mesh.clone()));
+    let proj = Projector::new(emb.clone()).unwrap();
+    let mean = emb.mean_edge_length();
+    let nv = mesh.n_vertices() as u32;
+    let mut ys = Vec::new();
+    let mut starts = Vec::new();
+    for k in 0..queries {
+        let u = |m: f64| (k as f64 * m).fract();
+        let f = (u(0.6180339887) * mesh.n_faces() as f64) as u32;
+        let (a, b) = (u(0.7548776662), u(0.5698402910));
+        let (a, b) = if a + b > 1.0 {
+            (1.0 - a, 1.0 - b)
+        } else {
+            (a, b)
+        };
+        let p = wavg_mesh::SurfacePoint::new(f, [a, b, 1.0 - a - b]);
+        let off = normal_to(&wavg_project::Mat2x8::zeros(), k as u64) * (0.3 * mean * u(0.31));
+        ys.push(emb.point(&p) + if k % 3 == 0 { off } else { off * 0.0 });
+        starts.push((u(0.3819660113) * nv as f64) as u32 % nv);
+    }
+    ys[5][2] = f64::NAN;
+    starts[13] = nv + 4;
+    let batch = proj.project_batch(&ys, &starts);
+    assert_eq!(batch.len(), queries);
+    for (k, ((y, &s), b)) in ys.iter().zip(&starts).zip(&batch).enumerate() {
+        assert_eq!(b, &proj.project(y, s), "{rel}: query {k}");
+    }
+    assert!(batch[5].is_err() && batch[13].is_err());
+}
+
+#[test]
+fn batches_equal_single_queries() {
+    batch_equals_single("meshes/camelhead.off", 3000);
+    batch_equals_single("meshes/armadillo.obj.gz", 3000);
+}
+
 #[test]
 fn knight() {
     check("meshes/decimated-knight.off", 2000, 200);
