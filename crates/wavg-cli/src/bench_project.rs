@@ -190,14 +190,6 @@ struct Timing {
     wall_us: f64,
 }
 
-/// CPU time consumed by the calling thread, in seconds (Linux: the scheduler's run time
-/// from `/proc/thread-self/schedstat`, nanoseconds). `None` elsewhere.
-fn thread_cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
-    Some(ns * 1e-9)
-}
-
 /// Projects every query on one thread; mean microseconds per query, the best of
 /// [`REPEATS`] passes. The machine may be shared, so the figure reported is the thread's
 /// CPU time (time it actually ran), which other processes do not inflate; wall time is
@@ -211,7 +203,7 @@ fn timed(p: &Projector, ys: &[Vec8], starts: &[VertexId], batch: bool) -> (Vec<A
     let n = ys.len() as f64;
     for _ in 0..REPEATS {
         out.clear();
-        let c0 = thread_cpu_seconds();
+        let c0 = crate::common::cpu_seconds(true);
         let t = Instant::now();
         if batch {
             out = p.project_batch(ys, starts);
@@ -221,7 +213,7 @@ fn timed(p: &Projector, ys: &[Vec8], starts: &[VertexId], batch: bool) -> (Vec<A
             }
         }
         let wall = t.elapsed().as_secs_f64();
-        let cpu = match (c0, thread_cpu_seconds()) {
+        let cpu = match (c0, crate::common::cpu_seconds(true)) {
             (Some(a), Some(b)) => b - a,
             _ => wall,
         };

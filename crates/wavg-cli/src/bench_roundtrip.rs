@@ -145,18 +145,6 @@ fn best_of<T>(repeat: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     (best, out.expect("at least one run"))
 }
 
-/// CPU time (user + system, all threads) of this process in seconds, where the platform
-/// reports it (Linux `/proc/self/stat`, 10 ms resolution); `None` elsewhere. On a shared
-/// machine it shows how much work a batch took, independently of waiting for a core.
-fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
-    let rest = stat.rsplit_once(')')?.1;
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
-}
-
 /// The 1-minute load average (Linux), to judge how busy the machine was.
 fn load_average() -> String {
     std::fs::read_to_string("/proc/loadavg")
@@ -167,9 +155,9 @@ fn load_average() -> String {
 
 /// Runs `f` and returns its result with the CPU seconds it used (NaN when unknown).
 fn with_cpu<T>(f: impl FnOnce() -> T) -> (T, f64) {
-    let c0 = process_cpu_seconds();
+    let c0 = crate::common::cpu_seconds(false);
     let r = f();
-    let dt = match (c0, process_cpu_seconds()) {
+    let dt = match (c0, crate::common::cpu_seconds(false)) {
         (Some(a), Some(b)) => b - a,
         _ => f64::NAN,
     };

@@ -53,3 +53,29 @@ pub fn load_valid(path_or_builtin: &str) -> Result<Arc<ValidMesh>, CliError> {
 pub fn one_line(e: &dyn std::fmt::Display) -> String {
     e.to_string().replace('\n', " ")
 }
+
+/// CPU time consumed so far by the calling thread (`thread`) or by the whole process (all
+/// threads), in seconds, from the POSIX CPU-time clocks (nanosecond resolution, unlike
+/// tick-based counters). `None` where they are unavailable.
+pub fn cpu_seconds(thread: bool) -> Option<f64> {
+    #[cfg(unix)]
+    {
+        let mut ts = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        let id = if thread {
+            libc::CLOCK_THREAD_CPUTIME_ID
+        } else {
+            libc::CLOCK_PROCESS_CPUTIME_ID
+        };
+        // SAFETY: `ts` is a valid, writable timespec for the duration of the call.
+        let r = unsafe { libc::clock_gettime(id, &mut ts) };
+        (r == 0).then(|| ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = thread;
+        None
+    }
+}
