@@ -71,7 +71,7 @@ pub fn cpu_seconds(thread: bool) -> Option<f64> {
         };
         // SAFETY: `ts` is a valid, writable timespec for the duration of the call.
         let r = unsafe { libc::clock_gettime(id, &mut ts) };
-        (r == 0).then(|| ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+        (r == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
     }
     #[cfg(not(unix))]
     {
