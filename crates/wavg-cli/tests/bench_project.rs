@@ -1,30 +1,14 @@
 //! `wavg bench project --json` prints exactly the documented keys, with sane values.
 
-use std::process::Command;
+mod common;
+
+use common::{json_object, wavg, wavg_ok};
 
 #[test]
 fn bench_project_reports_the_documented_json() {
-    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .args([
-            "bench",
-            "project",
-            "--mesh",
-            "builtin:torus",
-            "--queries",
-            "2000",
-            "--json",
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let o = v.as_object().unwrap();
-    let mut keys: Vec<&str> = o.keys().map(|k| k.as_str()).collect();
-    keys.sort();
+    let args = ["bench", "project", "--mesh", "builtin:torus"];
+    let out = wavg_ok(&[&args[..], &["--queries", "2000", "--json"]].concat());
+    let (o, keys) = json_object(&out);
     assert_eq!(
         keys,
         [
@@ -47,16 +31,6 @@ fn bench_project_reports_the_documented_json() {
     for k in ["init_s", "bytes_per_face", "onsurface_us", "offset_us"] {
         assert!(o[k].as_f64().unwrap() > 0.0, "{k}");
     }
-    let bad = Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .args([
-            "bench",
-            "project",
-            "--mesh",
-            "builtin:torus",
-            "--queries",
-            "0",
-        ])
-        .output()
-        .unwrap();
+    let bad = wavg(&[&args[..], &["--queries", "0"]].concat());
     assert_eq!(bad.status.code(), Some(2));
 }

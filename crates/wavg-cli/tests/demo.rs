@@ -1,25 +1,22 @@
 //! `wavg demo` runs the method end to end on a generated mesh and writes what it says.
 
-use std::process::Command;
+mod common;
+
+use common::{json_object, wavg, wavg_ok};
 
 #[test]
 fn demo_reports_and_writes_its_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("demo");
-    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .args(["demo", "--json", "--queries", "300", "--out"])
-        .arg(&out_dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let o = v.as_object().unwrap();
-    let mut keys: Vec<&str> = o.keys().map(|k| k.as_str()).collect();
-    keys.sort();
+    let out = wavg_ok(&[
+        "demo",
+        "--json",
+        "--queries",
+        "300",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let (o, keys) = json_object(&out);
     assert_eq!(
         keys,
         [
@@ -75,15 +72,9 @@ fn demo_reports_and_writes_its_outputs() {
 
 #[test]
 fn demo_rejects_bad_arguments() {
-    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .args(["demo", "--anchors", "2"])
-        .output()
-        .unwrap();
+    let out = wavg(&["demo", "--anchors", "2"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--anchors"));
-    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .args(["demo", "--mesh", "builtin:teapot"])
-        .output()
-        .unwrap();
+    let out = wavg(&["demo", "--mesh", "builtin:teapot"]);
     assert_eq!(out.status.code(), Some(2));
 }

@@ -1,14 +1,10 @@
 //! `wavg forward`, `wavg inverse` and `wavg bench roundtrip` run as a user would.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn wavg(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .args(args)
-        .output()
-        .expect("run wavg")
-}
+use std::path::{Path, PathBuf};
+
+use common::{json_object, wavg, wavg_ok};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
@@ -24,6 +20,15 @@ fn s(p: &Path) -> &str {
 const ANCHORS: &str = "# the icosahedron's vertices\nv 0\nv 1\nv 2\nv 3\n\nv 4\nv 5\nv 6\nv 7\nv 8\nv 9\nv 10\nf 0 0.2 0.3 0.5  # a face point\n";
 const MESH: &str = "builtin:sphere-small";
 
+/// A text file of numbers, one row per line.
+fn read_rows(p: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(p)
+        .unwrap()
+        .lines()
+        .map(parse_floats)
+        .collect()
+}
+
 fn parse_floats(line: &str) -> Vec<f64> {
     line.split_whitespace()
         .map(|t| t.parse().unwrap())
@@ -33,59 +38,6 @@ fn parse_floats(line: &str) -> Vec<f64> {
 #[test]
 fn inverse_then_forward_returns_the_points() {
     let dir = tempfile::tempdir().unwrap();
-    let anchors = write(dir.path(), "anchors.txt", ANCHORS);
-    let points = write(
-        dir.path(),
-        "points.txt",
-        "f 10 0.2 0.3 0.5\n# comment\n\nv 40\nf 100 0.6 0.2 0.2\nf 7 1 0 0\n",
-    );
-    let weights = dir.path().join("weights.txt");
-    let out = wavg(&[
-        "inverse",
-        "--mesh",
-        MESH,
-        "--anchors",
-        s(&anchors),
-        "--points",
-        s(&points),
-        "-o",
-        s(&weights),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let wtext = std::fs::read_to_string(&weights).unwrap();
-    let rows: Vec<Vec<f64>> = wtext.lines().map(parse_floats).collect();
-    assert_eq!(rows.len(), 4);
-    for r in &rows {
-        assert_eq!(r.len(), 12);
-        assert!((r.iter().sum::<f64>() - 1.0).abs() < 1e-9);
-    }
-    let result = dir.path().join("points_back.txt");
-    let out = wavg(&[
-        "forward",
-        "--mesh",
-        MESH,
-        "--anchors",
-        s(&anchors),
-        "--weights",
-        s(&weights),
-        "-o",
-        s(&result),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let back: Vec<Vec<f64>> = std::fs::read_to_string(&result)
-        .unwrap()
-        .lines()
-        .map(parse_floats)
-        .collect();
-    assert_eq!(back.len(), 4);
     // Compare 3-D positions with the library's positions of the original points.
     let mesh = wavg_mesh::procedural::builtin("sphere-small").unwrap();
     let originals = [
@@ -94,10 +46,14 @@ fn inverse_then_forward_returns_the_points() {
         wavg_mesh::SurfacePoint::new(100, [0.6, 0.2, 0.2]).position(&mesh),
         mesh.corners(7)[0],
     ];
-    for (b, o) in back.iter().zip(&originals) {
-        assert_eq!(b.len(), 7, "FACE B0 B1 B2 X Y Z");
-        let d = ((b[4] - o.x).powi(2) + (b[5] - o.y).powi(2) + (b[6] - o.z).powi(2)).sqrt();
-        assert!(d < 1e-6, "{b:?} vs {o:?}");
+    let points = "f 10 0.2 0.3 0.5\n# comment\n\nv 40\nf 100 0.6 0.2 0.2\nf 7 1 0 0\n";
+    inverse_forward_back(dir.path(), points, &[], &originals);
+    let (anchors, weights) = (
+        dir.path().join("anchors.txt"),
+        dir.path().join("weights.txt"),
+    );
+    let back = read_rows(&dir.path().join("back.txt"));
+    for b in &back {
         assert!((b[1] + b[2] + b[3] - 1.0).abs() < 1e-9);
     }
     // The exact search and stdout output agree.
@@ -368,49 +324,29 @@ fn bench_roundtrip_reports_the_documented_json() {
     assert_eq!(bad.status.code(), Some(2));
 }
 
-/// `wavg inverse --verified`: same format; the weights lead back (forward), and the
-/// summary on standard error is printed.
-#[test]
-fn verified_inverse_keeps_the_format_and_returns() {
-    let dir = tempfile::tempdir().unwrap();
-    let anchors = write(dir.path(), "anchors.txt", ANCHORS);
-    let points = write(
-        dir.path(),
-        "points.txt",
-        "f 10 0.2 0.3 0.5\nv 40\nf 100 0.6 0.2 0.2\n",
-    );
-    let weights = dir.path().join("weights.txt");
-    let out = wavg(&[
-        "inverse",
-        "--mesh",
-        MESH,
-        "--anchors",
-        s(&anchors),
-        "--points",
-        s(&points),
-        "-o",
-        s(&weights),
-        "--verified",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("verified: 3 points"), "{err}");
-    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&weights)
-        .unwrap()
-        .lines()
-        .map(parse_floats)
-        .collect();
-    assert_eq!(rows.len(), 3);
+/// Runs `wavg inverse` (with `extra` arguments) on `points`, then `wavg forward` on the
+/// weights; checks the weights' shape and that the points come back to `originals`.
+/// Returns the inverse's standard error.
+fn inverse_forward_back(
+    dir: &Path,
+    points: &str,
+    extra: &[&str],
+    originals: &[nalgebra::Vector3<f64>],
+) -> String {
+    let anchors = write(dir, "anchors.txt", ANCHORS);
+    let points = write(dir, "points.txt", points);
+    let weights = dir.join("weights.txt");
+    let base = ["inverse", "--mesh", MESH, "--anchors", s(&anchors)];
+    let io = ["--points", s(&points), "-o", s(&weights)];
+    let out = wavg_ok(&[&base[..], &io[..], extra].concat());
+    let rows: Vec<Vec<f64>> = read_rows(&weights);
+    assert_eq!(rows.len(), originals.len());
     for r in &rows {
         assert_eq!(r.len(), 12);
         assert!((r.iter().sum::<f64>() - 1.0).abs() < 1e-9);
     }
-    let back = dir.path().join("back.txt");
-    let out = wavg(&[
+    let back = dir.join("back.txt");
+    wavg_ok(&[
         "forward",
         "--mesh",
         MESH,
@@ -421,28 +357,35 @@ fn verified_inverse_keeps_the_format_and_returns() {
         "-o",
         s(&back),
     ]);
-    assert!(out.status.success());
+    let back: Vec<Vec<f64>> = read_rows(&back);
+    for (b, o) in back.iter().zip(originals) {
+        assert_eq!(b.len(), 7, "FACE B0 B1 B2 X Y Z");
+        let d = ((b[4] - o.x).powi(2) + (b[5] - o.y).powi(2) + (b[6] - o.z).powi(2)).sqrt();
+        assert!(d < 1e-6, "{b:?} vs {o:?}");
+    }
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// `wavg inverse --verified`: same format, the weights lead back, and the summary on
+/// standard error is printed.
+#[test]
+fn verified_inverse_keeps_the_format_and_returns() {
+    let dir = tempfile::tempdir().unwrap();
     let mesh = wavg_mesh::procedural::builtin("sphere-small").unwrap();
     let originals = [
         wavg_mesh::SurfacePoint::new(10, [0.2, 0.3, 0.5]).position(&mesh),
         mesh.positions[40],
         wavg_mesh::SurfacePoint::new(100, [0.6, 0.2, 0.2]).position(&mesh),
     ];
-    let back: Vec<Vec<f64>> = std::fs::read_to_string(&back)
-        .unwrap()
-        .lines()
-        .map(parse_floats)
-        .collect();
-    for (b, o) in back.iter().zip(&originals) {
-        let d = ((b[4] - o.x).powi(2) + (b[5] - o.y).powi(2) + (b[6] - o.z).powi(2)).sqrt();
-        assert!(d < 1e-6, "{b:?} vs {o:?}");
-    }
+    let points = "f 10 0.2 0.3 0.5\nv 40\nf 100 0.6 0.2 0.2\n";
+    let err = inverse_forward_back(dir.path(), points, &["--verified"], &originals);
+    assert!(err.contains("verified: 3 points"), "{err}");
 }
 
 /// `wavg bench roundtrip --verified` adds exactly the documented keys.
 #[test]
 fn bench_roundtrip_verified_adds_its_keys() {
-    let out = wavg(&[
+    let out = wavg_ok(&[
         "bench",
         "roundtrip",
         "--mesh",
@@ -456,14 +399,8 @@ fn bench_roundtrip_verified_adds_its_keys() {
         "--verified",
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let obj = v.as_object().unwrap();
-    assert_eq!(obj.len(), 13 + 5);
+    let (obj, keys) = json_object(&out);
+    assert_eq!(keys.len(), 13 + 5);
     for k in [
         "verified_inverse_us",
         "verified_roundtrip_ok_fraction",

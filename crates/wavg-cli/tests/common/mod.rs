@@ -1,0 +1,32 @@
+//! Helpers shared by the command-line tests: run `wavg`, check success, read JSON.
+#![allow(dead_code)] // each test binary uses a different subset
+
+use std::process::{Command, Output};
+
+/// Runs `wavg ARGS`.
+pub fn wavg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(args)
+        .output()
+        .expect("run wavg")
+}
+
+/// Runs `wavg ARGS` and asserts success (showing its standard error otherwise).
+pub fn wavg_ok(args: &[&str]) -> Output {
+    let out = wavg(args);
+    assert!(
+        out.status.success(),
+        "wavg {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The JSON object a command printed, and its keys sorted.
+pub fn json_object(out: &Output) -> (serde_json::Map<String, serde_json::Value>, Vec<String>) {
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON on stdout");
+    let o = v.as_object().expect("a JSON object").clone();
+    let mut keys: Vec<String> = o.keys().cloned().collect();
+    keys.sort();
+    (o, keys)
+}
