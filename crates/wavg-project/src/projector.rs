@@ -419,6 +419,31 @@ impl Projector {
         self.try_face(f, y).map(|b| b.xi)
     }
 
+    /// [`Projector::project_onto_face`] with the distance in R^8 from the projection to
+    /// `y` (computed from the corners already loaded, no further lookups).
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// let m = Arc::new(ValidMesh::new(procedural::grid(3, 3, 1.0, 1.0)).unwrap());
+    /// let emb = Arc::new(EmbeddedMesh::from_positions(m));
+    /// let p = Projector::new(emb.clone()).unwrap();
+    /// let mut y = emb.point(&SurfacePoint::new(4, [0.2, 0.3, 0.5]));
+    /// y[2] += 0.25; // off the plane z = 0
+    /// let (xi, d) = p.project_onto_face_with_distance(&y, 4).unwrap();
+    /// assert!((d - 0.25).abs() < 1e-12 && (xi[0] - 0.2).abs() < 1e-9);
+    /// ```
+    pub fn project_onto_face_with_distance(&self, y: &Vec8, f: FaceId) -> Option<([f64; 3], f64)> {
+        self.try_face(f, y).map(|b| (b.xi, b.d2.sqrt()))
+    }
+
+    /// The corner vertices of face `f` (from the projector's face record, usually in cache
+    /// after a projection onto it).
+    pub fn face_corners(&self, f: FaceId) -> [VertexId; 3] {
+        self.faces[f as usize].v
+    }
+
     #[inline]
     fn try_face(&self, f: FaceId, y: &Vec8) -> Option<Best> {
         let face = &self.faces[f as usize];

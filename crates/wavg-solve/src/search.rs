@@ -172,11 +172,10 @@ impl LocalSearch {
             let m = level.len();
             order[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             for &(_, f) in &order[..m] {
-                if let Some(xi) = proj.project_onto_face(y, f) {
-                    let p = SurfacePoint::new(f, xi);
+                if let Some((xi, distance)) = proj.project_onto_face_with_distance(y, f) {
                     return Some(LocalHit {
-                        point: p,
-                        distance: (emb.point(&p) - y).norm(),
+                        point: SurfacePoint::new(f, xi),
+                        distance,
                     });
                 }
             }

@@ -273,7 +273,14 @@ impl Solver {
         })?;
         Ok(ForwardResult {
             point: p.point,
-            position: p.point.position(mesh),
+            // Corners from the projector's face record (in cache): one lookup fewer.
+            position: {
+                let c = self.projector.face_corners(p.point.face);
+                let pos = &mesh.positions;
+                pos[c[0] as usize] * p.point.bary[0]
+                    + pos[c[1] as usize] * p.point.bary[1]
+                    + pos[c[2] as usize] * p.point.bary[2]
+            },
             distance: p.distance,
             path: p.path,
             start,
