@@ -37,9 +37,9 @@ brute-force answer (offset_bruteforce_agree_fraction). --json prints exactly tho
 plus mesh, vertices, faces, queries.
 
 Times are the calling thread's CPU time per query, best of three passes, on one thread
-through Projector::project_batch (the greedy walks of 8 queries interleaved; the answers
-equal one Projector::project call per query, which is checked). The table also shows the
-time of one project call at a time.")]
+through Projector::project_batch (queries visited in spatial order, the greedy walks of 8
+queries interleaved; the answers equal one Projector::project call per query, which is
+checked). The table also shows the time of one project call at a time.")]
 pub struct Args {
     /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
     #[arg(long)]
