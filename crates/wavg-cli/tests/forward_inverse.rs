@@ -20,6 +20,35 @@ fn s(p: &Path) -> &str {
 const ANCHORS: &str = "# the icosahedron's vertices\nv 0\nv 1\nv 2\nv 3\n\nv 4\nv 5\nv 6\nv 7\nv 8\nv 9\nv 10\nf 0 0.2 0.3 0.5  # a face point\n";
 const MESH: &str = "builtin:sphere-small";
 
+/// `wavg COMMAND --mesh MESH --anchors A --KIND INPUT -o OUT EXTRA...` for forward
+/// (`--weights`) and inverse (`--points`).
+fn solve_args<'a>(
+    command: &'a str,
+    anchors: &'a str,
+    input: &'a str,
+    out: &'a str,
+    extra: &[&'a str],
+) -> Vec<&'a str> {
+    let kind = if command == "forward" {
+        "--weights"
+    } else {
+        "--points"
+    };
+    let mut v = vec![
+        command,
+        "--mesh",
+        MESH,
+        "--anchors",
+        anchors,
+        kind,
+        input,
+        "-o",
+        out,
+    ];
+    v.extend_from_slice(extra);
+    v
+}
+
 /// A text file of numbers, one row per line.
 fn read_rows(p: &Path) -> Vec<Vec<f64>> {
     std::fs::read_to_string(p)
@@ -57,20 +86,13 @@ fn inverse_then_forward_returns_the_points() {
         assert!((b[1] + b[2] + b[3] - 1.0).abs() < 1e-9);
     }
     // The exact search and stdout output agree.
-    let out = wavg(&[
+    let out = wavg(&solve_args(
         "forward",
-        "--mesh",
-        MESH,
-        "--anchors",
         s(&anchors),
-        "--weights",
         s(&weights),
-        "-o",
         "-",
-        "--exact",
-        "--threads",
-        "1",
-    ]);
+        &["--exact", "--threads", "1"],
+    ));
     assert!(out.status.success());
     let exact: Vec<Vec<f64>> = String::from_utf8(out.stdout)
         .unwrap()
@@ -127,35 +149,20 @@ fn malformed_weights_are_reported_with_their_line() {
     ] {
         let w = write(dir.path(), "w.txt", text);
         expect_input_error(
-            &[
-                "forward",
-                "--mesh",
-                MESH,
-                "--anchors",
-                s(&anchors),
-                "--weights",
-                s(&w),
-                "-o",
-                s(&out),
-            ],
+            &solve_args("forward", s(&anchors), s(&w), s(&out), &[]),
             &out,
             needle,
         );
     }
     // --normalize accepts a wrong sum.
     let w = write(dir.path(), "w.txt", "2 3 5\n");
-    let r = wavg(&[
+    let r = wavg(&solve_args(
         "forward",
-        "--mesh",
-        MESH,
-        "--anchors",
         s(&anchors),
-        "--weights",
         s(&w),
-        "-o",
         s(&out),
-        "--normalize",
-    ]);
+        &["--normalize"],
+    ));
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     assert_eq!(std::fs::read_to_string(&out).unwrap().lines().count(), 1);
 }
@@ -179,51 +186,21 @@ fn malformed_points_and_anchors_are_reported_with_their_line() {
     ] {
         let p = write(dir.path(), "p.txt", text);
         expect_input_error(
-            &[
-                "inverse",
-                "--mesh",
-                MESH,
-                "--anchors",
-                s(&good),
-                "--points",
-                s(&p),
-                "-o",
-                s(&out),
-            ],
+            &solve_args("inverse", s(&good), s(&p), s(&out), &[]),
             &out,
             needle,
         );
         // The same file as anchors is rejected with its line too.
         let w = write(dir.path(), "w.txt", "1\n");
         expect_input_error(
-            &[
-                "forward",
-                "--mesh",
-                MESH,
-                "--anchors",
-                s(&p),
-                "--weights",
-                s(&w),
-                "-o",
-                s(&out),
-            ],
+            &solve_args("forward", s(&p), s(&w), s(&out), &[]),
             &out,
             needle,
         );
     }
     let missing = dir.path().join("missing.txt");
     expect_input_error(
-        &[
-            "inverse",
-            "--mesh",
-            MESH,
-            "--anchors",
-            s(&good),
-            "--points",
-            s(&missing),
-            "-o",
-            s(&out),
-        ],
+        &solve_args("inverse", s(&good), s(&missing), s(&out), &[]),
         &out,
         "missing.txt",
     );
@@ -346,17 +323,13 @@ fn inverse_forward_back(
         assert!((r.iter().sum::<f64>() - 1.0).abs() < 1e-9);
     }
     let back = dir.join("back.txt");
-    wavg_ok(&[
+    wavg_ok(&solve_args(
         "forward",
-        "--mesh",
-        MESH,
-        "--anchors",
         s(&anchors),
-        "--weights",
         s(&weights),
-        "-o",
         s(&back),
-    ]);
+        &[],
+    ));
     let back: Vec<Vec<f64>> = read_rows(&back);
     for (b, o) in back.iter().zip(originals) {
         assert_eq!(b.len(), 7, "FACE B0 B1 B2 X Y Z");

@@ -1,26 +1,16 @@
 //! `wavg info` run as a process: exit codes, JSON keys, one-line errors, no panics.
 
+mod common;
+
+use common::{wavg, wavg_ok};
+
 use std::path::Path;
-use std::process::{Command, Output};
 
 use serde_json::Value;
 use wavg_mesh::{data, io, procedural};
 
-fn wavg(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .args(args)
-        .output()
-        .expect("run wavg")
-}
-
 fn info_json(path: &Path) -> Value {
-    let out = wavg(&["info", "--json", path.to_str().unwrap()]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = wavg_ok(&["info", "--json", path.to_str().unwrap()]);
     serde_json::from_slice(&out.stdout).expect("one JSON object")
 }
 

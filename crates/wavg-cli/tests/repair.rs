@@ -1,17 +1,12 @@
 //! `wavg repair` run as a process: repaired output is valid, the vertex map points back to
 //! the input, remaining problems give exit 1, unreadable input exit 2.
 
-use std::process::{Command, Output};
+mod common;
+
+use common::{wavg, wavg_ok};
 
 use serde_json::Value;
 use wavg_mesh::{ValidMesh, io, procedural};
-
-fn wavg(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .args(args)
-        .output()
-        .expect("run wavg")
-}
 
 #[test]
 fn repairs_unwelded_mesh_and_writes_vertex_map() {
@@ -31,7 +26,7 @@ fn repairs_unwelded_mesh_and_writes_vertex_map() {
     io::save(&input, &soup).unwrap();
     let output = dir.path().join("fixed.off");
     let map = dir.path().join("map.txt");
-    let out = wavg(&[
+    let out = wavg_ok(&[
         "repair",
         input.to_str().unwrap(),
         "-o",
@@ -40,12 +35,6 @@ fn repairs_unwelded_mesh_and_writes_vertex_map() {
         map.to_str().unwrap(),
         "--json",
     ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let j: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(j["valid"], true);
     assert_eq!(j["vertices"], torus.n_vertices());
@@ -87,19 +76,13 @@ fn remaining_problems_exit_1_and_components_need_opt_in() {
     let input = dir.path().join("two.obj");
     io::save(&input, &two).unwrap();
     let output = dir.path().join("one.obj");
-    let out = wavg(&[
+    wavg_ok(&[
         "repair",
         input.to_str().unwrap(),
         "-o",
         output.to_str().unwrap(),
         "--largest-component",
     ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert_eq!(io::load(&output).unwrap().n_vertices(), a.n_vertices());
 
     // A fin (three faces on one edge) cannot be repaired: output written, exit 1.

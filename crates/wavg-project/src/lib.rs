@@ -32,7 +32,7 @@ pub mod embedded;
 pub mod error;
 pub mod euclid;
 pub mod frames;
-pub mod hugepage;
+mod hugepage;
 pub mod ort;
 pub mod projector;
 pub mod triangle;

@@ -181,6 +181,11 @@ pub struct FaceOrder {
 }
 
 impl FaceOrder {
+    const EMPTY: Self = Self {
+        faces: [0; 64],
+        n: 0,
+    };
+
     /// The faces, most promising first.
     pub fn as_slice(&self) -> &[FaceId] {
         &self.faces[..self.n]
@@ -440,6 +445,15 @@ impl Projector {
 
     /// The corner vertices of face `f` (from the projector's face record, usually in cache
     /// after a projection onto it).
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// let m = Arc::new(ValidMesh::new(procedural::icosphere(1)).unwrap());
+    /// let p = Projector::new(Arc::new(EmbeddedMesh::from_positions(m.clone()))).unwrap();
+    /// assert_eq!(p.face_corners(7), m.triangles[7]);
+    /// ```
     pub fn face_corners(&self, f: FaceId) -> [VertexId; 3] {
         self.faces[f as usize].v
     }
@@ -638,29 +652,37 @@ impl Projector {
         order.sort_unstable();
         let mut out: Vec<Option<Result<Projection, ProjectError>>> =
             std::iter::repeat_with(|| None).take(n).collect();
+        // Per group, fixed-size buffers (no allocation per group).
+        let mut yc = [Vec8::zeros(); WALK_GROUP];
+        let mut sc = [0 as VertexId; WALK_GROUP];
         let mut ends = [0 as VertexId; WALK_GROUP];
         for group in order.chunks(WALK_GROUP) {
-            let idx: Vec<usize> = group.iter().map(|&(_, i)| i as usize).collect();
-            let yc: Vec<Vec8> = idx.iter().map(|&i| ys[i]).collect();
-            let sc: Vec<VertexId> = idx.iter().map(|&i| starts[i]).collect();
+            let m = group.len();
+            for (k, &(_, i)) in group.iter().enumerate() {
+                (yc[k], sc[k]) = (ys[i as usize], starts[i as usize]);
+            }
+            let (yc, sc, ends) = (&yc[..m], &sc[..m], &mut ends[..m]);
             let valid = yc.iter().all(|y| y.iter().all(|v| v.is_finite()))
                 && sc.iter().all(|&s| (s as usize) < self.verts.len());
             if !valid {
                 // The per-query path reports each error.
-                for (k, &i) in idx.iter().enumerate() {
-                    out[i] = Some(self.project(&yc[k], sc[k]));
+                for (k, &(_, i)) in group.iter().enumerate() {
+                    out[i as usize] = Some(self.project(&yc[k], sc[k]));
                 }
                 continue;
             }
-            let ends = &mut ends[..yc.len()];
-            self.walk_group(&yc, &sc, ends);
-            let cands: Vec<FaceOrder> = yc
-                .iter()
-                .zip(ends.iter())
-                .map(|(y, &v)| self.order_faces(y, v, &self.ring_dists(y, v)))
-                .collect();
-            for (k, &i) in idx.iter().enumerate() {
-                out[i] = Some(self.search_around(&yc[k], ends[k], &cands[k]));
+            self.walk_group(yc, sc, ends);
+            // Every candidate order first (each requests its first face's data), then the
+            // solves, so those requests overlap.
+            let cands: [FaceOrder; WALK_GROUP] = std::array::from_fn(|k| {
+                if k < m {
+                    self.order_faces(&yc[k], ends[k], &self.ring_dists(&yc[k], ends[k]))
+                } else {
+                    FaceOrder::EMPTY
+                }
+            });
+            for (k, &(_, i)) in group.iter().enumerate() {
+                out[i as usize] = Some(self.search_around(&yc[k], ends[k], &cands[k]));
             }
         }
         out.into_iter()

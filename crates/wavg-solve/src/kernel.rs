@@ -132,7 +132,7 @@ impl AnchorCoords {
 /// Hints the processor to load the first lines (up to 1 KiB) of `v`; results are
 /// unaffected, and it is a no-op off x86-64.
 #[inline]
-pub fn prefetch_slice(v: &[f64]) {
+pub(crate) fn prefetch_slice(v: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};

@@ -164,6 +164,16 @@ impl Solver {
     }
 
     /// Mean 3-D edge length of the mesh (the unit of round-trip tolerances).
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{ValidMesh, procedural};
+    /// use wavg_solve::{Anchor, EmbeddedMesh, Projector, Solver};
+    /// let m = Arc::new(ValidMesh::new(procedural::grid(4, 4, 1.0, 1.0)).unwrap());
+    /// let p = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(m))).unwrap());
+    /// let s = Solver::new(p, (0..3).map(Anchor::Vertex)).unwrap();
+    /// assert!(s.mean_edge_length() > 0.25 && s.mean_edge_length() < 0.36);
+    /// ```
     pub fn mean_edge_length(&self) -> f64 {
         self.mean_edge
     }
