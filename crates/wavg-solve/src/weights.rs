@@ -35,10 +35,25 @@ pub fn validate(weights: &[f64], n_anchors: usize, norm: Normalization) -> Resul
             got: weights.len(),
         });
     }
-    if let Some((index, &value)) = weights.iter().enumerate().find(|(_, w)| !w.is_finite()) {
+    // One pass with four partial sums (the weights are usually a fresh cache miss and
+    // a single running sum is a chain of dependent additions); a NaN or infinite weight
+    // makes the sum non-finite, and only then are the weights searched for the culprit.
+    let mut acc = [0.0f64; 4];
+    let mut quads = weights.chunks_exact(4);
+    for q in &mut quads {
+        for k in 0..4 {
+            acc[k] += q[k];
+        }
+    }
+    for (k, &w) in quads.remainder().iter().enumerate() {
+        acc[k] += w;
+    }
+    let sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    if !sum.is_finite()
+        && let Some((index, &value)) = weights.iter().enumerate().find(|(_, w)| !w.is_finite())
+    {
         return Err(SolveError::NonFiniteWeight { index, value });
     }
-    let sum: f64 = weights.iter().sum();
     match norm {
         Normalization::Reject => {
             // Written so that an overflowing (NaN or infinite) sum is rejected too.
