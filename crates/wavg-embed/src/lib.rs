@@ -21,6 +21,7 @@ pub mod file;
 pub mod geodesic;
 pub mod lsmesh;
 pub mod mds;
+pub mod near_field;
 pub mod pipeline;
 pub mod quality;
 pub use decimate::{DecimateOptions, Decimated, decimate, select_landmarks};
