@@ -51,9 +51,9 @@
 //! run starts with exact polyhedral distances within [`crate::near_field::NEAR_FIELD_EDGES`]
 //! mean edge lengths of the source: straight lines from the source followed through the
 //! triangles they cross, unfolded into the plane ([`crate::near_field`]). On a 40k
-//! icosphere this lowered the mean error from 0.40-0.52% to 0.21-0.27% and the maximum
-//! from 3.9-4.5% to 0.8-1.0%; on pig, camelhead and fertility (300 landmarks) the largest
-//! asymmetry `|d(i,j) - d(j,i)| / mean` went from 8.7-16% to 3-5.5% and the pairs above 2%
+//! icosphere this lowered the mean error from 0.40-0.52% to 0.21-0.26% and the maximum
+//! from 3.9-4.5% to 0.7-0.9%; on pig, camelhead and fertility (300 landmarks) the largest
+//! asymmetry `|d(i,j) - d(j,i)| / mean` went from 8.7-16% to 2.8-5.5% and the pairs above 2%
 //! from 0.25-0.87% to 0.00-0.06%, for about 7% more time per run. (It replaces an exact
 //! second ring, which had lowered the icosphere's maximum from 11.8% to 4.5%.)
 //!
@@ -931,7 +931,7 @@ mod tests {
             worst_mean = worst_mean.max(mean);
             worst_max = worst_max.max(max);
         }
-        // Measured 0.21-0.27% mean, 0.8-1.0% max with the exact near field (0.40-0.52%
+        // Measured 0.21-0.26% mean, 0.7-0.9% max with the exact near field (0.40-0.52%
         // and 3.9-4.5% without).
         assert!(worst_mean < 0.005, "mean relative error {worst_mean}");
         assert!(worst_max < 0.02, "max relative error {worst_max}");

@@ -20,6 +20,16 @@ use wavg_mesh::{NONE, ValidMesh};
 type V2 = Vector2<f64>;
 
 /// Radius of the exact near field, in mean edge lengths of the mesh.
+///
+/// ```
+/// use wavg_embed::geodesic::distances_from;
+/// use wavg_mesh::{ValidMesh, procedural};
+/// // On a flat grid, fast marching is exact (Euclidean) within the near field of the
+/// // source: 3 x 2 cells away is well inside 8 edge lengths.
+/// let mesh = ValidMesh::new(procedural::grid(20, 20, 1.0, 1.0)).unwrap();
+/// let d = distances_from(&mesh, &[0]);
+/// assert!((d[2 * 21 + 3] - (0.15f64.powi(2) + 0.1f64.powi(2)).sqrt()).abs() < 1e-12);
+/// ```
 pub const NEAR_FIELD_EDGES: f64 = 8.0;
 
 /// Windows are not followed through more triangles than this (a guard; the radius stops
