@@ -691,8 +691,21 @@ impl Projector {
     }
 
     /// A 30-bit Morton code of the first three walk coordinates of `y` (10 bits each;
-    /// anything outside the bounding box, or not finite, clamps to its faces).
-    fn locality_key(&self, y: &Vec8) -> u32 {
+    /// anything outside the bounding box, or not finite, clamps to its faces): sorting
+    /// queries by it puts nearby ones together, so their searches share cached data.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// let m = Arc::new(ValidMesh::new(procedural::icosphere(2)).unwrap());
+    /// let emb = Arc::new(EmbeddedMesh::from_positions(m));
+    /// let p = Projector::new(emb.clone()).unwrap();
+    /// let y = emb.coords()[0];
+    /// assert_eq!(p.locality_key(&y), p.locality_key(&(y * (1.0 + 1e-12))));
+    /// assert!(p.locality_key(&y) < 1 << 30);
+    /// ```
+    pub fn locality_key(&self, y: &Vec8) -> u32 {
         let w = self.walk_point(y);
         let spread = |c: f32| {
             // `as` saturates (NaN to 0): a coordinate in 0..=1023.

@@ -129,23 +129,22 @@ impl AnchorCoords {
     }
 }
 
-/// Hints the processor to load the first lines (up to 1 KiB) of `v`; results are
+/// Hints the processor to load the (first 1 KiB of the) lines holding `r`; results are
 /// unaffected, and it is a no-op off x86-64.
 #[inline]
-pub(crate) fn prefetch_slice(v: &[f64]) {
+pub(crate) fn prefetch<T>(r: &T) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        let bytes = std::mem::size_of_val(v).min(1024);
-        let p = v.as_ptr() as *const i8;
+        let bytes = std::mem::size_of::<T>().min(1024);
+        let p = (r as *const T).cast::<i8>();
         for off in (0..bytes).step_by(64) {
-            // SAFETY: SSE is part of the x86-64 baseline and a prefetch never faults; the
-            // addresses lie inside `v` anyway.
+            // SAFETY: SSE is part of the x86-64 baseline and a prefetch never faults.
             unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(off)) };
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = v;
+    let _ = r;
 }
 
 /// Reusable buffers for [`inverse_weights`] (so batches do not allocate per query).

@@ -269,7 +269,11 @@ fn batches_equal_sequential_for_any_thread_count() {
     let s = solver_on(procedural::bump_sphere(3, 0.3), 20, 1);
     let pts = uniform_surface_points(s.mesh(), 500, 8).unwrap();
     let seq_w: Vec<_> = pts.iter().map(|p| s.inverse(p)).collect();
-    let weights: Vec<Vec<f64>> = seq_w.iter().map(|w| w.clone().unwrap()).collect();
+    let mut weights: Vec<Vec<f64>> = seq_w.iter().map(|w| w.clone().unwrap()).collect();
+    // Malformed rows among them: each batch reports the same typed error in its place.
+    weights[3] = vec![0.5; 3];
+    weights[100][0] = f64::INFINITY; // (not NaN: NaN != NaN in the comparison)
+    weights[200][1] += 0.5;
     let opts = ForwardOptions::default();
     let seq_f: Vec<_> = weights.iter().map(|w| s.forward(w, &opts)).collect();
     let mut seq_warm = Vec::new();
@@ -298,11 +302,11 @@ fn batches_equal_sequential_for_any_thread_count() {
                     "{threads} threads, inverse {i}"
                 );
             }
-            assert_eq!(
-                s.forward_batch(&weights, &opts),
-                seq_f,
-                "{threads} threads, forward"
-            );
+            let fb = s.forward_batch(&weights, &opts);
+            for (i, (a, b)) in fb.iter().zip(&seq_f).enumerate() {
+                assert_eq!(a, b, "{threads} threads, forward {i}");
+            }
+            assert_eq!(fb.len(), seq_f.len());
             assert_eq!(
                 s.forward_batch_warm(&weights, &opts, 50),
                 seq_warm,
