@@ -28,16 +28,6 @@ impl Coord32 {
     fn new(y: &Vec8) -> Self {
         Self(std::array::from_fn(|k| y[k] as f32))
     }
-
-    #[inline]
-    fn dist2(&self, y: &Coord32) -> f32 {
-        let mut s = 0.0;
-        for k in 0..8 {
-            let d = self.0[k] - y.0[k];
-            s += d * d;
-        }
-        s
-    }
 }
 
 /// The forward problem's local search over one projector, with compact f32 copies of the
@@ -74,18 +64,11 @@ impl LocalSearch {
         self.search_from(y, v)
     }
 
-    /// The vertex nearest to `y` (brute force over the f32 coordinates): the second chance
-    /// when the walk ends in a local minimum of the distance with no projection nearby.
+    /// The vertex nearest to `y` ([`Projector::nearest_vertex`], branch and bound): the
+    /// second chance when the walk ends in a local minimum of the distance with no
+    /// projection nearby.
     pub fn nearest_vertex(&self, y: &Vec8) -> VertexId {
-        let y = Coord32::new(y);
-        let mut best = (f32::INFINITY, 0);
-        for (v, c) in self.coords.iter().enumerate() {
-            let d = c.dist2(&y);
-            if d < best.0 {
-                best = (d, v as VertexId);
-            }
-        }
-        best.1
+        self.proj.nearest_vertex(y)
     }
 
     /// The breadth-first triangle search from vertex `v` itself (no walk).

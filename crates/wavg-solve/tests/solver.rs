@@ -501,8 +501,9 @@ fn round_trips_with_a_geodesic_embedding() {
     }
 }
 
-/// The second chance of the fast search: the nearest vertex (f32 brute force) agrees with
-/// the projector's, and the search from it finds points on the surface.
+/// The second chance of the fast search: the nearest vertex (branch and bound) is the
+/// brute-force one, near and far off the surface, and the search from it finds points on
+/// the surface.
 #[test]
 fn nearest_vertex_second_chance() {
     let s = solver_on(procedural::torus(48, 24, 1.0, 0.35), 4, 1);
@@ -513,11 +514,22 @@ fn nearest_vertex_second_chance() {
         .iter()
         .enumerate()
     {
-        let y = proj.embedded().point(p)
-            + wavg_solve::Vec8::from_fn(|k, _| ((i + k) % 3) as f64 * 0.01);
-        let a = s.local_search().nearest_vertex(&y);
-        let b = proj.nearest_vertex(&y);
-        assert!(((c[a as usize] - y).norm() - (c[b as usize] - y).norm()).abs() < 1e-5);
+        for scale in [0.01, 0.3, 3.0] {
+            let y = proj.embedded().point(p)
+                + wavg_solve::Vec8::from_fn(|k, _| ((i + k) % 3) as f64 * scale);
+            let brute = (0..c.len())
+                .min_by(|&a, &b| {
+                    (c[a] - y)
+                        .norm_squared()
+                        .total_cmp(&(c[b] - y).norm_squared())
+                })
+                .unwrap();
+            assert_eq!(
+                s.local_search().nearest_vertex(&y) as usize,
+                brute,
+                "{i} {scale}"
+            );
+        }
         let yhat = proj.embedded().point(p);
         let h = s
             .local_search()
