@@ -1061,7 +1061,7 @@ impl Projector {
                 if d < best.0 || (d == best.0 && v < best.1) {
                     best = (d, v);
                     // Keep boxes at exactly this distance: they may hold a lower index.
-                    *bound = d.next_up();
+                    *bound = f64::from_bits(d.to_bits() + 1); // the next float up (d >= 0)
                 }
             }
         });
