@@ -520,6 +520,17 @@ impl BatchWeights {
     pub fn iter(&self) -> impl Iterator<Item = Result<&[f64], &SolveError>> {
         (0..self.len()).map(|i| self.get(i))
     }
+
+    /// Replaces row `i` with `w` (the anchor count long) or marks it failed.
+    pub(crate) fn set(&mut self, i: usize, w: Result<&[f64], SolveError>) {
+        match w {
+            Ok(w) => {
+                self.data[i * self.n..(i + 1) * self.n].copy_from_slice(w);
+                self.status[i] = Ok(());
+            }
+            Err(e) => self.status[i] = Err(e),
+        }
+    }
 }
 
 #[cfg(test)]

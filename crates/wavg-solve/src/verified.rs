@@ -18,7 +18,7 @@ use wavg_mesh::SurfacePoint;
 use crate::error::SolveError;
 use crate::kernel::AnchorCoords;
 use crate::points::check_point;
-use crate::solver::{ForwardOptions, Solver};
+use crate::solver::{BatchWeights, ForwardOptions, ForwardResult, Solver};
 use crate::{DIM, Mat2x8, Vec8};
 
 /// The penalties tried, in order, after the paper's weights.
@@ -224,17 +224,119 @@ impl Solver {
     }
 
     /// [`Solver::inverse_verified`] for many points in parallel (results in input order,
-    /// the same for any thread count).
+    /// equal to the one-by-one ones for any thread count); see
+    /// [`Solver::inverse_verified_batch_into`].
     pub fn inverse_verified_batch(
         &self,
         points: &[SurfacePoint],
         tolerance: f64,
     ) -> Vec<Result<Verified, SolveError>> {
-        use rayon::prelude::*;
-        points
-            .par_iter()
-            .with_min_len(64)
-            .map(|p| self.inverse_verified(p, tolerance))
+        let mut weights = BatchWeights::default();
+        let mut trips = Vec::new();
+        self.inverse_verified_batch_into(points, tolerance, &mut weights, &mut trips);
+        weights
+            .iter()
+            .zip(trips)
+            .map(|(w, t)| {
+                Ok(Verified {
+                    weights: w.map_err(Clone::clone)?.to_vec(),
+                    round_trip: t?,
+                })
+            })
             .collect()
+    }
+
+    /// [`Solver::inverse_verified_batch`] into existing buffers (repeated batches then
+    /// neither allocate nor page-fault): row `i` of `weights` and `round_trips[i]` belong
+    /// to `points[i]` (both carry the error when it failed). In stages, each a batch: the
+    /// paper's weights for all points ([`Solver::inverse_batch_into`]) and their forward
+    /// problems ([`Solver::forward_batch`], which orders them for cache locality); then,
+    /// for the points still not returned, one rung of the penalty ladder at a time.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+    /// use wavg_solve::verified::{DEFAULT_TOLERANCE, RoundTrip};
+    /// use wavg_solve::{Anchor, BatchWeights, EmbeddedMesh, Projector, Solver};
+    /// let mesh = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
+    /// let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
+    /// let solver = Solver::new(proj, (0..12).map(Anchor::Vertex)).unwrap();
+    /// let points = [SurfacePoint::new(100, [0.2, 0.3, 0.5]), SurfacePoint::new(9999, [1.0, 0.0, 0.0])];
+    /// let (mut w, mut trips) = (BatchWeights::default(), Vec::new());
+    /// solver.inverse_verified_batch_into(&points, DEFAULT_TOLERANCE, &mut w, &mut trips);
+    /// assert_eq!(trips[0], Ok(RoundTrip::Paper));
+    /// assert!(w.get(1).is_err() && trips[1].is_err()); // no face 9999
+    /// ```
+    pub fn inverse_verified_batch_into(
+        &self,
+        points: &[SurfacePoint],
+        tolerance: f64,
+        weights: &mut BatchWeights,
+        round_trips: &mut Vec<Result<RoundTrip, SolveError>>,
+    ) {
+        use rayon::prelude::*;
+        self.inverse_batch_into(points, weights);
+        round_trips.clear();
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            let e = SolveError::InvalidParameter(format!(
+                "the round-trip tolerance must be finite and positive, got {tolerance}"
+            ));
+            for i in 0..points.len() {
+                weights.set(i, Err(e.clone()));
+            }
+            round_trips.resize(points.len(), Err(e));
+            return;
+        }
+        let mesh = self.mesh();
+        let tol = tolerance * self.mean_edge_length();
+        let returns = |p: &SurfacePoint, f: &Result<ForwardResult, SolveError>| {
+            f.as_ref().is_ok_and(|f| {
+                check_point(mesh, p).is_ok_and(|c| (f.position - c.position(mesh)).norm() <= tol)
+            })
+        };
+        let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
+        let fwd = self.forward_batch(&rows, &ForwardOptions::default());
+        let paper = &*weights;
+        (0..points.len())
+            .into_par_iter()
+            .map(|i| match paper.get(i) {
+                Err(e) => Err(e.clone()),
+                Ok(_) if returns(&points[i], &fwd[i]) => Ok(RoundTrip::Paper),
+                Ok(_) => Ok(RoundTrip::NotReached),
+            })
+            .collect_into_vec(round_trips);
+        let mut pending: Vec<usize> = (0..points.len())
+            .filter(|&i| round_trips[i] == Ok(RoundTrip::NotReached))
+            .collect();
+        for lambda in PENALTY_LADDER {
+            if pending.is_empty() {
+                break;
+            }
+            let tried: Vec<Result<Vec<f64>, SolveError>> = pending
+                .par_iter()
+                .map(|&i| {
+                    let p = check_point(mesh, &points[i])?;
+                    let (psi, yhat) = self.projector().psi_and_point(&p);
+                    penalized_weights(&psi, &yhat, self.anchors().coords(), self.gamma(), lambda)
+                })
+                .collect();
+            let rows: Vec<&[f64]> = tried.iter().map(|r| r.as_deref().unwrap_or(&[])).collect();
+            let fwd = self.forward_batch(&rows, &ForwardOptions::default());
+            let mut still = Vec::new();
+            for ((&i, w), f) in pending.iter().zip(&tried).zip(&fwd) {
+                match w {
+                    Err(e) => {
+                        weights.set(i, Err(e.clone()));
+                        round_trips[i] = Err(e.clone());
+                    }
+                    Ok(w) if returns(&points[i], f) => {
+                        weights.set(i, Ok(w));
+                        round_trips[i] = Ok(RoundTrip::Penalized(lambda));
+                    }
+                    Ok(_) => still.push(i),
+                }
+            }
+            pending = still;
+        }
     }
 }

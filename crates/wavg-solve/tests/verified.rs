@@ -8,7 +8,7 @@ use wavg_solve::kernel::{AnchorCoords, InverseScratch, inverse_weights};
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
 use wavg_solve::verified::{DEFAULT_TOLERANCE, penalized_weights};
 use wavg_solve::{
-    Anchor, EmbeddedMesh, ForwardOptions, Mat2x8, Projector, RoundTrip, Solver, Vec8,
+    Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, Mat2x8, Projector, RoundTrip, Solver, Vec8,
 };
 
 fn solver_on(mesh: TriMesh, k: usize) -> Solver {
@@ -177,4 +177,39 @@ fn verified_inverse_rejects_bad_input() {
     assert!(s.inverse_verified(&p, f64::NAN).is_err());
     let bad = SurfacePoint::new(u32::MAX, [0.2, 0.3, 0.5]);
     assert!(s.inverse_verified(&bad, DEFAULT_TOLERANCE).is_err());
+}
+
+/// The batch reports the one-by-one errors in place (bad point, bad tolerance) and
+/// reuses its buffers across calls with the same answers.
+#[test]
+fn verified_batch_errors_and_reuse() {
+    let s = solver_on(procedural::torus(32, 16, 1.0, 0.35), 10);
+    let mut pts = uniform_surface_points(s.mesh(), 40, 5).unwrap();
+    pts[7] = SurfacePoint::new(u32::MAX, [1.0, 0.0, 0.0]);
+    pts[9] = SurfacePoint::new(0, [f64::NAN, 0.5, 0.5]);
+    let batch = s.inverse_verified_batch(&pts, DEFAULT_TOLERANCE);
+    for (p, v) in pts.iter().zip(&batch) {
+        match (v, s.inverse_verified(p, DEFAULT_TOLERANCE)) {
+            (Ok(a), Ok(b)) => assert_eq!(*a, b),
+            (Err(a), Err(b)) => assert_eq!(format!("{a}"), format!("{b}")),
+            (a, b) => panic!("batch {a:?} vs one by one {b:?}"),
+        }
+    }
+    assert!(batch[7].is_err() && batch[9].is_err());
+    let (mut w, mut trips) = (BatchWeights::default(), Vec::new());
+    for _ in 0..2 {
+        s.inverse_verified_batch_into(&pts, DEFAULT_TOLERANCE, &mut w, &mut trips);
+        for (i, v) in batch.iter().enumerate() {
+            match v {
+                Ok(v) => {
+                    assert_eq!(w.get(i).unwrap(), &v.weights[..]);
+                    assert_eq!(trips[i], Ok(v.round_trip));
+                }
+                Err(_) => assert!(w.get(i).is_err() && trips[i].is_err()),
+            }
+        }
+    }
+    s.inverse_verified_batch_into(&pts, 0.0, &mut w, &mut trips);
+    assert!(trips.iter().all(|t| t.is_err()) && w.iter().all(|r| r.is_err()));
+    assert_eq!(trips.len(), pts.len());
 }
