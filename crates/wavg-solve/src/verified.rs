@@ -112,47 +112,58 @@ pub fn penalized_weights(
         ));
     }
     let mut sorted = d.clone();
-    sorted.sort_by(f64::total_cmp);
-    if sorted[0] <= 0.0 {
+    let k = 3.min(n - 1);
+    sorted.select_nth_unstable_by(k, f64::total_cmp);
+    if sorted[..=k].iter().any(|&x| x <= 0.0) {
         // The point is an anchor: the one-hot weight is exact (and has no offset).
         let i = d.iter().position(|&x| x <= 0.0).unwrap_or(0);
         return Ok((0..n).map(|j| if j == i { 1.0 } else { 0.0 }).collect());
     }
     // Scale-free: D / d_ref, and the penalty scaled the same way.
-    let d_ref = sorted[3.min(n - 1)];
+    let d_ref = sorted[k];
     let dinv2: Vec<f64> = d.iter().map(|x| (d_ref / x).powi(2)).collect();
     let mu = lambda / d_ref;
     // M = D^2 + mu V^T V; M^-1 x = z - D^-2 V^T S^-1 V z with z = D^-2 x and
     // S = I / mu + V D^-2 V^T (8x8).
-    let mut s = nalgebra::SMatrix::<f64, DIM, DIM>::zeros();
-    for (vi, &di) in v.iter().zip(&dinv2) {
-        s += vi * vi.transpose() * di;
+    // S is symmetric positive definite for mu > 0: its upper triangle by rank-one updates
+    // (a tenth of the flops of full outer products), then a Cholesky factor.
+    let s_chol = (mu > 0.0)
+        .then(|| {
+            let mut s = nalgebra::SMatrix::<f64, DIM, DIM>::identity() / mu;
+            for (vi, &di) in v.iter().zip(&dinv2) {
+                for c in 0..DIM {
+                    let x = vi[c] * di;
+                    for r in 0..=c {
+                        s[(r, c)] += vi[r] * x;
+                    }
+                }
+            }
+            s.fill_lower_triangle_with_upper_triangle();
+            s.cholesky()
+        })
+        .flatten();
+    // The constraint rows C = [a_0; a_1; 1] (3 x n) and Q = M^-1 C^T, row by row.
+    use nalgebra::Vector3;
+    let c: Vec<Vector3<f64>> = a.iter().map(|a| Vector3::new(a[0], a[1], 1.0)).collect();
+    let mut q: Vec<Vector3<f64>> = c.iter().zip(&dinv2).map(|(ci, &di)| ci * di).collect();
+    if let Some(s_chol) = &s_chol {
+        // Woodbury: subtract D^-2 V^T S^-1 V z from z = D^-2 x, for the three columns.
+        let mut t = nalgebra::SMatrix::<f64, DIM, 3>::zeros();
+        for (vi, qi) in v.iter().zip(&q) {
+            t += vi * qi.transpose();
+        }
+        let u = s_chol.solve(&t);
+        for ((qi, vi), &di) in q.iter_mut().zip(&v).zip(&dinv2) {
+            *qi -= (u.transpose() * vi) * di;
+        }
     }
-    let s_inv = if mu > 0.0 {
-        (s + nalgebra::SMatrix::<f64, DIM, DIM>::identity() / mu).try_inverse()
-    } else {
-        None
-    };
-    let apply = |x: &dyn Fn(usize) -> f64| -> Vec<f64> {
-        let z: Vec<f64> = (0..n).map(|i| dinv2[i] * x(i)).collect();
-        let Some(s_inv) = &s_inv else {
-            return z;
-        };
-        let t: Vec8 = v.iter().zip(&z).map(|(vi, zi)| vi * *zi).sum();
-        let u = s_inv * t;
-        (0..n).map(|i| z[i] - dinv2[i] * v[i].dot(&u)).collect()
-    };
-    let q = [apply(&|i| a[i][0]), apply(&|i| a[i][1]), apply(&|_| 1.0)];
-    let rows: [&dyn Fn(usize) -> f64; 3] = [&|i| a[i][0], &|i| a[i][1], &|_| 1.0];
-    let gm = nalgebra::Matrix3::from_fn(|r, c| (0..n).map(|i| rows[r](i) * q[c][i]).sum());
+    let gm: nalgebra::Matrix3<f64> = c.iter().zip(&q).map(|(ci, qi)| ci * qi.transpose()).sum();
     let z = gm
         .lu()
         .solve(&nalgebra::Vector3::new(0.0, 0.0, 1.0))
         .filter(|z| z.iter().all(|x| x.is_finite()))
         .ok_or(SolveError::DegenerateTangentPlane)?;
-    let mut w: Vec<f64> = (0..n)
-        .map(|i| z[0] * q[0][i] + z[1] * q[1][i] + z[2] * q[2][i])
-        .collect();
+    let mut w: Vec<f64> = q.iter().map(|qi| qi.dot(&z)).collect();
     let sum: f64 = w.iter().sum();
     if !(sum.is_finite() && sum.abs() > 1e-12) {
         return Err(SolveError::DegenerateTangentPlane);
