@@ -1,7 +1,8 @@
 //! Asymmetry of the full landmark distance matrix (fast marching from every landmark) and
 //! the time of those runs: the measure behind the fast-marching symmetry test.
 //!
-//! `cargo run --release -p wavg-embed --example symmetry -- [--landmarks N] [MESH...]`
+//! `cargo run --release -p wavg-embed --example symmetry -- [--landmarks N]
+//! [--near-field EDGES] [MESH...]`
 //! (default meshes: pig, camelhead, fertility from the shared data folder). `WORST=1` lists
 //! the most asymmetric pairs with both distances in mean edge lengths.
 
@@ -18,6 +19,11 @@ fn main() {
     let mut target = 1000usize;
     if let Some(i) = args.iter().position(|a| a == "--landmarks") {
         target = args[i + 1].parse().expect("--landmarks N");
+        args.drain(i..i + 2);
+    }
+    let mut near_field = wavg_embed::near_field::NEAR_FIELD_EDGES;
+    if let Some(i) = args.iter().position(|a| a == "--near-field") {
+        near_field = args[i + 1].parse().expect("--near-field EDGES");
         args.drain(i..i + 2);
     }
     let paths: Vec<std::path::PathBuf> = if args.is_empty() {
@@ -40,7 +46,7 @@ fn main() {
             ..Default::default()
         };
         let lm = select_landmarks(&mesh, &opts, &NoProgress).expect("landmarks");
-        let fm = FastMarching::new(&mesh);
+        let fm = FastMarching::new(&mesh).with_near_field_edges(near_field);
         let t = Instant::now();
         let rows: Vec<Vec<f64>> = lm
             .par_iter()

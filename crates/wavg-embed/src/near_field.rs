@@ -3,16 +3,27 @@
 //! First-order fast marching fits a plane wave to a front that is strongly curved near the
 //! source, so its relative error there is large (up to 10-20% a few edges away on
 //! irregular meshes), and `d(i, j)` and `d(j, i)` of two close landmarks disagree by as
-//! much. Within a few edge lengths, straight lines from the source can instead be followed
-//! exactly: the triangles a line crosses, unfolded into the plane, form a strip in which
-//! it is straight (Chen & Han / Mitchell-Mount-Papadimitriou *windows*, without the
-//! pseudo-sources at saddle vertices). Each window is an interval of a mesh edge seen from
-//! the source's image in the unfolded plane; crossing the triangle beyond it, the window is
-//! split at the triangle's third vertex, which gets the length of its straight line when
-//! the line passes through the window. Every such length is the length of a path on the
-//! surface, so it bounds the geodesic distance from above and is exact when the shortest
-//! path bends around no vertex; fast marching then starts from these values (taking the
-//! smaller of the two where both exist).
+//! much. Within a few edge lengths, shortest paths can instead be followed exactly: the
+//! triangles a straight line crosses, unfolded into the plane, form a strip in which it is
+//! straight, and a shortest path only bends at saddle vertices (angle sum above 2 pi) and
+//! convex boundary vertices. This is the exact algorithm of Chen & Han with the window
+//! pruning of Xin & Wang ("ICH"), limited to a radius:
+//!
+//! * a *window* is an interval of a mesh edge seen from the image of a source in the
+//!   unfolded plane; crossing the triangle beyond it, it is split at the triangle's third
+//!   vertex, which gets the length of its straight line when the line passes through;
+//! * saddle and boundary vertices reached become *pseudo-sources* that send windows of
+//!   their own (with their length as offset), so paths that bend around them are found;
+//! * windows are processed nearest first, and one is dropped when a vertex of its edge
+//!   already reaches its whole interval by a shorter path (then no shortest path crosses
+//!   it), which keeps the window count near linear in the vertices reached.
+//!
+//! Every length found is the length of a real path, so it bounds the distance from above;
+//! within the radius the search is complete, so each is the exact polyhedral distance
+//! (fast marching keeps these values and continues from them; its plane-wave update can
+//! undershoot where two fronts meet behind a saddle). Degenerate triangles and the guards
+//! ([`PSEUDO_SOURCES`], the window budget) mark a search incomplete, and its lengths are
+//! then used as upper bounds only.
 
 use nalgebra::{Vector2, Vector3};
 use wavg_mesh::{NONE, ValidMesh};
@@ -32,6 +43,12 @@ type V2 = Vector2<f64>;
 /// ```
 pub const NEAR_FIELD_EDGES: f64 = 8.0;
 
+/// Most pseudo-sources followed per source (a guard on meshes with many saddles).
+pub const PSEUDO_SOURCES: usize = 4096;
+
+/// Most windows queued per source (a guard on the memory of one run).
+const MAX_WINDOWS: usize = 1 << 22;
+
 /// Windows are not followed through more triangles than this (a guard; the radius stops
 /// them much earlier on any reasonable mesh).
 const MAX_DEPTH: u16 = 96;
@@ -46,13 +63,37 @@ pub(crate) struct NearField {
     /// Faces around each vertex (CSR).
     vf_offsets: Vec<u32>,
     vf: Vec<u32>,
+    /// Vertices a shortest path may bend around (pseudo-sources): interior saddles (angle
+    /// sum above 2 pi) and boundary vertices with an angle sum above pi.
+    bends: Vec<bool>,
+    /// Mean edge length of the mesh.
+    edge: f64,
     radius: f64,
 }
 
+/// Per-run buffers of [`NearField::candidates`] (reused: no allocation per source).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct NearScratch {
+    /// Best length found per vertex (`INFINITY` where none).
+    dist: Vec<f64>,
+    touched: Vec<u32>,
+    windows: Vec<Window>,
+    /// Windows and pseudo-sources by their smallest possible length: `(length bits,
+    /// index into windows, or PSEUDO | vertex)`.
+    heap: std::collections::BinaryHeap<std::cmp::Reverse<(u64, u32)>>,
+    /// Whether a guard or a degenerate triangle cut the last search short.
+    incomplete: bool,
+}
+
+const PSEUDO: u32 = 1 << 31;
+
 #[derive(Clone, Debug)]
-/// An interval `[w0, w1]` of edge `(p, q)` seen from the origin (the source's image),
-/// about to enter face `g`; `w0` lies on the `p` side.
+/// An interval `[w0, w1]` of edge `(p, q)` seen from the origin (the image of `src`, a
+/// source or pseudo-source at length `sigma`), about to enter face `g`; `w0` lies on the
+/// `p` side.
 pub(crate) struct Window {
+    src: u32,
+    sigma: f64,
     g: u32,
     p: u32,
     q: u32,
@@ -102,6 +143,32 @@ impl NearField {
             vf.extend_from_slice(topo.ring_faces(v));
             vf_offsets.push(vf.len() as u32);
         }
+        let mut angle = vec![0.0f64; n];
+        for t in &mesh.triangles {
+            for k in 0..3 {
+                let (a, b, c) = (
+                    t[k] as usize,
+                    t[(k + 1) % 3] as usize,
+                    t[(k + 2) % 3] as usize,
+                );
+                let (u, v) = (
+                    mesh.positions[b] - mesh.positions[a],
+                    mesh.positions[c] - mesh.positions[a],
+                );
+                angle[a] += u.cross(&v).norm().atan2(u.dot(&v));
+            }
+        }
+        let tau = std::f64::consts::TAU;
+        let bends = (0..n as u32)
+            .map(|v| {
+                let full = if topo.is_boundary_vertex(v) {
+                    tau / 2.0
+                } else {
+                    tau
+                };
+                angle[v as usize] > full * (1.0 + 1e-9)
+            })
+            .collect();
         Self {
             pos: mesh.positions.clone(),
             tris: mesh.triangles.clone(),
@@ -110,27 +177,140 @@ impl NearField {
                 .collect(),
             vf_offsets,
             vf,
+            bends,
+            edge: wavg_mesh::geometry::mean_edge_length(mesh),
             radius: NEAR_FIELD_EDGES * wavg_mesh::geometry::mean_edge_length(mesh),
         }
     }
 
-    /// Upper bounds of the distances from `s` (exact where the shortest path is straight in
-    /// an unfolding) for vertices within the near-field radius, appended to `out` (a vertex
-    /// may appear several times; use the smallest).
-    pub(crate) fn candidates(&self, s: u32, out: &mut Vec<(u32, f64)>, stack: &mut Vec<Window>) {
-        let ps = self.pos[s as usize];
-        let (lo, hi) = (
-            self.vf_offsets[s as usize] as usize,
-            self.vf_offsets[s as usize + 1] as usize,
+    /// Sets the radius to `edges` mean edge lengths (0 turns the near field off).
+    pub(crate) fn set_radius_edges(&mut self, edges: f64) {
+        self.radius = edges.max(0.0) * self.edge;
+    }
+
+    /// Upper bounds of the distances from `s` for the vertices within the near-field
+    /// radius, appended to `out` (one entry per vertex): the lengths of straight lines
+    /// followed through unfolded triangles from `s` and from the saddle and boundary
+    /// vertices they reach (pseudo-sources, where a shortest path may bend), nearest first
+    /// (Chen & Han's windows with Xin & Wang's pruning: a window is dropped when a vertex of
+    /// its edge already reaches its whole interval by a shorter path). Exact up to rounding
+    /// wherever the shortest path lies within the radius and bends around at most
+    /// [`PSEUDO_SOURCES`] vertices.
+    ///
+    /// Returns whether the search was complete (no guard hit and no degenerate triangle on
+    /// the way), so that every length appended is the exact polyhedral distance.
+    pub(crate) fn candidates(
+        &self,
+        s: u32,
+        out: &mut Vec<(u32, f64)>,
+        sc: &mut NearScratch,
+    ) -> bool {
+        let n = self.pos.len();
+        if sc.dist.len() != n {
+            sc.dist = vec![f64::INFINITY; n];
+            sc.touched.clear();
+        }
+        for &v in &sc.touched {
+            sc.dist[v as usize] = f64::INFINITY;
+        }
+        sc.touched.clear();
+        sc.windows.clear();
+        sc.heap.clear();
+        sc.incomplete = false;
+        if s as usize >= n {
+            return false;
+        }
+        sc.dist[s as usize] = 0.0;
+        sc.touched.push(s);
+        sc.heap
+            .push(std::cmp::Reverse((0.0f64.to_bits(), PSEUDO | s)));
+        let mut pseudo = 0;
+        while let Some(std::cmp::Reverse((key, i))) = sc.heap.pop() {
+            if i & PSEUDO != 0 {
+                let u = i & !PSEUDO;
+                let sigma = f64::from_bits(key);
+                // Superseded by a shorter length (pushed again), or over budget.
+                if sc.dist[u as usize] < sigma {
+                    continue;
+                }
+                if pseudo >= PSEUDO_SOURCES {
+                    sc.incomplete = true;
+                    continue;
+                }
+                pseudo += 1;
+                self.emit(u, sigma, sc);
+            } else {
+                let w = sc.windows[i as usize].clone();
+                if !self.dominated(&w, &sc.dist) {
+                    self.cross_face(w, sc);
+                }
+            }
+        }
+        out.extend(
+            sc.touched
+                .iter()
+                .map(|&v| (v, sc.dist[v as usize]))
+                .filter(|&(_, d)| d <= self.radius),
         );
-        stack.clear();
+        !sc.incomplete
+    }
+
+    /// Records length `d` for `x`; a saddle or boundary vertex whose length improves
+    /// becomes a pseudo-source.
+    fn reach(&self, x: u32, d: f64, sc: &mut NearScratch) {
+        let cur = &mut sc.dist[x as usize];
+        if d >= *cur || d > self.radius {
+            return;
+        }
+        if cur.is_infinite() {
+            sc.touched.push(x);
+        }
+        *cur = d;
+        if self.bends[x as usize] {
+            sc.heap.push(std::cmp::Reverse((d.to_bits(), PSEUDO | x)));
+        }
+    }
+
+    /// Queues window `w` (unless it lies beyond the radius).
+    fn push(&self, w: Window, sc: &mut NearScratch) {
+        let near = w.sigma + segment_distance(&w.w0, &w.w1);
+        if near <= self.radius && !self.dominated(&w, &sc.dist) {
+            if sc.windows.len() < MAX_WINDOWS {
+                sc.heap
+                    .push(std::cmp::Reverse((near.to_bits(), sc.windows.len() as u32)));
+                sc.windows.push(w);
+            } else {
+                sc.incomplete = true;
+            }
+        }
+    }
+
+    /// Whether a vertex of the window's edge reaches every point of its interval by a path
+    /// no longer than the window's lines: then no shortest path passes through it. The
+    /// length through the window minus the length via `p` only decreases away from `p`, so
+    /// checking the far end `w1` suffices (and `w0` for `q`).
+    fn dominated(&self, w: &Window, dist: &[f64]) -> bool {
+        let via_p = dist[w.p as usize] + (w.w1 - w.p2).norm();
+        let via_q = dist[w.q as usize] + (w.w0 - w.q2).norm();
+        let slack = 1.0 + 1e-9;
+        w.sigma + w.w1.norm() > via_p * slack || w.sigma + w.w0.norm() > via_q * slack
+    }
+
+    /// Straight lines from `u` (a source or pseudo-source at length `sigma`): its first
+    /// ring, and a window into every face beyond it.
+    fn emit(&self, u: u32, sigma: f64, sc: &mut NearScratch) {
+        let pu = self.pos[u as usize];
+        let (lo, hi) = (
+            self.vf_offsets[u as usize] as usize,
+            self.vf_offsets[u as usize + 1] as usize,
+        );
         for &f in &self.vf[lo..hi] {
             let t = self.tris[f as usize];
-            let Some(k) = t.iter().position(|&v| v == s) else {
+            let Some(k) = t.iter().position(|&v| v == u) else {
                 continue;
             };
             let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
-            let (va, vb) = (self.pos[a as usize] - ps, self.pos[b as usize] - ps);
+            let (va, vb) = (self.pos[a as usize] - pu, self.pos[b as usize] - pu);
             let la = va.norm();
             if la <= 0.0 {
                 continue;
@@ -138,42 +318,45 @@ impl NearField {
             let a2 = V2::new(la, 0.0);
             let b2 = V2::new(va.dot(&vb) / la, va.cross(&vb).norm() / la);
             // The first ring is exact along the edges.
-            out.push((a, la));
-            out.push((b, vb.norm()));
+            self.reach(a, sigma + la, sc);
+            self.reach(b, sigma + vb.norm(), sc);
             let g = self.adj[f as usize][(k + 1) % 3];
             if g != NONE && b2.iter().all(|c| c.is_finite()) {
-                stack.push(Window {
-                    g,
-                    p: a,
-                    q: b,
-                    p2: a2,
-                    q2: b2,
-                    w0: a2,
-                    w1: b2,
-                    depth: 0,
-                });
+                self.push(
+                    Window {
+                        src: u,
+                        sigma,
+                        g,
+                        p: a,
+                        q: b,
+                        p2: a2,
+                        q2: b2,
+                        w0: a2,
+                        w1: b2,
+                        depth: 0,
+                    },
+                    sc,
+                );
             }
-        }
-        while let Some(w) = stack.pop() {
-            self.cross_face(w, s, out, stack);
         }
     }
 
     /// Follows one window through its face `g`.
-    fn cross_face(&self, w: Window, s: u32, out: &mut Vec<(u32, f64)>, stack: &mut Vec<Window>) {
+    fn cross_face(&self, w: Window, sc: &mut NearScratch) {
         let orient = cross(&w.w0, &w.w1);
-        if w.depth >= MAX_DEPTH
-            || orient.is_nan()
-            || orient.abs() <= 1e-12 * w.w0.norm() * w.w1.norm()
-            || segment_distance(&w.w0, &w.w1) > self.radius
-        {
+        if w.depth >= MAX_DEPTH || orient.is_nan() {
+            sc.incomplete = true;
+            return;
+        }
+        if orient.abs() <= 1e-12 * w.w0.norm() * w.w1.norm() {
+            // Narrowed to a single line: nothing beyond it that its neighbours miss.
             return;
         }
         let t = self.tris[w.g as usize];
         let Some(x) = t.into_iter().find(|&v| v != w.p && v != w.q) else {
             return;
         };
-        if x == s {
+        if x == w.src {
             return;
         }
         let px = self.pos[x as usize];
@@ -183,6 +366,7 @@ impl NearField {
             (px - self.pos[w.p as usize]).norm(),
             (px - self.pos[w.q as usize]).norm(),
         ) else {
+            sc.incomplete = true;
             return;
         };
         // Which side of the wedge's two rays x lies on (the wedge from w0 to w1). A line
@@ -194,10 +378,7 @@ impl NearField {
         let right_of_w0 = side0 > 0.0;
         let left_of_w1 = side1 > 0.0;
         if side0 >= -tol && side1 >= -tol {
-            let d = x2.norm();
-            if d <= self.radius {
-                out.push((x, d));
-            }
+            self.reach(x, w.sigma + x2.norm(), sc);
         }
         let edge_face = |a: u32, b: u32| {
             (0..3)
@@ -218,16 +399,18 @@ impl NearField {
                 } else {
                     ray_hit(&w.w1, &w.p2, &x2)
                 };
-                stack.push(Window {
-                    g,
-                    p: w.p,
-                    q: x,
-                    p2: w.p2,
-                    q2: x2,
-                    w0: e0,
-                    w1: e1,
-                    depth,
-                });
+                self.push(
+                    Window {
+                        g,
+                        q: x,
+                        q2: x2,
+                        w0: e0,
+                        w1: e1,
+                        depth,
+                        ..w.clone()
+                    },
+                    sc,
+                );
             }
         }
         // Edge (x, q): unless x lies beyond the ray through w1.
@@ -240,16 +423,18 @@ impl NearField {
                     ray_hit(&w.w0, &x2, &w.q2)
                 };
                 let e1 = ray_hit(&w.w1, &x2, &w.q2);
-                stack.push(Window {
-                    g,
-                    p: x,
-                    q: w.q,
-                    p2: x2,
-                    q2: w.q2,
-                    w0: e0,
-                    w1: e1,
-                    depth,
-                });
+                self.push(
+                    Window {
+                        g,
+                        p: x,
+                        p2: x2,
+                        w0: e0,
+                        w1: e1,
+                        depth,
+                        ..w
+                    },
+                    sc,
+                );
             }
         }
     }
@@ -281,8 +466,8 @@ mod tests {
 
     /// Smallest candidate per vertex (`INFINITY` where none).
     fn best(nf: &NearField, n: usize, s: u32) -> Vec<f64> {
-        let (mut out, mut stack) = (Vec::new(), Vec::new());
-        nf.candidates(s, &mut out, &mut stack);
+        let (mut out, mut sc) = (Vec::new(), NearScratch::default());
+        assert!(nf.candidates(s, &mut out, &mut sc), "incomplete from {s}");
         let mut d = vec![f64::INFINITY; n];
         for (x, v) in out {
             d[x as usize] = d[x as usize].min(v);
@@ -350,8 +535,8 @@ mod tests {
             ValidMesh::new(procedural::with_noise(procedural::icosphere(4), 0.3, 7)).unwrap();
         let nf = NearField::new(&mesh);
         for s in [0u32, 100, 2000] {
-            let (mut out, mut stack) = (Vec::new(), Vec::new());
-            nf.candidates(s, &mut out, &mut stack);
+            let (mut out, mut sc) = (Vec::new(), NearScratch::default());
+            nf.candidates(s, &mut out, &mut sc);
             assert!(!out.is_empty());
             for (x, d) in out {
                 let chord = (mesh.positions[x as usize] - mesh.positions[s as usize]).norm();
@@ -361,5 +546,61 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// On a saddle surface (a noisy hyperbolic paraboloid: most vertices have angle sums
+    /// above 2 pi, so shortest paths bend around them and straight lines alone leave
+    /// shadows) the lengths must be exact polyhedral distances: symmetric to rounding and
+    /// obeying the triangle inequality, which no approximation does to 1e-9. Without the
+    /// pseudo-sources the same pairs disagree.
+    #[test]
+    fn saddle_surface_distances_are_exact() {
+        let mut mesh = procedural::grid(36, 36, 1.0, 1.0);
+        for p in &mut mesh.positions {
+            p.z = 0.8 * ((p.x - 0.5).powi(2) - (p.y - 0.5).powi(2));
+        }
+        let mesh = ValidMesh::new(procedural::with_noise(mesh, 0.2, 5)).unwrap();
+        let n = mesh.n_vertices();
+        let mut nf = NearField::new(&mesh);
+        let saddles = nf.bends.iter().filter(|&&b| b).count();
+        assert!(saddles > n / 4, "{saddles} of {n}");
+        // A 4 x 3 lattice of sources 5 to 6 cells apart in the middle of the 36 x 36 grid.
+        let sources: Vec<u32> = (0..12)
+            .map(|i| (10 + i % 4 * 5) * 37 + 10 + i / 4 * 6)
+            .collect();
+        let rows: Vec<Vec<f64>> = sources.iter().map(|&s| best(&nf, n, s)).collect();
+        let mut pairs = 0;
+        for (i, &a) in sources.iter().enumerate() {
+            for (j, &b) in sources.iter().enumerate() {
+                let (ab, ba) = (rows[i][b as usize], rows[j][a as usize]);
+                if a == b || !(ab.is_finite() && ba.is_finite()) {
+                    continue;
+                }
+                pairs += 1;
+                assert!((ab - ba).abs() <= 1e-9 * ab, "{a} <-> {b}: {ab} vs {ba}");
+                for (x, (&ax, &bx)) in rows[i].iter().zip(&rows[j]).enumerate() {
+                    if ax.is_finite() && bx.is_finite() {
+                        assert!(ax <= ab + bx + 1e-9 * ab, "{a} -> {x} via {b}");
+                    }
+                }
+            }
+        }
+        assert!(pairs > 40, "{pairs}");
+        // Straight lines only (pseudo-sources off) reach fewer vertices, never with a
+        // shorter length.
+        nf.bends.iter_mut().for_each(|b| *b = false);
+        let (mut full, mut straight) = (0, 0);
+        for (i, &a) in sources.iter().enumerate() {
+            let only = best(&nf, n, a);
+            for (x, (&d, &e)) in rows[i].iter().zip(&only).enumerate() {
+                full += usize::from(d.is_finite());
+                straight += usize::from(e.is_finite());
+                assert!(
+                    !e.is_finite() || e >= d * (1.0 - 1e-12),
+                    "{a} -> {x}: {e} < {d}"
+                );
+            }
+        }
+        assert!(straight < full, "{straight} vs {full}");
     }
 }
