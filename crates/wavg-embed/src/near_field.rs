@@ -21,7 +21,9 @@
 //! Every length found is the length of a real path, so it bounds the distance from above;
 //! within the radius the search is complete, so each is the exact polyhedral distance
 //! (fast marching keeps these values and continues from them; its plane-wave update can
-//! undershoot where two fronts meet behind a saddle). Degenerate triangles and the guards
+//! undershoot where two fronts meet behind a saddle). The search also stops after
+//! [`NEAR_FIELD_VERTICES`] vertices (the exact zone of a source among small triangles is
+//! smaller, not costlier). Degenerate triangles and the guards
 //! ([`PSEUDO_SOURCES`], the window budget) mark a search incomplete, and its lengths are
 //! then used as upper bounds only.
 
@@ -46,8 +48,13 @@ pub const NEAR_FIELD_EDGES: f64 = 8.0;
 /// Most pseudo-sources followed per source (a guard on meshes with many saddles).
 pub const PSEUDO_SOURCES: usize = 4096;
 
-/// Most windows queued per source (a guard on the memory of one run).
-const MAX_WINDOWS: usize = 1 << 22;
+/// Most windows queued per source (a guard on the memory of one run: 27 MB).
+const MAX_WINDOWS: usize = 1 << 18;
+
+/// Once this many vertices are reached the search stops at the distance it has got to,
+/// so a source among triangles much smaller than the mean (where the radius would hold
+/// many more) costs no more than an ordinary one; its exact zone is just smaller.
+pub const NEAR_FIELD_VERTICES: usize = 2048;
 
 /// Windows are not followed through more triangles than this (a guard; the radius stops
 /// them much earlier on any reasonable mesh).
@@ -225,7 +232,13 @@ impl NearField {
         sc.heap
             .push(std::cmp::Reverse((0.0f64.to_bits(), PSEUDO | s)));
         let mut pseudo = 0;
+        // Lengths below this are final (every item nearer has been processed).
+        let mut exact_below = f64::INFINITY;
         while let Some(std::cmp::Reverse((key, i))) = sc.heap.pop() {
+            if sc.touched.len() > NEAR_FIELD_VERTICES {
+                exact_below = f64::from_bits(key);
+                break;
+            }
             if i & PSEUDO != 0 {
                 let u = i & !PSEUDO;
                 let sigma = f64::from_bits(key);
@@ -250,7 +263,7 @@ impl NearField {
             sc.touched
                 .iter()
                 .map(|&v| (v, sc.dist[v as usize]))
-                .filter(|&(_, d)| d <= self.radius),
+                .filter(|&(_, d)| d <= self.radius && d < exact_below),
         );
         !sc.incomplete
     }
@@ -602,5 +615,40 @@ mod tests {
             }
         }
         assert!(straight < full, "{straight} vs {full}");
+    }
+
+    /// With a radius holding far more vertices than [`NEAR_FIELD_VERTICES`], the search
+    /// stops at the distance it has got to: about that many vertices, all exact, and all
+    /// the vertices nearer than the farthest one returned.
+    #[test]
+    fn vertex_budget_bounds_the_work_and_keeps_exactness() {
+        let mesh = ValidMesh::new(procedural::grid(120, 120, 1.0, 1.0)).unwrap();
+        let mut nf = NearField::new(&mesh);
+        nf.set_radius_edges(1000.0);
+        let s = 60 * 121 + 60;
+        let (mut out, mut sc) = (Vec::new(), NearScratch::default());
+        assert!(nf.candidates(s, &mut out, &mut sc));
+        assert!(out.len() > NEAR_FIELD_VERTICES / 2 && out.len() <= NEAR_FIELD_VERTICES + 1);
+        let flat = |v: u32| {
+            (mesh.positions[v as usize] - mesh.positions[s as usize])
+                .xy()
+                .norm()
+        };
+        let far = out.iter().map(|&(_, d)| d).fold(0.0, f64::max);
+        for &(x, d) in &out {
+            assert!(
+                (d - flat(x)).abs() <= 1e-9 * d.max(1e-9),
+                "{x}: {d} vs {}",
+                flat(x)
+            );
+        }
+        let inside = (0..mesh.n_vertices() as u32)
+            .filter(|&v| flat(v) < far * (1.0 - 1e-9))
+            .count();
+        assert!(
+            out.len() >= inside,
+            "{} returned, {inside} nearer",
+            out.len()
+        );
     }
 }

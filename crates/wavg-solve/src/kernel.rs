@@ -491,7 +491,9 @@ mod tests {
                 .map(|i| Vec8::from_fn(|k, _| ((i * 8 + k) as f64 * 0.7316).sin() * 3.0))
                 .collect();
             let c = AnchorCoords::from_points(&pts);
-            let w: Vec<f64> = (0..n).map(|i| ((i as f64) * 1.37).cos() / n as f64).collect();
+            let w: Vec<f64> = (0..n)
+                .map(|i| ((i as f64) * 1.37).cos() / n as f64)
+                .collect();
             let a = c.weighted_sum(&w, 1.25);
             let b = c.weighted_sum_portable(&w, 1.25);
             assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "{n}");
