@@ -56,8 +56,8 @@
 //! to 0.7-0.9%. On pig, camelhead and fertility (1000 landmarks) the largest asymmetry
 //! `|d(i,j) - d(j,i)| / mean` went from 8.7-16% (plain) to 5.3-7.3% (straight lines) and
 //! 2.7-6.4% (with pseudo-sources), and the pairs above 2% from 0.25-0.87% to 0.01-0.06% and
-//! 0.003-0.018%, for 1.4-2.1x the time of a plain run; at 16 edge lengths (8x the time)
-//! every pair is within 2% (1.6-1.9% at most).
+//! 0.003-0.018%, for 1.1-1.5x the time of a plain run; at 16 edge lengths (3-5x the
+//! time) every pair is within 2% (1.4-1.9% at most).
 //!
 //! All geometry is precomputed once per mesh in [`FastMarching`] (a flat list of
 //! update entries per freezing vertex, single precision), so one run only touches the
@@ -292,8 +292,8 @@ impl FastMarching {
 
     /// This fast marching with its exact near field reaching `edges` mean edge lengths
     /// from each source instead of [`NEAR_FIELD_EDGES`](crate::near_field::NEAR_FIELD_EDGES)
-    /// (0 turns it off). A wider near field costs more per run (about 8x the plain fast
-    /// marching at 16 edge lengths on real meshes, 1.4-2.1x at 8) and is exact further out.
+    /// (0 turns it off). A wider near field costs more per run (3-5x the plain fast
+    /// marching at 16 edge lengths on real meshes, 1.1-1.5x at 8) and is exact further out.
     ///
     /// ```
     /// use wavg_embed::geodesic::FastMarching;
@@ -1265,7 +1265,7 @@ mod tests {
     /// is not symmetric; the exact near field (with pseudo-sources at saddles) makes close
     /// pairs exact. At the default 8 edge lengths a few pairs a little farther apart stay
     /// above 2% (at most 0.025% of pairs here); with the near field at 16 edge lengths
-    /// every pair is within 2%.
+    /// every pair is within 2% (3-5x the time of a plain run).
     #[test]
     fn real_mesh_landmark_matrix_symmetry() {
         for file in [

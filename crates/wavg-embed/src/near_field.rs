@@ -13,7 +13,10 @@
 //!   unfolded plane; crossing the triangle beyond it, it is split at the triangle's third
 //!   vertex, which gets the length of its straight line when the line passes through;
 //! * saddle and boundary vertices reached become *pseudo-sources* that send windows of
-//!   their own (with their length as offset), so paths that bend around them are found;
+//!   their own (with their length as offset) into their *shadow*, the directions a
+//!   shortest path can only take by bending around them (turning by at least pi on both
+//!   sides); paths that bend around them are found, and no window duplicates the straight
+//!   lines passing by;
 //! * windows are processed nearest first, and one is dropped when a vertex of its edge
 //!   already reaches its whole interval by a shorter path (then no shortest path crosses
 //!   it), which keeps the window count near linear in the vertices reached.
@@ -67,12 +70,23 @@ pub(crate) struct NearField {
     tris: Vec<[u32; 3]>,
     /// `adj[f][i]`: the face across edge `(tris[f][i], tris[f][i + 1])`, or `NONE`.
     adj: Vec<[u32; 3]>,
-    /// Faces around each vertex (CSR).
+    /// Faces around each vertex (CSR), counter-clockwise: face `j` of `v` lies between
+    /// `ring(v)[j]` and `ring(v)[j + 1]` (cyclically inside the mesh).
     vf_offsets: Vec<u32>,
     vf: Vec<u32>,
+    /// The one-ring of each vertex, counter-clockwise (CSR; one more vertex than faces on
+    /// the boundary).
+    vv_offsets: Vec<u32>,
+    vv: Vec<u32>,
+    /// Angle around each vertex at the start of each of its faces, then the total angle
+    /// (CSR at `vf_offsets[v] + v`: one more entry than faces).
+    theta: Vec<f64>,
     /// Vertices a shortest path may bend around (pseudo-sources): interior saddles (angle
     /// sum above 2 pi) and boundary vertices with an angle sum above pi.
     bends: Vec<bool>,
+    /// Whether pseudo-sources send windows into their shadows only (always, except in a
+    /// test that checks this gives the same lengths as every direction).
+    shadows_only: bool,
     /// Mean edge length of the mesh.
     edge: f64,
     radius: f64,
@@ -83,6 +97,9 @@ pub(crate) struct NearField {
 pub(crate) struct NearScratch {
     /// Best length found per vertex (`INFINITY` where none).
     dist: Vec<f64>,
+    /// For saddle and boundary vertices: the direction back along that best path, as an
+    /// angle around the vertex (see `NearField::theta`).
+    back: Vec<f64>,
     touched: Vec<u32>,
     windows: Vec<Window>,
     /// Windows and pseudo-sources by their smallest possible length: `(length bits,
@@ -93,6 +110,15 @@ pub(crate) struct NearScratch {
 }
 
 const PSEUDO: u32 = 1 << 31;
+
+/// The direction a path arrives at a vertex from.
+#[derive(Clone, Copy, Debug)]
+enum Back {
+    /// Along the edge from this vertex.
+    Edge(u32),
+    /// Through face `g`, at `angle` from the face's edge towards vertex `from`.
+    Face { g: u32, from: u32, angle: f64 },
+}
 
 #[derive(Clone, Debug)]
 /// An interval `[w0, w1]` of edge `(p, q)` seen from the origin (the image of `src`, a
@@ -145,10 +171,26 @@ impl NearField {
         let n = mesh.n_vertices();
         let mut vf_offsets = Vec::with_capacity(n + 1);
         let mut vf = Vec::with_capacity(mesh.n_faces() * 3);
+        let (mut vv_offsets, mut vv) = (vec![0u32], Vec::with_capacity(mesh.n_faces() * 3));
+        let mut theta = Vec::with_capacity(mesh.n_faces() * 3 + n);
         vf_offsets.push(0);
         for v in 0..n as u32 {
-            vf.extend_from_slice(topo.ring_faces(v));
+            let (ring, faces) = (topo.ring(v), topo.ring_faces(v));
+            vf.extend_from_slice(faces);
             vf_offsets.push(vf.len() as u32);
+            vv.extend_from_slice(ring);
+            vv_offsets.push(vv.len() as u32);
+            let mut t = 0.0;
+            theta.push(t);
+            for j in 0..faces.len() {
+                let p = mesh.positions[v as usize];
+                let (a, b) = (
+                    mesh.positions[ring[j] as usize] - p,
+                    mesh.positions[ring[(j + 1) % ring.len()] as usize] - p,
+                );
+                t += a.cross(&b).norm().atan2(a.dot(&b));
+                theta.push(t);
+            }
         }
         let mut angle = vec![0.0f64; n];
         for t in &mesh.triangles {
@@ -184,7 +226,11 @@ impl NearField {
                 .collect(),
             vf_offsets,
             vf,
+            vv_offsets,
+            vv,
+            theta,
             bends,
+            shadows_only: true,
             edge: wavg_mesh::geometry::mean_edge_length(mesh),
             radius: NEAR_FIELD_EDGES * wavg_mesh::geometry::mean_edge_length(mesh),
         }
@@ -215,6 +261,7 @@ impl NearField {
         let n = self.pos.len();
         if sc.dist.len() != n {
             sc.dist = vec![f64::INFINITY; n];
+            sc.back = vec![0.0; n];
             sc.touched.clear();
         }
         for &v in &sc.touched {
@@ -251,7 +298,7 @@ impl NearField {
                     continue;
                 }
                 pseudo += 1;
-                self.emit(u, sigma, sc);
+                self.emit(u, sigma, u == s || !self.shadows_only, sc);
             } else {
                 let w = sc.windows[i as usize].clone();
                 if !self.dominated(&w, &sc.dist) {
@@ -270,7 +317,7 @@ impl NearField {
 
     /// Records length `d` for `x`; a saddle or boundary vertex whose length improves
     /// becomes a pseudo-source.
-    fn reach(&self, x: u32, d: f64, sc: &mut NearScratch) {
+    fn reach(&self, x: u32, d: f64, back: Back, sc: &mut NearScratch) {
         let cur = &mut sc.dist[x as usize];
         if d >= *cur || d > self.radius {
             return;
@@ -280,7 +327,36 @@ impl NearField {
         }
         *cur = d;
         if self.bends[x as usize] {
+            sc.back[x as usize] = self.back_angle(x, back);
             sc.heap.push(std::cmp::Reverse((d.to_bits(), PSEUDO | x)));
+        }
+    }
+
+    /// Faces, one-ring and angles (see the fields) around `v`.
+    fn fan(&self, v: u32) -> (&[u32], &[u32], &[f64]) {
+        let v = v as usize;
+        let (f0, f1) = (self.vf_offsets[v] as usize, self.vf_offsets[v + 1] as usize);
+        let (r0, r1) = (self.vv_offsets[v] as usize, self.vv_offsets[v + 1] as usize);
+        (
+            &self.vf[f0..f1],
+            &self.vv[r0..r1],
+            &self.theta[f0 + v..f1 + v + 1],
+        )
+    }
+
+    /// The angle around `x` of the direction `back` (NaN if it does not fit the fan).
+    fn back_angle(&self, x: u32, back: Back) -> f64 {
+        let (faces, ring, theta) = self.fan(x);
+        match back {
+            Back::Edge(e) => ring
+                .iter()
+                .position(|&r| r == e)
+                .map_or(f64::NAN, |k| theta[k]),
+            Back::Face { g, from, angle } => match faces.iter().position(|&f| f == g) {
+                Some(j) if ring[j] == from => theta[j] + angle,
+                Some(j) => theta[j + 1] - angle,
+                None => f64::NAN,
+            },
         }
     }
 
@@ -309,32 +385,74 @@ impl NearField {
         w.sigma + w.w1.norm() > via_p * slack || w.sigma + w.w0.norm() > via_q * slack
     }
 
-    /// Straight lines from `u` (a source or pseudo-source at length `sigma`): its first
-    /// ring, and a window into every face beyond it.
-    fn emit(&self, u: u32, sigma: f64, sc: &mut NearScratch) {
-        let pu = self.pos[u as usize];
-        let (lo, hi) = (
-            self.vf_offsets[u as usize] as usize,
-            self.vf_offsets[u as usize + 1] as usize,
-        );
-        for &f in &self.vf[lo..hi] {
-            let t = self.tris[f as usize];
-            let Some(k) = t.iter().position(|&v| v == u) else {
-                continue;
+    /// Straight lines from `u` at length `sigma`: its first ring, and windows into the
+    /// faces beyond. A source sends them in every direction; a pseudo-source only into its
+    /// *shadow*, the directions turning by at least pi on both sides from the way back
+    /// along its shortest path (elsewhere the straight lines passing `u` are shorter).
+    fn emit(&self, u: u32, sigma: f64, every_direction: bool, sc: &mut NearScratch) {
+        use std::f64::consts::PI;
+        // A little wider than the shadow: rounding must not lose a direction.
+        const EPS: f64 = 1e-9;
+        let (faces, ring, theta) = self.fan(u);
+        let total = theta[faces.len()];
+        let beta = sc.back[u as usize];
+        let mut ranges = [(0.0, total), (0.0, 0.0)];
+        if !every_direction && beta.is_finite() {
+            ranges = if ring.len() == faces.len() {
+                // Inside the mesh: one arc of the circle of length `total`.
+                let (lo, len) = (
+                    (beta + PI - EPS).rem_euclid(total),
+                    total - 2.0 * PI + 2.0 * EPS,
+                );
+                if len <= 0.0 {
+                    [(0.0, 0.0); 2]
+                } else if lo + len <= total {
+                    [(lo, lo + len), (0.0, 0.0)]
+                } else {
+                    [(lo, total), (0.0, lo + len - total)]
+                }
+            } else {
+                // On the boundary: both ends of the open fan.
+                [(0.0, beta - PI + EPS), (beta + PI - EPS, total)]
             };
-            let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+        }
+        let pu = self.pos[u as usize];
+        for (j, &f) in faces.iter().enumerate() {
+            let (a, b) = (ring[j], ring[(j + 1) % ring.len()]);
             let (va, vb) = (self.pos[a as usize] - pu, self.pos[b as usize] - pu);
             let la = va.norm();
-            if la <= 0.0 {
-                continue;
-            }
+            // The first ring is exact along the edges.
+            self.reach(a, sigma + la, Back::Edge(u), sc);
+            self.reach(b, sigma + vb.norm(), Back::Edge(u), sc);
             let a2 = V2::new(la, 0.0);
             let b2 = V2::new(va.dot(&vb) / la, va.cross(&vb).norm() / la);
-            // The first ring is exact along the edges.
-            self.reach(a, sigma + la, sc);
-            self.reach(b, sigma + vb.norm(), sc);
-            let g = self.adj[f as usize][(k + 1) % 3];
-            if g != NONE && b2.iter().all(|c| c.is_finite()) {
+            let t = self.tris[f as usize];
+            let g = (0..3)
+                .find(|&i| {
+                    let (x, y) = (t[i], t[(i + 1) % 3]);
+                    (x == a && y == b) || (x == b && y == a)
+                })
+                .map_or(NONE, |i| self.adj[f as usize][i]);
+            if g == NONE || la <= 0.0 || !b2.iter().all(|c| c.is_finite()) {
+                continue;
+            }
+            let gamma = theta[j + 1] - theta[j];
+            for &(r0, r1) in &ranges {
+                let (t0, t1) = ((r0 - theta[j]).max(0.0), (r1 - theta[j]).min(gamma));
+                if t1 <= t0 {
+                    continue;
+                }
+                let ray = |t: f64| V2::new(t.cos(), t.sin());
+                let w0 = if t0 <= 0.0 {
+                    a2
+                } else {
+                    ray_hit(&ray(t0), &a2, &b2)
+                };
+                let w1 = if t1 >= gamma {
+                    b2
+                } else {
+                    ray_hit(&ray(t1), &a2, &b2)
+                };
                 self.push(
                     Window {
                         src: u,
@@ -344,8 +462,8 @@ impl NearField {
                         q: b,
                         p2: a2,
                         q2: b2,
-                        w0: a2,
-                        w1: b2,
+                        w0,
+                        w1,
                         depth: 0,
                     },
                     sc,
@@ -391,7 +509,15 @@ impl NearField {
         let right_of_w0 = side0 > 0.0;
         let left_of_w1 = side1 > 0.0;
         if side0 >= -tol && side1 >= -tol {
-            self.reach(x, w.sigma + x2.norm(), sc);
+            // The way back from x: towards the origin, measured from its edge to p.
+            let (e, o) = (w.p2 - x2, -x2);
+            let angle = cross(&e, &o).abs().atan2(e.dot(&o));
+            let back = Back::Face {
+                g: w.g,
+                from: w.p,
+                angle,
+            };
+            self.reach(x, w.sigma + x2.norm(), back, sc);
         }
         let edge_face = |a: u32, b: u32| {
             (0..3)
@@ -566,13 +692,18 @@ mod tests {
     /// shadows) the lengths must be exact polyhedral distances: symmetric to rounding and
     /// obeying the triangle inequality, which no approximation does to 1e-9. Without the
     /// pseudo-sources the same pairs disagree.
-    #[test]
-    fn saddle_surface_distances_are_exact() {
+    /// A noisy hyperbolic paraboloid: most vertices are saddles.
+    fn saddle_surface() -> ValidMesh {
         let mut mesh = procedural::grid(36, 36, 1.0, 1.0);
         for p in &mut mesh.positions {
             p.z = 0.8 * ((p.x - 0.5).powi(2) - (p.y - 0.5).powi(2));
         }
-        let mesh = ValidMesh::new(procedural::with_noise(mesh, 0.2, 5)).unwrap();
+        ValidMesh::new(procedural::with_noise(mesh, 0.2, 5)).unwrap()
+    }
+
+    #[test]
+    fn saddle_surface_distances_are_exact() {
+        let mesh = saddle_surface();
         let n = mesh.n_vertices();
         let mut nf = NearField::new(&mesh);
         let saddles = nf.bends.iter().filter(|&&b| b).count();
@@ -650,5 +781,34 @@ mod tests {
             "{} returned, {inside} nearer",
             out.len()
         );
+    }
+
+    /// Pseudo-sources sending windows only into their shadows find the same lengths as
+    /// sending them in every direction (which is plainly exact), on real meshes with open
+    /// boundaries and on the saddle surface.
+    #[test]
+    fn shadows_only_changes_nothing() {
+        let mut meshes = vec![saddle_surface()];
+        for file in ["meshes/camelhead.off", "meshes/fertility.off"] {
+            if let Some(path) = wavg_mesh::data::require_data_file("near_field::shadows", file) {
+                meshes.push(ValidMesh::new(wavg_mesh::io::load(&path).unwrap()).unwrap());
+            }
+        }
+        for mesh in &meshes {
+            let n = mesh.n_vertices();
+            let mut nf = NearField::new(mesh);
+            let sources: Vec<u32> = (0..25).map(|i| (i * 7919 % n) as u32).collect();
+            let shadow: Vec<Vec<f64>> = sources.iter().map(|&s| best(&nf, n, s)).collect();
+            nf.shadows_only = false;
+            for (row, &s) in shadow.iter().zip(&sources) {
+                let every = best(&nf, n, s);
+                for (x, (&a, &b)) in row.iter().zip(&every).enumerate() {
+                    assert!(
+                        a == b || (a - b).abs() <= 1e-12 * b,
+                        "{s} -> {x}: {a} (shadows) vs {b} (every direction)"
+                    );
+                }
+            }
+        }
     }
 }
