@@ -443,6 +443,36 @@ impl Projector {
         self.try_face(f, y).map(|b| (b.xi, b.d2.sqrt()))
     }
 
+    /// [`Projector::project_onto_face_with_distance`], or on failure the neighbouring face
+    /// across the edge Newton's method left this one by (where the projection more likely
+    /// lies; [`NONE`] when it did not leave by an edge or the edge is on the boundary).
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// let m = Arc::new(ValidMesh::new(procedural::grid(3, 3, 1.0, 1.0)).unwrap());
+    /// let emb = Arc::new(EmbeddedMesh::from_positions(m.clone()));
+    /// let p = Projector::new(emb.clone()).unwrap();
+    /// // A point of face 4, tried on a neighbour of face 4: Newton leaves towards face 4.
+    /// let y = emb.point(&SurfacePoint::new(4, [0.2, 0.3, 0.5]));
+    /// let g = m.topology().face_neighbors(4).into_iter().find(|&g| g != u32::MAX).unwrap();
+    /// assert_eq!(p.project_onto_face_or_exit(&y, g), Err(4));
+    /// assert!(p.project_onto_face_or_exit(&y, 4).is_ok());
+    /// ```
+    pub fn project_onto_face_or_exit(
+        &self,
+        y: &Vec8,
+        f: FaceId,
+    ) -> Result<([f64; 3], f64), FaceId> {
+        match self.try_face_or_exit(f, y) {
+            Ok(b) => Ok((b.xi, b.d2.sqrt())),
+            // Corner k's coordinate went negative: out across the edge (k + 1, k + 2).
+            Err(Some(k)) => Err(self.emb.mesh().topology().face_neighbors(f)[(k + 1) % 3]),
+            Err(None) => Err(NONE),
+        }
+    }
+
     /// The corner vertices of face `f` (from the projector's face record, usually in cache
     /// after a projection onto it).
     ///
@@ -460,6 +490,13 @@ impl Projector {
 
     #[inline]
     fn try_face(&self, f: FaceId, y: &Vec8) -> Option<Best> {
+        self.try_face_or_exit(f, y).ok()
+    }
+
+    /// [`Projector::try_face`], or on failure the corner whose coordinate Newton's method
+    /// drove negative (see [`TriData::solve_or_exit`]).
+    #[inline]
+    fn try_face_or_exit(&self, f: FaceId, y: &Vec8) -> Result<Best, Option<usize>> {
         let face = &self.faces[f as usize];
         let r = [
             &self.verts[face.v[0] as usize],
@@ -468,7 +505,7 @@ impl Projector {
         ];
         let xi = face
             .d
-            .solve([&r[0].t, &r[1].t, &r[2].t], [&r[0].x, &r[1].x, &r[2].x], y)?;
+            .solve_or_exit([&r[0].t, &r[1].t, &r[2].t], [&r[0].x, &r[1].x, &r[2].x], y)?;
         let (a, b, cc) = (&r[0].x.data.0[0], &r[1].x.data.0[0], &r[2].x.data.0[0]);
         let yy = &y.data.0[0];
         let mut d2 = 0.0;
@@ -476,7 +513,7 @@ impl Projector {
             let d = a[k] * xi[0] + b[k] * xi[1] + cc[k] * xi[2] - yy[k];
             d2 += d * d;
         }
-        Some(Best { face: f, xi, d2 })
+        Ok(Best { face: f, xi, d2 })
     }
 
     fn is_zero(&self, b: &Best) -> bool {

@@ -290,6 +290,19 @@ impl TriData {
     /// (`|F| <= 1e-11 (|G| + |h|)`), so it does not depend on the mesh's scale or position.
     #[inline]
     pub fn solve(&self, frames: [&Frame32; 3], corners: [&Vec8; 3], y: &Vec8) -> Option<[f64; 3]> {
+        self.solve_or_exit(frames, corners, y).ok()
+    }
+
+    /// [`TriData::solve`], telling on failure which way the root lies when Newton was
+    /// pushed against an edge: `Err(Some(k))` when it left across the edge opposite corner
+    /// `k` (where a search continues), `Err(None)` otherwise.
+    #[inline]
+    pub fn solve_or_exit(
+        &self,
+        frames: [&Frame32; 3],
+        corners: [&Vec8; 3],
+        y: &Vec8,
+    ) -> Result<[f64; 3], Option<usize>> {
         let sys = System::new(self, frames, corners, y);
         let ftol = 1e-11 * sys.fscale;
         let mut xi = sys.initial_guess();
@@ -297,47 +310,52 @@ impl TriData {
         for _ in 0..MAX_NEWTON {
             let (f, j) = sys.eval(&xi);
             if f[0].abs().max(f[1].abs()) <= ftol {
-                return Some(xi);
+                return Ok(xi);
             }
             let det = j[0] * j[3] - j[1] * j[2];
             let jn = j[0].abs().max(j[1].abs()).max(j[2].abs()).max(j[3].abs());
             if !(det.abs() > 1e-14 * jn * jn) {
-                return None;
+                return Err(None);
             }
             let inv = 1.0 / det;
             let d0 = (j[1] * f[1] - j[3] * f[0]) * inv;
             let d1 = (j[2] * f[0] - j[0] * f[1]) * inv;
             let d = [d0, d1, -d0 - d1];
             // Largest step along d that stays in the triangle.
-            let mut t: f64 = 1.0;
+            let (mut t, mut block): (f64, Option<usize>) = (1.0, None);
             for k in 0..3 {
-                if xi[k] + d[k] < 0.0 {
-                    t = t.min(xi[k] / -d[k]);
+                if xi[k] + d[k] < 0.0 && xi[k] / -d[k] < t {
+                    (t, block) = (xi[k] / -d[k], Some(k));
                 }
             }
             if t < 1.0 && d[0].abs().max(d[1].abs()).max(d[2].abs()) <= BARY_EPS {
                 // The root is within BARY_EPS outside the triangle (on an edge, up to the
                 // rounding of the f32 data): a valid projection, clamped onto the triangle.
-                return renormalize([xi[0] + d[0], xi[1] + d[1], xi[2] + d[2]]);
+                return renormalize([xi[0] + d[0], xi[1] + d[1], xi[2] + d[2]]).ok_or(None);
             }
             if t < 1e-9 {
                 // On the boundary and pushing out: slide (clamp the full step); twice in
                 // a row means the root is outside.
                 stuck += 1;
                 if stuck >= 2 {
-                    return None;
+                    return Err(block);
                 }
-                xi = renormalize([xi[0] + d[0], xi[1] + d[1], xi[2] + d[2]])?;
+                xi = renormalize([xi[0] + d[0], xi[1] + d[1], xi[2] + d[2]]).ok_or(None)?;
             } else {
                 stuck = 0;
-                xi = renormalize([xi[0] + t * d[0], xi[1] + t * d[1], xi[2] + t * d[2]])?;
+                xi = renormalize([xi[0] + t * d[0], xi[1] + t * d[1], xi[2] + t * d[2]])
+                    .ok_or(None)?;
                 if (t * d0).abs().max((t * d1).abs()) < 1e-13 {
                     let (f, _) = sys.eval(&xi);
-                    return (f[0].abs().max(f[1].abs()) <= 1e-8 * sys.fscale).then_some(xi);
+                    return if f[0].abs().max(f[1].abs()) <= 1e-8 * sys.fscale {
+                        Ok(xi)
+                    } else {
+                        Err(None)
+                    };
                 }
             }
         }
-        None
+        Err(None)
     }
 
     /// `F(xi) = Psi(xi) (p(xi) - y)` given `h[i] = T_i (y - v_i)` (for tests).
