@@ -503,9 +503,9 @@ impl Projector {
             &self.verts[face.v[1] as usize],
             &self.verts[face.v[2] as usize],
         ];
-        let xi = face
-            .d
-            .solve_or_exit([&r[0].t, &r[1].t, &r[2].t], [&r[0].x, &r[1].x, &r[2].x], y)?;
+        let xi =
+            face.d
+                .solve_or_exit([&r[0].t, &r[1].t, &r[2].t], [&r[0].x, &r[1].x, &r[2].x], y)?;
         let (a, b, cc) = (&r[0].x.data.0[0], &r[1].x.data.0[0], &r[2].x.data.0[0]);
         let yy = &y.data.0[0];
         let mut d2 = 0.0;
