@@ -8,10 +8,9 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use wavg_embed::NoProgress;
 use wavg_embed::decimate::{DecimateOptions, select_landmarks};
-use wavg_embed::geodesic::FastMarching;
+use wavg_embed::geodesic::{FastMarching, landmark_rows};
 use wavg_mesh::ValidMesh;
 
 fn main() {
@@ -48,16 +47,7 @@ fn main() {
         let lm = select_landmarks(&mesh, &opts, &NoProgress).expect("landmarks");
         let fm = FastMarching::new(&mesh).with_near_field_edges(near_field);
         let t = Instant::now();
-        let rows: Vec<Vec<f64>> = lm
-            .par_iter()
-            .map_init(
-                || fm.workspace(),
-                |ws, &s| {
-                    let d = fm.run(ws, &[s]);
-                    lm.iter().map(|&l| d[l as usize]).collect()
-                },
-            )
-            .collect();
+        let rows = landmark_rows(&fm, &lm, &NoProgress).expect("landmark rows");
         let secs = t.elapsed().as_secs_f64();
         let h = wavg_mesh::geometry::mean_edge_length(&mesh);
         let mut all = asymmetries(&rows);

@@ -707,6 +707,47 @@ pub fn landmark_distances_with(
     landmarks: &[u32],
     progress: &dyn Progress,
 ) -> Result<Vec<f64>, EmbedError> {
+    let rows = landmark_rows(fm, landmarks, progress)?;
+    let n = landmarks.len();
+    let mut q = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            q[i * n + j] = 0.5 * (rows[i][j] + rows[j][i]);
+        }
+        q[i * n + i] = 0.0;
+    }
+    if let Some(k) = q.iter().position(|d| !d.is_finite()) {
+        return Err(EmbedError::InvalidArgument(format!(
+            "landmarks {} and {} are in different components (no geodesic between them); \
+             keep only one component (`--largest-component`)",
+            landmarks[k / n],
+            landmarks[k % n]
+        )));
+    }
+    Ok(q)
+}
+
+/// The raw rows behind [`landmark_distances_with`]: row `i` holds the fast-marching
+/// distances from `landmarks[i]` to every landmark, not symmetrised (`rows[i][j]` and
+/// `rows[j][i]` differ by the method's error). Runs in parallel, each stopping once every
+/// landmark is reached; progress is reported as [`Stage::Geodesics`].
+///
+/// Errors: a landmark id out of range or repeated, or cancellation.
+///
+/// ```
+/// use wavg_embed::NoProgress;
+/// use wavg_embed::geodesic::{FastMarching, landmark_rows};
+/// use wavg_mesh::{ValidMesh, procedural};
+/// let mesh = ValidMesh::new(procedural::icosphere(3)).unwrap();
+/// let rows = landmark_rows(&FastMarching::new(&mesh), &[0, 5, 100], &NoProgress).unwrap();
+/// assert_eq!(rows[1][1], 0.0);
+/// assert!((rows[0][2] - rows[2][0]).abs() < 0.02 * rows[0][2]);
+/// ```
+pub fn landmark_rows(
+    fm: &FastMarching,
+    landmarks: &[u32],
+    progress: &dyn Progress,
+) -> Result<Vec<Vec<f64>>, EmbedError> {
     let n = landmarks.len();
     let mut is_target = vec![false; fm.n];
     for &l in landmarks {
@@ -738,22 +779,7 @@ pub fn landmark_distances_with(
             },
         )
         .collect::<Result<_, EmbedError>>()?;
-    let mut q = vec![0.0; n * n];
-    for i in 0..n {
-        for j in 0..n {
-            q[i * n + j] = 0.5 * (rows[i][j] + rows[j][i]);
-        }
-        q[i * n + i] = 0.0;
-    }
-    if let Some(k) = q.iter().position(|d| !d.is_finite()) {
-        return Err(EmbedError::InvalidArgument(format!(
-            "landmarks {} and {} are in different components (no geodesic between them); \
-             keep only one component (`--largest-component`)",
-            landmarks[k / n],
-            landmarks[k % n]
-        )));
-    }
-    Ok(q)
+    Ok(rows)
 }
 
 /// Landmark pairs closer than this many mean edge lengths of the coarse mesh get their
@@ -1232,16 +1258,7 @@ mod tests {
     /// Asymmetry `|d_ij - d_ji| / mean` of the full landmark matrix: mean, max, and the
     /// share of pairs above 2%.
     fn matrix_asymmetry(fm: &FastMarching, lm: &[u32]) -> (f64, f64, f64) {
-        let rows: Vec<Vec<f64>> = lm
-            .par_iter()
-            .map_init(
-                || fm.workspace(),
-                |ws, &s| {
-                    let d = fm.run(ws, &[s]);
-                    lm.iter().map(|&l| d[l as usize]).collect()
-                },
-            )
-            .collect();
+        let rows = landmark_rows(fm, lm, &NoProgress).unwrap();
         let a: Vec<f64> = rows
             .iter()
             .enumerate()

@@ -169,6 +169,7 @@ impl NearField {
     pub(crate) fn new(mesh: &ValidMesh) -> Self {
         let topo = mesh.topology();
         let n = mesh.n_vertices();
+        let edge = wavg_mesh::geometry::mean_edge_length(mesh);
         let mut vf_offsets = Vec::with_capacity(n + 1);
         let mut vf = Vec::with_capacity(mesh.n_faces() * 3);
         let (mut vv_offsets, mut vv) = (vec![0u32], Vec::with_capacity(mesh.n_faces() * 3));
@@ -180,10 +181,10 @@ impl NearField {
             vf_offsets.push(vf.len() as u32);
             vv.extend_from_slice(ring);
             vv_offsets.push(vv.len() as u32);
+            let p = mesh.positions[v as usize];
             let mut t = 0.0;
             theta.push(t);
             for j in 0..faces.len() {
-                let p = mesh.positions[v as usize];
                 let (a, b) = (
                     mesh.positions[ring[j] as usize] - p,
                     mesh.positions[ring[(j + 1) % ring.len()] as usize] - p,
@@ -192,30 +193,17 @@ impl NearField {
                 theta.push(t);
             }
         }
-        let mut angle = vec![0.0f64; n];
-        for t in &mesh.triangles {
-            for k in 0..3 {
-                let (a, b, c) = (
-                    t[k] as usize,
-                    t[(k + 1) % 3] as usize,
-                    t[(k + 2) % 3] as usize,
-                );
-                let (u, v) = (
-                    mesh.positions[b] - mesh.positions[a],
-                    mesh.positions[c] - mesh.positions[a],
-                );
-                angle[a] += u.cross(&v).norm().atan2(u.dot(&v));
-            }
-        }
+        // Total angle around each vertex: the last fan entry.
         let tau = std::f64::consts::TAU;
-        let bends = (0..n as u32)
+        let bends = (0..n)
             .map(|v| {
-                let full = if topo.is_boundary_vertex(v) {
+                let total = theta[vf_offsets[v + 1] as usize + v];
+                let full = if topo.is_boundary_vertex(v as u32) {
                     tau / 2.0
                 } else {
                     tau
                 };
-                angle[v as usize] > full * (1.0 + 1e-9)
+                total > full * (1.0 + 1e-9)
             })
             .collect();
         Self {
@@ -231,8 +219,8 @@ impl NearField {
             theta,
             bends,
             shadows_only: true,
-            edge: wavg_mesh::geometry::mean_edge_length(mesh),
-            radius: NEAR_FIELD_EDGES * wavg_mesh::geometry::mean_edge_length(mesh),
+            edge,
+            radius: NEAR_FIELD_EDGES * edge,
         }
     }
 
@@ -332,6 +320,18 @@ impl NearField {
         }
     }
 
+    /// The face across edge `(a, b)` of face `f` (`NONE` on the boundary or if `(a, b)` is
+    /// not an edge of `f`).
+    fn across(&self, f: u32, a: u32, b: u32) -> u32 {
+        let t = self.tris[f as usize];
+        (0..3)
+            .find(|&i| {
+                let (u, v) = (t[i], t[(i + 1) % 3]);
+                (u == a && v == b) || (u == b && v == a)
+            })
+            .map_or(NONE, |i| self.adj[f as usize][i])
+    }
+
     /// Faces, one-ring and angles (see the fields) around `v`.
     fn fan(&self, v: u32) -> (&[u32], &[u32], &[f64]) {
         let v = v as usize;
@@ -426,13 +426,7 @@ impl NearField {
             self.reach(b, sigma + vb.norm(), Back::Edge(u), sc);
             let a2 = V2::new(la, 0.0);
             let b2 = V2::new(va.dot(&vb) / la, va.cross(&vb).norm() / la);
-            let t = self.tris[f as usize];
-            let g = (0..3)
-                .find(|&i| {
-                    let (x, y) = (t[i], t[(i + 1) % 3]);
-                    (x == a && y == b) || (x == b && y == a)
-                })
-                .map_or(NONE, |i| self.adj[f as usize][i]);
+            let g = self.across(f, a, b);
             if g == NONE || la <= 0.0 || !b2.iter().all(|c| c.is_finite()) {
                 continue;
             }
@@ -519,14 +513,7 @@ impl NearField {
             };
             self.reach(x, w.sigma + x2.norm(), back, sc);
         }
-        let edge_face = |a: u32, b: u32| {
-            (0..3)
-                .find(|&i| {
-                    let (u, v) = (t[i], t[(i + 1) % 3]);
-                    (u == a && v == b) || (u == b && v == a)
-                })
-                .map_or(NONE, |i| self.adj[w.g as usize][i])
-        };
+        let edge_face = |a: u32, b: u32| self.across(w.g, a, b);
         let depth = w.depth + 1;
         // Edge (p, x): the wedge crosses it unless x lies beyond the ray through w0.
         if right_of_w0 {
