@@ -295,7 +295,9 @@ impl TriData {
 
     /// [`TriData::solve`], telling on failure which way the root lies when Newton was
     /// pushed against an edge: `Err(Some(k))` when it left across the edge opposite corner
-    /// `k` (where a search continues), `Err(None)` otherwise.
+    /// `k` (where a search continues), `Err(None)` otherwise. For an example through a
+    /// projector (which holds the frames), see
+    /// [`Projector::project_onto_face_or_exit`](crate::Projector::project_onto_face_or_exit).
     #[inline]
     pub fn solve_or_exit(
         &self,
