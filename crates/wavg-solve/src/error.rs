@@ -90,3 +90,17 @@ pub enum SolveError {
     #[error("projection failed: {0}")]
     Project(#[from] wavg_project::ProjectError),
 }
+
+impl SolveError {
+    /// True when the question was well-formed but has no answer (no weighted average, no
+    /// weights for the point), as opposed to malformed input.
+    pub fn is_no_solution(&self) -> bool {
+        matches!(
+            self,
+            SolveError::NoWeightedAverage
+                | SolveError::DegenerateAnchors
+                | SolveError::DegenerateTangentPlane
+                | SolveError::Project(wavg_project::ProjectError::NoProjection)
+        )
+    }
+}

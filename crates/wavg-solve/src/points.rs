@@ -18,6 +18,12 @@ pub enum Anchor {
     Point(SurfacePoint),
 }
 
+impl From<VertexId> for Anchor {
+    fn from(v: VertexId) -> Self {
+        Anchor::Vertex(v)
+    }
+}
+
 impl From<SurfacePoint> for Anchor {
     fn from(p: SurfacePoint) -> Self {
         Anchor::Point(p)

@@ -1,0 +1,46 @@
+//! One-off questions, answered without keeping a [`Solver`](crate::Solver): convenient
+//! for a single query; for many queries on the same anchors make a solver once with
+//! [`Surface::solver`] and use its batch calls.
+
+use wavg_mesh::SurfacePoint;
+use wavg_solve::{Anchor, ForwardOptions, ForwardResult};
+
+use crate::error::Result;
+use crate::surface::Surface;
+
+/// The weighted average of `anchors` with `weights` (one per anchor, summing to 1): the
+/// forward problem.
+///
+/// ```
+/// let surface = wavg::Surface::from_mesh(wavg::mesh::procedural::icosphere(3))?;
+/// let mid = wavg::weighted_average(&surface, [0u32, 1], &[0.5, 0.5])?;
+/// assert!(mid.position.norm() > 0.99); // on the unit sphere, not the chord
+/// # Ok::<(), wavg::Error>(())
+/// ```
+pub fn weighted_average<A: Into<Anchor>>(
+    surface: &Surface,
+    anchors: impl IntoIterator<Item = A>,
+    weights: &[f64],
+) -> Result<ForwardResult> {
+    let solver = surface.solver(anchors)?;
+    Ok(solver.forward(weights, &ForwardOptions::default())?)
+}
+
+/// Generalised barycentric weights of `point` with respect to `anchors` (one per anchor,
+/// summing to 1): the paper's inverse problem.
+///
+/// ```
+/// let surface = wavg::Surface::from_mesh(wavg::mesh::procedural::icosphere(3))?;
+/// let anchors = surface.spread_anchors(12, 0)?;
+/// let w = wavg::barycentric_weights(&surface, anchors, &wavg::SurfacePoint::new(5, [0.2, 0.3, 0.5]))?;
+/// assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+/// # Ok::<(), wavg::Error>(())
+/// ```
+pub fn barycentric_weights<A: Into<Anchor>>(
+    surface: &Surface,
+    anchors: impl IntoIterator<Item = A>,
+    point: &SurfacePoint,
+) -> Result<Vec<f64>> {
+    let solver = surface.solver(anchors)?;
+    Ok(solver.inverse(point)?)
+}

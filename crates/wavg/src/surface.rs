@@ -1,0 +1,207 @@
+//! [`Surface`]: a validated mesh with its embedding and projector, the one object every
+//! question about weighted averages on that mesh starts from.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use nalgebra::Vector3;
+use wavg_embed::{Embedding, PrecomputeOptions, Progress, Report};
+use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, VertexId};
+use wavg_project::{EmbeddedMesh, Projector, Vec8};
+use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
+use wavg_solve::{Anchor, Solver};
+
+use crate::error::Result;
+
+/// A validated triangle mesh with its embedding in R^8 and the projector built on it.
+///
+/// A freshly opened surface embeds every vertex at its own 3-D position (Phong projection
+/// onto the mesh itself: useful for tests and for meshes without a precomputed embedding).
+/// [`Surface::precompute`] or [`Surface::load_embedding`] replace that by the geodesic
+/// embedding the method is about.
+///
+/// `Surface` is `Send + Sync` and cheap to clone: clones share the mesh, embedding and
+/// projector. Changing the embedding of one clone does not affect the others.
+///
+/// ```
+/// use wavg::{NoProgress, PrecomputeOptions, Surface, SurfacePoint};
+/// let mut surface = Surface::from_mesh(wavg::mesh::procedural::torus(40, 16, 1.0, 0.35))?;
+/// surface.precompute(&PrecomputeOptions { landmarks: 60, ..Default::default() }, &NoProgress)?;
+/// let solver = surface.solver(surface.spread_anchors(16, 0)?)?;
+/// let w = solver.inverse(&SurfacePoint::new(17, [0.2, 0.3, 0.5]))?;
+/// assert_eq!(w.len(), 16);
+/// # Ok::<(), wavg::Error>(())
+/// ```
+#[derive(Clone)]
+pub struct Surface {
+    inner: Arc<Inner>,
+}
+
+struct Inner {
+    mesh: Arc<ValidMesh>,
+    /// `None` while the 3-D positions are the embedding.
+    embedding: Option<Embedding>,
+    projector: Arc<Projector>,
+}
+
+impl Surface {
+    /// Loads a mesh file (`.obj`, `.off`, `.ply`, each optionally gzipped as `.gz`) and
+    /// validates it. The embedding is the 3-D positions until one is computed or loaded.
+    pub fn open(path: impl AsRef<Path>) -> Result<Self> {
+        let mesh = wavg_mesh::io::load(path.as_ref())?;
+        Self::from_mesh(mesh)
+    }
+
+    /// Validates `mesh` (an oriented manifold without degenerate faces or unreferenced
+    /// vertices; see [`ValidMesh::new`]) and builds a surface on it.
+    pub fn from_mesh(mesh: TriMesh) -> Result<Self> {
+        Self::from_valid(ValidMesh::new(mesh)?)
+    }
+
+    /// A surface on an already validated mesh.
+    pub fn from_valid(mesh: impl Into<Arc<ValidMesh>>) -> Result<Self> {
+        let mesh = mesh.into();
+        let projector = Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh.clone())))?;
+        Ok(Self {
+            inner: Arc::new(Inner {
+                mesh,
+                embedding: None,
+                projector: Arc::new(projector),
+            }),
+        })
+    }
+
+    /// A surface from flat arrays: vertex positions and counter-clockwise triangles
+    /// (0-based vertex indices). Out-of-range indices and non-finite coordinates are
+    /// reported as an invalid mesh.
+    pub fn from_arrays(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Self> {
+        let positions = positions.iter().map(|p| Vector3::from(*p)).collect();
+        Self::from_mesh(TriMesh::new(positions, triangles.to_vec()))
+    }
+
+    /// Computes the 8-D embedding (landmarks, geodesics, MDS, least-squares mesh) and
+    /// uses it from now on. `progress` receives per-stage fractions and can cancel
+    /// ([`crate::ErrorKind::Cancelled`]); on any error the surface is unchanged.
+    pub fn precompute(
+        &mut self,
+        options: &PrecomputeOptions,
+        progress: &dyn Progress,
+    ) -> Result<Report> {
+        let (embedding, report) = wavg_embed::precompute(&self.inner.mesh, options, progress)?;
+        self.set_embedding(embedding)?;
+        Ok(report)
+    }
+
+    /// Reads a `.wavg` file computed for this mesh (its fingerprint is checked) and uses
+    /// it from now on; on any error the surface is unchanged.
+    pub fn load_embedding(&mut self, path: impl AsRef<Path>) -> Result<()> {
+        let embedding = wavg_embed::file::load(path.as_ref(), &self.inner.mesh)?;
+        self.set_embedding(embedding)
+    }
+
+    /// Writes the embedding to a `.wavg` file (atomically: a temporary file renamed into
+    /// place). Fails when the surface has no computed or loaded embedding.
+    pub fn save_embedding(&self, path: impl AsRef<Path>) -> Result<()> {
+        let embedding = self.inner.embedding.as_ref().ok_or_else(|| {
+            wavg_embed::EmbedError::InvalidArgument(
+                "the surface has no embedding to save: precompute or load one first".into(),
+            )
+        })?;
+        wavg_embed::file::save(path.as_ref(), embedding, &self.inner.mesh)?;
+        Ok(())
+    }
+
+    /// Uses `embedding` (one point per vertex) from now on; on any error the surface is
+    /// unchanged.
+    pub fn set_embedding(&mut self, embedding: Embedding) -> Result<()> {
+        embedding
+            .validate(self.inner.mesh.n_vertices())
+            .map_err(wavg_embed::EmbedError::InvalidArgument)?;
+        let coords = embedding.coords.iter().map(|c| Vec8::from(*c)).collect();
+        let emb = EmbeddedMesh::new(self.inner.mesh.clone(), coords)?;
+        let projector = Projector::new(Arc::new(emb))?;
+        self.inner = Arc::new(Inner {
+            mesh: self.inner.mesh.clone(),
+            embedding: Some(embedding),
+            projector: Arc::new(projector),
+        });
+        Ok(())
+    }
+
+    /// The validated mesh.
+    pub fn mesh(&self) -> &Arc<ValidMesh> {
+        &self.inner.mesh
+    }
+
+    /// The computed or loaded embedding; `None` while the 3-D positions serve as one.
+    pub fn embedding(&self) -> Option<&Embedding> {
+        self.inner.embedding.as_ref()
+    }
+
+    /// Every vertex's point in R^8 (3-D positions padded with zeros when there is no
+    /// embedding).
+    pub fn embedded_coords(&self) -> &[Vec8] {
+        self.inner.projector.embedded().coords()
+    }
+
+    /// The landmark vertices of the embedding (empty when there is none).
+    pub fn landmarks(&self) -> &[u32] {
+        self.inner
+            .embedding
+            .as_ref()
+            .map_or(&[], |e| e.landmarks.as_slice())
+    }
+
+    /// The Phong projector over the embedding (for projecting arbitrary points of R^8).
+    pub fn projector(&self) -> &Arc<Projector> {
+        &self.inner.projector
+    }
+
+    /// Number of vertices.
+    pub fn n_vertices(&self) -> usize {
+        self.inner.mesh.n_vertices()
+    }
+
+    /// Number of triangles.
+    pub fn n_faces(&self) -> usize {
+        self.inner.mesh.n_faces()
+    }
+
+    /// The surface point at vertex `v` (a corner of one of its faces).
+    pub fn vertex_point(&self, v: VertexId) -> Result<SurfacePoint> {
+        Ok(wavg_solve::points::vertex_point(&self.inner.mesh, v)?)
+    }
+
+    /// The 3-D position of a surface point (its face and barycentrics are checked).
+    pub fn position(&self, p: &SurfacePoint) -> Result<Vector3<f64>> {
+        let p = wavg_solve::points::check_point(&self.inner.mesh, p)?;
+        Ok(p.position(&self.inner.mesh))
+    }
+
+    /// `k` vertices spread over the surface by farthest-point sampling along mesh edges
+    /// (the first drawn from `seed`), as anchors: a good default anchor set.
+    pub fn spread_anchors(&self, k: usize, seed: u64) -> Result<Vec<Anchor>> {
+        let v = farthest_point_vertices(&self.inner.mesh, k, seed, FpsMetric::EdgeGraph)?;
+        Ok(v.into_iter().map(Anchor::Vertex).collect())
+    }
+
+    /// A solver of forward and inverse problems for these anchors (vertex ids, surface
+    /// points or [`Anchor`]s; each is validated). The solver shares this surface's
+    /// projector and keeps working if the surface later changes its embedding.
+    pub fn solver<A: Into<Anchor>>(&self, anchors: impl IntoIterator<Item = A>) -> Result<Solver> {
+        Ok(Solver::new(
+            self.inner.projector.clone(),
+            anchors.into_iter().map(Into::into),
+        )?)
+    }
+}
+
+impl std::fmt::Debug for Surface {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Surface")
+            .field("vertices", &self.n_vertices())
+            .field("faces", &self.n_faces())
+            .field("embedded", &self.inner.embedding.is_some())
+            .finish()
+    }
+}
