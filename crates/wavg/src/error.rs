@@ -48,9 +48,8 @@ impl Error {
                 MeshError::Io { .. } | MeshError::Parse { .. } | MeshError::Unsupported { .. },
             ) => ErrorKind::Io,
             Error::Embed(EmbedError::Cancelled) => ErrorKind::Cancelled,
-            Error::Embed(EmbedError::InvalidArgument(_) | EmbedError::Numerical(_)) => {
-                ErrorKind::InvalidMesh
-            }
+            Error::Embed(EmbedError::InvalidArgument(_)) => ErrorKind::InvalidArgument,
+            Error::Embed(EmbedError::Numerical(_)) => ErrorKind::InvalidMesh,
             Error::Embed(_) => ErrorKind::Io,
             Error::Project(ProjectError::NoProjection) => ErrorKind::NoSolution,
             Error::Project(ProjectError::EmptyMesh) => ErrorKind::InvalidMesh,
