@@ -143,19 +143,40 @@ fn io_err(path: &Path, source: std::io::Error) -> MeshError {
     }
 }
 
+/// Largest accepted expansion of a gzip-compressed mesh file: real meshes expand 2-5x, so
+/// anything beyond this many times the compressed size (and beyond
+/// [`GZIP_MIN_LIMIT`]) is refused as a decompression bomb instead of filling memory.
+pub const GZIP_MAX_RATIO: u64 = 100;
+/// Decompressed bytes always accepted, whatever the compressed size.
+pub const GZIP_MIN_LIMIT: u64 = 64 << 20;
+
 fn read_bytes(path: &Path, gz: bool) -> Result<Vec<u8>, MeshError> {
     let raw = std::fs::read(path).map_err(|e| io_err(path, e))?;
     if !gz {
         return Ok(raw);
     }
-    let mut out = Vec::with_capacity(raw.len() * 4);
-    flate2::read::MultiGzDecoder::new(&raw[..])
+    gunzip_bounded(&raw).map_err(|message| MeshError::Parse {
+        path: path.to_path_buf(),
+        line: 0,
+        message,
+    })
+}
+
+/// Decompresses `raw`, refusing output beyond `max(GZIP_MIN_LIMIT, GZIP_MAX_RATIO x
+/// compressed size)`: memory and time stay proportional to the bytes in the file.
+fn gunzip_bounded(raw: &[u8]) -> Result<Vec<u8>, String> {
+    let limit = GZIP_MIN_LIMIT.max(GZIP_MAX_RATIO.saturating_mul(raw.len() as u64));
+    let mut out = Vec::with_capacity(raw.len().saturating_mul(4));
+    flate2::read::MultiGzDecoder::new(raw)
+        .take(limit.saturating_add(1))
         .read_to_end(&mut out)
-        .map_err(|e| MeshError::Parse {
-            path: path.to_path_buf(),
-            line: 0,
-            message: format!("gzip: {e}"),
-        })?;
+        .map_err(|e| format!("gzip: {e}"))?;
+    if out.len() as u64 > limit {
+        return Err(format!(
+            "gzip: the data expands to more than {limit} bytes ({GZIP_MAX_RATIO}x the \
+             compressed size): refused as a decompression bomb"
+        ));
+    }
     Ok(out)
 }
 
@@ -185,5 +206,33 @@ pub fn to_bytes(mesh: &TriMesh, format: Format) -> std::io::Result<Vec<u8>> {
         Format::Obj => Ok(obj::write(mesh)),
         Format::Off => Ok(off::write(mesh)),
         Format::Ply => ply::write(mesh),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gzip(data: &[u8]) -> Vec<u8> {
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+        enc.write_all(data).unwrap();
+        enc.finish().unwrap()
+    }
+
+    #[test]
+    fn gzip_within_the_limit_round_trips() {
+        let text = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".repeat(1000);
+        assert_eq!(gunzip_bounded(&gzip(&text)).unwrap(), text);
+    }
+
+    #[test]
+    fn gzip_bomb_is_refused_in_bounded_memory() {
+        // 200 MB of zeros compress to about 200 KB: far beyond 100x.
+        let zeros = vec![0u8; 200 << 20];
+        let bomb = gzip(&zeros);
+        drop(zeros);
+        assert!(bomb.len() < 1 << 20);
+        let e = gunzip_bounded(&bomb).unwrap_err();
+        assert!(e.contains("decompression bomb"), "{e}");
     }
 }
