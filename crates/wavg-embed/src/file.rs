@@ -47,8 +47,8 @@
 //! all of that; [`save`] writes atomically (temporary file in the same directory, `fsync`,
 //! rename), so an interrupted run never leaves a partial file under the final name.
 
-use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::io::Read;
+use std::path::Path;
 
 use wavg_mesh::TriMesh;
 
@@ -484,32 +484,10 @@ pub fn decode(bytes: &[u8], mesh: &TriMesh, path: &Path) -> Result<Embedding, Em
 /// ```
 pub fn save(path: &Path, emb: &Embedding, mesh: &TriMesh) -> Result<(), EmbedError> {
     let bytes = encode(emb, mesh)?;
-    let io = |source| EmbedError::Io {
+    wavg_mesh::io::write_atomic(path, |w| w.write_all(&bytes)).map_err(|source| EmbedError::Io {
         path: path.to_path_buf(),
         source,
-    };
-    let dir: PathBuf = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".wavg-tmp-");
-    // Temporary files are private (0600) by default; the result should get the usual
-    // permissions of a new file (0666 minus the umask), as `File::create` would give it.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut tmp = builder.tempfile_in(&dir).map_err(io)?;
-    tmp.write_all(&bytes).map_err(io)?;
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    // Make the rename itself durable where the platform allows it (best effort).
-    if let Ok(d) = std::fs::File::open(&dir) {
-        let _ = d.sync_all();
-    }
-    Ok(())
+    })
 }
 
 /// Reads and checks a `.wavg` file for `mesh`.

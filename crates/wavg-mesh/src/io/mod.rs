@@ -18,6 +18,7 @@
 //! assert_eq!(back.positions, mesh.positions); // shortest round-trip float text: bit-exact
 //! ```
 
+mod atomic;
 mod obj;
 mod off;
 mod ply;
@@ -25,6 +26,8 @@ mod text;
 
 use std::io::{Read, Write};
 use std::path::Path;
+
+pub use atomic::write_atomic;
 
 use crate::error::MeshError;
 use crate::mesh::TriMesh;
@@ -184,20 +187,20 @@ fn gunzip_bounded(raw: &[u8]) -> Result<Vec<u8>, String> {
 /// texture coordinates), OFF (positions and triangles only) or binary little-endian PLY
 /// (double positions; texture coordinates as a per-face `texcoord` list). A trailing `.gz`
 /// compresses. Positions are written exactly (shortest round-trip decimal, or raw doubles).
+/// The file is written atomically ([`write_atomic`]).
 pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
     let (format, gz) = Format::from_path(path)?;
     let bytes = to_bytes(mesh, format).map_err(|e| io_err(path, e))?;
-    let file = std::fs::File::create(path).map_err(|e| io_err(path, e))?;
-    let mut w = std::io::BufWriter::new(file);
-    let res = if gz {
-        let mut enc = flate2::write::GzEncoder::new(w, flate2::Compression::default());
-        enc.write_all(&bytes)
-            .and_then(|_| enc.finish())
-            .and_then(|mut w| w.flush())
-    } else {
-        w.write_all(&bytes).and_then(|_| w.flush())
-    };
-    res.map_err(|e| io_err(path, e))
+    write_atomic(path, |w| {
+        if gz {
+            let mut enc = flate2::write::GzEncoder::new(w, flate2::Compression::default());
+            enc.write_all(&bytes)?;
+            enc.finish().map(drop)
+        } else {
+            w.write_all(&bytes)
+        }
+    })
+    .map_err(|e| io_err(path, e))
 }
 
 /// Serialises a mesh in memory (uncompressed).
