@@ -52,7 +52,10 @@ fn check_kills(args: &[&str], out: &Path, runs: usize, seed: u64) {
         }
     }
     eprintln!("{args:?}: {runs} kills within {full:?}, output absent after {absent}");
-    assert!(absent > 0, "no kill interrupted {args:?}: the test did not test anything");
+    assert!(
+        absent > 0,
+        "no kill interrupted {args:?}: the test did not test anything"
+    );
     // Leave the complete output for the commands that read it next.
     std::fs::write(out, &reference).unwrap();
 }

@@ -363,7 +363,11 @@ fn key(f: f64) -> u64 {
 /// The working state: a compact corner table (halfedge `3 f + i` runs from corner `i` to
 /// corner `i + 1` of face `f`) with opposite halfedges, plus the modules' data.
 struct Decimator<'a> {
-    pos: &'a [Vector3<f64>],
+    /// Positions relative to the bounding-box centre: quadric errors are differences of
+    /// squares, which lose their precision when the mesh sits far from the origin.
+    pos: Vec<Vector3<f64>>,
+    /// The input positions, for the result.
+    orig: &'a [Vector3<f64>],
     corner: Vec<u32>,
     opp: Vec<u32>,
     face_alive: Vec<bool>,
@@ -397,7 +401,11 @@ impl<'a> Decimator<'a> {
         let n = mesh.n_vertices();
         let nf = mesh.n_faces();
         let topo = mesh.topology();
-        let pos = &mesh.positions[..];
+        let orig = &mesh.positions[..];
+        let centre = mesh
+            .bounding_box()
+            .map_or_else(Vector3::zeros, |(lo, hi)| (lo + hi) * 0.5);
+        let pos: Vec<Vector3<f64>> = orig.iter().map(|p| p - centre).collect();
         let corner: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
         let mut opp = vec![NONE; 3 * nf];
         for f in 0..nf {
@@ -449,6 +457,7 @@ impl<'a> Decimator<'a> {
         let flip_deg = opts.max_normal_deviation_deg;
         Self {
             pos,
+            orig,
             corner,
             opp,
             face_alive: vec![true; nf],
@@ -864,7 +873,7 @@ impl<'a> Decimator<'a> {
             if self.alive[v] {
                 *id = landmarks.len() as u32;
                 landmarks.push(v as u32);
-                positions.push(self.pos[v]);
+                positions.push(self.orig[v]);
             }
         }
         let triangles = (0..self.face_alive.len())
