@@ -11,6 +11,7 @@ mod info;
 mod inverse;
 mod precompute;
 mod repair;
+mod subdivide;
 mod textio;
 
 use std::process::ExitCode;
@@ -41,6 +42,8 @@ enum Command {
     Forward(forward::Args),
     /// Inverse problem: anchors + surface points -> weights.
     Inverse(inverse::Args),
+    /// Loop subdivision: make a larger mesh from a smaller one.
+    Subdivide(subdivide::Args),
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -65,6 +68,7 @@ fn main() -> ExitCode {
         Command::Precompute(a) => precompute::run(a),
         Command::Forward(a) => forward::run(a),
         Command::Inverse(a) => inverse::run(a),
+        Command::Subdivide(a) => subdivide::run(a),
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),

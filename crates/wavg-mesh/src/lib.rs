@@ -38,6 +38,7 @@ pub mod mesh;
 pub mod problem;
 pub mod procedural;
 pub mod repair;
+pub mod subdivide;
 pub mod topology;
 pub mod valid;
 

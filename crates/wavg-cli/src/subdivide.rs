@@ -1,0 +1,66 @@
+//! `wavg subdivide IN -o OUT [--levels N]`: Loop subdivision, to make large meshes
+//! reproducibly from the ones at hand (igea's 134k vertices become about 2.1M at level 2).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use wavg_mesh::subdivide::loop_subdivide;
+use wavg_mesh::{ValidMesh, io};
+
+use crate::CliError;
+use crate::common::{load_valid, one_line};
+
+/// Arguments of `wavg subdivide`.
+#[derive(clap::Args)]
+#[command(long_about = "Loop subdivision: every level splits each triangle into four and \
+    smooths the vertices (boundaries follow their own curve). Vertex ids of the input are \
+    kept (they come first); the input must be a valid mesh.\n\n\
+    --json prints one object: input_vertices, input_faces, vertices, faces, levels, seconds.")]
+pub struct Args {
+    /// Input mesh (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    pub input: String,
+    /// Output mesh; the format follows the extension (binary .ply is the fastest to read).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Subdivision levels (each multiplies the face count by 4).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=6))]
+    pub levels: u32,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `wavg subdivide`.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let input = load_valid(&args.input)?;
+    let t = Instant::now();
+    let (nv0, nf0) = (input.n_vertices(), input.n_faces());
+    let mut mesh = std::sync::Arc::unwrap_or_clone(input);
+    for _ in 0..args.levels {
+        let next = loop_subdivide(&mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+        mesh = ValidMesh::new(next).map_err(|e| CliError::failure(one_line(&e)))?;
+    }
+    let seconds = t.elapsed().as_secs_f64();
+    io::save(&args.output, &mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    if args.json {
+        let report = serde_json::json!({
+            "input_vertices": nv0,
+            "input_faces": nf0,
+            "vertices": mesh.n_vertices(),
+            "faces": mesh.n_faces(),
+            "levels": args.levels,
+            "seconds": seconds,
+        });
+        println!("{report}");
+    } else {
+        println!(
+            "{} -> {}: {nv0} -> {} vertices, {nf0} -> {} faces, {} level(s) in {seconds:.2} s",
+            args.input,
+            args.output.display(),
+            mesh.n_vertices(),
+            mesh.n_faces(),
+            args.levels
+        );
+    }
+    Ok(())
+}
