@@ -12,10 +12,12 @@ use crate::common::{load_valid, one_line};
 
 /// Arguments of `wavg subdivide`.
 #[derive(clap::Args)]
-#[command(long_about = "Loop subdivision: every level splits each triangle into four and \
+#[command(
+    long_about = "Loop subdivision: every level splits each triangle into four and \
     smooths the vertices (boundaries follow their own curve). Vertex ids of the input are \
     kept (they come first); the input must be a valid mesh.\n\n\
-    --json prints one object: input_vertices, input_faces, vertices, faces, levels, seconds.")]
+    --json prints one object: input_vertices, input_faces, vertices, faces, levels, seconds."
+)]
 pub struct Args {
     /// Input mesh (.obj/.off/.ply, optionally .gz) or builtin:NAME.
     pub input: String,
