@@ -1,6 +1,8 @@
 //! Build and test automation: `cargo xtask test` runs every check the project has, in the
 //! order CI runs them, and tells you exactly what to install when a tool is missing.
 
+mod fuzz;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 use std::time::Instant;
@@ -9,11 +11,41 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("test") => run_all(&workspace_root()),
-        _ => {
-            eprintln!(
-                "usage: cargo xtask test\n\n  test   rustfmt check, clippy (-D warnings), cargo test --workspace"
-            );
-            ExitCode::from(2)
+        Some("fuzz") => match fuzz_seconds(&args[1..]) {
+            Some(seconds) => report(fuzz::run(&workspace_root(), seconds)),
+            None => usage(),
+        },
+        _ => usage(),
+    }
+}
+
+fn usage() -> ExitCode {
+    eprintln!(
+        "usage: cargo xtask test | cargo xtask fuzz [--seconds N]\n\n  \
+         test   rustfmt check, clippy (-D warnings), cargo test --workspace, a {SMOKE_SECONDS} s \
+         smoke run of every fuzz target\n  \
+         fuzz   every fuzz target for N seconds (default 60) each"
+    );
+    ExitCode::from(2)
+}
+
+/// Seconds each fuzz target runs within `cargo xtask test`.
+const SMOKE_SECONDS: u64 = 15;
+
+fn fuzz_seconds(args: &[String]) -> Option<u64> {
+    match args {
+        [] => Some(60),
+        [flag, n] if flag == "--seconds" => n.parse().ok(),
+        _ => None,
+    }
+}
+
+fn report(result: Result<(), String>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(msg) => {
+            eprintln!("xtask: {msg}");
+            ExitCode::FAILURE
         }
     }
 }
@@ -89,6 +121,10 @@ fn run_all(root: &Path) -> ExitCode {
                 return ExitCode::FAILURE;
             }
         }
+    }
+    if let Err(msg) = fuzz::run(root, SMOKE_SECONDS) {
+        eprintln!("==> fuzz smoke FAILED: {msg}");
+        return ExitCode::FAILURE;
     }
     eprintln!(
         "==> all checks passed in {:.1} s",

@@ -1,0 +1,140 @@
+//! `cargo xtask fuzz [--seconds N]`: builds the coverage-guided fuzz targets in `fuzz/`
+//! (cargo-fuzz, libFuzzer, no sanitizer, so the stable toolchain suffices), seeds their
+//! corpora from meshes the project generates, and runs each target for N seconds.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The fuzz targets, in the order they run.
+pub const TARGETS: &[&str] = &["mesh_read", "wavg_file", "validate_repair", "solver"];
+
+/// Runs every target for `seconds` each; `Err` names the first failure.
+pub fn run(root: &Path, seconds: u64) -> Result<(), String> {
+    ensure_cargo_fuzz()?;
+    let fuzz_dir = root.join("fuzz");
+    seed_corpora(root, &fuzz_dir)?;
+    for target in TARGETS {
+        eprintln!("==> fuzz {target} for {seconds} s");
+        let corpus = fuzz_dir.join("corpus").join(target);
+        std::fs::create_dir_all(&corpus).map_err(|e| format!("{}: {e}", corpus.display()))?;
+        let status = Command::new("cargo")
+            .args(["fuzz", "run", "--sanitizer", "none", target])
+            .arg(&corpus)
+            .args([
+                "--",
+                &format!("-max_total_time={seconds}"),
+                "-rss_limit_mb=4096",
+                "-timeout=20",
+                "-print_final_stats=1",
+            ])
+            .current_dir(&fuzz_dir)
+            .status()
+            .map_err(|e| format!("could not start cargo fuzz: {e}"))?;
+        if !status.success() {
+            return Err(format!(
+                "fuzz target {target} failed ({status}); the input is in fuzz/artifacts/{target}/: \
+                 add it as a regression test"
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn ensure_cargo_fuzz() -> Result<(), String> {
+    let have = Command::new("cargo")
+        .args(["fuzz", "--version"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if have {
+        return Ok(());
+    }
+    eprintln!("==> installing cargo-fuzz (cargo install cargo-fuzz --locked)");
+    let ok = Command::new("cargo")
+        .args(["install", "cargo-fuzz", "--locked"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if ok {
+        Ok(())
+    } else {
+        Err("cargo-fuzz is missing and `cargo install cargo-fuzz --locked` failed".into())
+    }
+}
+
+/// Writes seed inputs made by the `wavg` binary from built-in meshes (and two small
+/// shared meshes when the data folder is there) into the corpus folders, once.
+fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
+    let seeds = fuzz_dir.join("corpus");
+    let mesh_dir = seeds.join("mesh_read");
+    let file_dir = seeds.join("wavg_file");
+    if mesh_dir.is_dir() && file_dir.is_dir() {
+        return Ok(());
+    }
+    let status = Command::new("cargo")
+        .args(["build", "--release", "--quiet", "-p", "wavg-cli"])
+        .current_dir(root)
+        .status()
+        .map_err(|e| format!("cargo build: {e}"))?;
+    if !status.success() {
+        return Err("building wavg for the seed corpora failed".into());
+    }
+    let wavg = root.join("target/release/wavg");
+    let tmp = seeds.join("tmp");
+    for d in [&mesh_dir, &file_dir, &tmp] {
+        std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;
+    }
+    let run = |args: &[&str]| -> Result<(), String> {
+        let out = Command::new(&wavg)
+            .args(args)
+            .output()
+            .map_err(|e| format!("wavg: {e}"))?;
+        if out.status.success() {
+            Ok(())
+        } else {
+            Err(format!(
+                "wavg {args:?}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            ))
+        }
+    };
+    let mut sources: Vec<PathBuf> = Vec::new();
+    for (name, builtin) in [("sphere", "builtin:sphere-small"), ("grid", "builtin:grid")] {
+        for ext in ["obj", "off", "ply"] {
+            let p = tmp.join(format!("{name}.{ext}"));
+            run(&["repair", builtin, "-o", p.to_str().unwrap_or_default()])?;
+            sources.push(p);
+        }
+    }
+    let data = std::env::var_os("WAVG_DATA_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("../shared/data"));
+    for rel in ["meshes/spot_control_mesh.obj", "meshes/3holes.off"] {
+        let p = data.join(rel);
+        if p.is_file() {
+            sources.push(p);
+        }
+    }
+    for (i, src) in sources.iter().enumerate() {
+        let ext = src.extension().and_then(|e| e.to_str()).unwrap_or("");
+        let pick = match ext {
+            "obj" => 0u8,
+            "off" => 1,
+            _ => 2,
+        };
+        let body = std::fs::read(src).map_err(|e| format!("{}: {e}", src.display()))?;
+        let mut seed = vec![pick];
+        seed.extend(body);
+        let dst = mesh_dir.join(format!("seed-{i}"));
+        std::fs::write(&dst, seed).map_err(|e| format!("{}: {e}", dst.display()))?;
+    }
+    let emb = file_dir.join("seed-sphere.wavg");
+    run(&[
+        "precompute",
+        "builtin:sphere-small",
+        "-o",
+        emb.to_str().unwrap_or_default(),
+        "--landmarks",
+        "20",
+    ])?;
+    let _ = std::fs::remove_dir_all(&tmp);
+    Ok(())
+}
