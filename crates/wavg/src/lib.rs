@@ -26,6 +26,7 @@
 //! [`solve`]) for what the front door does not cover.
 
 mod error;
+pub mod npy;
 mod oneoff;
 mod surface;
 

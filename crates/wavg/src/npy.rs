@@ -1,0 +1,439 @@
+//! NumPy `.npy` files of 2-D float arrays, read and written a row at a time (streaming), so
+//! weights and points can go to and from Python without text parsing.
+//!
+//! Reads format versions 1-3 with `descr` `<f8`, `>f8`, `<f4` or `>f4`, C or Fortran order
+//! (Fortran order needs the whole array: [`read_matrix`] handles it, [`NpyReader`] refuses
+//! it), and shape `(rows, cols)` or `(rows,)` (one column). Writes version 1.0, `<f8`, C order.
+//!
+//! ```
+//! let mut bytes = Vec::new();
+//! let mut w = wavg::npy::NpyWriter::new(&mut bytes, 2, 3)?;
+//! w.write_row(&[1.0, 2.0, 3.0])?;
+//! w.write_row(&[4.0, 5.0, 6.0])?;
+//! w.finish()?;
+//! let (rows, cols, data) = wavg::npy::read_matrix(&bytes[..])?;
+//! assert_eq!((rows, cols), (2, 3));
+//! assert_eq!(data, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::io::{Read, Write};
+
+const MAGIC: &[u8; 6] = b"\x93NUMPY";
+/// Longest header accepted (NumPy's own limit for safe loading is 10 000 bytes).
+const MAX_HEADER: usize = 1 << 16;
+
+/// Why an `.npy` stream could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum NpyError {
+    /// Reading failed.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    /// The bytes are not a supported `.npy` array.
+    #[error("not a supported .npy array: {0}")]
+    Format(String),
+    /// The data ended before `rows x cols` values.
+    #[error(".npy data ends after {values_read} of {expected} values")]
+    Truncated {
+        /// Values read before the end.
+        values_read: usize,
+        /// Values the header declared.
+        expected: usize,
+    },
+}
+
+fn bad(msg: impl Into<String>) -> NpyError {
+    NpyError::Format(msg.into())
+}
+
+/// What the header says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Header {
+    rows: usize,
+    cols: usize,
+    f32: bool,
+    big_endian: bool,
+    fortran: bool,
+}
+
+fn read_header(r: &mut impl Read) -> Result<Header, NpyError> {
+    let mut pre = [0u8; 8];
+    r.read_exact(&mut pre)
+        .map_err(|_| bad("shorter than the magic string and version"))?;
+    if &pre[..6] != MAGIC {
+        return Err(bad("missing the \\x93NUMPY magic string"));
+    }
+    let len = match pre[6] {
+        1 => {
+            let mut b = [0u8; 2];
+            r.read_exact(&mut b).map_err(|_| bad("truncated header"))?;
+            usize::from(u16::from_le_bytes(b))
+        }
+        2 | 3 => {
+            let mut b = [0u8; 4];
+            r.read_exact(&mut b).map_err(|_| bad("truncated header"))?;
+            u32::from_le_bytes(b) as usize
+        }
+        v => return Err(bad(format!("format version {v} is not supported"))),
+    };
+    if len > MAX_HEADER {
+        return Err(bad(format!("header of {len} bytes is too long")));
+    }
+    let mut text = vec![0u8; len];
+    r.read_exact(&mut text)
+        .map_err(|_| bad("truncated header"))?;
+    let text = String::from_utf8(text).map_err(|_| bad("header is not text"))?;
+    parse_dict(&text)
+}
+
+/// Parses NumPy's header dictionary, e.g.
+/// `{'descr': '<f8', 'fortran_order': False, 'shape': (3, 4), }`.
+fn parse_dict(text: &str) -> Result<Header, NpyError> {
+    let value = |key: &str| -> Result<&str, NpyError> {
+        let at = text
+            .find(&format!("'{key}'"))
+            .ok_or_else(|| bad(format!("header has no '{key}'")))?;
+        let rest = text[at + key.len() + 2..].trim_start();
+        Ok(rest
+            .strip_prefix(':')
+            .ok_or_else(|| bad(format!("'{key}' has no value")))?
+            .trim_start())
+    };
+    let descr = value("descr")?;
+    let descr = descr
+        .strip_prefix('\'')
+        .and_then(|d| d.split_once('\''))
+        .map(|(d, _)| d)
+        .ok_or_else(|| bad("descr is not a string"))?;
+    let (f32, big_endian) = match descr {
+        "<f8" | "=f8" | "f8" => (false, false),
+        ">f8" => (false, true),
+        "<f4" | "=f4" | "f4" => (true, false),
+        ">f4" => (true, true),
+        other => {
+            return Err(bad(format!(
+                "dtype {other:?}: only float64 and float32 arrays are read"
+            )));
+        }
+    };
+    let fortran = match value("fortran_order")? {
+        v if v.starts_with("False") => false,
+        v if v.starts_with("True") => true,
+        _ => return Err(bad("fortran_order is not True or False")),
+    };
+    let shape = value("shape")?;
+    let inner = shape
+        .strip_prefix('(')
+        .and_then(|s| s.split_once(')'))
+        .map(|(s, _)| s)
+        .ok_or_else(|| bad("shape is not a tuple"))?;
+    let dims: Vec<usize> = inner
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| s.trim_end_matches('L').parse::<usize>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad(format!("shape ({inner}) is not a tuple of sizes")))?;
+    let (rows, cols) = match dims[..] {
+        [n] => (n, 1),
+        [n, k] => (n, k),
+        _ => {
+            return Err(bad(format!(
+                "shape ({inner}): a 1-D or 2-D array is needed"
+            )));
+        }
+    };
+    rows.checked_mul(cols)
+        .and_then(|n| n.checked_mul(8))
+        .ok_or_else(|| bad(format!("shape ({inner}) is too large")))?;
+    Ok(Header {
+        rows,
+        cols,
+        f32,
+        big_endian,
+        fortran,
+    })
+}
+
+/// Reads a C-order `.npy` array one row at a time.
+pub struct NpyReader<R: Read> {
+    inner: R,
+    header: Header,
+    rows_read: usize,
+    buf: Vec<u8>,
+}
+
+impl<R: Read> NpyReader<R> {
+    /// Reads and checks the header. Fortran-order arrays are refused (use [`read_matrix`]).
+    pub fn new(mut inner: R) -> Result<Self, NpyError> {
+        let header = read_header(&mut inner)?;
+        if header.fortran && header.rows > 1 && header.cols > 1 {
+            return Err(bad(
+                "Fortran-order arrays cannot be streamed by rows (save with C order)",
+            ));
+        }
+        let width = if header.f32 { 4 } else { 8 };
+        Ok(Self {
+            inner,
+            header,
+            rows_read: 0,
+            buf: vec![0; header.cols * width],
+        })
+    }
+
+    /// Rows the header declares.
+    pub fn rows(&self) -> usize {
+        self.header.rows
+    }
+
+    /// Values per row.
+    pub fn cols(&self) -> usize {
+        self.header.cols
+    }
+
+    /// Reads the next row into `out` (`cols` long); `Ok(false)` after the last row.
+    pub fn read_row(&mut self, out: &mut [f64]) -> Result<bool, NpyError> {
+        if self.rows_read == self.header.rows {
+            return Ok(false);
+        }
+        if out.len() != self.header.cols {
+            return Err(bad(format!(
+                "row buffer of {} values for {} columns",
+                out.len(),
+                self.header.cols
+            )));
+        }
+        if let Err(e) = self.inner.read_exact(&mut self.buf) {
+            return Err(match e.kind() {
+                std::io::ErrorKind::UnexpectedEof => NpyError::Truncated {
+                    values_read: self.rows_read * self.header.cols,
+                    expected: self.header.rows * self.header.cols,
+                },
+                _ => e.into(),
+            });
+        }
+        let h = self.header;
+        if h.f32 {
+            for (o, b) in out.iter_mut().zip(self.buf.chunks_exact(4)) {
+                let b: [u8; 4] = b.try_into().expect("4 bytes");
+                *o = f64::from(if h.big_endian {
+                    f32::from_be_bytes(b)
+                } else {
+                    f32::from_le_bytes(b)
+                });
+            }
+        } else {
+            for (o, b) in out.iter_mut().zip(self.buf.chunks_exact(8)) {
+                let b: [u8; 8] = b.try_into().expect("8 bytes");
+                *o = if h.big_endian {
+                    f64::from_be_bytes(b)
+                } else {
+                    f64::from_le_bytes(b)
+                };
+            }
+        }
+        self.rows_read += 1;
+        Ok(true)
+    }
+}
+
+/// Reads a whole array (C or Fortran order) as `(rows, cols, row-major values)`.
+pub fn read_matrix(inner: impl Read) -> Result<(usize, usize, Vec<f64>), NpyError> {
+    let mut inner = inner;
+    let header = read_header(&mut inner)?;
+    let (rows, cols) = (header.rows, header.cols);
+    // Stream as if C-ordered with the dimensions swapped, then transpose if needed.
+    let (r, c) = if header.fortran {
+        (cols, rows)
+    } else {
+        (rows, cols)
+    };
+    let mut reader = NpyReader {
+        inner,
+        header: Header {
+            rows: r,
+            cols: c,
+            fortran: false,
+            ..header
+        },
+        rows_read: 0,
+        buf: vec![0; c * if header.f32 { 4 } else { 8 }],
+    };
+    let mut data = Vec::new();
+    let mut row = vec![0.0; c];
+    while reader.read_row(&mut row)? {
+        data.extend_from_slice(&row);
+    }
+    if header.fortran {
+        let mut t = vec![0.0; data.len()];
+        for i in 0..rows {
+            for j in 0..cols {
+                t[i * cols + j] = data[j * rows + i];
+            }
+        }
+        data = t;
+    }
+    Ok((rows, cols, data))
+}
+
+/// Writes a `rows x cols` float64 array (version 1.0, little-endian, C order) row by row.
+pub struct NpyWriter<W: Write> {
+    inner: W,
+    rows: usize,
+    cols: usize,
+    written: usize,
+}
+
+impl<W: Write> NpyWriter<W> {
+    /// Writes the header of a `rows x cols` array.
+    pub fn new(mut inner: W, rows: usize, cols: usize) -> std::io::Result<Self> {
+        let dict =
+            format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
+        // Magic (6) + version (2) + length (2) + dict + padding + '\n', a multiple of 64.
+        let unpadded = 10 + dict.len() + 1;
+        let total = unpadded.div_ceil(64) * 64;
+        let len = total - 10;
+        let len16 = u16::try_from(len).map_err(|_| std::io::Error::other("npy header too long"))?;
+        inner.write_all(MAGIC)?;
+        inner.write_all(&[1, 0])?;
+        inner.write_all(&len16.to_le_bytes())?;
+        inner.write_all(dict.as_bytes())?;
+        inner.write_all(&vec![b' '; len - dict.len() - 1])?;
+        inner.write_all(b"\n")?;
+        Ok(Self {
+            inner,
+            rows,
+            cols,
+            written: 0,
+        })
+    }
+
+    /// Writes the next row (`cols` values).
+    pub fn write_row(&mut self, row: &[f64]) -> std::io::Result<()> {
+        if row.len() != self.cols || self.written == self.rows {
+            return Err(std::io::Error::other(format!(
+                "npy row {} of {} values for a {} x {} array",
+                self.written,
+                row.len(),
+                self.rows,
+                self.cols
+            )));
+        }
+        for v in row {
+            self.inner.write_all(&v.to_le_bytes())?;
+        }
+        self.written += 1;
+        Ok(())
+    }
+
+    /// Checks that every row was written and returns the writer.
+    pub fn finish(mut self) -> std::io::Result<W> {
+        if self.written != self.rows {
+            return Err(std::io::Error::other(format!(
+                "npy array declared {} rows but {} were written",
+                self.rows, self.written
+            )));
+        }
+        self.inner.flush()?;
+        Ok(self.inner)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(rows: usize, cols: usize, data: &[f64]) -> Vec<u8> {
+        let mut w = NpyWriter::new(Vec::new(), rows, cols).unwrap();
+        for r in data.chunks(cols.max(1)).take(rows) {
+            w.write_row(r).unwrap();
+        }
+        w.finish().unwrap()
+    }
+
+    #[test]
+    fn header_is_aligned_and_round_trips() {
+        for (rows, cols) in [(0, 3), (1, 1), (5, 4), (1000, 93)] {
+            let data: Vec<f64> = (0..rows * cols).map(|i| i as f64 * 0.5 - 3.0).collect();
+            let bytes = write(rows, cols, &data);
+            let header_len = usize::from(u16::from_le_bytes([bytes[8], bytes[9]]));
+            assert_eq!((10 + header_len) % 64, 0);
+            assert_eq!(bytes[9 + header_len], b'\n');
+            assert_eq!(read_matrix(&bytes[..]).unwrap(), (rows, cols, data));
+        }
+    }
+
+    /// Bytes NumPy 1.26 writes for `np.save(f, np.array([[1.5, -2.0], [3.0, 4.25]]))`.
+    #[test]
+    fn reads_numpy_output() {
+        let mut bytes = b"\x93NUMPY\x01\x00\x76\x00".to_vec();
+        let dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }";
+        bytes.extend(dict.as_bytes());
+        bytes.extend(vec![b' '; 0x76 - dict.len() - 1]);
+        bytes.push(b'\n');
+        for v in [1.5f64, -2.0, 3.0, 4.25] {
+            bytes.extend(v.to_le_bytes());
+        }
+        assert_eq!(
+            read_matrix(&bytes[..]).unwrap(),
+            (2, 2, vec![1.5, -2.0, 3.0, 4.25])
+        );
+    }
+
+    #[test]
+    fn fortran_order_float32_and_big_endian() {
+        let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+        let dict = "{'descr': '>f4', 'fortran_order': True, 'shape': (2, 3), }\n";
+        bytes.extend((dict.len() as u16).to_le_bytes());
+        bytes.extend(dict.as_bytes());
+        // Column-major 2 x 3: [[1, 2, 3], [4, 5, 6]] stored as 1 4 2 5 3 6.
+        for v in [1.0f32, 4.0, 2.0, 5.0, 3.0, 6.0] {
+            bytes.extend(v.to_be_bytes());
+        }
+        assert_eq!(
+            read_matrix(&bytes[..]).unwrap(),
+            (2, 3, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+        );
+        assert!(matches!(
+            NpyReader::new(&bytes[..]),
+            Err(NpyError::Format(_))
+        ));
+    }
+
+    #[test]
+    fn malformed_files_are_typed_errors() {
+        let good = write(3, 2, &[1.0; 6]);
+        assert!(matches!(
+            read_matrix(&good[..good.len() - 3]),
+            Err(NpyError::Truncated {
+                values_read: 4,
+                expected: 6
+            })
+        ));
+        for cut in [0, 5, 9, 20] {
+            assert!(matches!(
+                read_matrix(&good[..cut]),
+                Err(NpyError::Format(_))
+            ));
+        }
+        let swap = |from: &str, to: &str| {
+            let s = String::from_utf8_lossy(&good).replace(from, to);
+            s.into_bytes()
+        };
+        for (from, to) in [
+            ("<f8", "<i8"),
+            ("(3, 2)", "(3, 2, 1)"),
+            ("(3, 2)", "(x, 2)"),
+            ("(3, 2)", "(99999999999999999999, 2)"),
+            ("False", "Maybe"),
+        ] {
+            assert!(
+                matches!(read_matrix(&swap(from, to)[..]), Err(NpyError::Format(_))),
+                "{from} -> {to}"
+            );
+        }
+        let mut w = NpyWriter::new(Vec::new(), 1, 2).unwrap();
+        assert!(w.write_row(&[1.0]).is_err());
+        assert!(w.finish().is_err());
+    }
+}
