@@ -14,7 +14,7 @@ use crate::kernel::{DEFAULT_GAMMA, InverseScratch, inverse_weights};
 use crate::points::{check_point, nearest_corner};
 use crate::search::LocalSearch;
 use crate::weights::{Normalization, validate};
-use crate::{Projector, Vec8};
+use crate::{Mat2x8, Projector, Vec8};
 
 /// How the forward problem searches for the projection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -336,8 +336,29 @@ impl Solver {
         out: &mut Vec<f64>,
     ) -> Result<(), SolveError> {
         let p = check_point(self.mesh(), point)?;
-        let (psi, yhat) = self.projector.psi_and_point(&p);
+        let (psi, yhat) = self.tangent_plane(&p);
         inverse_weights(&psi, &yhat, self.anchors.coords(), self.gamma, scratch, out)
+    }
+
+    /// The tangent plane the inverse problem uses at a checked point, and the embedded
+    /// point: the interpolated `Psi`, except where it (nearly) loses rank, which happens
+    /// where a triangle's corner frames disagree in orientation (the embedding folds, as
+    /// on thin extremities): there `Psi` blends a rotation with a reflection. The frame of
+    /// the nearest corner is used instead; at a vertex it spans the tangent plane exactly.
+    pub(crate) fn tangent_plane(&self, p: &SurfacePoint) -> (Mat2x8, Vec8) {
+        let (psi, y) = self.projector.psi_and_point(p);
+        let g00 = psi.row(0).norm_squared();
+        let g11 = psi.row(1).norm_squared();
+        let g01 = psi.row(0).dot(&psi.row(1));
+        // det(G) = s_min^2 s_max^2: the smaller singular value below 1% of the larger.
+        if g00 * g11 - g01 * g01 > 1e-4 * g00.max(g11).powi(2) {
+            return (psi, y);
+        }
+        let k = (0..3)
+            .max_by(|&a, &b| p.bary[a].total_cmp(&p.bary[b]))
+            .unwrap_or(0);
+        let v = self.projector.face_corners(p.face)[k];
+        (self.projector.frame(v), y)
     }
 
     /// Forward problem for many weight vectors in parallel; result `i` belongs to

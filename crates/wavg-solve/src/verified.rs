@@ -218,7 +218,7 @@ impl Solver {
                 round_trip: RoundTrip::Paper,
             });
         }
-        let (psi, yhat) = self.projector().psi_and_point(&p);
+        let (psi, yhat) = self.tangent_plane(&p);
         for lambda in PENALTY_LADDER {
             let w = penalized_weights(&psi, &yhat, self.anchors().coords(), self.gamma(), lambda)?;
             if returns(&w) {
@@ -327,7 +327,7 @@ impl Solver {
                 .par_iter()
                 .map(|&i| {
                     let p = check_point(mesh, &points[i])?;
-                    let (psi, yhat) = self.projector().psi_and_point(&p);
+                    let (psi, yhat) = self.tangent_plane(&p);
                     penalized_weights(&psi, &yhat, self.anchors().coords(), self.gamma(), lambda)
                 })
                 .collect();
