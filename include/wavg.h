@@ -198,7 +198,7 @@ void wavg_solver_free(struct wavg_solver *solver);
 
 // Forward problem for `n_queries` weight vectors, in parallel: `weights` holds
 // `n_queries * n_anchors` doubles, row-major (one row of anchor weights per query, each
-// summing to 1 within 1e-9). Writes `out_points[i]` (and, unless NULL, the 3-D position
+// summing to 1 within 1e-6). Writes `out_points[i]` (and, unless NULL, the 3-D position
 // `out_xyz[3*i..3*i+3]` and `out_statuses[i]`). A query without an answer gets its own
 // status, `face = UINT32_MAX` and NaN coordinates, while the others are answered; the
 // call returns the first failing query's status (and message), or `WAVG_STATUS_OK`.

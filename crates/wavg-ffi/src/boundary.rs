@@ -107,7 +107,11 @@ pub(crate) unsafe fn handle_mut<'a, T>(ptr: *mut T, what: &str) -> Result<&'a mu
 ///
 /// # Safety
 /// `ptr` must be NULL or point to `len` readable `T`.
-pub(crate) unsafe fn slice<'a, T>(ptr: *const T, len: usize, what: &str) -> Result<&'a [T], Failure> {
+pub(crate) unsafe fn slice<'a, T>(
+    ptr: *const T,
+    len: usize,
+    what: &str,
+) -> Result<&'a [T], Failure> {
     if ptr.is_null() {
         return Err(Failure::arg(format!("{what} is NULL")));
     }
@@ -181,6 +185,8 @@ mod tests {
         let s = guard(|| Err(Failure::arg("bad\0thing")));
         assert_eq!(s, wavg_status::WAVG_STATUS_INVALID_ARGUMENT);
         assert_eq!(last(), "bad thing");
-        std::thread::spawn(|| assert_eq!(last(), "")).join().unwrap();
+        std::thread::spawn(|| assert_eq!(last(), ""))
+            .join()
+            .unwrap();
     }
 }

@@ -86,5 +86,8 @@ impl wavg_precompute_options {
 /// set. Thread-safe; cannot fail.
 #[unsafe(no_mangle)]
 pub extern "C" fn wavg_precompute_options_default() -> wavg_precompute_options {
-    guard_value(wavg_precompute_options::defaults(), wavg_precompute_options::defaults)
+    guard_value(
+        wavg_precompute_options::defaults(),
+        wavg_precompute_options::defaults,
+    )
 }

@@ -3,10 +3,13 @@
 
 use std::sync::Mutex;
 
+use rayon::prelude::*;
+
+use wavg::solve::SolveError;
 use wavg::{BatchWeights, ForwardOptions, RoundTrip, Solver, SurfacePoint};
 
 use crate::boundary::{
-    Failure, Outcome, guard, guard_value, handle, handle_mut, product, slice, slice_mut,
+    Failure, Outcome, guard, guard_value, handle, handle_mut, product, slice, slice_mut, status_of,
 };
 use crate::surface::wavg_surface;
 use crate::types::{wavg_point, wavg_status};
@@ -21,8 +24,14 @@ pub struct wavg_solver {
     solver: Solver,
     /// Reused output of the inverse batches (taken when free, so concurrent calls never
     /// wait for each other).
-    scratch: Mutex<(BatchWeights, Vec<Result<RoundTrip, wavg::solve::SolveError>>)>,
+    scratch: Mutex<(
+        BatchWeights,
+        Vec<Result<RoundTrip, wavg::solve::SolveError>>,
+    )>,
 }
+
+/// Weights and round trips of a verified inverse batch.
+type VerifiedScratch = (BatchWeights, Vec<Result<RoundTrip, SolveError>>);
 
 fn point_in(p: &wavg_point) -> SurfacePoint {
     SurfacePoint::new(p.face, p.bary)
@@ -73,7 +82,9 @@ pub unsafe extern "C" fn wavg_solver_new(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn wavg_solver_anchor_count(solver: *const wavg_solver) -> usize {
     // SAFETY: per this function's contract.
-    guard_value(0, || unsafe { solver.as_ref() }.map_or(0, |s| s.solver.n_anchors()))
+    guard_value(0, || {
+        unsafe { solver.as_ref() }.map_or(0, |s| s.solver.n_anchors())
+    })
 }
 
 /// Replaces anchor `index` (0-based) by `anchor`; on failure the solver is unchanged.
@@ -116,16 +127,16 @@ struct Statuses<'a> {
 }
 
 impl Statuses<'_> {
-    fn set(&mut self, i: usize, r: Result<(), &wavg::solve::SolveError>) {
+    fn set(&mut self, i: usize, r: Result<(), &SolveError>) {
         let status = match r {
             Ok(()) => wavg_status::WAVG_STATUS_OK,
             Err(e) => {
-                let f = Failure::from(wavg::Error::from(e.clone()));
-                let status = f.status;
+                let e = wavg::Error::from(e.clone());
+                let status = status_of(e.kind());
                 if self.first.is_none() {
                     self.first = Some(Failure {
                         status,
-                        message: format!("query {i}: {}", f.message),
+                        message: format!("query {i}: {e}"),
                     });
                 }
                 status
@@ -222,6 +233,97 @@ pub unsafe extern "C" fn wavg_forward(
     })
 }
 
+/// How one inverse row ended.
+enum Row {
+    Ok,
+    NotReached,
+    Failed(SolveError),
+}
+
+/// Paper weights of each point straight into its row of `out` (NaN for failures), in
+/// parallel: `Solver::inverse_batch_into`'s loop, without its buffer and the copy out of
+/// it (a visible share of a batch this fast).
+fn inverse_rows(solver: &Solver, points: &[wavg_point], out: &mut [f64]) -> Vec<Row> {
+    const CHUNK: usize = 64;
+    let n = solver.n_anchors();
+    let proj = solver.projector();
+    out.par_chunks_mut(n * CHUNK)
+        .zip(points.par_chunks(CHUNK))
+        .flat_map_iter(|(rows, pts)| {
+            let mut scratch = Default::default();
+            let mut buf = Vec::with_capacity(n);
+            // Random points read random face records, then their corners' records:
+            // request both a few points ahead so the waits overlap.
+            for p in pts.iter().take(4) {
+                proj.prefetch_point_data(p.face, false);
+            }
+            let mut done = Vec::with_capacity(pts.len());
+            for (k, (row, p)) in rows.chunks_exact_mut(n).zip(pts).enumerate() {
+                if let Some(q) = pts.get(k + 4) {
+                    proj.prefetch_point_data(q.face, false);
+                }
+                if let Some(q) = pts.get(k + 2) {
+                    proj.prefetch_point_data(q.face, true);
+                }
+                match solver.inverse_into(&point_in(p), &mut scratch, &mut buf) {
+                    Ok(()) => {
+                        row.copy_from_slice(&buf);
+                        done.push(Row::Ok);
+                    }
+                    Err(e) => {
+                        row.fill(f64::NAN);
+                        done.push(Row::Failed(e));
+                    }
+                }
+            }
+            done
+        })
+        .collect()
+}
+
+/// Verified weights of each point into its row of `out` (NaN when there are none),
+/// through `Solver::inverse_verified_batch_into` with the solver's reusable buffers.
+fn verified_rows(
+    solver: &Solver,
+    scratch: &Mutex<VerifiedScratch>,
+    points: &[wavg_point],
+    out: &mut [f64],
+) -> Vec<Row> {
+    let points: Vec<SurfacePoint> = points.iter().map(point_in).collect();
+    // Taken when free, so concurrent calls never wait for each other.
+    let mut owned = VerifiedScratch::default();
+    let mut shared = scratch.try_lock().ok();
+    let (batch, trips) = match shared.as_deref_mut() {
+        Some(b) => (&mut b.0, &mut b.1),
+        None => (&mut owned.0, &mut owned.1),
+    };
+    solver.inverse_verified_batch_into(
+        &points,
+        wavg::solve::verified::DEFAULT_TOLERANCE,
+        batch,
+        trips,
+    );
+    let n = solver.n_anchors();
+    out.par_chunks_exact_mut(n)
+        .enumerate()
+        .with_min_len(1024)
+        .map(|(i, row)| match (batch.get(i), &trips[i]) {
+            (Ok(w), Ok(t)) if *t != RoundTrip::NotReached => {
+                row.copy_from_slice(w);
+                Row::Ok
+            }
+            (Ok(_), Ok(_)) => {
+                row.fill(f64::NAN);
+                Row::NotReached
+            }
+            (Err(e), _) | (_, Err(e)) => {
+                row.fill(f64::NAN);
+                Row::Failed(e.clone())
+            }
+        })
+        .collect()
+}
+
 /// An optional output array: `None` for NULL.
 ///
 /// # Safety
@@ -266,49 +368,28 @@ pub unsafe extern "C" fn wavg_inverse(
         let (points, out, statuses) = unsafe {
             (
                 slice(points, n_points, "points")?,
-                slice_mut(out_weights, product(n_points, n, "n_points")?, "out_weights")?,
+                slice_mut(
+                    out_weights,
+                    product(n_points, n, "n_points")?,
+                    "out_weights",
+                )?,
                 optional(out_statuses, n_points),
             )
         };
-        let points: Vec<SurfacePoint> = points.iter().map(point_in).collect();
-        let mut owned = Default::default();
-        let mut shared = s.scratch.try_lock().ok();
-        let (batch, trips) = match shared.as_deref_mut() {
-            Some(b) => (&mut b.0, &mut b.1),
-            None => {
-                let o: &mut (BatchWeights, Vec<_>) = &mut owned;
-                (&mut o.0, &mut o.1)
-            }
-        };
-        if verified {
-            s.solver.inverse_verified_batch_into(
-                &points,
-                wavg::solve::verified::DEFAULT_TOLERANCE,
-                batch,
-                trips,
-            );
+        let rows = if verified {
+            verified_rows(&s.solver, &s.scratch, points, out)
         } else {
-            s.solver.inverse_batch_into(&points, batch);
-        }
+            inverse_rows(&s.solver, points, out)
+        };
         let mut st = Statuses {
             out: statuses,
             first: None,
         };
-        for (i, row) in out.chunks_exact_mut(n).enumerate() {
-            let reached = !verified || !matches!(trips[i], Ok(RoundTrip::NotReached));
-            match batch.get(i) {
-                Ok(w) if reached => {
-                    row.copy_from_slice(w);
-                    st.set(i, Ok(()));
-                }
-                Ok(_) => {
-                    row.fill(f64::NAN);
-                    st.no_solution(i);
-                }
-                Err(e) => {
-                    row.fill(f64::NAN);
-                    st.set(i, Err(e));
-                }
+        for (i, r) in rows.into_iter().enumerate() {
+            match r {
+                Row::Ok => st.set(i, Ok(())),
+                Row::NotReached => st.no_solution(i),
+                Row::Failed(e) => st.set(i, Err(&e)),
             }
         }
         st.finish()

@@ -234,7 +234,9 @@ pub unsafe extern "C" fn wavg_surface_save_embedding(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn wavg_surface_vertex_count(surface: *const wavg_surface) -> usize {
     // SAFETY: per this function's contract.
-    guard_value(0, || unsafe { surface.as_ref() }.map_or(0, |s| s.inner.n_vertices()))
+    guard_value(0, || {
+        unsafe { surface.as_ref() }.map_or(0, |s| s.inner.n_vertices())
+    })
 }
 
 /// Number of triangles (0 for NULL). Thread-safe.
@@ -244,7 +246,9 @@ pub unsafe extern "C" fn wavg_surface_vertex_count(surface: *const wavg_surface)
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn wavg_surface_face_count(surface: *const wavg_surface) -> usize {
     // SAFETY: per this function's contract.
-    guard_value(0, || unsafe { surface.as_ref() }.map_or(0, |s| s.inner.n_faces()))
+    guard_value(0, || {
+        unsafe { surface.as_ref() }.map_or(0, |s| s.inner.n_faces())
+    })
 }
 
 /// The surface point at `vertex` (a corner of one of its triangles) into `*out`.
