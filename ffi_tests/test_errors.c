@@ -88,6 +88,31 @@ int main(void) {
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_surface_precompute(s, &o, NULL, NULL));
   o = wavg_precompute_options_default();
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_surface_precompute(NULL, &o, NULL, NULL));
+  o = wavg_precompute_options_default();
+  o.struct_size = sizeof o - 1; /* shorter than any published layout */
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_surface_precompute(s, &o, NULL, NULL));
+  n = 42;
+  CHECK_OK(wavg_surface_landmarks(s, NULL, 0, &n));
+  CHECK(n == 0);
+  /* A caller compiled against a newer header (a longer struct) is accepted; the fields
+   * this library does not know are ignored. */
+  {
+    struct {
+      wavg_precompute_options known;
+      uint64_t from_the_future;
+    } newer;
+    newer.known = wavg_precompute_options_default();
+    newer.known.struct_size = sizeof newer;
+    newer.known.landmarks = 20;
+    newer.known.quality_pairs = 0;
+    newer.from_the_future = 0xdeadbeef;
+    wavg_surface *s3 = NULL;
+    CHECK_OK(wavg_surface_from_arrays(xyz, nv, tris, nt, &s3));
+    CHECK_OK(wavg_surface_precompute(s3, &newer.known, NULL, NULL));
+    CHECK_OK(wavg_surface_landmarks(s3, NULL, 0, &n));
+    CHECK(n == 20);
+    wavg_surface_free(s3);
+  }
   /* A mesh with two components cannot be embedded. */
   {
     double *x2 = malloc(sizeof(double) * 6 * nv);
@@ -98,6 +123,7 @@ int main(void) {
     for (size_t i = 0; i < 3 * nt; i++) t2[3 * nt + i] = tris[i] + (uint32_t)nv;
     wavg_surface *two = NULL;
     CHECK_OK(wavg_surface_from_arrays(x2, 2 * nv, t2, 2 * nt, &two));
+    o = wavg_precompute_options_default();
     o.landmarks = 20;
     CHECK_FAILS(WAVG_STATUS_INVALID_MESH, wavg_surface_precompute(two, &o, NULL, NULL));
     wavg_surface_free(two);
