@@ -83,26 +83,27 @@ fn main() {
     surface.precompute(&opts, &NoProgress).expect("precompute");
     let dir = std::env::temp_dir().join(format!("abi_overhead_{}.wavg", std::process::id()));
     surface.save_embedding(&dir).expect("save");
-    let anchors = surface.spread_anchors(n_anchors, 0).expect("anchors");
+    // Anchors and points as ffi_tests/bench_abi.c makes them (same generator and seed),
+    // so its C timings compare with these.
+    let landmarks = surface.landmarks().to_vec();
+    let anchors: Vec<wavg::Anchor> = (0..n_anchors)
+        .map(|i| wavg::Anchor::Vertex(landmarks[i * landmarks.len() / n_anchors]))
+        .collect();
     let solver = surface.solver(anchors.clone()).expect("solver");
-    let nf = surface.n_faces() as u64;
-    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-    let mut next = || {
+    let nf = surface.n_faces() as f64;
+    let mut state = 11u64;
+    let mut rnd = || {
         state = state
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
+        (state >> 11) as f64 / 9007199254740992.0
     };
     let points: Vec<SurfacePoint> = (0..n_queries)
         .map(|_| {
-            let f = (next() * nf as f64) as u32;
-            let (a, b) = (next(), next());
-            let (a, b) = if a + b > 1.0 {
-                (1.0 - a, 1.0 - b)
-            } else {
-                (a, b)
-            };
-            SurfacePoint::new(f, [1.0 - a - b, a, b])
+            let f = (rnd() * nf) as u32;
+            let (a, b, c) = (0.05 + rnd(), 0.05 + rnd(), 0.05 + rnd());
+            let s = a + b + c;
+            SurfacePoint::new(f, [a / s, b / s, 1.0 - a / s - b / s])
         })
         .collect();
 
