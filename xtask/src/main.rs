@@ -1,6 +1,8 @@
 //! Build and test automation: `cargo xtask test` runs every check the project has, in the
 //! order CI runs them, and tells you exactly what to install when a tool is missing.
 
+mod cbuild;
+mod examples;
 mod fuzz;
 
 use std::path::{Path, PathBuf};
@@ -22,8 +24,10 @@ fn main() -> ExitCode {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test | cargo xtask fuzz [--seconds N]\n\n  \
-         test   rustfmt check, clippy (-D warnings), cargo test --workspace, a {SMOKE_SECONDS} s \
-         smoke run of every fuzz target\n  \
+         test   rustfmt check, clippy (-D warnings), cargo test --workspace, the examples \
+         (and quickstart.rs as a crate outside the workspace), the C/C++ build (CMake: \
+         libwavg, C tests, examples, OpenMesh harness) and ctest, a {SMOKE_SECONDS} s smoke \
+         run of every fuzz target\n  \
          fuzz   every fuzz target for N seconds (default 60) each"
     );
     ExitCode::from(2)
@@ -94,32 +98,25 @@ fn run_all(root: &Path) -> ExitCode {
         eprintln!("xtask: {msg}");
         return ExitCode::FAILURE;
     }
-    report_data_dir(root);
+    let data_dir = report_data_dir(root);
     let total = Instant::now();
     for step in STEPS {
-        eprintln!(
-            "==> {} ({} {})",
-            step.name,
-            step.program,
-            step.args.join(" ")
-        );
-        let t = Instant::now();
-        let status = Command::new(step.program)
-            .args(step.args)
-            .current_dir(root)
-            .status();
-        match status {
-            Ok(s) if s.success() => {
-                eprintln!("==> {} ok in {:.1} s", step.name, t.elapsed().as_secs_f64())
-            }
-            Ok(s) => {
-                eprintln!("==> {} FAILED ({s})", step.name);
-                return ExitCode::FAILURE;
-            }
-            Err(e) => {
-                eprintln!("==> {} could not start {}: {e}", step.name, step.program);
-                return ExitCode::FAILURE;
-            }
+        let args: Vec<String> = step.args.iter().map(|a| a.to_string()).collect();
+        if !run_step(root, step.name, step.program, &args) {
+            return ExitCode::FAILURE;
+        }
+    }
+    if let Err(msg) = examples::run(root) {
+        eprintln!("==> examples FAILED: {msg}");
+        return ExitCode::FAILURE;
+    }
+    if let Err(msg) = cbuild::ensure_packages() {
+        eprintln!("xtask: {msg}");
+        return ExitCode::FAILURE;
+    }
+    for (name, program, args) in cbuild::steps(root, &data_dir) {
+        if !run_step(root, name, &program, &args) {
+            return ExitCode::FAILURE;
         }
     }
     if let Err(msg) = fuzz::run(root, SMOKE_SECONDS) {
@@ -131,6 +128,26 @@ fn run_all(root: &Path) -> ExitCode {
         total.elapsed().as_secs_f64()
     );
     ExitCode::SUCCESS
+}
+
+/// Runs one step from the repository root, reporting its time; false when it failed.
+fn run_step(root: &Path, name: &str, program: &str, args: &[String]) -> bool {
+    eprintln!("==> {name} ({program} {})", args.join(" "));
+    let t = Instant::now();
+    match Command::new(program).args(args).current_dir(root).status() {
+        Ok(s) if s.success() => {
+            eprintln!("==> {name} ok in {:.1} s", t.elapsed().as_secs_f64());
+            true
+        }
+        Ok(s) => {
+            eprintln!("==> {name} FAILED ({s})");
+            false
+        }
+        Err(e) => {
+            eprintln!("==> {name} could not start {program}: {e}");
+            false
+        }
+    }
 }
 
 /// rustfmt and clippy ship as rustup components; they cannot be downloaded from here, so
@@ -150,7 +167,8 @@ fn check_tools() -> Result<(), String> {
     Ok(())
 }
 
-fn report_data_dir(root: &Path) {
+/// Prints which test-data folder the tests will read, and returns it.
+fn report_data_dir(root: &Path) -> PathBuf {
     let dir = std::env::var_os("WAVG_DATA_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("../shared/data"));
@@ -163,4 +181,5 @@ fn report_data_dir(root: &Path) {
             dir.display()
         );
     }
+    dir
 }

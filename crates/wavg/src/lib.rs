@@ -25,11 +25,13 @@
 //! The workspace crates stay reachable as modules ([`mesh`], [`embed`], [`project`],
 //! [`solve`]) for what the front door does not cover.
 
+mod decimate;
 mod error;
 pub mod npy;
 mod oneoff;
 mod surface;
 
+pub use decimate::Decimation;
 pub use error::{Error, ErrorKind, Result};
 pub use nalgebra::Vector3;
 pub use oneoff::{barycentric_weights, weighted_average};

@@ -1,0 +1,41 @@
+//! The C ABI of wavg (`libwavg.so`, `libwavg.a`, header `include/wavg.h`).
+//!
+//! Every entry point is `extern "C"`, checks its pointers and lengths, runs inside a panic
+//! boundary (a panic becomes [`wavg_status::WAVG_STATUS_PANIC`], never an abort) and
+//! reports failures as a [`wavg_status`] plus a per-thread message ([`wavg_last_error`]).
+//! Handles are opaque and owned by the caller from creation to their `_free` call. No Rust
+//! type crosses the boundary.
+#![allow(non_camel_case_types)]
+
+mod boundary;
+mod decimate;
+mod options;
+mod solver;
+mod surface;
+mod types;
+
+pub use boundary::{wavg_abi_version, wavg_last_error};
+pub use decimate::wavg_surface_decimate;
+pub use options::{wavg_precompute_options, wavg_precompute_options_default};
+pub use solver::{
+    wavg_forward, wavg_inverse, wavg_solver, wavg_solver_anchor_count, wavg_solver_free,
+    wavg_solver_new, wavg_solver_set_anchor,
+};
+pub use surface::{
+    wavg_surface, wavg_surface_embedding, wavg_surface_face_count, wavg_surface_free,
+    wavg_surface_from_arrays, wavg_surface_landmarks, wavg_surface_load_embedding,
+    wavg_surface_open, wavg_surface_positions, wavg_surface_precompute,
+    wavg_surface_save_embedding, wavg_surface_triangles, wavg_surface_vertex_count,
+    wavg_surface_vertex_point,
+};
+pub use types::{wavg_point, wavg_progress_fn, wavg_stage, wavg_status};
+
+/// Major version of the library (incompatible API changes).
+pub const WAVG_VERSION_MAJOR: u32 = 0;
+/// Minor version of the library (additions).
+pub const WAVG_VERSION_MINOR: u32 = 1;
+/// Patch version of the library (fixes).
+pub const WAVG_VERSION_PATCH: u32 = 0;
+/// Version of the binary interface, the number in the library's soname
+/// (`libwavg.so.0`); compare it with `wavg_abi_version()` at run time.
+pub const WAVG_ABI_VERSION: u32 = 0;

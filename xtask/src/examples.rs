@@ -1,0 +1,85 @@
+//! The Rust examples step of `cargo xtask test`: runs every example of the facade crate,
+//! then builds and runs `quickstart.rs` unchanged in a crate outside the workspace that
+//! depends only on `wavg` (by path), as a new user's project would.
+
+use std::path::Path;
+use std::process::Command;
+
+/// Runs the examples; `Err` names the first failure.
+pub fn run(root: &Path) -> Result<(), String> {
+    let dir = root.join("crates/wavg/examples");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .filter_map(|e| e.ok())
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            name.strip_suffix(".rs").map(str::to_owned)
+        })
+        .collect();
+    names.sort();
+    for name in &names {
+        cargo(
+            root,
+            &[
+                "run",
+                "--release",
+                "--quiet",
+                "-p",
+                "wavg",
+                "--example",
+                name,
+            ],
+        )?;
+    }
+    outside_crate(root)
+}
+
+fn cargo(dir: &Path, args: &[&str]) -> Result<(), String> {
+    eprintln!("==> cargo {}", args.join(" "));
+    let ok = Command::new("cargo")
+        .args(args)
+        .current_dir(dir)
+        .env("CARGO_TARGET_DIR", dir.join("target"))
+        .status()
+        .is_ok_and(|s| s.success());
+    if ok {
+        Ok(())
+    } else {
+        Err(format!("cargo {} failed", args.join(" ")))
+    }
+}
+
+/// A crate in `target/outside-quickstart` with `wavg` as its only dependency and the
+/// workspace's lock file and release profile, so it reuses the built dependencies.
+fn outside_crate(root: &Path) -> Result<(), String> {
+    let dir = root.join("target/outside-quickstart");
+    let src = dir.join("src");
+    std::fs::create_dir_all(&src).map_err(|e| format!("{}: {e}", src.display()))?;
+    let manifest = format!(
+        "[package]\nname = \"outside-quickstart\"\nversion = \"0.0.0\"\nedition = \"2024\"\n\
+         publish = false\n\n[dependencies]\nwavg = {{ path = {:?} }}\n\n\
+         [profile.release]\ndebug = \"line-tables-only\"\n\n[workspace]\n",
+        root.join("crates/wavg").display().to_string()
+    );
+    let write = |name: &Path, body: &[u8]| {
+        std::fs::write(name, body).map_err(|e| format!("{}: {e}", name.display()))
+    };
+    write(&dir.join("Cargo.toml"), manifest.as_bytes())?;
+    let lock = std::fs::read(root.join("Cargo.lock")).map_err(|e| format!("Cargo.lock: {e}"))?;
+    write(&dir.join("Cargo.lock"), &lock)?;
+    let quickstart = std::fs::read(root.join("crates/wavg/examples/quickstart.rs"))
+        .map_err(|e| format!("quickstart.rs: {e}"))?;
+    write(&src.join("main.rs"), &quickstart)?;
+    eprintln!("==> quickstart.rs as a crate outside the workspace");
+    let ok = Command::new("cargo")
+        .args(["run", "--release", "--quiet"])
+        .current_dir(&dir)
+        .env("CARGO_TARGET_DIR", root.join("target"))
+        .status()
+        .is_ok_and(|s| s.success());
+    if ok {
+        Ok(())
+    } else {
+        Err("quickstart.rs did not build or run in a crate outside the workspace".into())
+    }
+}
