@@ -63,33 +63,25 @@ pub struct Args {
     pub json: bool,
 }
 
-/// Uniform cubic B-spline basis at `u` in [0, 1).
-fn bspline(u: f64) -> [f64; 4] {
-    let (u2, u3) = (u * u, u * u * u);
-    [
-        (1.0 - u).powi(3) / 6.0,
-        (3.0 * u3 - 6.0 * u2 + 4.0) / 6.0,
-        (-3.0 * u3 + 3.0 * u2 + 3.0 * u + 1.0) / 6.0,
-        u3 / 6.0,
-    ]
-}
-
-/// Weights (one per anchor) of `samples` points along the closed B-spline whose control
-/// points are the anchors in the order `order`.
-fn spline_weights(order: &[usize], samples: usize) -> Vec<Vec<f64>> {
-    let n = order.len();
-    (0..samples)
-        .map(|s| {
-            let t = s as f64 * n as f64 / samples as f64;
-            let i = t.floor() as usize;
-            let b = bspline(t - i as f64);
-            let mut w = vec![0.0; n];
-            for (k, bk) in b.iter().enumerate() {
-                w[order[(i + n + k - 1) % n]] += bk;
+/// Weights (one per anchor) of `samples` points along the closed cubic B-spline whose
+/// control points are the anchors in the order `order`.
+fn spline_weights(order: &[usize], samples: usize) -> Result<Vec<Vec<f64>>, CliError> {
+    let kind = wavg::apps::SplineKind::BSpline {
+        degree: 3,
+        closed: true,
+    };
+    let rows = wavg::apps::spline_weights(kind, order.len(), samples)
+        .map_err(|e| CliError::input(e.to_string()))?;
+    Ok(rows
+        .into_iter()
+        .map(|row| {
+            let mut w = vec![0.0; order.len()];
+            for (c, x) in row.into_iter().enumerate() {
+                w[order[c]] = x;
             }
             w
         })
-        .collect()
+        .collect())
 }
 
 /// Runs the command.
@@ -146,7 +138,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         p.y.atan2(p.x)
     };
     order.sort_by(|&a, &b| angle(a).total_cmp(&angle(b)));
-    let weights = spline_weights(&order, args.samples);
+    let weights = spline_weights(&order, args.samples)?;
     let t0 = Instant::now();
     let curve = solver.forward_batch_warm(&weights, &ForwardOptions::default(), args.samples);
     let curve_us = t0.elapsed().as_secs_f64() / args.samples as f64 * 1e6;
@@ -284,13 +276,13 @@ mod tests {
     #[test]
     fn spline_weights_sum_to_one_and_are_local() {
         let order = [3, 0, 4, 1, 5, 2];
-        for w in spline_weights(&order, 97) {
+        for w in spline_weights(&order, 97).unwrap() {
             assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
             assert!(w.iter().all(|&x| x >= 0.0));
             assert!(w.iter().filter(|&&x| x > 0.0).count() <= 4);
         }
         // At a knot the curve sits at (1/6, 4/6, 1/6) of three consecutive controls.
-        let w = &spline_weights(&order, 6)[1];
+        let w = &spline_weights(&order, 6).unwrap()[1];
         assert!((w[0] - 4.0 / 6.0).abs() < 1e-12);
         assert!((w[3] - 1.0 / 6.0).abs() < 1e-12 && (w[4] - 1.0 / 6.0).abs() < 1e-12);
     }

@@ -1,5 +1,6 @@
 //! The `wavg` command line: diagnostics, precomputation, forward/inverse problems, benchmarks.
 
+mod apps_common;
 mod bench_load;
 mod bench_project;
 mod bench_roundtrip;
@@ -11,6 +12,7 @@ mod info;
 mod inverse;
 mod precompute;
 mod repair;
+mod spline;
 mod subdivide;
 mod textio;
 
@@ -42,6 +44,8 @@ enum Command {
     Forward(forward::Args),
     /// Inverse problem: anchors + surface points -> weights.
     Inverse(inverse::Args),
+    /// A B-spline or Bézier curve on the surface through control points.
+    Spline(spline::Args),
     /// Loop subdivision: make a larger mesh from a smaller one.
     Subdivide(subdivide::Args),
     /// Benchmarks (report timings and quality figures).
@@ -68,6 +72,7 @@ fn main() -> ExitCode {
         Command::Precompute(a) => precompute::run(a),
         Command::Forward(a) => forward::run(a),
         Command::Inverse(a) => inverse::run(a),
+        Command::Spline(a) => spline::run(a),
         Command::Subdivide(a) => subdivide::run(a),
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),

@@ -43,6 +43,7 @@ pub use wavg_solve::{
     Solver, Verified,
 };
 
+pub use wavg_apps as apps;
 pub use wavg_embed as embed;
 pub use wavg_mesh as mesh;
 pub use wavg_project as project;
