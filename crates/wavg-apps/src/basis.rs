@@ -40,9 +40,7 @@ pub fn spline_weights(
         return bad("a curve needs at least one sample".into());
     }
     match kind {
-        SplineKind::BSpline { degree, .. } if degree == 0 => {
-            bad("the spline degree must be at least 1".into())
-        }
+        SplineKind::BSpline { degree: 0, .. } => bad("the spline degree must be at least 1".into()),
         SplineKind::BSpline { degree, .. } if n_controls < degree + 1 => bad(format!(
             "a degree-{degree} B-spline needs at least {} control points, got {n_controls}",
             degree + 1

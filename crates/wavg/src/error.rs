@@ -21,6 +21,10 @@ pub enum Error {
     /// A forward or inverse problem was refused or has no answer.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// A valid mesh that this operation cannot use (for example a disconnected mesh for
+    /// the embedding); the message says how to fix it.
+    #[error("{0}")]
+    Unsuitable(String),
 }
 
 /// Coarse classes of [`Error`], stable enough to map to exit codes or C status codes.
@@ -56,6 +60,7 @@ impl Error {
             Error::Project(_) => ErrorKind::InvalidArgument,
             Error::Solve(e) if e.is_no_solution() => ErrorKind::NoSolution,
             Error::Solve(_) => ErrorKind::InvalidArgument,
+            Error::Unsuitable(_) => ErrorKind::InvalidMesh,
         }
     }
 }

@@ -11,7 +11,7 @@ use wavg_project::{EmbeddedMesh, Projector, Vec8};
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
 use wavg_solve::{Anchor, Solver};
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 
 /// A validated triangle mesh with its embedding in R^8 and the projector built on it.
 ///
@@ -87,6 +87,13 @@ impl Surface {
         options: &PrecomputeOptions,
         progress: &dyn Progress,
     ) -> Result<Report> {
+        let components = self.inner.mesh.topology().n_components();
+        if components != 1 {
+            return Err(Error::Unsuitable(format!(
+                "the mesh has {components} connected components; the embedding needs exactly \
+                 one (keep the largest with `wavg repair --largest-component`)"
+            )));
+        }
         let (embedding, report) = wavg_embed::precompute(&self.inner.mesh, options, progress)?;
         self.set_embedding(embedding)?;
         Ok(report)

@@ -163,6 +163,21 @@ fn bad_meshes_are_invalid_mesh_errors() {
 }
 
 #[test]
+fn disconnected_meshes_cannot_be_embedded() {
+    let mut two = procedural::icosphere(2);
+    let other = procedural::icosphere(2).map_positions(|p| p + wavg::Vector3::new(3.0, 0.0, 0.0));
+    let n = two.n_vertices() as u32;
+    two.positions.extend(other.positions);
+    two.triangles
+        .extend(other.triangles.iter().map(|t| t.map(|v| v + n)));
+    let mut s = Surface::from_mesh(two).unwrap();
+    let e = s.precompute(&small_opts(), &NoProgress).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::InvalidMesh, "{e}");
+    assert!(e.to_string().contains("2 connected components"));
+    assert!(s.embedding().is_none());
+}
+
+#[test]
 fn open_reads_a_mesh_file() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sphere.obj");
