@@ -46,7 +46,7 @@ fn main() {
     let decimate_only = args.iter().any(|a| a == "--decimate-only");
     args.retain(|a| a != "--decimate-only");
     let paths: Vec<std::path::PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_mesh::data::require_data_dir("landmark_timing") else {
+        let Some(dir) = wavg_testdata::require_data_dir("landmark_timing") else {
             return;
         };
         ["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"]

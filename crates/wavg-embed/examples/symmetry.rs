@@ -26,7 +26,7 @@ fn main() {
         args.drain(i..i + 2);
     }
     let paths: Vec<std::path::PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_mesh::data::require_data_dir("symmetry") else {
+        let Some(dir) = wavg_testdata::require_data_dir("symmetry") else {
             return;
         };
         ["pig.off", "camelhead.off", "fertility.off"]

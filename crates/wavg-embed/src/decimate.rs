@@ -1309,8 +1309,7 @@ mod tests {
             ("meshes/3holes.off", 300),
             ("meshes/torus.obj", 50),
         ] {
-            let Some(path) = wavg_mesh::data::require_data_file("decimate::real_meshes", file)
-            else {
+            let Some(path) = wavg_testdata::require_data_file("decimate::real_meshes", file) else {
                 return;
             };
             let mesh = valid(wavg_mesh::io::load(&path).unwrap());

@@ -1290,8 +1290,7 @@ mod tests {
             "meshes/camelhead.off",
             "meshes/fertility.off",
         ] {
-            let Some(path) =
-                wavg_mesh::data::require_data_file("geodesic::real_mesh_symmetry", file)
+            let Some(path) = wavg_testdata::require_data_file("geodesic::real_mesh_symmetry", file)
             else {
                 return;
             };

@@ -777,7 +777,7 @@ mod tests {
     fn shadows_only_changes_nothing() {
         let mut meshes = vec![saddle_surface()];
         for file in ["meshes/camelhead.off", "meshes/fertility.off"] {
-            if let Some(path) = wavg_mesh::data::require_data_file("near_field::shadows", file) {
+            if let Some(path) = wavg_testdata::require_data_file("near_field::shadows", file) {
                 meshes.push(ValidMesh::new(wavg_mesh::io::load(&path).unwrap()).unwrap());
             }
         }

@@ -3,7 +3,8 @@
 //! meets the targets (geodesic relative error p50 <= 0.05, p90 <= 0.15).
 
 use wavg_embed::{NoProgress, PrecomputeOptions, file, precompute};
-use wavg_mesh::{ValidMesh, data, io};
+use wavg_mesh::{ValidMesh, io};
+use wavg_testdata as data;
 
 fn load(test: &str, rel: &str) -> Option<ValidMesh> {
     let path = data::require_data_file(test, rel)?;

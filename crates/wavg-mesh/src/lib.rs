@@ -30,7 +30,6 @@
 //! ```
 
 pub mod analyze;
-pub mod data;
 pub mod error;
 pub mod geometry;
 pub mod io;

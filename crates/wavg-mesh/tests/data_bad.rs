@@ -6,7 +6,8 @@ use std::path::Path;
 
 use wavg_mesh::ProblemKind::{self, *};
 use wavg_mesh::repair::{self, RepairOptions};
-use wavg_mesh::{MeshError, ValidMesh, analyze, data, io};
+use wavg_mesh::{MeshError, ValidMesh, analyze, io};
+use wavg_testdata as data;
 
 enum Expect {
     /// Unparseable: a parse error at this line.

@@ -75,7 +75,7 @@ fn round_trips_on_procedural_meshes() {
 #[test]
 fn round_trips_on_a_real_mesh() {
     let Some(path) =
-        wavg_mesh::data::require_data_file("round_trips_on_a_real_mesh", "meshes/pig.off")
+        wavg_testdata::require_data_file("round_trips_on_a_real_mesh", "meshes/pig.off")
     else {
         return;
     };

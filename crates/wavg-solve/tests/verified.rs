@@ -130,7 +130,7 @@ fn verified_weights_round_trip_on_a_thin_torus() {
 /// with the real geodesic embedding (the precomputation pipeline).
 #[test]
 fn verified_weights_round_trip_on_a_real_mesh() {
-    let Some(path) = wavg_mesh::data::require_data_file(
+    let Some(path) = wavg_testdata::require_data_file(
         "verified_weights_round_trip_on_a_real_mesh",
         "meshes/pig.off",
     ) else {
