@@ -18,10 +18,11 @@
 use std::time::Instant;
 
 use wavg_embed::NoProgress;
-use wavg_embed::decimate::{DecimateOptions, decimate_with_snapshots};
-use wavg_embed::geodesic::{
-    FastMarching, landmark_distances_coarse, landmark_distances_two_level, landmark_distances_with,
+use wavg_embed::internal::{
+    decimate_with_snapshots, landmark_distances_coarse, landmark_distances_two_level,
+    landmark_distances_with,
 };
+use wavg_embed::{DecimateOptions, FastMarching};
 use wavg_mesh::ValidMesh;
 
 fn main() {
@@ -83,7 +84,7 @@ fn main() {
         let t_build = t.elapsed().as_secs_f64();
         let mut ws = fm.workspace();
         if runs_only {
-            let per_run = |fm: &FastMarching, ws: &mut wavg_embed::geodesic::Workspace| {
+            let per_run = |fm: &FastMarching, ws: &mut wavg_embed::Workspace| {
                 // Best on-CPU time of 5 batches of 10 runs (the machine is shared).
                 let mut best = f64::INFINITY;
                 for b in 0..5 {

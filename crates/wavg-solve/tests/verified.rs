@@ -152,9 +152,9 @@ fn verified_weights_round_trip_on_a_real_mesh() {
     );
 
     let mesh = Arc::new(ValidMesh::new(mesh).unwrap());
-    let (e, _) = wavg_embed::pipeline::precompute(
+    let (e, _) = wavg_embed::precompute(
         &mesh,
-        &wavg_embed::pipeline::PrecomputeOptions::default(),
+        &wavg_embed::PrecomputeOptions::default(),
         &wavg_embed::NoProgress,
     )
     .unwrap();
