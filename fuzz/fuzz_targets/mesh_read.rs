@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use wavg::mesh::io::{Format, parse_bytes, to_bytes};
+use wavg::mesh::Format;
+use wavg::mesh::io::{parse_bytes, to_bytes};
 
 fuzz_target!(|data: &[u8]| {
     let Some((&pick, bytes)) = data.split_first() else {

@@ -5,7 +5,8 @@
 use arbitrary::Arbitrary;
 use libfuzzer_sys::fuzz_target;
 use nalgebra::Vector3;
-use wavg::mesh::repair::{RepairOptions, repair_all};
+use wavg::mesh::RepairOptions;
+use wavg::mesh::repair::repair_all;
 use wavg::{TriMesh, ValidMesh};
 
 #[derive(Arbitrary, Debug)]

@@ -419,8 +419,8 @@ fn run_verified(
 fn precompute_embedding(
     mesh: &std::sync::Arc<wavg_mesh::ValidMesh>,
 ) -> Result<std::sync::Arc<wavg_solve::EmbeddedMesh>, CliError> {
-    let opts = wavg_embed::pipeline::PrecomputeOptions::default();
-    let (emb, _) = wavg_embed::pipeline::precompute(mesh, &opts, &wavg_embed::NoProgress)
+    let opts = wavg_embed::PrecomputeOptions::default();
+    let (emb, _) = wavg_embed::precompute(mesh, &opts, &wavg_embed::NoProgress)
         .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))?;
     let coords = emb
         .coords

@@ -113,12 +113,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         mesh.n_faces()
     ));
     let t0 = Instant::now();
-    let opts = wavg_embed::pipeline::PrecomputeOptions {
+    let opts = wavg_embed::PrecomputeOptions {
         landmarks,
         seed: args.seed,
         ..Default::default()
     };
-    let (emb, _) = wavg_embed::pipeline::precompute(&mesh, &opts, &wavg_embed::NoProgress)
+    let (emb, _) = wavg_embed::precompute(&mesh, &opts, &wavg_embed::NoProgress)
         .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))?;
     let precompute_s = t0.elapsed().as_secs_f64();
     let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();

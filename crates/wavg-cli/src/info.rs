@@ -4,8 +4,8 @@
 //! status 2 and a one-line message naming the file and line.
 
 use serde_json::{Value, json};
-use wavg_mesh::io::{self, LoadNotes};
 use wavg_mesh::{Analysis, ProblemKind, TriMesh, analyze, procedural, repair};
+use wavg_mesh::{LoadNotes, io};
 
 use crate::CliError;
 use crate::common::one_line;
@@ -144,7 +144,7 @@ struct RepairOutcome {
 }
 
 fn repair_outcome(mesh: &TriMesh) -> RepairOutcome {
-    let r = repair::repair_all(mesh, &repair::RepairOptions::default());
+    let r = repair::repair_all(mesh, &wavg_mesh::RepairOptions::default());
     let after = analyze(&r.mesh);
     RepairOutcome {
         removed_vertices: r.removed_vertices(),

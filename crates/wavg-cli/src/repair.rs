@@ -4,7 +4,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use wavg_mesh::repair::{RepairOptions, repair_all};
+use wavg_mesh::RepairOptions;
+use wavg_mesh::repair::repair_all;
 use wavg_mesh::{analyze, io};
 
 use crate::CliError;

@@ -7,7 +7,8 @@ use common::{wavg, wavg_ok};
 use std::path::Path;
 
 use serde_json::Value;
-use wavg_mesh::{data, io, procedural};
+use wavg_mesh::{io, procedural};
+use wavg_testdata as data;
 
 fn info_json(path: &Path) -> Value {
     let out = wavg_ok(&["info", "--json", path.to_str().unwrap()]);

@@ -18,10 +18,11 @@
 use std::time::Instant;
 
 use wavg_embed::NoProgress;
-use wavg_embed::decimate::{DecimateOptions, decimate_with_snapshots};
-use wavg_embed::geodesic::{
-    FastMarching, landmark_distances_coarse, landmark_distances_two_level, landmark_distances_with,
+use wavg_embed::internal::{
+    decimate_with_snapshots, landmark_distances_coarse, landmark_distances_two_level,
+    landmark_distances_with,
 };
+use wavg_embed::{DecimateOptions, FastMarching};
 use wavg_mesh::ValidMesh;
 
 fn main() {
@@ -46,7 +47,7 @@ fn main() {
     let decimate_only = args.iter().any(|a| a == "--decimate-only");
     args.retain(|a| a != "--decimate-only");
     let paths: Vec<std::path::PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_mesh::data::require_data_dir("landmark_timing") else {
+        let Some(dir) = wavg_testdata::require_data_dir("landmark_timing") else {
             return;
         };
         ["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"]
@@ -83,7 +84,7 @@ fn main() {
         let t_build = t.elapsed().as_secs_f64();
         let mut ws = fm.workspace();
         if runs_only {
-            let per_run = |fm: &FastMarching, ws: &mut wavg_embed::geodesic::Workspace| {
+            let per_run = |fm: &FastMarching, ws: &mut wavg_embed::Workspace| {
                 // Best on-CPU time of 5 batches of 10 runs (the machine is shared).
                 let mut best = f64::INFINITY;
                 for b in 0..5 {

@@ -25,14 +25,14 @@ fn main() {
         })
         .collect();
     let t = Instant::now();
-    let a = wavg_embed::lsmesh::bilaplacian(&mesh).unwrap();
+    let a = wavg_embed::internal::bilaplacian(&mesh).unwrap();
     println!(
         "bilaplacian {:.3}s nnz {}",
         t.elapsed().as_secs_f64(),
         a.val().len()
     );
     let t = Instant::now();
-    let x = wavg_embed::lsmesh::least_squares_mesh(&mesh, &lm, &vals, 8, &NoProgress).unwrap();
+    let x = wavg_embed::internal::least_squares_mesh(&mesh, &lm, &vals, 8, &NoProgress).unwrap();
     println!(
         "least_squares_mesh {:.3}s ({} vertices) {}",
         t.elapsed().as_secs_f64(),

@@ -1,7 +1,7 @@
 //! Dev experiment: landmark distances of a mesh cached in /tmp, then MDS variants.
 use std::path::Path;
 use wavg_embed::NoProgress;
-use wavg_embed::mds::{MdsOptions, metric_mds};
+use wavg_embed::{MdsOptions, internal::metric_mds};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -26,9 +26,8 @@ fn main() {
             .collect();
         (lm, q)
     } else {
-        let lm = wavg_embed::decimate::select_landmarks(&mesh, &Default::default(), &NoProgress)
-            .unwrap();
-        let q = wavg_embed::geodesic::landmark_distances(&mesh, &lm, &NoProgress).unwrap();
+        let lm = wavg_embed::select_landmarks(&mesh, &Default::default(), &NoProgress).unwrap();
+        let q = wavg_embed::landmark_distances(&mesh, &lm, &NoProgress).unwrap();
         let mut b = (lm.len() as u64).to_le_bytes().to_vec();
         lm.iter().for_each(|l| b.extend(l.to_le_bytes()));
         q.iter().for_each(|x| b.extend(x.to_le_bytes()));
@@ -49,10 +48,11 @@ fn main() {
     )
     .unwrap();
     let t_mds = t.elapsed().as_secs_f64();
-    let x = wavg_embed::lsmesh::least_squares_mesh(&mesh, &lm, &r.points, 8, &NoProgress).unwrap();
-    let fm = wavg_embed::geodesic::FastMarching::new(&mesh);
+    let x =
+        wavg_embed::internal::least_squares_mesh(&mesh, &lm, &r.points, 8, &NoProgress).unwrap();
+    let fm = wavg_embed::FastMarching::new(&mesh);
     let qq =
-        wavg_embed::quality::geodesic_quality(&mesh, &fm, &x, &Default::default(), &NoProgress)
+        wavg_embed::internal::geodesic_quality(&mesh, &fm, &x, &Default::default(), &NoProgress)
             .unwrap();
     println!(
         "{name} tol {tol:e}: mds {t_mds:.2}s it {} stress {:.5} (init {:.5}) p50 {:.4} p90 {:.4}",

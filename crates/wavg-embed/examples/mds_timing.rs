@@ -1,7 +1,7 @@
 //! Times metric MDS on great-circle distances between random sphere points.
 use rand::{Rng, SeedableRng};
 use wavg_embed::NoProgress;
-use wavg_embed::mds::{MdsOptions, metric_mds};
+use wavg_embed::{MdsOptions, internal::metric_mds};
 
 fn main() {
     let n: usize = std::env::args().nth(1).map_or(1000, |s| s.parse().unwrap());
@@ -30,9 +30,9 @@ fn main() {
         })
         .collect();
     let t = std::time::Instant::now();
-    let c = wavg_embed::mds::classical_mds(&q, n, 8).unwrap();
+    let c = wavg_embed::internal::classical_mds(&q, n, 8).unwrap();
     println!("classical {:.3}s", t.elapsed().as_secs_f64());
-    let s0 = wavg_embed::mds::relative_stress(&q, n, &c).unwrap();
+    let s0 = wavg_embed::internal::relative_stress(&q, n, &c).unwrap();
     let t = std::time::Instant::now();
     let r = metric_mds(&q, n, &MdsOptions::default(), &NoProgress).unwrap();
     println!(

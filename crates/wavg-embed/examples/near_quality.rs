@@ -3,8 +3,8 @@
 //!
 //! `cargo run --release -p wavg-embed --example near_quality -- MESH FRACTION A.wavg [B.wavg ...]`
 use std::path::Path;
-use wavg_embed::geodesic::FastMarching;
-use wavg_embed::quality::percentile;
+use wavg_embed::FastMarching;
+use wavg_embed::internal::percentile;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -21,7 +21,7 @@ fn main() {
         args.drain(i..i + 2);
     }
     let paths: Vec<PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_mesh::data::require_data_dir("precompute_table") else {
+        let Some(dir) = wavg_testdata::require_data_dir("precompute_table") else {
             return;
         };
         ["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"]

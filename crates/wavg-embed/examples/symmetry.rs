@@ -9,8 +9,7 @@
 use std::time::Instant;
 
 use wavg_embed::NoProgress;
-use wavg_embed::decimate::{DecimateOptions, select_landmarks};
-use wavg_embed::geodesic::{FastMarching, landmark_rows};
+use wavg_embed::{DecimateOptions, FastMarching, internal::landmark_rows, select_landmarks};
 use wavg_mesh::ValidMesh;
 
 fn main() {
@@ -20,13 +19,13 @@ fn main() {
         target = args[i + 1].parse().expect("--landmarks N");
         args.drain(i..i + 2);
     }
-    let mut near_field = wavg_embed::near_field::NEAR_FIELD_EDGES;
+    let mut near_field = wavg_embed::internal::NEAR_FIELD_EDGES;
     if let Some(i) = args.iter().position(|a| a == "--near-field") {
         near_field = args[i + 1].parse().expect("--near-field EDGES");
         args.drain(i..i + 2);
     }
     let paths: Vec<std::path::PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_mesh::data::require_data_dir("symmetry") else {
+        let Some(dir) = wavg_testdata::require_data_dir("symmetry") else {
             return;
         };
         ["pig.off", "camelhead.off", "fertility.off"]

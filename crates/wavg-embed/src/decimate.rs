@@ -125,7 +125,7 @@ impl Decimated {
 /// ids, ascending. See the module documentation for the rules.
 ///
 /// ```
-/// use wavg_embed::{NoProgress, decimate::{DecimateOptions, select_landmarks}};
+/// use wavg_embed::{DecimateOptions, NoProgress, select_landmarks};
 /// use wavg_mesh::{ValidMesh, procedural};
 /// let mesh = ValidMesh::new(procedural::torus(40, 20, 1.0, 0.3)).unwrap();
 /// let opts = DecimateOptions { target: 100, ..Default::default() };
@@ -144,7 +144,7 @@ pub fn select_landmarks(
 /// Decimates `mesh` to `opts.target` vertices; returns the coarse mesh and the landmarks.
 ///
 /// ```
-/// use wavg_embed::{NoProgress, decimate::{DecimateOptions, decimate}};
+/// use wavg_embed::{DecimateOptions, NoProgress, decimate};
 /// use wavg_mesh::{ValidMesh, procedural};
 /// let mesh = ValidMesh::new(procedural::grid(30, 30, 1.0, 1.0)).unwrap();
 /// let d = decimate(&mesh, &DecimateOptions { target: 50, ..Default::default() }, &NoProgress).unwrap();
@@ -1309,8 +1309,7 @@ mod tests {
             ("meshes/3holes.off", 300),
             ("meshes/torus.obj", 50),
         ] {
-            let Some(path) = wavg_mesh::data::require_data_file("decimate::real_meshes", file)
-            else {
+            let Some(path) = wavg_testdata::require_data_file("decimate::real_meshes", file) else {
                 return;
             };
             let mesh = valid(wavg_mesh::io::load(&path).unwrap());

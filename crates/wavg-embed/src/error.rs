@@ -102,7 +102,7 @@ impl Progress for NoProgress {
 }
 
 /// Returns `Err(Cancelled)` if the sink asks to stop.
-pub fn check_cancel(p: &dyn Progress) -> Result<(), EmbedError> {
+pub(crate) fn check_cancel(p: &dyn Progress) -> Result<(), EmbedError> {
     if p.cancelled() {
         Err(EmbedError::Cancelled)
     } else {

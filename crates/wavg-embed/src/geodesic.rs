@@ -75,10 +75,10 @@ use crate::near_field::{NearField, NearScratch};
 /// Vertex count of the intermediate mesh for landmark geodesics on large meshes (see the
 /// module documentation), the pipeline's default: about 2.5 ms per fast-marching run.
 /// 15 000 costs a third more time for about 0.1-0.2 points less mean error.
-pub const DEFAULT_GEODESIC_VERTICES: usize = 10_000;
+pub(crate) const DEFAULT_GEODESIC_VERTICES: usize = 10_000;
 
 /// How many triangles the obtuse-angle unfolding may cross before giving up.
-pub const MAX_UNFOLD_STEPS: usize = 40;
+pub(crate) const MAX_UNFOLD_STEPS: usize = 40;
 
 /// One update that freezing a vertex `v` triggers on a neighbour `x`.
 ///
@@ -99,7 +99,7 @@ struct Entry {
 /// any number of threads.
 ///
 /// ```
-/// use wavg_embed::geodesic::FastMarching;
+/// use wavg_embed::FastMarching;
 /// use wavg_mesh::{ValidMesh, procedural};
 /// let mesh = ValidMesh::new(procedural::grid(20, 20, 1.0, 1.0)).unwrap();
 /// let fm = FastMarching::new(&mesh);
@@ -296,7 +296,7 @@ impl FastMarching {
     /// marching at 16 edge lengths on real meshes, 1.1-1.5x at 8) and is exact further out.
     ///
     /// ```
-    /// use wavg_embed::geodesic::FastMarching;
+    /// use wavg_embed::FastMarching;
     /// use wavg_mesh::{ValidMesh, procedural};
     /// let mesh = ValidMesh::new(procedural::grid(40, 40, 1.0, 1.0)).unwrap();
     /// let fm = FastMarching::new(&mesh).with_near_field_edges(16.0);
@@ -668,7 +668,7 @@ fn across(mesh: &ValidMesh, topo: &wavg_mesh::Topology, face: u32, p: u32, r: u3
 /// For many runs on one mesh, build a [`FastMarching`] once instead.
 ///
 /// ```
-/// use wavg_embed::geodesic::distances_from;
+/// use wavg_embed::distances_from;
 /// use wavg_mesh::{ValidMesh, procedural};
 /// let sphere = ValidMesh::new(procedural::icosphere(4)).unwrap();
 /// let d = distances_from(&sphere, &[0]);
@@ -736,7 +736,7 @@ pub fn landmark_distances_with(
 ///
 /// ```
 /// use wavg_embed::NoProgress;
-/// use wavg_embed::geodesic::{FastMarching, landmark_rows};
+/// use wavg_embed::{FastMarching, internal::landmark_rows};
 /// use wavg_mesh::{ValidMesh, procedural};
 /// let mesh = ValidMesh::new(procedural::icosphere(3)).unwrap();
 /// let rows = landmark_rows(&FastMarching::new(&mesh), &[0, 5, 100], &NoProgress).unwrap();
@@ -784,7 +784,7 @@ pub fn landmark_rows(
 
 /// Landmark pairs closer than this many mean edge lengths of the coarse mesh get their
 /// distance from the fine mesh in [`landmark_distances_two_level`].
-pub const NEAR_PAIR_RADIUS_EDGES: f64 = 8.0;
+pub(crate) const NEAR_PAIR_RADIUS_EDGES: f64 = 8.0;
 
 /// [`landmark_distances`] computed on a coarser mesh, to save time on large meshes: the
 /// mesh is first decimated (with the landmarks locked, so they all survive) down to
@@ -812,7 +812,7 @@ pub fn landmark_distances_coarse(
 /// Landmark distances from two resolutions: every pair from fast marching on `coarse` (a
 /// decimation of the fine mesh containing all landmarks, for example a snapshot of the
 /// landmark decimation, [`crate::decimate::decimate_with_snapshots`]), then pairs closer
-/// than [`NEAR_PAIR_RADIUS_EDGES`] coarse edge lengths replaced by fine-mesh values from
+/// than `NEAR_PAIR_RADIUS_EDGES` (8) coarse edge lengths replaced by fine-mesh values from
 /// short radius-limited runs on `fine` (the coarse mesh's few large triangles between
 /// close landmarks give errors of 20-80% there, and MDS weights close pairs most). The
 /// fine runs cost little: each covers only a small disc.
@@ -832,7 +832,7 @@ pub fn landmark_distances_two_level(
 /// `radius` of each other on `fine` with fine-mesh fast-marching distances (averaged over
 /// both directions when both runs reach the other landmark). Returns the number of pairs
 /// replaced.
-pub fn refine_near_pairs(
+pub(crate) fn refine_near_pairs(
     fine: &FastMarching,
     landmarks: &[u32],
     radius: f64,
@@ -889,7 +889,7 @@ pub fn refine_near_pairs(
 /// [`landmark_distances`] on an already decimated mesh only (no fine-mesh correction of
 /// close pairs, see [`landmark_distances_two_level`]); `landmarks` are original vertex ids
 /// and must all be vertices of `coarse`.
-pub fn landmark_distances_decimated(
+pub(crate) fn landmark_distances_decimated(
     coarse: &Decimated,
     landmarks: &[u32],
     progress: &dyn Progress,
@@ -1290,8 +1290,7 @@ mod tests {
             "meshes/camelhead.off",
             "meshes/fertility.off",
         ] {
-            let Some(path) =
-                wavg_mesh::data::require_data_file("geodesic::real_mesh_symmetry", file)
+            let Some(path) = wavg_testdata::require_data_file("geodesic::real_mesh_symmetry", file)
             else {
                 return;
             };

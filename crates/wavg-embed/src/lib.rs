@@ -15,17 +15,48 @@
 //! assert_eq!(report.dim, 8);
 //! ```
 
-pub mod decimate;
-pub mod error;
+#![deny(unreachable_pub)]
+#![forbid(unsafe_code)]
+
+mod decimate;
+mod embedding;
+mod error;
 pub mod file;
-pub mod geodesic;
-pub mod lsmesh;
-pub mod mds;
-pub mod near_field;
-pub mod pipeline;
-pub mod quality;
+mod geodesic;
+mod lsmesh;
+mod mds;
+mod near_field;
+mod pipeline;
+mod quality;
+
+// The precomputation and its settings.
 pub use decimate::{DecimateOptions, Decimated, decimate, select_landmarks};
-pub use error::{EmbedError, NoProgress, Progress, Stage};
-pub use file::{Embedding, EmbeddingParams};
-pub use geodesic::{FastMarching, distances_from, landmark_distances};
+pub use mds::MdsOptions;
 pub use pipeline::{PrecomputeOptions, Report, StageSeconds, precompute};
+
+// Its result (saved and loaded by the `file` module).
+pub use embedding::{Embedding, EmbeddingParams};
+
+// Geodesic distances.
+pub use geodesic::{FastMarching, Workspace, distances_from, landmark_distances};
+
+// Progress, cancellation and errors.
+pub use error::{EmbedError, NoProgress, Progress, Stage};
+
+/// The precomputation's individual stages, for this workspace's experiments, benchmarks and
+/// tests.
+///
+/// **Unstable**: not part of the public API; anything here may change or disappear in any
+/// release.
+#[doc(hidden)]
+pub mod internal {
+    pub use crate::decimate::decimate_with_snapshots;
+    pub use crate::geodesic::{
+        landmark_distances_coarse, landmark_distances_two_level, landmark_distances_with,
+        landmark_rows,
+    };
+    pub use crate::lsmesh::{bilaplacian, least_squares_mesh};
+    pub use crate::mds::{MdsResult, classical_mds, metric_mds, relative_stress, smacof};
+    pub use crate::near_field::NEAR_FIELD_EDGES;
+    pub use crate::quality::{Quality, QualityOptions, QualityPairs, geodesic_quality, percentile};
+}

@@ -69,7 +69,7 @@ fn fixed_mask(n: usize, landmarks: &[u32]) -> Result<Vec<bool>, EmbedError> {
 /// The factored least-squares-mesh system of a mesh and a landmark set; [`Self::solve`]
 /// then extends any landmark values. The factorisation depends only on the mesh and the
 /// landmarks, so it can run before (or while) the landmark values are computed.
-pub struct LsMeshSolver {
+pub(crate) struct LsMeshSolver {
     n: usize,
     landmarks: Vec<u32>,
     /// Free vertex ids, in system order.
@@ -86,7 +86,7 @@ impl LsMeshSolver {
     /// The mesh should be connected (otherwise a component without landmarks makes the
     /// system singular, reported as [`EmbedError::Numerical`]). Progress is reported as
     /// [`Stage::LsMesh`] up to 0.9.
-    pub fn new(
+    pub(crate) fn new(
         mesh: &ValidMesh,
         landmarks: &[u32],
         progress: &dyn Progress,
@@ -193,7 +193,7 @@ impl LsMeshSolver {
     /// One point per vertex, equal to `values[k]` at vertex `landmarks[k]` and minimising the
     /// bi-Laplacian energy elsewhere. Only the first `dim` entries of each value are used;
     /// the rest of the output is zero.
-    pub fn solve(
+    pub(crate) fn solve(
         &self,
         values: &[[f64; MAX_DIM]],
         dim: usize,
@@ -259,11 +259,11 @@ impl LsMeshSolver {
 /// `dim` entries of each value are used; the rest of the output is zero.
 ///
 /// The mesh should be connected (otherwise a component without landmarks makes the system
-/// singular, reported as [`EmbedError::Numerical`]). See [`LsMeshSolver`] to factor once
-/// and solve several times.
+/// singular, reported as [`EmbedError::Numerical`]). The crate-internal `LsMeshSolver` factors once
+/// and solves several times.
 ///
 /// ```
-/// use wavg_embed::lsmesh::least_squares_mesh;
+/// use wavg_embed::internal::least_squares_mesh;
 /// use wavg_embed::NoProgress;
 /// use wavg_mesh::{ValidMesh, procedural};
 /// let mesh = ValidMesh::new(procedural::icosphere(2)).unwrap();

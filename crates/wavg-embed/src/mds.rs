@@ -591,7 +591,7 @@ fn smacof_normalised(
 /// the matrix is symmetrised by averaging).
 ///
 /// ```
-/// use wavg_embed::mds::{MdsOptions, metric_mds};
+/// use wavg_embed::{MdsOptions, internal::metric_mds};
 /// use wavg_embed::NoProgress;
 /// // Four corners of a unit square.
 /// let p: [[f64; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];

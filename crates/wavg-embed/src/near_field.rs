@@ -38,7 +38,7 @@ type V2 = Vector2<f64>;
 /// Radius of the exact near field, in mean edge lengths of the mesh.
 ///
 /// ```
-/// use wavg_embed::geodesic::distances_from;
+/// use wavg_embed::distances_from;
 /// use wavg_mesh::{ValidMesh, procedural};
 /// // On a flat grid, fast marching is exact (Euclidean) within the near field of the
 /// // source: 3 x 2 cells away is well inside 8 edge lengths.
@@ -49,7 +49,7 @@ type V2 = Vector2<f64>;
 pub const NEAR_FIELD_EDGES: f64 = 8.0;
 
 /// Most pseudo-sources followed per source (a guard on meshes with many saddles).
-pub const PSEUDO_SOURCES: usize = 4096;
+pub(crate) const PSEUDO_SOURCES: usize = 4096;
 
 /// Most windows queued per source (a guard on the memory of one run: 27 MB).
 const MAX_WINDOWS: usize = 1 << 18;
@@ -57,7 +57,7 @@ const MAX_WINDOWS: usize = 1 << 18;
 /// Once this many vertices are reached the search stops at the distance it has got to,
 /// so a source among triangles much smaller than the mean (where the radius would hold
 /// many more) costs no more than an ordinary one; its exact zone is just smaller.
-pub const NEAR_FIELD_VERTICES: usize = 2048;
+pub(crate) const NEAR_FIELD_VERTICES: usize = 2048;
 
 /// Windows are not followed through more triangles than this (a guard; the radius stops
 /// them much earlier on any reasonable mesh).
@@ -777,7 +777,7 @@ mod tests {
     fn shadows_only_changes_nothing() {
         let mut meshes = vec![saddle_surface()];
         for file in ["meshes/camelhead.off", "meshes/fertility.off"] {
-            if let Some(path) = wavg_mesh::data::require_data_file("near_field::shadows", file) {
+            if let Some(path) = wavg_testdata::require_data_file("near_field::shadows", file) {
                 meshes.push(ValidMesh::new(wavg_mesh::io::load(&path).unwrap()).unwrap());
             }
         }

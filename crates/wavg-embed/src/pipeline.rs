@@ -6,7 +6,7 @@ use wavg_mesh::ValidMesh;
 
 use crate::decimate::{DecimateOptions, decimate_with_snapshots, select_landmarks};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
-use crate::file::{Embedding, EmbeddingParams, MAX_DIM};
+use crate::file::MAX_DIM;
 use crate::geodesic::{
     FastMarching, landmark_distances_decimated, landmark_distances_two_level,
     landmark_distances_with,
@@ -14,6 +14,7 @@ use crate::geodesic::{
 use crate::lsmesh::LsMeshSolver;
 use crate::mds::{MdsOptions, metric_mds};
 use crate::quality::{QualityOptions, QualityPairs};
+use crate::{Embedding, EmbeddingParams};
 
 /// Settings of [`precompute`].
 #[derive(Clone, Debug, PartialEq)]
@@ -96,7 +97,7 @@ pub struct Report {
     pub geodesic_mesh_vertices: usize,
     /// Embedding dimension.
     pub dim: usize,
-    /// Final MDS stress (RMS relative landmark distance error, see [`crate::mds`]).
+    /// Final MDS stress (RMS relative landmark distance error).
     pub stress: f64,
     /// Stress of the classical-MDS start.
     pub initial_stress: f64,
@@ -123,7 +124,7 @@ pub struct Report {
 /// stops at the next check and returns [`EmbedError::Cancelled`].
 ///
 /// ```
-/// use wavg_embed::pipeline::{PrecomputeOptions, precompute};
+/// use wavg_embed::{PrecomputeOptions, precompute};
 /// use wavg_embed::NoProgress;
 /// use wavg_mesh::{ValidMesh, procedural};
 /// let mesh = ValidMesh::new(procedural::torus(48, 24, 1.0, 0.4)).unwrap();

@@ -213,8 +213,8 @@ impl QualityPairs {
 /// entries are used; unused dimensions must be zero).
 ///
 /// ```
-/// use wavg_embed::geodesic::FastMarching;
-/// use wavg_embed::quality::{QualityOptions, geodesic_quality};
+/// use wavg_embed::FastMarching;
+/// use wavg_embed::internal::{QualityOptions, geodesic_quality};
 /// use wavg_embed::NoProgress;
 /// use wavg_mesh::{ValidMesh, procedural};
 /// // A flat grid embedded as itself: geodesic = Euclidean, small error.

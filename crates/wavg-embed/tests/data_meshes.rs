@@ -3,7 +3,8 @@
 //! meets the targets (geodesic relative error p50 <= 0.05, p90 <= 0.15).
 
 use wavg_embed::{NoProgress, PrecomputeOptions, file, precompute};
-use wavg_mesh::{ValidMesh, data, io};
+use wavg_mesh::{ValidMesh, io};
+use wavg_testdata as data;
 
 fn load(test: &str, rel: &str) -> Option<ValidMesh> {
     let path = data::require_data_file(test, rel)?;
@@ -66,8 +67,8 @@ fn pig_meets_the_quality_targets() {
 
 #[test]
 fn least_squares_mesh_of_own_positions_stays_close_on_real_meshes() {
-    use wavg_embed::decimate::{DecimateOptions, select_landmarks};
-    use wavg_embed::lsmesh::least_squares_mesh;
+    use wavg_embed::internal::least_squares_mesh;
+    use wavg_embed::{DecimateOptions, select_landmarks};
     for rel in [
         "meshes/pig.off",
         "meshes/3holes.off",

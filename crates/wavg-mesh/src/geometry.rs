@@ -1,5 +1,5 @@
 //! Geometric quantities: areas, normals, edge lengths, the cotangent stiffness and lumped
-//! mass matrices, and surface points.
+//! mass matrices.
 //!
 //! These take a `&TriMesh` so that they also serve repairs and diagnostics, but they assume
 //! face indices are in range (they index positions directly and panic otherwise): pass a
@@ -9,7 +9,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use nalgebra::Vector3;
 
 use crate::error::MeshError;
-use crate::mesh::{FaceId, TriMesh};
+use crate::mesh::TriMesh;
 
 /// Area of triangle `f`.
 pub fn face_area(mesh: &TriMesh, f: usize) -> f64 {
@@ -155,54 +155,4 @@ pub fn lumped_mass_matrix(mesh: &TriMesh) -> Result<SparseColMat<usize, f64>, Me
         .collect();
     SparseColMat::try_new_from_triplets(m.len(), m.len(), &trip)
         .map_err(|e| MeshError::InvalidArgument(format!("cannot assemble mass matrix: {e:?}")))
-}
-
-/// A point on the surface: a face and barycentric coordinates (summing to 1) with respect
-/// to its corners in order.
-///
-/// ```
-/// use wavg_mesh::{SurfacePoint, procedural};
-/// let m = procedural::grid(1, 1, 1.0, 1.0);
-/// let p = SurfacePoint::new(0, [1.0 / 3.0; 3]);
-/// assert!((p.position(&m).z).abs() < 1e-12);
-/// let x: f64 = p.interpolate(&m, &[0.0, 3.0, 6.0, 9.0]);
-/// assert!(x > 0.0);
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SurfacePoint {
-    /// The face.
-    pub face: FaceId,
-    /// Barycentric coordinates with respect to the face's corners.
-    pub bary: [f64; 3],
-}
-
-impl SurfacePoint {
-    /// A surface point.
-    pub fn new(face: FaceId, bary: [f64; 3]) -> Self {
-        Self { face, bary }
-    }
-
-    /// The point at corner `corner` of `face`.
-    pub fn at_corner(face: FaceId, corner: usize) -> Self {
-        let mut bary = [0.0; 3];
-        bary[corner.min(2)] = 1.0;
-        Self { face, bary }
-    }
-
-    /// Its 3-D position on `mesh`.
-    pub fn position(&self, mesh: &TriMesh) -> Vector3<f64> {
-        let p = mesh.corners(self.face as usize);
-        p[0] * self.bary[0] + p[1] * self.bary[1] + p[2] * self.bary[2]
-    }
-
-    /// Linear interpolation of any per-vertex attribute (positions, UVs, embeddings, ...).
-    pub fn interpolate<T>(&self, mesh: &TriMesh, values: &[T]) -> T
-    where
-        T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
-    {
-        let t = mesh.triangles[self.face as usize];
-        values[t[0] as usize] * self.bary[0]
-            + values[t[1] as usize] * self.bary[1]
-            + values[t[2] as usize] * self.bary[2]
-    }
 }

@@ -13,7 +13,7 @@
 //! A file from a scanner, end to end ([`io::load`] reads OBJ/OFF/PLY, optionally `.gz`):
 //!
 //! ```
-//! use wavg_mesh::{ValidMesh, analyze, io, repair};
+//! use wavg_mesh::{RepairOptions, ValidMesh, analyze, io, repair};
 //! # let dir = tempfile::tempdir().unwrap();
 //! # let path = dir.path().join("scan.off");
 //! # std::fs::write(&path, "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n9 9 9\n\
@@ -23,29 +23,43 @@
 //! if !report.is_valid() {
 //!     eprintln!("{report}"); // duplicate face 2, unreferenced vertex 4
 //! }
-//! let fixed = repair::repair_all(&raw, &repair::RepairOptions::default());
+//! let fixed = repair::repair_all(&raw, &RepairOptions::default());
 //! let mesh = ValidMesh::new(fixed.mesh)?;
 //! assert_eq!((mesh.n_vertices(), mesh.n_faces()), (4, 2));
 //! # Ok::<(), wavg_mesh::MeshError>(())
 //! ```
 
-pub mod analyze;
-pub mod data;
-pub mod error;
+#![deny(unreachable_pub)]
+#![forbid(unsafe_code)]
+
+mod analyze;
+mod error;
 pub mod geometry;
 pub mod io;
-pub mod mesh;
-pub mod problem;
+mod mesh;
+mod point;
+mod problem;
 pub mod procedural;
 pub mod repair;
 pub mod subdivide;
-pub mod topology;
-pub mod valid;
+mod topology;
+mod valid;
 
-pub use analyze::{Analysis, MeshStats, analyze};
-pub use error::MeshError;
-pub use geometry::SurfacePoint;
+// Meshes and their validation.
 pub use mesh::{FaceId, NONE, TexCoords, TriMesh, VertexId};
-pub use problem::{Problem, ProblemKind, ValidationReport};
 pub use topology::Topology;
 pub use valid::ValidMesh;
+
+// Diagnostics.
+pub use analyze::{Analysis, MeshStats, ZERO_AREA_RELATIVE_TOLERANCE, analyze};
+pub use problem::{Problem, ProblemKind, ProblemSummary, ValidationReport};
+
+// Points on the surface.
+pub use point::SurfacePoint;
+
+// Files and repairs (the functions live in the `io` and `repair` modules).
+pub use io::format::{Format, LoadNotes};
+pub use repair::types::{RepairOptions, Repaired};
+
+// Errors.
+pub use error::MeshError;

@@ -5,8 +5,9 @@
 use std::path::Path;
 
 use wavg_mesh::ProblemKind::{self, *};
-use wavg_mesh::repair::{self, RepairOptions};
-use wavg_mesh::{MeshError, ValidMesh, analyze, data, io};
+use wavg_mesh::{MeshError, ValidMesh, analyze, io};
+use wavg_mesh::{RepairOptions, repair};
+use wavg_testdata as data;
 
 enum Expect {
     /// Unparseable: a parse error at this line.
@@ -244,7 +245,7 @@ fn damaged_bad_files_never_panic() {
             continue;
         }
         let bytes = std::fs::read(&path).unwrap();
-        let (format, _) = io::Format::from_path(&path).unwrap();
+        let (format, _) = wavg_mesh::Format::from_path(&path).unwrap();
         let n = bytes.len();
         for k in 0..40usize {
             let cut = n * k / 40;

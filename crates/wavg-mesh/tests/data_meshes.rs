@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use wavg_mesh::{ValidMesh, data, io};
+use wavg_mesh::{ValidMesh, io};
+use wavg_testdata as data;
 
 /// A README table row: file, V, triangles after fan triangulation (README's F is the
 /// polygon count for polygon meshes: spot_control 4x3 + 160x4 + 16x5 -> 372 triangles),

@@ -5,7 +5,8 @@
 use std::io::Write;
 use std::path::Path;
 
-use wavg_mesh::io::{Format, parse_bytes};
+use wavg_mesh::Format;
+use wavg_mesh::io::parse_bytes;
 use wavg_mesh::{MeshError, TriMesh, ValidMesh, io};
 
 fn parse(bytes: &[u8], format: Format) -> Result<TriMesh, MeshError> {

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use proptest::prelude::*;
-use wavg_mesh::io::{self, Format, LoadNotes};
+use wavg_mesh::{Format, LoadNotes, io};
 use wavg_mesh::{MeshError, ProblemKind, TriMesh, analyze};
 
 fn parse(text: &str, format: Format) -> Result<(TriMesh, LoadNotes), MeshError> {

@@ -6,7 +6,7 @@ use nalgebra::{Vector2, Vector3};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use wavg_mesh::io::{self, Format};
+use wavg_mesh::{Format, io};
 use wavg_mesh::{TexCoords, TriMesh, ValidMesh, analyze, geometry, procedural};
 
 /// `y = L x` from the compressed columns (no dense copy needed).

@@ -2,8 +2,8 @@
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
-use wavg_mesh::repair::{self, RepairOptions, Repaired};
 use wavg_mesh::{NONE, ProblemKind, TexCoords, TriMesh, ValidMesh, analyze, procedural};
+use wavg_mesh::{RepairOptions, Repaired, repair};
 
 /// Every face of the result is the mapped original face, every position is the original's,
 /// and the two vertex maps are consistent.

@@ -6,8 +6,9 @@ mod common;
 use std::sync::Arc;
 
 use common::*;
-use wavg_mesh::{ValidMesh, data, io};
+use wavg_mesh::{ValidMesh, io};
 use wavg_project::{EmbeddedMesh, Projector};
+use wavg_testdata as data;
 
 fn check(rel: &str, queries: usize, brute: usize) {
     let Some(path) = data::require_data_file("wavg-project real meshes", rel) else {

@@ -82,11 +82,10 @@ fn main() {
         // `mds:MAX_ITERATIONS:TOLERANCE`: precompute with these SMACOF settings.
         Some(spec) if spec.starts_with("mds:") => {
             let f: Vec<&str> = spec.split(':').collect();
-            let mut opts = wavg_embed::pipeline::PrecomputeOptions::default();
+            let mut opts = wavg_embed::PrecomputeOptions::default();
             opts.mds.max_iterations = f[1].parse().unwrap();
             opts.mds.tolerance = f[2].parse().unwrap();
-            let (e, r) =
-                wavg_embed::pipeline::precompute(&mesh, &opts, &wavg_embed::NoProgress).unwrap();
+            let (e, r) = wavg_embed::precompute(&mesh, &opts, &wavg_embed::NoProgress).unwrap();
             println!(
                 "  precomputed: MDS {} iterations (converged {}), stress {:.5}",
                 r.mds_iterations, r.mds_converged, r.stress

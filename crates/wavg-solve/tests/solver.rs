@@ -75,7 +75,7 @@ fn round_trips_on_procedural_meshes() {
 #[test]
 fn round_trips_on_a_real_mesh() {
     let Some(path) =
-        wavg_mesh::data::require_data_file("round_trips_on_a_real_mesh", "meshes/pig.off")
+        wavg_testdata::require_data_file("round_trips_on_a_real_mesh", "meshes/pig.off")
     else {
         return;
     };
@@ -479,12 +479,11 @@ fn round_trips_with_a_geodesic_embedding() {
         ("torus", procedural::torus(64, 24, 1.0, 0.35), 60),
     ] {
         let mesh = Arc::new(ValidMesh::new(mesh).unwrap());
-        let opts = wavg_embed::pipeline::PrecomputeOptions {
+        let opts = wavg_embed::PrecomputeOptions {
             landmarks: 300,
             ..Default::default()
         };
-        let (e, _) =
-            wavg_embed::pipeline::precompute(&mesh, &opts, &wavg_embed::NoProgress).unwrap();
+        let (e, _) = wavg_embed::precompute(&mesh, &opts, &wavg_embed::NoProgress).unwrap();
         let coords = e
             .coords
             .iter()

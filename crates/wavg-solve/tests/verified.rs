@@ -130,7 +130,7 @@ fn verified_weights_round_trip_on_a_thin_torus() {
 /// with the real geodesic embedding (the precomputation pipeline).
 #[test]
 fn verified_weights_round_trip_on_a_real_mesh() {
-    let Some(path) = wavg_mesh::data::require_data_file(
+    let Some(path) = wavg_testdata::require_data_file(
         "verified_weights_round_trip_on_a_real_mesh",
         "meshes/pig.off",
     ) else {
@@ -152,9 +152,9 @@ fn verified_weights_round_trip_on_a_real_mesh() {
     );
 
     let mesh = Arc::new(ValidMesh::new(mesh).unwrap());
-    let (e, _) = wavg_embed::pipeline::precompute(
+    let (e, _) = wavg_embed::precompute(
         &mesh,
-        &wavg_embed::pipeline::PrecomputeOptions::default(),
+        &wavg_embed::PrecomputeOptions::default(),
         &wavg_embed::NoProgress,
     )
     .unwrap();

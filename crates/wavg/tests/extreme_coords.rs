@@ -108,7 +108,7 @@ fn generated_mesh_quality_is_scale_and_translation_invariant() {
 
 #[test]
 fn real_mesh_quality_is_scale_and_translation_invariant() {
-    let Some(path) = wavg::mesh::data::require_data_file("extreme_coords", "meshes/pig.off") else {
+    let Some(path) = wavg_testdata::require_data_file("extreme_coords", "meshes/pig.off") else {
         return;
     };
     let mesh = wavg::mesh::io::load(&path).unwrap();

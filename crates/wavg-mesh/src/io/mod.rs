@@ -19,6 +19,7 @@
 //! ```
 
 mod atomic;
+pub(crate) mod format;
 mod obj;
 mod off;
 mod ply;
@@ -28,76 +29,10 @@ use std::io::{Read, Write};
 use std::path::Path;
 
 pub use atomic::write_atomic;
+use format::{Format, LoadNotes};
 
 use crate::error::MeshError;
 use crate::mesh::TriMesh;
-
-/// Facts about a file that the [`TriMesh`] does not keep, for diagnostics (`wavg info`).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct LoadNotes {
-    /// The format that was read.
-    pub format: Option<Format>,
-    /// Polygons read from the file, before fan triangulation.
-    pub polygons: usize,
-    /// Polygons with more than three corners (they were fan-triangulated).
-    pub non_triangles: usize,
-    /// Faces with fewer than three corners (OBJ 1- and 2-index faces), skipped.
-    pub skipped_faces: usize,
-    /// Texture coordinates were present on some but not all faces and were dropped.
-    pub uv_dropped: bool,
-}
-
-/// The mesh file formats wavg reads and writes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Format {
-    /// Wavefront OBJ (positions, texture coordinates, polygons).
-    Obj,
-    /// Object File Format (ASCII).
-    Off,
-    /// Stanford PLY (ASCII or binary).
-    Ply,
-}
-
-impl Format {
-    /// The format for a path from its extension (a trailing `.gz` is looked through),
-    /// and whether the file is gzip-compressed.
-    ///
-    /// ```
-    /// use wavg_mesh::io::Format;
-    /// use std::path::Path;
-    /// assert_eq!(Format::from_path(Path::new("a/b.off.gz")).unwrap(), (Format::Off, true));
-    /// assert!(Format::from_path(Path::new("b.stl")).is_err());
-    /// ```
-    pub fn from_path(path: &Path) -> Result<(Format, bool), MeshError> {
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        let (stem, gz) = match name.strip_suffix(".gz") {
-            Some(s) => (s.to_string(), true),
-            None => (name.clone(), false),
-        };
-        let ext = Path::new(&stem)
-            .extension()
-            .map(|e| e.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let format = match ext.as_str() {
-            "obj" => Format::Obj,
-            "off" => Format::Off,
-            "ply" => Format::Ply,
-            _ => {
-                return Err(MeshError::Unsupported {
-                    path: path.to_path_buf(),
-                    message: format!(
-                        "unknown extension {:?} (expected .obj, .off or .ply, optionally .gz)",
-                        ext
-                    ),
-                });
-            }
-        };
-        Ok((format, gz))
-    }
-}
 
 /// Reads a mesh file, choosing the format from the extension (`.obj`, `.off`, `.ply`,
 /// each optionally followed by `.gz`).

@@ -6,7 +6,7 @@
 //! keep per-corner texture coordinates aligned with the faces they keep.
 //!
 //! ```
-//! use wavg_mesh::{TriMesh, ValidMesh, repair};
+//! use wavg_mesh::{RepairOptions, TriMesh, ValidMesh, repair};
 //! use nalgebra::Vector3;
 //! // Two triangles of a square written as a soup: 6 vertices, 4 distinct positions.
 //! let p = |x: f64, y: f64| Vector3::new(x, y, 0.0);
@@ -14,7 +14,7 @@
 //!     vec![p(0., 0.), p(1., 0.), p(1., 1.), p(0., 0.), p(1., 1.), p(0., 1.)],
 //!     vec![[0, 1, 2], [3, 4, 5]],
 //! );
-//! let r = repair::repair_all(&soup, &repair::RepairOptions::default());
+//! let r = repair::repair_all(&soup, &RepairOptions::default());
 //! assert_eq!(r.mesh.n_vertices(), 4);
 //! assert_eq!(r.vertex_map, vec![0, 1, 2, 5]); // new -> original
 //! assert_eq!(r.new_vertex(4), Some(2)); // original 4 was welded onto original 2
@@ -24,85 +24,12 @@
 use std::collections::HashMap;
 
 use crate::analyze::is_degenerate;
-use crate::mesh::{FaceId, NONE, TriMesh, VertexId};
+use crate::mesh::{NONE, TriMesh};
 use crate::topology::face_components;
 
-/// A repaired mesh and how its indices relate to the input's.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Repaired {
-    /// The repaired mesh.
-    pub mesh: TriMesh,
-    /// For each new vertex, the original vertex it comes from (for welded vertices: the
-    /// lowest original index of the group).
-    pub vertex_map: Vec<VertexId>,
-    /// For each original vertex, its new index, or [`NONE`] when it was dropped.
-    pub original_to_new: Vec<VertexId>,
-    /// For each new face, the original face it comes from.
-    pub face_map: Vec<FaceId>,
-}
+pub(crate) mod types;
 
-impl Repaired {
-    /// The new index of original vertex `v`, if it survived.
-    pub fn new_vertex(&self, v: VertexId) -> Option<VertexId> {
-        self.original_to_new
-            .get(v as usize)
-            .copied()
-            .filter(|&n| n != NONE)
-    }
-
-    /// Number of original vertices that were merged into others or dropped.
-    pub fn removed_vertices(&self) -> usize {
-        self.original_to_new.len() - self.vertex_map.len()
-    }
-
-    /// Number of original faces that were dropped.
-    pub fn removed_faces(&self, original_faces: usize) -> usize {
-        original_faces - self.face_map.len()
-    }
-
-    /// The identity repair of `mesh`.
-    fn identity(mesh: &TriMesh) -> Self {
-        let nv = mesh.n_vertices() as u32;
-        Self {
-            mesh: mesh.clone(),
-            vertex_map: (0..nv).collect(),
-            original_to_new: (0..nv).collect(),
-            face_map: (0..mesh.n_faces() as u32).collect(),
-        }
-    }
-
-    /// Applies `next` (a repair of `self.mesh`) on top of `self`: maps compose so that
-    /// they still refer to the original input.
-    fn then(self, next: Repaired) -> Repaired {
-        let vertex_map = next
-            .vertex_map
-            .iter()
-            .map(|&v| self.vertex_map[v as usize])
-            .collect();
-        let original_to_new = self
-            .original_to_new
-            .iter()
-            .map(|&v| {
-                if v == NONE {
-                    NONE
-                } else {
-                    next.original_to_new[v as usize]
-                }
-            })
-            .collect();
-        let face_map = next
-            .face_map
-            .iter()
-            .map(|&f| self.face_map[f as usize])
-            .collect();
-        Repaired {
-            mesh: next.mesh,
-            vertex_map,
-            original_to_new,
-            face_map,
-        }
-    }
-}
+use types::{RepairOptions, Repaired};
 
 /// Keeps the faces for which `keep` is true (vertices unchanged).
 fn filter_faces(mesh: &TriMesh, keep: impl Fn(usize) -> bool) -> Repaired {
@@ -330,36 +257,6 @@ pub fn keep_largest_component(mesh: &TriMesh) -> Repaired {
     let faces = filter_faces(mesh, |f| Some(comps.of_face[f] as usize) == best);
     let verts = drop_unreferenced_vertices(&faces.mesh);
     faces.then(verts)
-}
-
-/// Which repairs [`repair_all`] applies, in this order: weld, drop degenerate faces, drop
-/// duplicate faces, keep the largest component, drop unreferenced vertices.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RepairOptions {
-    /// Weld vertices closer than this distance (`Some(0.0)`: identical positions only).
-    pub weld: Option<f64>,
-    /// Drop out-of-range, repeated-index, non-finite and zero-area faces.
-    pub drop_degenerate_faces: bool,
-    /// Drop faces repeating an earlier face's vertices.
-    pub drop_duplicate_faces: bool,
-    /// Keep only the largest connected component.
-    pub keep_largest_component: bool,
-    /// Drop vertices no face uses.
-    pub drop_unreferenced_vertices: bool,
-}
-
-impl Default for RepairOptions {
-    /// Everything that cannot lose surface: exact weld, drop degenerate and duplicate
-    /// faces and unreferenced vertices; components are kept.
-    fn default() -> Self {
-        Self {
-            weld: Some(0.0),
-            drop_degenerate_faces: true,
-            drop_duplicate_faces: true,
-            keep_largest_component: false,
-            drop_unreferenced_vertices: true,
-        }
-    }
 }
 
 /// Applies the selected repairs in order, composing the index maps so that they refer to

@@ -1,4 +1,4 @@
-//! Locating the shared test-mesh folder (`$WAVG_DATA_DIR`, default `../shared/data` beside
+//! Test support, not published: locating the shared test-mesh folder (`$WAVG_DATA_DIR`, default `../shared/data` beside
 //! the repository) for tests and benchmarks. The meshes are never copied into the repository.
 
 use std::path::PathBuf;
@@ -6,7 +6,7 @@ use std::path::PathBuf;
 /// The data folder if it exists: `$WAVG_DATA_DIR`, else `<repository>/../shared/data`.
 ///
 /// ```
-/// if let Some(dir) = wavg_mesh::data::data_dir() {
+/// if let Some(dir) = wavg_testdata::data_dir() {
 ///     assert!(dir.is_dir());
 /// }
 /// ```
