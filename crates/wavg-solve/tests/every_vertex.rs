@@ -10,16 +10,16 @@ use wavg_solve::{Anchor, EmbeddedMesh, Projector, Solver, Vec8};
 
 #[test]
 fn armadillo_has_weights_at_every_vertex() {
-    let Some(path) = wavg_mesh::data::require_data_file(
+    let Some(path) = wavg_testdata::require_data_file(
         "armadillo_has_weights_at_every_vertex",
         "meshes/armadillo.obj.gz",
     ) else {
         return;
     };
     let mesh = Arc::new(ValidMesh::new(wavg_mesh::io::load(&path).unwrap()).unwrap());
-    let (e, _) = wavg_embed::pipeline::precompute(
+    let (e, _) = wavg_embed::precompute(
         &mesh,
-        &wavg_embed::pipeline::PrecomputeOptions {
+        &wavg_embed::PrecomputeOptions {
             quality_pairs: 0,
             ..Default::default()
         },
