@@ -87,6 +87,15 @@ typedef struct wavg_solver wavg_solver;
 // freed (they share its data).
 typedef struct wavg_surface wavg_surface;
 
+// A point on the surface: a triangle and barycentric coordinates with respect to its
+// corners, in the order the triangle lists them (non-negative, summing to 1 within 1e-6).
+typedef struct wavg_point {
+  // 0-based triangle index; `UINT32_MAX` in outputs marks a query without an answer.
+  uint32_t face;
+  // Barycentric coordinates (NaN in outputs of a query without an answer).
+  double bary[3];
+} wavg_point;
+
 // Settings of `wavg_surface_precompute`. Always start from
 // `wavg_precompute_options_default()` and change the fields you need.
 //
@@ -110,15 +119,6 @@ typedef struct wavg_precompute_options {
   size_t quality_pairs;
 } wavg_precompute_options;
 
-// A point on the surface: a triangle and barycentric coordinates with respect to its
-// corners, in the order the triangle lists them (non-negative, summing to 1 within 1e-6).
-typedef struct wavg_point {
-  // 0-based triangle index; `UINT32_MAX` in outputs marks a query without an answer.
-  uint32_t face;
-  // Barycentric coordinates (NaN in outputs of a query without an answer).
-  double bary[3];
-} wavg_point;
-
 // Progress callback: `fraction` (0 to 1) of `stage` is done. Return `true` to go on,
 // `false` to cancel (the call then returns `WAVG_STATUS_CANCELLED` soon after and changes
 // nothing). It may be called from any of the library's threads, but never by two at
@@ -129,6 +129,31 @@ typedef bool (*wavg_progress_fn)(enum wavg_stage stage, double fraction, void *u
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
+
+// Samples a curve on the surface whose control points are the solver's anchors, in
+// anchor order: with `bezier`, a Bézier curve of degree `n_anchors - 1`; otherwise a
+// uniform B-spline of `degree` (at least 1, with at least `degree + 1` anchors), clamped
+// (from the first anchor to the last) or, with `closed`, periodic (a loop). Each of the
+// `n_samples` samples (uniform in the curve parameter) is the weighted average of the
+// anchors with the curve's blending weights, warm-started from the previous sample.
+// Writes `out_points[i]` and, unless NULL, `out_xyz[3*i..3*i+3]` and `out_statuses[i]`;
+// a sample without an answer gets its own status, `face = UINT32_MAX` and NaN, while the
+// others are answered; the call returns the first failing sample's status, or
+// `WAVG_STATUS_OK`. Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL solver or `out_points`,
+// `n_samples == 0`, a degree the anchors cannot support), writing nothing.
+// Thread-safe on a shared solver.
+//
+// # Safety
+// `solver` must be NULL or live; every non-NULL array must hold the stated number of
+// elements (`out_points` and `out_statuses`: `n_samples`, `out_xyz`: `3 * n_samples`).
+enum wavg_status wavg_spline(const struct wavg_solver *solver,
+                             uint32_t degree,
+                             bool closed,
+                             bool bezier,
+                             size_t n_samples,
+                             struct wavg_point *out_points,
+                             double *out_xyz,
+                             enum wavg_status *out_statuses);
 
 // The ABI version of the library as loaded: compare with `WAVG_ABI_VERSION` from the
 // header you compiled against. Thread-safe; cannot fail.

@@ -7,6 +7,7 @@
 //! type crosses the boundary.
 #![allow(non_camel_case_types)]
 
+mod apps;
 mod boundary;
 mod decimate;
 mod options;
@@ -14,6 +15,7 @@ mod solver;
 mod surface;
 mod types;
 
+pub use apps::wavg_spline;
 pub use boundary::{wavg_abi_version, wavg_last_error};
 pub use decimate::wavg_surface_decimate;
 pub use options::{wavg_precompute_options, wavg_precompute_options_default};

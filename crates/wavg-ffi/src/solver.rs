@@ -30,6 +30,13 @@ pub struct wavg_solver {
     )>,
 }
 
+impl wavg_solver {
+    /// The wrapped solver.
+    pub(crate) fn inner(&self) -> &Solver {
+        &self.solver
+    }
+}
+
 /// Weights and round trips of a verified inverse batch.
 type VerifiedScratch = (BatchWeights, Vec<Result<RoundTrip, SolveError>>);
 
@@ -198,7 +205,7 @@ pub unsafe extern "C" fn wavg_forward(
         let n = s.solver.n_anchors();
         let len = product(n_queries, n, "n_queries")?;
         // SAFETY: per this function's contract.
-        let (weights, points, mut xyz, statuses) = unsafe {
+        let (weights, points, xyz, statuses) = unsafe {
             (
                 slice(weights, len, "weights")?,
                 slice_mut(out_points, n_queries, "out_points")?,
@@ -208,29 +215,40 @@ pub unsafe extern "C" fn wavg_forward(
         };
         let rows: Vec<&[f64]> = weights.chunks_exact(n).collect();
         let results = s.solver.forward_batch(&rows, &ForwardOptions::default());
-        let mut st = Statuses {
-            out: statuses,
-            first: None,
-        };
-        for (i, r) in results.iter().enumerate() {
-            let (p, x) = match r {
-                Ok(r) => (
-                    wavg_point {
-                        face: r.point.face,
-                        bary: r.point.bary,
-                    },
-                    [r.position.x, r.position.y, r.position.z],
-                ),
-                Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
-            };
-            points[i] = p;
-            if let Some(xyz) = xyz.as_deref_mut() {
-                xyz[3 * i..3 * i + 3].copy_from_slice(&x);
-            }
-            st.set(i, r.as_ref().map(|_| ()));
-        }
-        st.finish()
+        write_points(&results, points, xyz, statuses)
     })
+}
+
+/// Writes forward answers: points (`wavg_point::NONE` and NaN positions where there is
+/// none), positions and statuses; the first failure becomes the call's outcome.
+pub(crate) fn write_points(
+    results: &[Result<wavg::ForwardResult, SolveError>],
+    points: &mut [wavg_point],
+    mut xyz: Option<&mut [f64]>,
+    statuses: Option<&mut [wavg_status]>,
+) -> Outcome {
+    let mut st = Statuses {
+        out: statuses,
+        first: None,
+    };
+    for (i, r) in results.iter().enumerate() {
+        let (p, x) = match r {
+            Ok(r) => (
+                wavg_point {
+                    face: r.point.face,
+                    bary: r.point.bary,
+                },
+                [r.position.x, r.position.y, r.position.z],
+            ),
+            Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
+        };
+        points[i] = p;
+        if let Some(xyz) = xyz.as_deref_mut() {
+            xyz[3 * i..3 * i + 3].copy_from_slice(&x);
+        }
+        st.set(i, r.as_ref().map(|_| ()));
+    }
+    st.finish()
 }
 
 /// How one inverse row ended.
@@ -328,7 +346,7 @@ fn verified_rows(
 ///
 /// # Safety
 /// `ptr` must be NULL or hold `len` writable, unaliased elements.
-unsafe fn optional<'a, T>(ptr: *mut T, len: usize) -> Option<&'a mut [T]> {
+pub(crate) unsafe fn optional<'a, T>(ptr: *mut T, len: usize) -> Option<&'a mut [T]> {
     // SAFETY: per this function's contract.
     (!ptr.is_null()).then(|| unsafe { std::slice::from_raw_parts_mut(ptr, len) })
 }
