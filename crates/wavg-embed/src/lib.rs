@@ -26,6 +26,7 @@ mod geodesic;
 mod lsmesh;
 mod mds;
 mod near_field;
+mod ordering;
 mod pipeline;
 mod quality;
 
