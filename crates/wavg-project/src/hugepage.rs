@@ -12,7 +12,7 @@ const HUGE: usize = 2 << 20;
 
 /// An empty vector with room for `n` elements whose memory is advised to use huge pages.
 /// Fill it before reading (the advice applies as pages are first touched).
-pub fn vec_with_capacity<T>(n: usize) -> Vec<T> {
+pub(crate) fn vec_with_capacity<T>(n: usize) -> Vec<T> {
     let v: Vec<T> = Vec::with_capacity(n);
     let bytes = n.saturating_mul(std::mem::size_of::<T>());
     if bytes >= MIN_BYTES {
@@ -22,7 +22,7 @@ pub fn vec_with_capacity<T>(n: usize) -> Vec<T> {
 }
 
 /// Collects `n` items into a vector advised to use huge pages.
-pub fn collect<T>(n: usize, items: impl IntoIterator<Item = T>) -> Vec<T> {
+pub(crate) fn collect<T>(n: usize, items: impl IntoIterator<Item = T>) -> Vec<T> {
     let mut v = vec_with_capacity(n);
     v.extend(items);
     v

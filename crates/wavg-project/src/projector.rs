@@ -399,7 +399,7 @@ impl Projector {
     /// ids (`corners == true`; request the record a few queries earlier). For software
     /// pipelining over batches; no effect on results.
     #[inline]
-    pub fn prefetch_point_data(&self, f: FaceId, corners: bool) {
+    pub(crate) fn prefetch_point_data(&self, f: FaceId, corners: bool) {
         let Some(face) = self.faces.get(f as usize) else {
             return;
         };
@@ -739,10 +739,11 @@ impl Projector {
     /// let emb = Arc::new(EmbeddedMesh::from_positions(m));
     /// let p = Projector::new(emb.clone()).unwrap();
     /// let y = emb.coords()[0];
-    /// assert_eq!(p.locality_key(&y), p.locality_key(&(y * (1.0 + 1e-12))));
-    /// assert!(p.locality_key(&y) < 1 << 30);
+    /// use wavg_project::internal::locality_key;
+    /// assert_eq!(locality_key(&p, &y), locality_key(&p, &(y * (1.0 + 1e-12))));
+    /// assert!(locality_key(&p, &y) < 1 << 30);
     /// ```
-    pub fn locality_key(&self, y: &Vec8) -> u32 {
+    pub(crate) fn locality_key(&self, y: &Vec8) -> u32 {
         let w = self.walk_point(y);
         let spread = |c: f32| {
             // `as` saturates (NaN to 0): a coordinate in 0..=1023.
@@ -830,9 +831,10 @@ impl Projector {
     /// let p = Projector::new(emb.clone()).unwrap();
     /// let f = m.topology().ring_faces(5)[2];
     /// let y = emb.point(&SurfacePoint::new(f, [0.4, 0.3, 0.3]));
-    /// assert_eq!(p.faces_by_promise(&y, 5).as_slice()[0], f);
+    /// let order = wavg_project::internal::faces_by_promise(&p, &y, 5);
+    /// assert_eq!(order.as_slice()[0], f);
     /// ```
-    pub fn faces_by_promise(&self, y: &Vec8, v: VertexId) -> FaceOrder {
+    pub(crate) fn faces_by_promise(&self, y: &Vec8, v: VertexId) -> FaceOrder {
         self.order_faces(y, v, &[f32::INFINITY; 64])
     }
 

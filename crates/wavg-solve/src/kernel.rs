@@ -24,7 +24,7 @@ use crate::{DIM, Mat2x8, Vec8};
 pub const DEFAULT_GAMMA: f64 = 10.0;
 
 /// Lanes of the per-anchor reductions; storage is padded to a multiple of this.
-pub const LANES: usize = 4;
+pub(crate) const LANES: usize = 4;
 
 /// Anchor coordinates in R^8, one array per coordinate (structure of arrays) so the
 /// per-anchor loops vectorise; each array is padded with zeros to a multiple of [`LANES`].
@@ -209,7 +209,7 @@ pub struct InverseScratch {
 /// coincident anchors) when the point is exactly at an anchor, and tend to that smoothly.
 ///
 /// ```
-/// use wavg_solve::kernel::{AnchorCoords, InverseScratch, inverse_weights};
+/// use wavg_solve::{AnchorCoords, InverseScratch, inverse_weights};
 /// use wavg_solve::{Mat2x8, Vec8};
 /// // Three anchors in the plane spanned by the first two axes, point at their centroid.
 /// let mut psi = Mat2x8::zeros();
