@@ -30,16 +30,7 @@ pub(crate) fn collect<T>(n: usize, items: impl IntoIterator<Item = T>) -> Vec<T>
 
 #[cfg(target_os = "linux")]
 fn advise(start: usize, bytes: usize) {
-    // Only whole 2 MiB pages inside the allocation can be huge.
-    let lo = start.next_multiple_of(HUGE);
-    let hi = (start + bytes) / HUGE * HUGE;
-    if hi > lo {
-        // SAFETY: [lo, hi) lies inside the allocation just made by this process; the
-        // advice changes no contents and no permissions, and its failure is harmless.
-        unsafe {
-            libc::madvise(lo as *mut libc::c_void, hi - lo, libc::MADV_HUGEPAGE);
-        }
-    }
+    crate::arch::advise_huge_pages(start, bytes, HUGE);
 }
 
 #[cfg(not(target_os = "linux"))]

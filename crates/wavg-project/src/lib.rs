@@ -27,7 +27,11 @@
 // The small fixed-size kernels index several arrays in step; explicit indices read better.
 #![allow(clippy::needless_range_loop)]
 #![deny(unreachable_pub)]
+#![deny(unsafe_code)]
 
+// The only module allowed `unsafe` (prefetch hints, SSE2, huge-page advice).
+#[allow(unsafe_code)]
+mod arch;
 mod bvh;
 mod embedded;
 mod error;
@@ -74,6 +78,13 @@ pub mod internal {
     #[inline]
     pub fn locality_key(proj: &Projector, y: &Vec8) -> u32 {
         proj.locality_key(y)
+    }
+
+    /// Hints the processor to load the first KiB (or less) of `r` into cache; no effect on
+    /// results.
+    #[inline(always)]
+    pub fn prefetch<T>(r: &T) {
+        crate::arch::prefetch_lines(r, std::mem::size_of::<T>().min(1024).div_ceil(64));
     }
 
     /// The faces around vertex `v`, most promising for `y` first.

@@ -30,6 +30,7 @@
 //! ```
 
 #![deny(unreachable_pub)]
+#![forbid(unsafe_code)]
 
 mod anchors;
 mod error;
@@ -37,6 +38,7 @@ mod kernel;
 mod points;
 pub mod sampling;
 mod search;
+mod simd;
 mod solver;
 mod verified;
 mod weights;

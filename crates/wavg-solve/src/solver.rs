@@ -409,7 +409,7 @@ impl Solver {
             .with_min_len(64)
             .map(|(k, &i)| {
                 if let Some(&j) = order.get(k + AHEAD) {
-                    crate::kernel::prefetch(&prepared[j as usize]);
+                    wavg_project::internal::prefetch(&prepared[j as usize]);
                 }
                 match &prepared[i as usize] {
                     Ok(p) => self.forward_prepared(p, opts),
