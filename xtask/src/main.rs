@@ -1,6 +1,8 @@
 //! Build and test automation: `cargo xtask test` runs every check the project has, in the
 //! order CI runs them, and tells you exactly what to install when a tool is missing.
 
+#![forbid(unsafe_code)]
+
 mod cbuild;
 mod examples;
 mod fuzz;

@@ -26,7 +26,7 @@ pub fn solver_for(
         .map(|&(line, s)| spec_anchor(s).map_err(|m| located(anchors, line, &m)))
         .collect::<Result<Vec<_>, _>>()?;
     for (&(line, _), a) in specs.iter().zip(&list) {
-        wavg::solve::points::resolve(&mesh, a).map_err(|e| located(anchors, line, &e))?;
+        wavg::solve::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
     let mut surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
     match embedding {

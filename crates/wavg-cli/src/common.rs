@@ -60,18 +60,14 @@ pub fn one_line(e: &dyn std::fmt::Display) -> String {
 pub fn cpu_seconds(thread: bool) -> Option<f64> {
     #[cfg(unix)]
     {
-        let mut ts = libc::timespec {
-            tv_sec: 0,
-            tv_nsec: 0,
-        };
+        use nix::time::{ClockId, clock_gettime};
         let id = if thread {
-            libc::CLOCK_THREAD_CPUTIME_ID
+            ClockId::CLOCK_THREAD_CPUTIME_ID
         } else {
-            libc::CLOCK_PROCESS_CPUTIME_ID
+            ClockId::CLOCK_PROCESS_CPUTIME_ID
         };
-        // SAFETY: `ts` is a valid, writable timespec for the duration of the call.
-        let r = unsafe { libc::clock_gettime(id, &mut ts) };
-        (r == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+        let ts = clock_gettime(id).ok()?;
+        Some(ts.tv_sec() as f64 + ts.tv_nsec() as f64 * 1e-9)
     }
     #[cfg(not(unix))]
     {

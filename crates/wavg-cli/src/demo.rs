@@ -11,8 +11,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use wavg_mesh::{SurfacePoint, ValidMesh};
+use wavg_solve::DEFAULT_TOLERANCE;
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
-use wavg_solve::verified::DEFAULT_TOLERANCE;
 use wavg_solve::{Anchor, EmbeddedMesh, ForwardOptions, Solver, Vec8};
 
 use crate::CliError;

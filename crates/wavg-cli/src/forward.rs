@@ -61,7 +61,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     // Check every line before computing anything, so errors name their line.
     for (line, w) in &lines {
-        wavg_solve::weights::validate(w, solver.n_anchors(), normalization)
+        wavg_solve::validate_weights(w, solver.n_anchors(), normalization)
             .map_err(|e| located(&args.weights, *line, &e))?;
     }
     let opts = ForwardOptions {

@@ -36,7 +36,7 @@ pub struct Args {
     #[arg(long)]
     pub points: PathBuf,
     /// How much more distance off the tangent plane counts than distance along it.
-    #[arg(long, default_value_t = wavg_solve::kernel::DEFAULT_GAMMA)]
+    #[arg(long, default_value_t = wavg_solve::DEFAULT_GAMMA)]
     pub gamma: f64,
     /// Check each answer by the forward problem; penalise the average's offset where the
     /// paper's weights do not lead back.
@@ -78,8 +78,8 @@ fn run_verified(
     solver: &wavg_solve::Solver,
     points: &[wavg_mesh::SurfacePoint],
 ) -> Result<(), CliError> {
+    use wavg_solve::DEFAULT_TOLERANCE;
     use wavg_solve::RoundTrip;
-    use wavg_solve::verified::DEFAULT_TOLERANCE;
     let batch = textio::with_threads(args.problem.threads, || {
         solver.inverse_verified_batch(points, DEFAULT_TOLERANCE)
     })?;

@@ -1,5 +1,7 @@
 //! The `wavg` command line: diagnostics, precomputation, forward/inverse problems, benchmarks.
 
+#![forbid(unsafe_code)]
+
 mod apps_common;
 mod bench_load;
 mod bench_project;

@@ -236,7 +236,7 @@ pub fn resolve_points(
         .iter()
         .map(|&(line, spec)| {
             let a = spec_anchor(spec).map_err(|m| located(file, line, &m))?;
-            wavg_solve::points::resolve(mesh, &a).map_err(|e| located(file, line, &e))
+            wavg_solve::resolve_anchor(mesh, &a).map_err(|e| located(file, line, &e))
         })
         .collect()
 }
@@ -283,7 +283,7 @@ pub fn load_solver(
         .collect::<Result<Vec<_>, _>>()?;
     // Validate each anchor with its line number before building anything expensive.
     for (&(line, _), a) in specs.iter().zip(&anchor_list) {
-        wavg_solve::points::resolve(&mesh, a).map_err(|e| located(anchors, line, &e))?;
+        wavg_solve::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
     let emb = load_embedded(mesh, embedding)?;
     let proj = build_projector(emb)?;

@@ -176,7 +176,7 @@ fn main() {
     let mut c_xyz = vec![0.0; 3 * n_queries];
     let mut rust_batch = wavg::BatchWeights::default();
     let mut rust_trips = Vec::new();
-    let tol = wavg::solve::verified::DEFAULT_TOLERANCE;
+    let tol = wavg::solve::DEFAULT_TOLERANCE;
     println!("queries {n_queries}, anchors {n_anchors}, best of {rounds} (alternating)");
     println!(
         "{:<18} {:>10} {:>10} {:>8}",

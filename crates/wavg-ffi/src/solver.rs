@@ -5,6 +5,7 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
+use wavg::project::internal::prefetch_point_data;
 use wavg::solve::SolveError;
 use wavg::{BatchWeights, ForwardOptions, RoundTrip, Solver, SurfacePoint};
 
@@ -273,15 +274,15 @@ fn inverse_rows(solver: &Solver, points: &[wavg_point], out: &mut [f64]) -> Vec<
             // Random points read random face records, then their corners' records:
             // request both a few points ahead so the waits overlap.
             for p in pts.iter().take(4) {
-                proj.prefetch_point_data(p.face, false);
+                prefetch_point_data(proj, p.face, false);
             }
             let mut done = Vec::with_capacity(pts.len());
             for (k, (row, p)) in rows.chunks_exact_mut(n).zip(pts).enumerate() {
                 if let Some(q) = pts.get(k + 4) {
-                    proj.prefetch_point_data(q.face, false);
+                    prefetch_point_data(proj, q.face, false);
                 }
                 if let Some(q) = pts.get(k + 2) {
-                    proj.prefetch_point_data(q.face, true);
+                    prefetch_point_data(proj, q.face, true);
                 }
                 match solver.inverse_into(&point_in(p), &mut scratch, &mut buf) {
                     Ok(()) => {
@@ -315,12 +316,7 @@ fn verified_rows(
         Some(b) => (&mut b.0, &mut b.1),
         None => (&mut owned.0, &mut owned.1),
     };
-    solver.inverse_verified_batch_into(
-        &points,
-        wavg::solve::verified::DEFAULT_TOLERANCE,
-        batch,
-        trips,
-    );
+    solver.inverse_verified_batch_into(&points, wavg::solve::DEFAULT_TOLERANCE, batch, trips);
     let n = solver.n_anchors();
     out.par_chunks_exact_mut(n)
         .enumerate()

@@ -22,7 +22,7 @@ struct Node {
 
 /// The hierarchy: nodes in depth-first order and the face ids in leaf order.
 #[derive(Clone, Debug)]
-pub struct Bvh {
+pub(crate) struct Bvh {
     nodes: Vec<Node>,
     items: Vec<u32>,
 }
@@ -56,7 +56,7 @@ fn step(f: f32, up: bool) -> f32 {
 impl Bvh {
     /// Builds the hierarchy over the triangles `tris` with corners `coords` (median
     /// splits along the widest axis of the centroids; large subtrees in parallel).
-    pub fn new(tris: &[[u32; 3]], coords: &[Vec8]) -> Self {
+    pub(crate) fn new(tris: &[[u32; 3]], coords: &[Vec8]) -> Self {
         use rayon::prelude::*;
         let mut items: Vec<u32> = (0..tris.len() as u32).collect();
         let centers: Vec<[f32; 8]> = tris
@@ -81,13 +81,13 @@ impl Bvh {
     }
 
     /// Heap bytes used.
-    pub fn bytes(&self) -> usize {
+    pub(crate) fn bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<Node>() + self.items.len() * 4
     }
 
     /// Branch and bound: visits (in roughly nearest-first order) every face whose box is
     /// closer to `y` than `sqrt(*best)`; `visit(face, best)` may lower `*best`.
-    pub fn search(&self, y: &Vec8, best: &mut f64, mut visit: impl FnMut(u32, &mut f64)) {
+    pub(crate) fn search(&self, y: &Vec8, best: &mut f64, mut visit: impl FnMut(u32, &mut f64)) {
         if self.nodes.is_empty() {
             return;
         }

@@ -6,7 +6,7 @@ use crate::Vec8;
 /// Barycentrics of the point of triangle `(a, b, c)` closest to `p`.
 ///
 /// ```
-/// use wavg_project::{Vec8, euclid::closest_point_barycentric};
+/// use wavg_project::{Vec8, closest_point_barycentric};
 /// let a = Vec8::zeros();
 /// let b = Vec8::x();
 /// let c = Vec8::y();

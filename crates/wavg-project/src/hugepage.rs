@@ -12,7 +12,7 @@ const HUGE: usize = 2 << 20;
 
 /// An empty vector with room for `n` elements whose memory is advised to use huge pages.
 /// Fill it before reading (the advice applies as pages are first touched).
-pub fn vec_with_capacity<T>(n: usize) -> Vec<T> {
+pub(crate) fn vec_with_capacity<T>(n: usize) -> Vec<T> {
     let v: Vec<T> = Vec::with_capacity(n);
     let bytes = n.saturating_mul(std::mem::size_of::<T>());
     if bytes >= MIN_BYTES {
@@ -22,7 +22,7 @@ pub fn vec_with_capacity<T>(n: usize) -> Vec<T> {
 }
 
 /// Collects `n` items into a vector advised to use huge pages.
-pub fn collect<T>(n: usize, items: impl IntoIterator<Item = T>) -> Vec<T> {
+pub(crate) fn collect<T>(n: usize, items: impl IntoIterator<Item = T>) -> Vec<T> {
     let mut v = vec_with_capacity(n);
     v.extend(items);
     v
@@ -30,16 +30,7 @@ pub fn collect<T>(n: usize, items: impl IntoIterator<Item = T>) -> Vec<T> {
 
 #[cfg(target_os = "linux")]
 fn advise(start: usize, bytes: usize) {
-    // Only whole 2 MiB pages inside the allocation can be huge.
-    let lo = start.next_multiple_of(HUGE);
-    let hi = (start + bytes) / HUGE * HUGE;
-    if hi > lo {
-        // SAFETY: [lo, hi) lies inside the allocation just made by this process; the
-        // advice changes no contents and no permissions, and its failure is harmless.
-        unsafe {
-            libc::madvise(lo as *mut libc::c_void, hi - lo, libc::MADV_HUGEPAGE);
-        }
-    }
+    crate::arch::advise_huge_pages(start, bytes, HUGE);
 }
 
 #[cfg(not(target_os = "linux"))]

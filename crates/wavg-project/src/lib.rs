@@ -26,20 +26,73 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 // The small fixed-size kernels index several arrays in step; explicit indices read better.
 #![allow(clippy::needless_range_loop)]
+#![deny(unreachable_pub)]
+#![deny(unsafe_code)]
 
-pub mod bvh;
-pub mod embedded;
-pub mod error;
-pub mod euclid;
-pub mod frames;
+// The only module allowed `unsafe` (prefetch hints, SSE2, huge-page advice).
+#[allow(unsafe_code)]
+mod arch;
+mod bvh;
+mod embedded;
+mod error;
+mod euclid;
+mod frames;
 mod hugepage;
-pub mod ort;
-pub mod projector;
-pub mod triangle;
+mod ort;
+mod projector;
+mod triangle;
 
+// The embedded mesh and its projector.
 pub use embedded::EmbeddedMesh;
+pub use projector::{Projection, ProjectionPath, Projector};
+
+// Tangent frames and geometry in R^8.
+pub use euclid::closest_point_barycentric;
+pub use frames::{FrameKind, vertex_frame, vertex_frames};
+
+// Errors.
 pub use error::ProjectError;
-pub use projector::{FaceOrder, Projection, ProjectionPath, Projector};
+
+/// Batching hooks of the projector for this workspace's solvers and C ABI.
+///
+/// **Unstable**: not part of the public API; anything here may change or disappear in any
+/// release.
+#[doc(hidden)]
+pub mod internal {
+    use wavg_mesh::{FaceId, VertexId};
+
+    use crate::{Projector, Vec8};
+
+    pub use crate::projector::{FaceOrder, WALK_GROUP, ZERO_DISTANCE};
+
+    /// Starts loading what [`Projector::psi_and_point`] reads of face `f`: its record
+    /// (`corners == false`) or its corners' records (`corners == true`). For software
+    /// pipelining over batches; no effect on results.
+    #[inline]
+    pub fn prefetch_point_data(proj: &Projector, f: FaceId, corners: bool) {
+        proj.prefetch_point_data(f, corners);
+    }
+
+    /// A 30-bit Morton key of `y`'s cell in the walk grid: nearby points get nearby keys,
+    /// so sorting a batch by it improves cache locality.
+    #[inline]
+    pub fn locality_key(proj: &Projector, y: &Vec8) -> u32 {
+        proj.locality_key(y)
+    }
+
+    /// Hints the processor to load the first KiB (or less) of `r` into cache; no effect on
+    /// results.
+    #[inline(always)]
+    pub fn prefetch<T>(r: &T) {
+        crate::arch::prefetch_lines(r, std::mem::size_of::<T>().min(1024).div_ceil(64));
+    }
+
+    /// The faces around vertex `v`, most promising for `y` first.
+    #[inline]
+    pub fn faces_by_promise(proj: &Projector, y: &Vec8, v: VertexId) -> FaceOrder {
+        proj.faces_by_promise(y, v)
+    }
+}
 
 /// Dimension of the embedding space.
 pub const DIM: usize = 8;

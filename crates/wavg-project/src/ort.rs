@@ -1,24 +1,17 @@
 //! 2x2 helpers: the orthogonal polar factor `Ort` and small products, row-major `[a, b, c, d]`.
 
 /// A 2x2 matrix `[[m[0], m[1]], [m[2], m[3]]]`.
-pub type M2 = [f64; 4];
+pub(crate) type M2 = [f64; 4];
 
 /// Identity.
-pub const I2: M2 = [1.0, 0.0, 0.0, 1.0];
+pub(crate) const I2: M2 = [1.0, 0.0, 0.0, 1.0];
 
 /// Closest orthogonal matrix (rotation or reflection) to `a` in the Frobenius norm.
 ///
 /// Closed form for 2x2: with `C = [[d, -c], [-b, a]]`, `a + C` (det >= 0) or `a - C`
 /// (det < 0) has the polar factor's direction; normalise the columns. A (near) zero input
 /// has no defined polar factor: the identity is returned so nothing downstream is NaN.
-///
-/// ```
-/// use wavg_project::ort::{ort, mul};
-/// let q = ort(&[2.0, 1.0, -0.5, 3.0]);
-/// let qtq = mul(&[q[0], q[2], q[1], q[3]], &q);
-/// assert!((qtq[0] - 1.0).abs() < 1e-12 && qtq[1].abs() < 1e-12);
-/// ```
-pub fn ort(m: &M2) -> M2 {
+pub(crate) fn ort(m: &M2) -> M2 {
     let [a, b, c, d] = *m;
     // Rotation [[p, -q], [q, p]] from (a + d, c - b); reflection [[p, q], [q, -p]] from
     // (a - d, b + c). The branch matches the sign of det(m); when its vector vanishes
@@ -44,7 +37,7 @@ pub fn ort(m: &M2) -> M2 {
 
 /// Product `a b`.
 #[inline]
-pub fn mul(a: &M2, b: &M2) -> M2 {
+pub(crate) fn mul(a: &M2, b: &M2) -> M2 {
     [
         a[0] * b[0] + a[1] * b[2],
         a[0] * b[1] + a[1] * b[3],
@@ -55,12 +48,24 @@ pub fn mul(a: &M2, b: &M2) -> M2 {
 
 /// Sum `a + b`.
 #[inline]
-pub fn add(a: &M2, b: &M2) -> M2 {
+pub(crate) fn add(a: &M2, b: &M2) -> M2 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
 }
 
 /// Transpose.
 #[inline]
-pub fn transpose(a: &M2) -> M2 {
+pub(crate) fn transpose(a: &M2) -> M2 {
     [a[0], a[2], a[1], a[3]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{mul, ort};
+
+    #[test]
+    fn polar_factor_is_orthogonal() {
+        let q = ort(&[2.0, 1.0, -0.5, 3.0]);
+        let qtq = mul(&[q[0], q[2], q[1], q[3]], &q);
+        assert!((qtq[0] - 1.0).abs() < 1e-12 && qtq[1].abs() < 1e-12);
+    }
 }

@@ -102,23 +102,7 @@ impl WalkPoint {
     #[inline(always)]
     fn dist2(&self, y: &[f32; 8]) -> f32 {
         #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::*;
-            // SAFETY: SSE2 is part of the x86-64 baseline; the loads read the 16 bytes of
-            // `self.c` and the 32 bytes of `y`, unaligned loads of valid memory.
-            unsafe {
-                let c = _mm_loadu_si128(self.c.as_ptr() as *const __m128i);
-                let z = _mm_setzero_si128();
-                let lo = _mm_cvtepi32_ps(_mm_unpacklo_epi16(c, z));
-                let hi = _mm_cvtepi32_ps(_mm_unpackhi_epi16(c, z));
-                let d0 = _mm_sub_ps(lo, _mm_loadu_ps(y.as_ptr()));
-                let d1 = _mm_sub_ps(hi, _mm_loadu_ps(y.as_ptr().add(4)));
-                // s[k] = d0[k]^2 + d1[k]^2, then (s0 + s2) + (s1 + s3) as in `wdist2`.
-                let s = _mm_add_ps(_mm_mul_ps(d0, d0), _mm_mul_ps(d1, d1));
-                let t = _mm_add_ps(s, _mm_movehl_ps(s, s));
-                _mm_cvtss_f32(_mm_add_ss(t, _mm_shuffle_ps::<0b01>(t, t)))
-            }
-        }
+        return crate::arch::dist2_u16(&self.c, y);
         #[cfg(not(target_arch = "x86_64"))]
         wdist2(&self.unpack(), y)
     }
@@ -399,7 +383,7 @@ impl Projector {
     /// ids (`corners == true`; request the record a few queries earlier). For software
     /// pipelining over batches; no effect on results.
     #[inline]
-    pub fn prefetch_point_data(&self, f: FaceId, corners: bool) {
+    pub(crate) fn prefetch_point_data(&self, f: FaceId, corners: bool) {
         let Some(face) = self.faces.get(f as usize) else {
             return;
         };
@@ -739,10 +723,11 @@ impl Projector {
     /// let emb = Arc::new(EmbeddedMesh::from_positions(m));
     /// let p = Projector::new(emb.clone()).unwrap();
     /// let y = emb.coords()[0];
-    /// assert_eq!(p.locality_key(&y), p.locality_key(&(y * (1.0 + 1e-12))));
-    /// assert!(p.locality_key(&y) < 1 << 30);
+    /// use wavg_project::internal::locality_key;
+    /// assert_eq!(locality_key(&p, &y), locality_key(&p, &(y * (1.0 + 1e-12))));
+    /// assert!(locality_key(&p, &y) < 1 << 30);
     /// ```
-    pub fn locality_key(&self, y: &Vec8) -> u32 {
+    pub(crate) fn locality_key(&self, y: &Vec8) -> u32 {
         let w = self.walk_point(y);
         let spread = |c: f32| {
             // `as` saturates (NaN to 0): a coordinate in 0..=1023.
@@ -830,9 +815,10 @@ impl Projector {
     /// let p = Projector::new(emb.clone()).unwrap();
     /// let f = m.topology().ring_faces(5)[2];
     /// let y = emb.point(&SurfacePoint::new(f, [0.4, 0.3, 0.3]));
-    /// assert_eq!(p.faces_by_promise(&y, 5).as_slice()[0], f);
+    /// let order = wavg_project::internal::faces_by_promise(&p, &y, 5);
+    /// assert_eq!(order.as_slice()[0], f);
     /// ```
-    pub fn faces_by_promise(&self, y: &Vec8, v: VertexId) -> FaceOrder {
+    pub(crate) fn faces_by_promise(&self, y: &Vec8, v: VertexId) -> FaceOrder {
         self.order_faces(y, v, &[f32::INFINITY; 64])
     }
 
@@ -1107,35 +1093,16 @@ impl Projector {
 }
 
 /// Hints the processor to bring `r`'s two cache lines (records here are 128 bytes, 64
-/// aligned) into cache; no effect on results, a no-op off x86-64.
+/// aligned) into cache; no effect on results.
 #[inline(always)]
 fn prefetch<T>(r: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        let p = r as *const T as *const i8;
-        // SAFETY: SSE is part of the x86-64 baseline, and a prefetch never faults or
-        // dereferences (any address is allowed; this one points into a live record).
-        unsafe {
-            _mm_prefetch::<_MM_HINT_T0>(p);
-            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = r;
+    crate::arch::prefetch_lines(r, 2);
 }
 
 /// Hints the processor to load the cache line holding the start of `r`.
 #[inline(always)]
 fn prefetch_line<T>(r: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        // SAFETY: as in `prefetch`.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>(r as *const T as *const i8) };
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = r;
+    crate::arch::prefetch_lines(r, 1);
 }
 
 /// Compile-time check that the projector can be shared across threads.

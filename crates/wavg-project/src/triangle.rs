@@ -16,25 +16,25 @@ use crate::ort::{self, M2};
 use crate::{Mat2x8, Vec8};
 
 /// Corner whose frame term `e` multiplies.
-pub const TERM_VERTEX: [usize; 6] = [0, 1, 1, 2, 2, 0];
+pub(crate) const TERM_VERTEX: [usize; 6] = [0, 1, 1, 2, 2, 0];
 
 /// Block coordinate descent sweeps for the in-plane rotations.
-pub const PROCRUSTES_SWEEPS: usize = 10;
+pub(crate) const PROCRUSTES_SWEEPS: usize = 10;
 
 /// Maximum Newton iterations per triangle.
-pub const MAX_NEWTON: usize = 16;
+pub(crate) const MAX_NEWTON: usize = 16;
 
 /// Barycentric tolerance of a valid projection (the reference's `eps`).
-pub const BARY_EPS: f64 = 1e-4;
+pub(crate) const BARY_EPS: f64 = 1e-4;
 
 /// `S` below which a point counts as a vertex and `Psi` takes its limit there.
 const S_MIN: f64 = 1e-12;
 
 /// A tangent frame stored compactly: rows 0 and 1, eight f32 each.
-pub type Frame32 = [f32; 16];
+pub(crate) type Frame32 = [f32; 16];
 
 /// Converts a frame to f32 storage.
-pub fn frame_to_f32(t: &Mat2x8) -> Frame32 {
+pub(crate) fn frame_to_f32(t: &Mat2x8) -> Frame32 {
     let mut f = [0f32; 16];
     for r in 0..2 {
         for c in 0..8 {
@@ -45,7 +45,7 @@ pub fn frame_to_f32(t: &Mat2x8) -> Frame32 {
 }
 
 /// The f64 frame of a stored one.
-pub fn frame_to_f64(f: &Frame32) -> Mat2x8 {
+pub(crate) fn frame_to_f64(f: &Frame32) -> Mat2x8 {
     Mat2x8::from_fn(|r, c| f[r * 8 + c] as f64)
 }
 
@@ -56,12 +56,13 @@ pub fn frame_to_f64(f: &Frame32) -> Mat2x8 {
 /// zero of `p(xi) - y`.
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C, align(32))]
-pub struct TriData {
+pub(crate) struct TriData {
     /// The six 2x2 blend matrices `X_e` (row-major).
     pub x: [[f32; 4]; 6],
 }
 
 /// Gram blocks `T_i T_j^T` of the three corner frames (`[C01, C12, C20]`).
+#[cfg(test)]
 fn frame_products(t: &[Mat2x8; 3]) -> [M2; 3] {
     [0, 1, 2].map(|i| {
         let (a, b) = (&t[i], &t[(i + 1) % 3]);
@@ -105,6 +106,7 @@ struct Procrustes {
 const CORNER: [usize; 6] = [0, 1, 1, 2, 2, 0];
 
 impl Procrustes {
+    #[cfg(test)]
     fn new(t: &[Mat2x8; 3]) -> Self {
         Self::from_products(frame_products(t))
     }
@@ -141,6 +143,7 @@ impl Procrustes {
     }
 
     /// Block coordinate descent from identities; returns `E` after `sweeps` sweeps.
+    #[cfg(test)]
     fn rotations(&self, sweeps: usize) -> [M2; 3] {
         rotations_batch([self], sweeps)[0]
     }
@@ -163,6 +166,7 @@ impl Procrustes {
     }
 
     /// `sum_{a<b} |A_a - A_b|^2` with `A_a = E_{pair(a)} B_a`.
+    #[cfg(test)]
     fn energy(&self, e: &[M2; 3]) -> f64 {
         let mut s = 0.0;
         for a in 0..6 {
@@ -199,17 +203,10 @@ fn rotations_batch<const N: usize>(ps: [&Procrustes; N], sweeps: usize) -> [[M2;
     e
 }
 
-/// The edge alignments `R_k = Ort(T_{k+1} T_k^T)` and rotations `E_k` of a triangle with
-/// orthonormal frames `t` (block coordinate descent, [`PROCRUSTES_SWEEPS`] sweeps from
-/// identities).
-pub fn alignments(t: &[Mat2x8; 3]) -> ([M2; 3], [M2; 3]) {
-    let p = Procrustes::new(t);
-    (p.r, p.rotations(PROCRUSTES_SWEEPS))
-}
-
 /// The Procrustes energy after 0, 1, ..., [`PROCRUSTES_SWEEPS`] sweeps (non-increasing;
 /// for tests and diagnostics).
-pub fn procrustes_energies(t: &[Mat2x8; 3]) -> [f64; PROCRUSTES_SWEEPS + 1] {
+#[cfg(test)]
+fn procrustes_energies(t: &[Mat2x8; 3]) -> [f64; PROCRUSTES_SWEEPS + 1] {
     let p = Procrustes::new(t);
     std::array::from_fn(|s| p.energy(&p.rotations(s)))
 }
@@ -220,12 +217,12 @@ fn from_m2(m: &M2) -> nalgebra::Matrix2<f64> {
 
 impl TriData {
     /// Precomputes a triangle from its stored corner frames and embedded corners.
-    pub fn new(frames: [&Frame32; 3]) -> Self {
+    pub(crate) fn new(frames: [&Frame32; 3]) -> Self {
         Self::new_batch([frames])[0]
     }
 
     /// [`TriData::new`] for `N` triangles at once (faster: see `rotations_batch`).
-    pub fn new_batch<const N: usize>(frames: [[&Frame32; 3]; N]) -> [Self; N] {
+    pub(crate) fn new_batch<const N: usize>(frames: [[&Frame32; 3]; N]) -> [Self; N] {
         let ps: [Procrustes; N] =
             std::array::from_fn(|n| Procrustes::from_products(frame_products32(&frames[n])));
         let es: [[M2; 3]; N] =
@@ -243,7 +240,7 @@ impl TriData {
     }
 
     /// `Psi(xi)` for corner frames `frames` (2x8; rows span the interpolated tangent plane).
-    pub fn psi(&self, frames: [&Frame32; 3], xi: &[f64; 3]) -> Mat2x8 {
+    pub(crate) fn psi(&self, frames: [&Frame32; 3], xi: &[f64; 3]) -> Mat2x8 {
         let (c, _) = coefficients(xi);
         // Two terms share each corner's frame: sum their weighted blends first, then one
         // 2x2-by-2x8 product per corner.
@@ -269,7 +266,7 @@ impl TriData {
     /// The partial derivatives `dPsi/dxi_k`, `k = 0, 1, 2`, treating the three barycentrics
     /// as independent (on the plane `sum xi = 1` take differences). At a vertex, where
     /// `Psi` is not differentiable, the derivative just inside the triangle is returned.
-    pub fn psi_derivatives(&self, frames: [&Frame32; 3], xi: &[f64; 3]) -> [Mat2x8; 3] {
+    pub(crate) fn psi_derivatives(&self, frames: [&Frame32; 3], xi: &[f64; 3]) -> [Mat2x8; 3] {
         let (_, dc) = coefficients(xi);
         let mut out = [Mat2x8::zeros(); 3];
         for (e, dce) in dc.iter().enumerate() {
@@ -282,24 +279,14 @@ impl TriData {
     }
 
     /// Newton's method for `Psi(xi) (p(xi) - y) = 0`, `sum xi = 1`, from the centroid,
-    /// kept inside the triangle (`frames` and `corners` are the triangle's). Returns the barycentrics of a
-    /// projection, or `None` when Newton finds none (the root lies outside the triangle,
-    /// the Jacobian is singular, or it does not converge in [`MAX_NEWTON`] steps).
-    ///
-    /// Convergence is tested relative to the triangle's size and the query's distance
-    /// (`|F| <= 1e-11 (|G| + |h|)`), so it does not depend on the mesh's scale or position.
-    #[inline]
-    pub fn solve(&self, frames: [&Frame32; 3], corners: [&Vec8; 3], y: &Vec8) -> Option<[f64; 3]> {
-        self.solve_or_exit(frames, corners, y).ok()
-    }
-
-    /// [`TriData::solve`], telling on failure which way the root lies when Newton was
+    /// kept inside the triangle (`frames` and `corners` are the triangle's): the
+    /// barycentrics of a projection, or on failure which way the root lies when Newton was
     /// pushed against an edge: `Err(Some(k))` when it left across the edge opposite corner
     /// `k` (where a search continues), `Err(None)` otherwise. For an example through a
     /// projector (which holds the frames), see
     /// [`Projector::project_onto_face_or_exit`](crate::Projector::project_onto_face_or_exit).
     #[inline]
-    pub fn solve_or_exit(
+    pub(crate) fn solve_or_exit(
         &self,
         frames: [&Frame32; 3],
         corners: [&Vec8; 3],
@@ -358,17 +345,6 @@ impl TriData {
             }
         }
         Err(None)
-    }
-
-    /// `F(xi) = Psi(xi) (p(xi) - y)` given `h[i] = T_i (y - v_i)` (for tests).
-    pub fn tangent_residual(
-        &self,
-        frames: [&Frame32; 3],
-        corners: [&Vec8; 3],
-        y: &Vec8,
-        xi: &[f64; 3],
-    ) -> [f64; 2] {
-        System::new(self, frames, corners, y).eval(xi).0
     }
 }
 
@@ -565,7 +541,7 @@ fn renormalize(n: [f64; 3]) -> Option<[f64; 3]> {
 /// terms of that corner, so `Psi` spans the corner's frame) and the derivatives are those
 /// at a point just inside, so nothing divides by zero.
 #[inline(always)]
-pub fn coefficients(xi: &[f64; 3]) -> ([f64; 6], [[f64; 3]; 6]) {
+pub(crate) fn coefficients(xi: &[f64; 3]) -> ([f64; 6], [[f64; 3]; 6]) {
     let s = xi[0] * xi[1] + xi[1] * xi[2] + xi[2] * xi[0];
     if s >= S_MIN {
         return coefficients_regular(xi, s);

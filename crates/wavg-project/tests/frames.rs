@@ -8,8 +8,8 @@ use std::sync::Arc;
 use common::*;
 use nalgebra::Vector3;
 use wavg_mesh::{TriMesh, ValidMesh, procedural};
-use wavg_project::frames::{FrameKind, vertex_frames};
 use wavg_project::{EmbeddedMesh, Mat2x8, Projector, Vec8};
+use wavg_project::{FrameKind, vertex_frames};
 
 /// Largest angle between a frame plane (padded 3-D) and the plane with normal `n`.
 fn tilt(f: &Mat2x8, n: &Vector3<f64>) -> f64 {

@@ -8,7 +8,7 @@ use wavg_mesh::{SurfacePoint, VertexId};
 
 use crate::error::SolveError;
 use crate::kernel::AnchorCoords;
-use crate::points::{Anchor, nearest_corner, resolve};
+use crate::points::{Anchor, nearest_corner, resolve_anchor};
 use crate::{EmbeddedMesh, Vec8};
 
 /// An ordered set of anchors on one embedded mesh. Weights refer to anchors by position
@@ -17,7 +17,7 @@ use crate::{EmbeddedMesh, Vec8};
 /// ```
 /// use std::sync::Arc;
 /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
-/// use wavg_solve::{AnchorSet, EmbeddedMesh, points::Anchor};
+/// use wavg_solve::{Anchor, AnchorSet, EmbeddedMesh};
 /// let mesh = Arc::new(ValidMesh::new(procedural::icosphere(2)).unwrap());
 /// let emb = Arc::new(EmbeddedMesh::from_positions(mesh));
 /// let mut a = AnchorSet::new(emb);
@@ -95,7 +95,7 @@ impl AnchorSet {
     /// Validates `a` and computes what is cached about it.
     fn prepare(&self, a: &Anchor) -> Result<(Anchor, SurfacePoint, VertexId, Vec8), SolveError> {
         let mesh = self.emb.mesh();
-        let p = resolve(mesh, a)?;
+        let p = resolve_anchor(mesh, a)?;
         let (a, start, y) = match *a {
             Anchor::Vertex(v) => (*a, v, self.emb.coords()[v as usize]),
             Anchor::Point(_) => (

@@ -24,7 +24,7 @@ use crate::{DIM, Mat2x8, Vec8};
 pub const DEFAULT_GAMMA: f64 = 10.0;
 
 /// Lanes of the per-anchor reductions; storage is padded to a multiple of this.
-pub const LANES: usize = 4;
+pub(crate) const LANES: usize = 4;
 
 /// Anchor coordinates in R^8, one array per coordinate (structure of arrays) so the
 /// per-anchor loops vectorise; each array is padded with zeros to a multiple of [`LANES`].
@@ -106,54 +106,17 @@ impl AnchorCoords {
     }
 
     /// `sum_j w_j y_j * scale`: the weighted average in R^8 (`weights` has one entry per
-    /// anchor; extra entries are ignored, missing ones count as zero). Compiled for AVX2
-    /// too and chosen at run time; both give the same bits (same operations, same order).
+    /// anchor; extra entries are ignored, missing ones count as zero). Compiled for the
+    /// CPU's SIMD width at run time; every build gives the same bits (same operations, same
+    /// order).
     pub fn weighted_sum(&self, weights: &[f64], scale: f64) -> Vec8 {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: `weighted_sum_avx2` only requires AVX2, which the CPU was just
-            // checked to have.
-            return unsafe { self.weighted_sum_avx2(weights, scale) };
-        }
-        self.weighted_sum_portable(weights, scale)
+        crate::simd::weighted_sum(self, weights, scale)
     }
 
-    /// [`AnchorCoords::weighted_sum_portable`] with its four partial sums in one AVX
-    /// register (the same multiplications and additions in the same order).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx,avx2")]
-    unsafe fn weighted_sum_avx2(&self, weights: &[f64], scale: f64) -> Vec8 {
-        use std::arch::x86_64::{
-            _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd, _mm256_storeu_pd,
-        };
-        const _: () = assert!(LANES == 4);
-        let n = self.n.min(weights.len());
-        let w = &weights[..n];
-        let mut out = [0.0; DIM];
-        for (o, dim) in out.iter_mut().zip(&self.dims) {
-            let y = &dim[..n];
-            let (wc, yc) = (w.chunks_exact(LANES), y.chunks_exact(LANES));
-            let (wr, yr) = (wc.remainder(), yc.remainder());
-            let mut acc = _mm256_setzero_pd();
-            for (wc, yc) in wc.zip(yc) {
-                // SAFETY: both chunks hold exactly four f64 (unaligned loads).
-                let (a, b) =
-                    unsafe { (_mm256_loadu_pd(wc.as_ptr()), _mm256_loadu_pd(yc.as_ptr())) };
-                acc = _mm256_add_pd(acc, _mm256_mul_pd(a, b));
-            }
-            let mut lanes = [0.0; LANES];
-            // SAFETY: `lanes` holds four f64.
-            unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), acc) };
-            let mut s = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
-            for (a, b) in wr.iter().zip(yr) {
-                s += a * b;
-            }
-            *o = s * scale;
-        }
-        Vec8::from(out)
-    }
-
-    fn weighted_sum_portable(&self, weights: &[f64], scale: f64) -> Vec8 {
+    /// The weighted sum as portable loops over [`LANES`]-wide partial sums (what
+    /// [`AnchorCoords::weighted_sum`] runs, compiled for the CPU's SIMD width).
+    #[inline(always)]
+    pub(crate) fn weighted_sum_portable(&self, weights: &[f64], scale: f64) -> Vec8 {
         let n = self.n.min(weights.len());
         let w = &weights[..n];
         let mut out = [0.0; DIM];
@@ -177,24 +140,6 @@ impl AnchorCoords {
     }
 }
 
-/// Hints the processor to load the (first 1 KiB of the) lines holding `r`; results are
-/// unaffected, and it is a no-op off x86-64.
-#[inline]
-pub(crate) fn prefetch<T>(r: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        let bytes = std::mem::size_of::<T>().min(1024);
-        let p = (r as *const T).cast::<i8>();
-        for off in (0..bytes).step_by(64) {
-            // SAFETY: SSE is part of the x86-64 baseline and a prefetch never faults.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(off)) };
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = r;
-}
-
 /// Reusable buffers for [`inverse_weights`] (so batches do not allocate per query).
 #[derive(Clone, Debug, Default)]
 pub struct InverseScratch {
@@ -209,7 +154,7 @@ pub struct InverseScratch {
 /// coincident anchors) when the point is exactly at an anchor, and tend to that smoothly.
 ///
 /// ```
-/// use wavg_solve::kernel::{AnchorCoords, InverseScratch, inverse_weights};
+/// use wavg_solve::{AnchorCoords, InverseScratch, inverse_weights};
 /// use wavg_solve::{Mat2x8, Vec8};
 /// // Three anchors in the plane spanned by the first two axes, point at their centroid.
 /// let mut psi = Mat2x8::zeros();
@@ -264,13 +209,13 @@ pub fn inverse_weights(
     scratch.a1.resize(padded, 0.0);
     scratch.d.resize(padded, 0.0);
     out.resize(padded, 0.0);
-    let r = dispatch(&ctx, anchors, scratch, out);
+    let r = crate::simd::inverse_kernel(&ctx, anchors, scratch, out);
     out.truncate(if r.is_ok() { n } else { 0 });
     r
 }
 
 /// The per-query constants of the kernel.
-struct Ctx {
+pub(crate) struct Ctx {
     p0: [f64; DIM],
     p1: [f64; DIM],
     yh: [f64; DIM],
@@ -279,38 +224,11 @@ struct Ctx {
     n: usize,
 }
 
-/// Runs [`kernel`] compiled for AVX2 when the CPU has it (same operations in the same
-/// order, so the same results bit for bit; only wider registers).
-fn dispatch(
-    ctx: &Ctx,
-    ys: &AnchorCoords,
-    sc: &mut InverseScratch,
-    out: &mut [f64],
-) -> Result<(), SolveError> {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: `kernel_avx2` only requires AVX2, which the CPU was just checked to have.
-        return unsafe { kernel_avx2(ctx, ys, sc, out) };
-    }
-    kernel(ctx, ys, sc, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx,avx2")]
-unsafe fn kernel_avx2(
-    ctx: &Ctx,
-    ys: &AnchorCoords,
-    sc: &mut InverseScratch,
-    out: &mut [f64],
-) -> Result<(), SolveError> {
-    kernel(ctx, ys, sc, out)
-}
-
 /// The inverse problem's passes over the anchors, written as loops over contiguous arrays
 /// (or [`LANES`]-wide partial sums) so they vectorise. `sc` and `out` have the padded
 /// length; padded entries get `d = inf`, hence `s = 0` and no influence.
 #[inline(always)]
-fn kernel(
+pub(crate) fn kernel(
     ctx: &Ctx,
     ys: &AnchorCoords,
     sc: &mut InverseScratch,
@@ -534,7 +452,7 @@ mod tests {
                 let mut out = vec![0.0; padded];
                 f(&mut sc, &mut out).map(|()| out)
             };
-            let a = run(&|sc, out| dispatch(&ctx, &coords, sc, out));
+            let a = run(&|sc, out| crate::simd::inverse_kernel(&ctx, &coords, sc, out));
             let b = run(&|sc, out| kernel(&ctx, &coords, sc, out));
             assert_eq!(a, b, "n = {n}");
         }

@@ -5,17 +5,17 @@
 //!   ([`Solver::forward`]).
 //! * Inverse problem (surface point -> weights): the minimum-norm weights that make the
 //!   point the Phong projection of the average, penalising far anchors
-//!   ([`Solver::inverse`], linear algebra in [`kernel`]).
+//!   ([`Solver::inverse`], linear algebra in [`inverse_weights`]).
 //!
-//! Modules: [`anchors`] (editable anchor sets), [`points`] (validating user locations),
-//! [`weights`] (validating weights), [`solver`] (single and batched problems),
-//! [`search`] (the paper's local search for the forward problem), [`sampling`] (seeded
-//! anchors and query points for benchmarks and tests).
+//! Also: [`AnchorSet`] (editable anchor sets), [`resolve_anchor`] and [`check_point`]
+//! (validating user locations), [`validate_weights`], [`inverse_weights`] (the inverse
+//! problem's kernel on its own), and [`sampling`] (seeded anchors and query points for
+//! benchmarks and tests).
 //!
 //! ```
 //! use std::sync::Arc;
 //! use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
-//! use wavg_solve::{EmbeddedMesh, ForwardOptions, Projector, Solver, points::Anchor};
+//! use wavg_solve::{Anchor, EmbeddedMesh, ForwardOptions, Projector, Solver};
 //!
 //! let mesh = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
 //! let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
@@ -29,20 +29,45 @@
 //! assert!((p.position - solver.mesh().positions[anchors[3] as usize]).norm() < 1e-9);
 //! ```
 
-pub mod anchors;
-pub mod error;
-pub mod kernel;
-pub mod points;
-pub mod sampling;
-pub mod search;
-pub mod solver;
-pub mod verified;
-pub mod weights;
+#![deny(unreachable_pub)]
+#![forbid(unsafe_code)]
 
-pub use anchors::AnchorSet;
-pub use error::SolveError;
-pub use points::Anchor;
+mod anchors;
+mod error;
+mod kernel;
+mod points;
+pub mod sampling;
+mod search;
+mod simd;
+mod solver;
+mod verified;
+mod weights;
+
+// The solver and its problems.
 pub use solver::{BatchWeights, ForwardOptions, ForwardResult, SearchMode, Solver, Start};
-pub use verified::{RoundTrip, Verified};
+pub use verified::{DEFAULT_TOLERANCE, PENALTY_LADDER, RoundTrip, Verified};
+
+// Anchors, points and weights.
+pub use anchors::AnchorSet;
+pub use kernel::{AnchorCoords, DEFAULT_GAMMA, InverseScratch, inverse_weights};
+pub use points::{
+    Anchor, BARY_TOLERANCE, check_point, nearest_corner, resolve_anchor, vertex_point,
+};
+pub use weights::{Normalization, WEIGHT_SUM_TOLERANCE, validate_weights};
+
+// The embedded mesh and projector the solver works on.
 pub use wavg_project::{DIM, EmbeddedMesh, Mat2x8, ProjectError, ProjectionPath, Projector, Vec8};
-pub use weights::Normalization;
+
+// Errors.
+pub use error::SolveError;
+
+/// The forward problem's local search and the verified inverse's penalised weights, for
+/// this workspace's tests, experiments and C ABI.
+///
+/// **Unstable**: not part of the public API; anything here may change or disappear in any
+/// release.
+#[doc(hidden)]
+pub mod internal {
+    pub use crate::search::{LOCAL_BUDGET, LocalHit, LocalSearch};
+    pub use crate::verified::penalized_weights;
+}

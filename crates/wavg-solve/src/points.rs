@@ -36,7 +36,7 @@ impl From<SurfacePoint> for Anchor {
 ///
 /// ```
 /// use wavg_mesh::{SurfacePoint, procedural};
-/// use wavg_solve::points::check_point;
+/// use wavg_solve::check_point;
 /// let m = procedural::icosphere(1);
 /// assert!(check_point(&m, &SurfacePoint::new(3, [0.2, 0.3, 0.5])).is_ok());
 /// assert!(check_point(&m, &SurfacePoint::new(3, [0.2, 0.3, 0.6])).is_err());
@@ -87,7 +87,7 @@ pub fn vertex_point(mesh: &ValidMesh, v: VertexId) -> Result<SurfacePoint, Solve
 }
 
 /// Validates `a` against `mesh` and returns it as a surface point.
-pub fn resolve(mesh: &ValidMesh, a: &Anchor) -> Result<SurfacePoint, SolveError> {
+pub fn resolve_anchor(mesh: &ValidMesh, a: &Anchor) -> Result<SurfacePoint, SolveError> {
     match a {
         Anchor::Vertex(v) => vertex_point(mesh, *v),
         Anchor::Point(p) => check_point(mesh, p),
@@ -136,7 +136,7 @@ mod tests {
         assert_eq!(p.bary[0], 0.0);
         assert!((p.bary.iter().sum::<f64>() - 1.0).abs() < 1e-15);
         assert!(matches!(
-            resolve(&m, &Anchor::Vertex(m.n_vertices() as u32)),
+            resolve_anchor(&m, &Anchor::Vertex(m.n_vertices() as u32)),
             Err(SolveError::VertexOutOfRange { .. })
         ));
         for v in 0..m.n_vertices() as u32 {

@@ -147,7 +147,7 @@ impl LocalSearch {
         };
         // First ring: the faces around v, ordered by the projector from the walk records
         // the walk has just read (the same score as below).
-        let first = proj.faces_by_promise(y, v);
+        let first = wavg_project::internal::faces_by_promise(proj, y, v);
         for (j, &f) in first.as_slice().iter().enumerate().take(LOCAL_BUDGET) {
             seen.ids[seen.n] = f;
             order[j] = (j as f32, f);

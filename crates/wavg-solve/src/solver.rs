@@ -13,15 +13,15 @@ use crate::error::SolveError;
 use crate::kernel::{DEFAULT_GAMMA, InverseScratch, inverse_weights};
 use crate::points::{check_point, nearest_corner};
 use crate::search::LocalSearch;
-use crate::weights::{Normalization, validate};
+use crate::weights::{Normalization, validate_weights};
 use crate::{Mat2x8, Projector, Vec8};
 
 /// How the forward problem searches for the projection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SearchMode {
-    /// The paper's method ([`crate::search`]): greedy walk from a start vertex, then a
+    /// The paper's method (the local search): greedy walk from a start vertex, then a
     /// breadth-first search over triangles; the first triangle holding a valid projection
-    /// wins. When none is found within [`crate::search::LOCAL_BUDGET`] triangles, the same
+    /// wins. When none is found within `LOCAL_BUDGET` (96) triangles, the same
     /// search runs once more from the vertex nearest to the average; if that fails too, the
     /// projector's certified search is used (reported as [`ProjectionPath::Fallback`]).
     #[default]
@@ -98,7 +98,7 @@ pub struct ForwardResult {
 /// ```
 /// use std::sync::Arc;
 /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
-/// use wavg_solve::{EmbeddedMesh, ForwardOptions, Projector, Solver, points::Anchor};
+/// use wavg_solve::{Anchor, EmbeddedMesh, ForwardOptions, Projector, Solver};
 /// let mesh = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
 /// let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
 /// let anchors = [0u32, 50, 100, 200, 300, 400, 500, 600].map(Anchor::Vertex);
@@ -190,7 +190,9 @@ impl Solver {
         &self.projector
     }
 
-    /// The local search used by [`SearchMode::Fast`].
+    /// The local search used by [`SearchMode::Fast`] (for tests and experiments;
+    /// **unstable**, like the crate's `internal` module).
+    #[doc(hidden)]
     pub fn local_search(&self) -> &LocalSearch {
         &self.local
     }
@@ -217,7 +219,7 @@ impl Solver {
 
     /// The weighted average `sum w_i y_i` in R^8 of validated weights.
     pub fn average(&self, weights: &[f64], norm: Normalization) -> Result<Vec8, SolveError> {
-        let scale = validate(weights, self.n_anchors(), norm)?;
+        let scale = validate_weights(weights, self.n_anchors(), norm)?;
         Ok(self.anchors.coords().weighted_sum(weights, scale))
     }
 
@@ -387,7 +389,10 @@ impl Solver {
             .enumerate()
             .map(|(i, p)| {
                 let key = match p {
-                    Ok(p) => u64::from(self.projector.locality_key(&p.ybar)),
+                    Ok(p) => u64::from(wavg_project::internal::locality_key(
+                        &self.projector,
+                        &p.ybar,
+                    )),
                     Err(_) => u64::MAX,
                 };
                 (key, i as u32)
@@ -404,7 +409,7 @@ impl Solver {
             .with_min_len(64)
             .map(|(k, &i)| {
                 if let Some(&j) = order.get(k + AHEAD) {
-                    crate::kernel::prefetch(&prepared[j as usize]);
+                    wavg_project::internal::prefetch(&prepared[j as usize]);
                 }
                 match &prepared[i as usize] {
                     Ok(p) => self.forward_prepared(p, opts),
@@ -470,15 +475,15 @@ impl Solver {
                 let mut buf = Vec::with_capacity(n);
                 let ahead = |k: usize| pts.get(k).map(|p| p.face);
                 for f in (0..4).filter_map(ahead) {
-                    proj.prefetch_point_data(f, false);
+                    wavg_project::internal::prefetch_point_data(proj, f, false);
                 }
                 let mut status = Vec::with_capacity(pts.len());
                 for (k, (row, p)) in rows.chunks_mut(n.max(1)).zip(pts).enumerate() {
                     if let Some(f) = ahead(k + 4) {
-                        proj.prefetch_point_data(f, false);
+                        wavg_project::internal::prefetch_point_data(proj, f, false);
                     }
                     if let Some(f) = ahead(k + 2) {
-                        proj.prefetch_point_data(f, true);
+                        wavg_project::internal::prefetch_point_data(proj, f, true);
                     }
                     let r = self.inverse_into(p, &mut scratch, &mut buf);
                     if r.is_ok() {

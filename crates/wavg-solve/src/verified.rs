@@ -57,8 +57,8 @@ pub struct Verified {
 /// around 1e6 (the ladder stops at 1e4).
 ///
 /// ```
-/// use wavg_solve::kernel::AnchorCoords;
-/// use wavg_solve::verified::penalized_weights;
+/// use wavg_solve::AnchorCoords;
+/// use wavg_solve::internal::penalized_weights;
 /// use wavg_solve::{Mat2x8, Vec8};
 /// let mut psi = Mat2x8::zeros();
 /// psi[(0, 0)] = 1.0;
@@ -184,7 +184,7 @@ impl Solver {
     /// ```
     /// use std::sync::Arc;
     /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
-    /// use wavg_solve::verified::{DEFAULT_TOLERANCE, RoundTrip};
+    /// use wavg_solve::{DEFAULT_TOLERANCE, RoundTrip};
     /// use wavg_solve::{Anchor, EmbeddedMesh, Projector, Solver};
     /// let mesh = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
     /// let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
@@ -267,7 +267,7 @@ impl Solver {
     /// ```
     /// use std::sync::Arc;
     /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
-    /// use wavg_solve::verified::{DEFAULT_TOLERANCE, RoundTrip};
+    /// use wavg_solve::{DEFAULT_TOLERANCE, RoundTrip};
     /// use wavg_solve::{Anchor, BatchWeights, EmbeddedMesh, Projector, Solver};
     /// let mesh = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
     /// let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());

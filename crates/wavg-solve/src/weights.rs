@@ -20,12 +20,16 @@ pub enum Normalization {
 /// [`WEIGHT_SUM_TOLERANCE`].
 ///
 /// ```
-/// use wavg_solve::weights::{Normalization, validate};
-/// assert_eq!(validate(&[0.25, 0.75], 2, Normalization::Reject).unwrap(), 1.0);
-/// assert!(validate(&[1.0, 1.0], 2, Normalization::Reject).is_err());
-/// assert_eq!(validate(&[1.0, 1.0], 2, Normalization::Normalize).unwrap(), 0.5);
+/// use wavg_solve::{Normalization, validate_weights};
+/// assert_eq!(validate_weights(&[0.25, 0.75], 2, Normalization::Reject).unwrap(), 1.0);
+/// assert!(validate_weights(&[1.0, 1.0], 2, Normalization::Reject).is_err());
+/// assert_eq!(validate_weights(&[1.0, 1.0], 2, Normalization::Normalize).unwrap(), 0.5);
 /// ```
-pub fn validate(weights: &[f64], n_anchors: usize, norm: Normalization) -> Result<f64, SolveError> {
+pub fn validate_weights(
+    weights: &[f64],
+    n_anchors: usize,
+    norm: Normalization,
+) -> Result<f64, SolveError> {
     if n_anchors == 0 {
         return Err(SolveError::NoAnchors);
     }
@@ -89,31 +93,31 @@ mod tests {
     fn rejects_each_malformed_vector() {
         use Normalization::*;
         assert_eq!(
-            validate(&[1.0], 2, Reject),
+            validate_weights(&[1.0], 2, Reject),
             Err(SolveError::WeightCount {
                 expected: 2,
                 got: 1
             })
         );
         assert!(matches!(
-            validate(&[f64::NAN, 1.0], 2, Reject),
+            validate_weights(&[f64::NAN, 1.0], 2, Reject),
             Err(SolveError::NonFiniteWeight { index: 0, .. })
         ));
         assert!(matches!(
-            validate(&[0.5, f64::INFINITY], 2, Normalize),
+            validate_weights(&[0.5, f64::INFINITY], 2, Normalize),
             Err(SolveError::NonFiniteWeight { index: 1, .. })
         ));
         assert!(matches!(
-            validate(&[0.5, 0.5 + 2e-6], 2, Reject),
+            validate_weights(&[0.5, 0.5 + 2e-6], 2, Reject),
             Err(SolveError::WeightSum { .. })
         ));
-        assert_eq!(validate(&[0.5, 0.5 + 5e-7], 2, Reject), Ok(1.0));
+        assert_eq!(validate_weights(&[0.5, 0.5 + 5e-7], 2, Reject), Ok(1.0));
         assert!(matches!(
-            validate(&[1.0, -1.0], 2, Normalize),
+            validate_weights(&[1.0, -1.0], 2, Normalize),
             Err(SolveError::ZeroWeightSum { .. })
         ));
-        assert_eq!(validate(&[], 0, Reject), Err(SolveError::NoAnchors));
-        assert_eq!(validate(&[2.0, 2.0], 2, Normalize), Ok(0.25));
-        assert_eq!(validate(&[-1.0, 2.0], 2, Reject), Ok(1.0));
+        assert_eq!(validate_weights(&[], 0, Reject), Err(SolveError::NoAnchors));
+        assert_eq!(validate_weights(&[2.0, 2.0], 2, Normalize), Ok(0.25));
+        assert_eq!(validate_weights(&[-1.0, 2.0], 2, Reject), Ok(1.0));
     }
 }

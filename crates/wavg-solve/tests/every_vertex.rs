@@ -32,7 +32,7 @@ fn armadillo_has_weights_at_every_vertex() {
     );
     let n = mesh.n_vertices();
     let points: Vec<_> = (0..n as u32)
-        .map(|v| wavg_solve::points::vertex_point(&mesh, v).unwrap())
+        .map(|v| wavg_solve::vertex_point(&mesh, v).unwrap())
         .collect();
 
     // Corners where the interpolated plane is (nearly) rank one: the case under test.

@@ -2,7 +2,7 @@
 
 use nalgebra::{DMatrix, DVector};
 use proptest::prelude::*;
-use wavg_solve::kernel::{AnchorCoords, InverseScratch, inverse_weights};
+use wavg_solve::{AnchorCoords, InverseScratch, inverse_weights};
 use wavg_solve::{Mat2x8, SolveError, Vec8};
 
 /// The textbook formula `w = S C^T (C S C^T)^{-1} b` with `S = diag(1/d^2)`, uncentred,

@@ -4,12 +4,13 @@ use std::sync::Arc;
 
 use proptest::prelude::*;
 use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, procedural};
-use wavg_solve::kernel::{AnchorCoords, InverseScratch, inverse_weights};
+use wavg_solve::DEFAULT_TOLERANCE;
+use wavg_solve::internal::penalized_weights;
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
-use wavg_solve::verified::{DEFAULT_TOLERANCE, penalized_weights};
 use wavg_solve::{
     Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, Mat2x8, Projector, RoundTrip, Solver, Vec8,
 };
+use wavg_solve::{AnchorCoords, InverseScratch, inverse_weights};
 
 fn solver_on(mesh: TriMesh, k: usize) -> Solver {
     let mesh = Arc::new(ValidMesh::new(mesh).unwrap());

@@ -1,6 +1,8 @@
 //! Test support, not published: locating the shared test-mesh folder (`$WAVG_DATA_DIR`, default `../shared/data` beside
 //! the repository) for tests and benchmarks. The meshes are never copied into the repository.
 
+#![forbid(unsafe_code)]
+
 use std::path::PathBuf;
 
 /// The data folder if it exists: `$WAVG_DATA_DIR`, else `<repository>/../shared/data`.

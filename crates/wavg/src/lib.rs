@@ -25,6 +25,8 @@
 //! The workspace crates stay reachable as modules ([`mesh`], [`embed`], [`project`],
 //! [`solve`]) for what the front door does not cover.
 
+#![forbid(unsafe_code)]
+
 mod decimate;
 mod error;
 pub mod npy;

@@ -176,12 +176,12 @@ impl Surface {
 
     /// The surface point at vertex `v` (a corner of one of its faces).
     pub fn vertex_point(&self, v: VertexId) -> Result<SurfacePoint> {
-        Ok(wavg_solve::points::vertex_point(&self.inner.mesh, v)?)
+        Ok(wavg_solve::vertex_point(&self.inner.mesh, v)?)
     }
 
     /// The 3-D position of a surface point (its face and barycentrics are checked).
     pub fn position(&self, p: &SurfacePoint) -> Result<Vector3<f64>> {
-        let p = wavg_solve::points::check_point(&self.inner.mesh, p)?;
+        let p = wavg_solve::check_point(&self.inner.mesh, p)?;
         Ok(p.position(&self.inner.mesh))
     }
 
