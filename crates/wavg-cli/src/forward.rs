@@ -1,12 +1,14 @@
 //! `wavg forward`: anchors + weights -> points on the surface.
 
 use std::io::Write;
+
 use std::path::PathBuf;
+use wavg::text;
 
 use wavg_solve::{ForwardOptions, Normalization, SearchMode, SolveError};
 
 use crate::CliError;
-use crate::textio::{self, located, write_numbers};
+use crate::textio::{self, located};
 
 const LONG_ABOUT: &str = "\
 Forward problem: for each line of weights, the point of the surface that is the weighted
@@ -44,11 +46,9 @@ pub struct Args {
     pub warm: bool,
 }
 
-/// Runs the command.
+/// Runs the command: the weights stream through in chunks (parsed, checked, solved and
+/// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let text = textio::read_text(&args.weights)?;
-    let lines =
-        textio::parse_weights(&text).map_err(|e| located(&args.weights, e.line, &e.message))?;
     let solver = textio::load_solver(
         &args.problem.mesh,
         args.problem.embedding.as_deref(),
@@ -59,11 +59,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else {
         Normalization::Reject
     };
-    // Check every line before computing anything, so errors name their line.
-    for (line, w) in &lines {
-        wavg_solve::validate_weights(w, solver.n_anchors(), normalization)
-            .map_err(|e| located(&args.weights, *line, &e))?;
-    }
     let opts = ForwardOptions {
         mode: if args.exact {
             SearchMode::Exact
@@ -73,37 +68,52 @@ pub fn run(args: Args) -> Result<(), CliError> {
         normalization,
         warm_start: None,
     };
-    let weights: Vec<&[f64]> = lines.iter().map(|(_, w)| &w[..]).collect();
-    let results = textio::with_threads(args.problem.threads, || {
-        if args.warm {
+    // Every line is checked before anything of its chunk is computed, so errors name their line.
+    let check = |rows: &[(usize, Vec<f64>)]| {
+        rows.iter().try_for_each(|(line, w)| {
+            wavg_solve::validate_weights(w, solver.n_anchors(), normalization)
+                .map(|_| ())
+                .map_err(|e| located(&args.weights, *line, &e))
+        })
+    };
+    let solve = |rows: Vec<(usize, Vec<f64>)>, w: &mut dyn Write| -> Result<(), CliError> {
+        let weights: Vec<&[f64]> = rows.iter().map(|(_, w)| &w[..]).collect();
+        let results = if args.warm {
             solver.forward_batch_warm(&weights, &opts, 256)
         } else {
             solver.forward_batch(&weights, &opts)
-        }
-    })?;
-    // Anything but "no average" after validation is a bug or a broken mesh: fail whole.
-    for (r, (line, _)) in results.iter().zip(&lines) {
-        if let Err(e) = r
-            && *e != SolveError::NoWeightedAverage
-        {
-            return Err(CliError::failure(format!(
-                "{}:{line}: {e}",
-                args.weights.display()
-            )));
-        }
-    }
-    textio::write_atomic(&args.problem.output, |w: &mut dyn Write| {
-        for r in &results {
-            match r {
-                Ok(r) => {
-                    let p = r.point;
-                    write!(w, "{} ", p.face)?;
-                    write_numbers(w, p.bary.into_iter().chain(r.position.iter().copied()))?;
-                }
-                Err(e) => write!(w, "none {}", crate::common::one_line(e))?,
+        };
+        // Anything but "no average" after validation is a bug or a broken mesh: fail whole.
+        for (r, (line, _)) in results.iter().zip(&rows) {
+            if let Err(e) = r
+                && *e != SolveError::NoWeightedAverage
+            {
+                return Err(CliError::failure(format!(
+                    "{}:{line}: {e}",
+                    args.weights.display()
+                )));
             }
-            writeln!(w)?;
         }
-        Ok(())
-    })
+        text::write_lines(w, &results, |r, out| match r {
+            Ok(r) => {
+                let p = r.point;
+                out.extend_from_slice(p.face.to_string().as_bytes());
+                out.push(b' ');
+                text::push_numbers(out, p.bary.into_iter().chain(r.position.iter().copied()));
+            }
+            Err(e) => {
+                out.extend_from_slice(format!("none {}", crate::common::one_line(e)).as_bytes())
+            }
+        })
+        .map_err(|e| CliError::failure(format!("{}: {e}", args.problem.output.display())))
+    };
+    textio::with_threads(args.problem.threads, || {
+        textio::stream_queries(
+            &args.weights,
+            &args.problem.output,
+            text::parse_weights,
+            check,
+            solve,
+        )
+    })?
 }

@@ -3,8 +3,11 @@
 use std::io::Write;
 use std::path::PathBuf;
 
+use wavg::text::{self, PointSpec};
+use wavg_solve::{BatchWeights, DEFAULT_TOLERANCE, RoundTrip, Verified};
+
 use crate::CliError;
-use crate::textio::{self, write_numbers};
+use crate::textio;
 
 const LONG_ABOUT: &str = "\
 Inverse problem: for each surface point, weights (one per anchor, summing to 1) whose
@@ -44,9 +47,9 @@ pub struct Args {
     pub verified: bool,
 }
 
-/// Runs the command.
+/// Runs the command: the points stream through in chunks (parsed, resolved, solved and
+/// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let specs = textio::read_points(&args.points)?;
     let mut solver = textio::load_solver(
         &args.problem.mesh,
         args.problem.embedding.as_deref(),
@@ -55,70 +58,87 @@ pub fn run(args: Args) -> Result<(), CliError> {
     solver
         .set_gamma(args.gamma)
         .map_err(|e| CliError::input(format!("--gamma: {e}")))?;
-    let points = textio::resolve_points(solver.mesh(), &specs, &args.points)?;
+    let solver = solver;
+    let resolve =
+        |rows: &[(usize, PointSpec)]| textio::resolve_points(solver.mesh(), rows, &args.points);
+    let mut summary = VerifiedSummary::default();
+    let mut weights = BatchWeights::default();
+    let solve = |rows: Vec<(usize, PointSpec)>, w: &mut dyn Write| -> Result<(), CliError> {
+        let points = resolve(&rows)?;
+        let written = if args.verified {
+            let batch = solver.inverse_verified_batch(&points, DEFAULT_TOLERANCE);
+            summary.add(&batch);
+            text::write_lines(w, &batch, |r, out| match r {
+                Ok(v) => text::push_numbers(out, v.weights.iter().copied()),
+                Err(e) => none(out, e),
+            })
+        } else {
+            solver.inverse_batch_into(&points, &mut weights);
+            let rows: Vec<usize> = (0..weights.len()).collect();
+            text::write_lines(w, &rows, |&i, out| match weights.get(i) {
+                Ok(ws) => text::push_numbers(out, ws.iter().copied()),
+                Err(e) => none(out, e),
+            })
+        };
+        written.map_err(|e| CliError::failure(format!("{}: {e}", args.problem.output.display())))
+    };
+    let check = |rows: &[(usize, PointSpec)]| resolve(rows).map(|_| ());
+    textio::with_threads(args.problem.threads, || {
+        textio::stream_queries(
+            &args.points,
+            &args.problem.output,
+            text::parse_points,
+            check,
+            solve,
+        )
+    })??;
     if args.verified {
-        return run_verified(&args, &solver, &points);
+        summary.report();
     }
-    let batch = textio::with_threads(args.problem.threads, || solver.inverse_batch(&points))?;
-    textio::write_atomic(&args.problem.output, |w: &mut dyn Write| {
-        for r in batch.iter() {
-            match r {
-                Ok(ws) => write_numbers(w, ws.iter().copied())?,
-                Err(e) => write!(w, "none {}", crate::common::one_line(e))?,
-            }
-            writeln!(w)?;
-        }
-        Ok(())
-    })
+    Ok(())
 }
 
-/// `--verified`: the same output, from [`wavg_solve::Solver::inverse_verified`].
-fn run_verified(
-    args: &Args,
-    solver: &wavg_solve::Solver,
-    points: &[wavg_mesh::SurfacePoint],
-) -> Result<(), CliError> {
-    use wavg_solve::DEFAULT_TOLERANCE;
-    use wavg_solve::RoundTrip;
-    let batch = textio::with_threads(args.problem.threads, || {
-        solver.inverse_verified_batch(points, DEFAULT_TOLERANCE)
-    })?;
-    textio::write_atomic(&args.problem.output, |w: &mut dyn Write| {
-        for r in &batch {
+/// `none REASON` for a point without weights.
+fn none(out: &mut Vec<u8>, e: &wavg_solve::SolveError) {
+    out.extend_from_slice(format!("none {}", crate::common::one_line(e)).as_bytes());
+}
+
+/// What `--verified` reports on standard error: penalised points and points no weights
+/// reach (counted from 1 over the whole file).
+#[derive(Default)]
+struct VerifiedSummary {
+    points: usize,
+    penalised: usize,
+    missed: Vec<usize>,
+}
+
+impl VerifiedSummary {
+    fn add(&mut self, batch: &[Result<Verified, wavg_solve::SolveError>]) {
+        for (i, r) in batch.iter().enumerate() {
             match r {
-                Ok(v) => write_numbers(w, v.weights.iter().copied())?,
-                Err(e) => write!(w, "none {}", crate::common::one_line(e))?,
+                Ok(v) if matches!(v.round_trip, RoundTrip::Penalized(_)) => self.penalised += 1,
+                Ok(v) if v.round_trip == RoundTrip::NotReached => {
+                    self.missed.push(self.points + i + 1);
+                }
+                _ => {}
             }
-            writeln!(w)?;
         }
-        Ok(())
-    })?;
-    let penalised = batch
-        .iter()
-        .filter(|r| matches!(r, Ok(v) if matches!(v.round_trip, RoundTrip::Penalized(_))))
-        .count();
-    let missed: Vec<String> = batch
-        .iter()
-        .enumerate()
-        .filter(|(_, r)| matches!(r, Ok(v) if v.round_trip == RoundTrip::NotReached))
-        .map(|(i, _)| (i + 1).to_string())
-        .collect();
-    eprintln!(
-        "verified: {} points, {penalised} with penalised weights, {} not reached{}",
-        batch.len(),
-        missed.len(),
-        if missed.is_empty() {
-            String::new()
-        } else {
-            let shown = missed
-                .iter()
-                .take(20)
-                .cloned()
-                .collect::<Vec<_>>()
-                .join(", ");
-            let more = if missed.len() > 20 { ", ..." } else { "" };
-            format!(" (points {shown}{more}, counted from 1)")
-        }
-    );
-    Ok(())
+        self.points += batch.len();
+    }
+
+    fn report(&self) {
+        let shown: Vec<String> = self.missed.iter().take(20).map(|i| i.to_string()).collect();
+        eprintln!(
+            "verified: {} points, {} with penalised weights, {} not reached{}",
+            self.points,
+            self.penalised,
+            self.missed.len(),
+            if shown.is_empty() {
+                String::new()
+            } else {
+                let more = if self.missed.len() > 20 { ", ..." } else { "" };
+                format!(" (points {}{more}, counted from 1)", shown.join(", "))
+            }
+        );
+    }
 }

@@ -34,119 +34,7 @@ Numbers are written in the shortest form that reads back to the same f64.
 Malformed input exits with status 2 and nothing is written (the output file is written to
 a temporary file beside it and renamed only on success); '-o -' writes to stdout.";
 
-/// A malformed line.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LineError {
-    /// 1-based line number.
-    pub line: usize,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl fmt::Display for LineError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "line {}: {}", self.line, self.message)
-    }
-}
-
-/// A surface point as written in a file (not yet checked against a mesh).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum PointSpec {
-    /// `v VERTEX`.
-    Vertex(u64),
-    /// `f FACE B0 B1 B2`.
-    Face {
-        /// Face index.
-        face: u64,
-        /// Barycentric coordinates as written.
-        bary: [f64; 3],
-    },
-}
-
-/// The non-blank, non-comment lines of `text` with their 1-based line numbers, each split
-/// into whitespace-separated tokens.
-fn content_lines(text: &str) -> impl Iterator<Item = (usize, Vec<&str>)> {
-    text.lines().enumerate().filter_map(|(i, l)| {
-        let l = l.split_once('#').map_or(l, |(a, _)| a);
-        let toks: Vec<&str> = l.split_whitespace().collect();
-        (!toks.is_empty()).then_some((i + 1, toks))
-    })
-}
-
-fn number(tok: &str, line: usize, what: &str) -> Result<f64, LineError> {
-    let x: f64 = tok.parse().map_err(|_| LineError {
-        line,
-        message: format!("{what}: '{tok}' is not a number"),
-    })?;
-    if !x.is_finite() {
-        return Err(LineError {
-            line,
-            message: format!("{what}: '{tok}' is not finite"),
-        });
-    }
-    Ok(x)
-}
-
-fn index(tok: &str, line: usize, what: &str) -> Result<u64, LineError> {
-    tok.parse().map_err(|_| LineError {
-        line,
-        message: format!("{what}: '{tok}' is not a non-negative integer"),
-    })
-}
-
-/// Parses a surface-point file (`v VERTEX` / `f FACE B0 B1 B2` lines).
-pub fn parse_points(text: &str) -> Result<Vec<(usize, PointSpec)>, LineError> {
-    content_lines(text)
-        .map(|(line, t)| {
-            let spec = match (t[0], t.len()) {
-                ("v", 2) => PointSpec::Vertex(index(t[1], line, "vertex index")?),
-                ("f", 5) => PointSpec::Face {
-                    face: index(t[1], line, "face index")?,
-                    bary: [
-                        number(t[2], line, "barycentric B0")?,
-                        number(t[3], line, "barycentric B1")?,
-                        number(t[4], line, "barycentric B2")?,
-                    ],
-                },
-                ("v", n) => {
-                    return Err(LineError {
-                        line,
-                        message: format!("'v' takes 1 value (VERTEX), got {}", n - 1),
-                    });
-                }
-                ("f", n) => {
-                    return Err(LineError {
-                        line,
-                        message: format!("'f' takes 4 values (FACE B0 B1 B2), got {}", n - 1),
-                    });
-                }
-                (other, _) => {
-                    return Err(LineError {
-                        line,
-                        message: format!(
-                            "expected 'v VERTEX' or 'f FACE B0 B1 B2', found '{other}'"
-                        ),
-                    });
-                }
-            };
-            Ok((line, spec))
-        })
-        .collect()
-}
-
-/// Parses a weights file: every content line is a list of numbers.
-pub fn parse_weights(text: &str) -> Result<Vec<(usize, Vec<f64>)>, LineError> {
-    content_lines(text)
-        .map(|(line, t)| {
-            let w = t
-                .iter()
-                .enumerate()
-                .map(|(i, tok)| number(tok, line, &format!("weight {i}")))
-                .collect::<Result<Vec<f64>, _>>()?;
-            Ok((line, w))
-        })
-        .collect()
-}
+pub use wavg::text::PointSpec;
 
 /// Reads a whole text file, mapping failures to exit status 2.
 pub fn read_text(path: &Path) -> Result<String, CliError> {
@@ -181,6 +69,68 @@ pub fn write_atomic(
     }
     tmp.persist(path).map_err(|e| fail(&e.error))?;
     Ok(())
+}
+
+/// A chunk parser of `wavg::text`: the chunk's text and first line number to numbered rows.
+pub type ParseChunk<T> = fn(&str, usize) -> Result<Vec<(usize, T)>, wavg::text::LineError>;
+
+/// Lines read, checked, computed and written per round when streaming a query file.
+const STREAM_LINES: usize = 1 << 16;
+
+/// Streams the query file `input` through bounded memory: each chunk of lines is parsed by
+/// `parse` (in parallel), checked by `check` (errors name their line), and handed to
+/// `each`, which writes its answers. The output goes to a temporary file renamed on
+/// success, so a bad line anywhere leaves nothing; for stdout (`-`) a first pass parses and
+/// checks the whole file before anything is written, for the same guarantee.
+pub fn stream_queries<T: Send>(
+    input: &Path,
+    output: &Path,
+    parse: ParseChunk<T>,
+    check: impl Fn(&[(usize, T)]) -> Result<(), CliError>,
+    mut each: impl FnMut(Vec<(usize, T)>, &mut dyn Write) -> Result<(), CliError>,
+) -> Result<(), CliError> {
+    let open = || -> Result<_, CliError> {
+        let file = std::fs::File::open(input)
+            .map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
+        Ok(wavg::text::LineChunks::new(
+            std::io::BufReader::with_capacity(1 << 20, file),
+            STREAM_LINES,
+        ))
+    };
+    let next = |chunks: &mut wavg::text::LineChunks<_>| -> Result<_, CliError> {
+        let Some(chunk) = chunks
+            .next_chunk()
+            .map_err(|e| CliError::input(format!("{}: {e}", input.display())))?
+        else {
+            return Ok(None);
+        };
+        let rows =
+            parse(&chunk.text, chunk.first_line).map_err(|e| located(input, e.line, &e.message))?;
+        check(&rows)?;
+        Ok(Some(rows))
+    };
+    if output == Path::new("-") {
+        let mut chunks = open()?;
+        while next(&mut chunks)?.is_some() {}
+    }
+    let mut chunks = open()?;
+    let mut failure = None;
+    let written = write_atomic(output, |w: &mut dyn Write| {
+        let mut round = || -> Result<(), CliError> {
+            while let Some(rows) = next(&mut chunks)? {
+                each(rows, w)?;
+            }
+            Ok(())
+        };
+        round().map_err(|e| {
+            failure = Some(e);
+            std::io::Error::other("stopped")
+        })
+    });
+    match failure {
+        Some(e) => Err(e),
+        None => written,
+    }
 }
 
 /// Arguments shared by `wavg forward` and `wavg inverse`: the mesh, its embedding, the
@@ -260,7 +210,7 @@ pub fn located(file: &Path, line: usize, msg: &dyn fmt::Display) -> CliError {
 
 /// Reads and parses a point file, mapping errors to `file:line` input errors.
 pub fn read_points(file: &Path) -> Result<Vec<(usize, PointSpec)>, CliError> {
-    parse_points(&read_text(file)?).map_err(|e| located(file, e.line, &e.message))
+    wavg::text::parse_points(&read_text(file)?, 1).map_err(|e| located(file, e.line, &e.message))
 }
 
 /// Loads mesh, embedding and anchors, and makes the solver (shared by forward/inverse).
@@ -308,64 +258,14 @@ pub fn with_threads<T: Send>(
 
 /// Writes numbers separated by single spaces.
 pub fn write_numbers(w: &mut dyn Write, xs: impl IntoIterator<Item = f64>) -> std::io::Result<()> {
-    for (i, x) in xs.into_iter().enumerate() {
-        if i > 0 {
-            w.write_all(b" ")?;
-        }
-        write!(w, "{x:?}")?;
-    }
-    Ok(())
+    let mut buf = Vec::new();
+    wavg::text::push_numbers(&mut buf, xs);
+    w.write_all(&buf)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn parses_points_with_comments_and_blank_lines() {
-        let t = "# anchors\n\nv 3\n  f 2 0.25 0.25 0.5   # inline\nv 0\n";
-        let p = parse_points(t).unwrap();
-        assert_eq!(
-            p,
-            vec![
-                (3, PointSpec::Vertex(3)),
-                (
-                    4,
-                    PointSpec::Face {
-                        face: 2,
-                        bary: [0.25, 0.25, 0.5]
-                    }
-                ),
-                (5, PointSpec::Vertex(0)),
-            ]
-        );
-    }
-
-    #[test]
-    fn point_errors_name_the_line() {
-        for (t, line, needle) in [
-            ("v 1\nv -1\n", 2, "non-negative integer"),
-            ("v 1\n\nq 3\n", 3, "expected 'v VERTEX'"),
-            ("f 1 0.5 0.5\n", 1, "takes 4 values"),
-            ("v 1 2\n", 1, "takes 1 value"),
-            ("f 1 0.5 nan 0.5\n", 1, "not finite"),
-            ("f 1 0.5 x 0.5\n", 1, "not a number"),
-            ("v 1.5\n", 1, "non-negative integer"),
-        ] {
-            let e = parse_points(t).unwrap_err();
-            assert_eq!(e.line, line, "{t:?}");
-            assert!(e.message.contains(needle), "{t:?}: {}", e.message);
-        }
-    }
-
-    #[test]
-    fn parses_weights() {
-        let w = parse_weights("0.5 0.5\n# c\n1e-1\t0.9\n").unwrap();
-        assert_eq!(w, vec![(1, vec![0.5, 0.5]), (3, vec![0.1, 0.9])]);
-        let e = parse_weights("0.5 0.5\n0.5 inf\n").unwrap_err();
-        assert_eq!(e.line, 2);
-        assert!(e.message.contains("weight 1"));
-    }
 
     #[test]
     fn atomic_write_leaves_nothing_on_error() {

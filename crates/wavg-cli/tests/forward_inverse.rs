@@ -390,3 +390,77 @@ fn bench_roundtrip_verified_adds_its_keys() {
     let reached = 1.0 - obj["verified_not_reached_fraction"].as_f64().unwrap();
     assert!((verified - reached).abs() < 1e-9, "{verified} vs {reached}");
 }
+
+/// Files longer than one streaming chunk (65,536 lines): answers in order across chunk
+/// boundaries, the same on one thread and on stdout; a bad line in a late chunk still
+/// names its line, leaves the old output untouched, and writes nothing to stdout.
+#[test]
+fn long_files_stream_in_chunks() {
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = write(dir.path(), "anchors.txt", ANCHORS);
+    let n_faces = 320;
+    let mut points = String::new();
+    let n = 150_000;
+    for i in 0..n {
+        let f = (i * 7) % n_faces;
+        let a = 0.1 + 0.8 * ((i % 13) as f64 / 13.0);
+        let b = (1.0 - a) * 0.5;
+        points.push_str(&format!("f {f} {a} {b} {}\n", 1.0 - a - b));
+    }
+    let pts = write(dir.path(), "points.txt", &points);
+    let w_file = dir.path().join("weights.txt");
+    wavg_ok(&solve_args(
+        "inverse",
+        s(&anchors),
+        s(&pts),
+        s(&w_file),
+        &[],
+    ));
+    let weights = read_rows(&w_file);
+    assert_eq!(weights.len(), n);
+    // Spot checks against a one-line run at a chunk boundary and far into the file.
+    for i in [0usize, 65_535, 65_536, 131_072, n - 1] {
+        let one = write(dir.path(), "one.txt", points.lines().nth(i).unwrap());
+        let one_out = dir.path().join("one_out.txt");
+        wavg_ok(&solve_args(
+            "inverse",
+            s(&anchors),
+            s(&one),
+            s(&one_out),
+            &[],
+        ));
+        assert_eq!(read_rows(&one_out)[0], weights[i], "line {}", i + 1);
+    }
+    // Forward on one thread to stdout equals forward to a file on all threads.
+    let back = dir.path().join("back.txt");
+    wavg_ok(&solve_args(
+        "forward",
+        s(&anchors),
+        s(&w_file),
+        s(&back),
+        &[],
+    ));
+    let out = wavg_ok(&solve_args(
+        "forward",
+        s(&anchors),
+        s(&w_file),
+        "-",
+        &["--threads", "1"],
+    ));
+    assert_eq!(out.stdout, std::fs::read(&back).unwrap());
+    // A bad line in the third chunk.
+    let mut bad = points.clone();
+    bad.push_str("f 1 0.5 0.5\n");
+    let bad_pts = write(dir.path(), "bad.txt", &bad);
+    expect_input_error(
+        &solve_args("inverse", s(&anchors), s(&bad_pts), s(&w_file), &[]),
+        &w_file,
+        &format!("bad.txt:{}:", n + 1),
+    );
+    let out = wavg(&solve_args("inverse", s(&anchors), s(&bad_pts), "-", &[]));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        out.stdout.is_empty(),
+        "stdout got output before the bad line"
+    );
+}

@@ -32,6 +32,7 @@ mod error;
 pub mod npy;
 mod oneoff;
 mod surface;
+pub mod text;
 
 pub use decimate::Decimation;
 pub use error::{Error, ErrorKind, Result};

@@ -1,0 +1,386 @@
+//! The plain-text formats of surface points and weights, parsed and written in parallel a
+//! chunk of lines at a time, so files of any length stream through bounded memory.
+//!
+//! Files have one item per line. `#` starts a comment that runs to the end of the line;
+//! blank (or comment-only) lines are skipped. Line numbers in errors count every physical
+//! line from 1.
+//!
+//! * Surface points (anchors, query points): `v VERTEX` (a mesh vertex, 0-based) or
+//!   `f FACE B0 B1 B2` (0-based face, barycentric coordinates of its three corners).
+//! * Weights: whitespace-separated decimal numbers, one query per line.
+//!
+//! Numbers are written in the shortest form that reads back to the same `f64`, exactly as
+//! Rust's `{:?}` writes them.
+//!
+//! ```
+//! use wavg::text::{LineChunks, PointSpec, parse_points, push_numbers};
+//! let text = "# two anchors\nv 3\nf 2 0.25 0.25 0.5\n";
+//! let mut chunks = LineChunks::new(text.as_bytes(), 1000);
+//! let chunk = chunks.next_chunk()?.expect("one chunk");
+//! let points = parse_points(&chunk.text, chunk.first_line)?;
+//! assert_eq!(points[0], (2, PointSpec::Vertex(3)));
+//! let mut out = Vec::new();
+//! push_numbers(&mut out, [0.1, 1.0, 2.5e-300]);
+//! assert_eq!(out, b"0.1 1.0 2.5e-300");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+use std::fmt;
+use std::io::{self, BufRead, Write};
+
+use rayon::prelude::*;
+
+/// Lines parsed or formatted by one task: large enough to amortise scheduling, small
+/// enough to spread a chunk over every thread.
+const LINES_PER_TASK: usize = 2048;
+
+/// A malformed line.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub struct LineError {
+    /// 1-based line number.
+    pub line: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for LineError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "line {}: {}", self.line, self.message)
+    }
+}
+
+/// A surface point as written in a file (not yet checked against a mesh).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PointSpec {
+    /// `v VERTEX`.
+    Vertex(u64),
+    /// `f FACE B0 B1 B2`.
+    Face {
+        /// Face index.
+        face: u64,
+        /// Barycentric coordinates as written.
+        bary: [f64; 3],
+    },
+}
+
+/// Whole lines of a text stream, a bounded number at a time.
+pub struct LineChunks<R> {
+    reader: R,
+    next_line: usize,
+    lines_per_chunk: usize,
+}
+
+/// Consecutive whole lines of a stream.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Chunk {
+    /// 1-based number of the chunk's first line.
+    pub first_line: usize,
+    /// The lines, each with its line break (the stream's last line may lack one).
+    pub text: String,
+}
+
+impl<R: BufRead> LineChunks<R> {
+    /// Reads `reader` in chunks of at most `lines_per_chunk` lines (at least 1).
+    pub fn new(reader: R, lines_per_chunk: usize) -> Self {
+        Self {
+            reader,
+            next_line: 1,
+            lines_per_chunk: lines_per_chunk.max(1),
+        }
+    }
+
+    /// The next chunk, or `None` at the end of the stream. Text that is not UTF-8 is an
+    /// [`io::ErrorKind::InvalidData`] error.
+    pub fn next_chunk(&mut self) -> io::Result<Option<Chunk>> {
+        let mut text = String::new();
+        let mut lines = 0;
+        while lines < self.lines_per_chunk && self.reader.read_line(&mut text)? > 0 {
+            lines += 1;
+        }
+        if lines == 0 {
+            return Ok(None);
+        }
+        let chunk = Chunk {
+            first_line: self.next_line,
+            text,
+        };
+        self.next_line += lines;
+        Ok(Some(chunk))
+    }
+}
+
+/// Parses surface-point lines (`v VERTEX` / `f FACE B0 B1 B2`) in parallel; `first_line`
+/// is the number of the first line of `text`. Returns each point with its line number;
+/// the error is the first malformed line's.
+pub fn parse_points(text: &str, first_line: usize) -> Result<Vec<(usize, PointSpec)>, LineError> {
+    parse_lines(text, first_line, point_line)
+}
+
+/// Parses weight lines (whitespace-separated finite numbers) in parallel; `first_line` is
+/// the number of the first line of `text`. Returns each row with its line number; the
+/// error is the first malformed line's. Row lengths are not checked here.
+pub fn parse_weights(text: &str, first_line: usize) -> Result<Vec<(usize, Vec<f64>)>, LineError> {
+    parse_lines(text, first_line, |line, toks| {
+        toks.iter()
+            .enumerate()
+            .map(|(i, tok)| number(tok, line, &format!("weight {i}")))
+            .collect()
+    })
+}
+
+/// Runs `parse` on the tokens of every content line, in parallel over groups of lines,
+/// keeping input order and reporting the first error.
+fn parse_lines<T: Send>(
+    text: &str,
+    first_line: usize,
+    parse: impl Fn(usize, &[&str]) -> Result<T, LineError> + Sync,
+) -> Result<Vec<(usize, T)>, LineError> {
+    let lines: Vec<&str> = text.lines().collect();
+    let groups: Vec<Result<Vec<(usize, T)>, LineError>> = lines
+        .par_chunks(LINES_PER_TASK)
+        .enumerate()
+        .map(|(g, group)| {
+            let mut out = Vec::with_capacity(group.len());
+            let mut toks = Vec::new();
+            for (i, l) in group.iter().enumerate() {
+                let l = l.split_once('#').map_or(*l, |(a, _)| a);
+                toks.clear();
+                toks.extend(l.split_whitespace());
+                if !toks.is_empty() {
+                    let line = first_line + g * LINES_PER_TASK + i;
+                    out.push((line, parse(line, &toks)?));
+                }
+            }
+            Ok(out)
+        })
+        .collect();
+    let mut out = Vec::new();
+    for g in groups {
+        out.extend(g?);
+    }
+    Ok(out)
+}
+
+fn point_line(line: usize, t: &[&str]) -> Result<PointSpec, LineError> {
+    let err = |message: String| Err(LineError { line, message });
+    match (t[0], t.len()) {
+        ("v", 2) => Ok(PointSpec::Vertex(index(t[1], line, "vertex index")?)),
+        ("f", 5) => Ok(PointSpec::Face {
+            face: index(t[1], line, "face index")?,
+            bary: [
+                number(t[2], line, "barycentric B0")?,
+                number(t[3], line, "barycentric B1")?,
+                number(t[4], line, "barycentric B2")?,
+            ],
+        }),
+        ("v", n) => err(format!("'v' takes 1 value (VERTEX), got {}", n - 1)),
+        ("f", n) => err(format!("'f' takes 4 values (FACE B0 B1 B2), got {}", n - 1)),
+        (other, _) => err(format!(
+            "expected 'v VERTEX' or 'f FACE B0 B1 B2', found '{other}'"
+        )),
+    }
+}
+
+fn number(tok: &str, line: usize, what: &str) -> Result<f64, LineError> {
+    let x: f64 = tok.parse().map_err(|_| LineError {
+        line,
+        message: format!("{what}: '{tok}' is not a number"),
+    })?;
+    if !x.is_finite() {
+        return Err(LineError {
+            line,
+            message: format!("{what}: '{tok}' is not finite"),
+        });
+    }
+    Ok(x)
+}
+
+fn index(tok: &str, line: usize, what: &str) -> Result<u64, LineError> {
+    tok.parse().map_err(|_| LineError {
+        line,
+        message: format!("{what}: '{tok}' is not a non-negative integer"),
+    })
+}
+
+/// Appends one number in the shortest form that reads back to the same `f64`, as `{:?}`
+/// writes it.
+pub fn push_number(out: &mut Vec<u8>, x: f64) {
+    // zmij writes the same digits as `{:?}` and the same layout between 1e-4 and 1e16
+    // (tested); elsewhere `{:?}` switches to exponent notation at other thresholds.
+    let a = x.abs();
+    if x.is_finite() && (x == 0.0 || (1e-4..1e16).contains(&a)) {
+        out.extend_from_slice(zmij::Buffer::new().format_finite(x).as_bytes());
+    } else {
+        // Writing into a Vec cannot fail.
+        let _ = write!(out, "{x:?}");
+    }
+}
+
+/// Appends numbers separated by single spaces.
+pub fn push_numbers(out: &mut Vec<u8>, xs: impl IntoIterator<Item = f64>) {
+    for (i, x) in xs.into_iter().enumerate() {
+        if i > 0 {
+            out.push(b' ');
+        }
+        push_number(out, x);
+    }
+}
+
+/// Writes one line per item, formatted by `format` in parallel (each call appends one
+/// line's text without its line break), in input order.
+pub fn write_lines<T: Sync>(
+    w: &mut dyn Write,
+    items: &[T],
+    format: impl Fn(&T, &mut Vec<u8>) + Sync,
+) -> io::Result<()> {
+    let buffers: Vec<Vec<u8>> = items
+        .par_chunks(LINES_PER_TASK)
+        .map(|group| {
+            let mut buf = Vec::new();
+            for item in group {
+                format(item, &mut buf);
+                buf.push(b'\n');
+            }
+            buf
+        })
+        .collect();
+    for b in &buffers {
+        w.write_all(b)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn parses_points_with_comments_and_blank_lines() {
+        let t = "# anchors\n\nv 3\n  f 2 0.25 0.25 0.5   # inline\nv 0\n";
+        let p = parse_points(t, 1).unwrap();
+        assert_eq!(
+            p,
+            vec![
+                (3, PointSpec::Vertex(3)),
+                (
+                    4,
+                    PointSpec::Face {
+                        face: 2,
+                        bary: [0.25, 0.25, 0.5]
+                    }
+                ),
+                (5, PointSpec::Vertex(0)),
+            ]
+        );
+    }
+
+    #[test]
+    fn point_errors_name_the_line() {
+        for (t, line, needle) in [
+            ("v 1\nv -1\n", 2, "non-negative integer"),
+            ("v 1\n\nq 3\n", 3, "expected 'v VERTEX'"),
+            ("f 1 0.5 0.5\n", 1, "takes 4 values"),
+            ("v 1 2\n", 1, "takes 1 value"),
+            ("f 1 0.5 nan 0.5\n", 1, "not finite"),
+            ("f 1 0.5 x 0.5\n", 1, "not a number"),
+            ("v 1.5\n", 1, "non-negative integer"),
+        ] {
+            let e = parse_points(t, 1).unwrap_err();
+            assert_eq!(e.line, line, "{t:?}");
+            assert!(e.message.contains(needle), "{t:?}: {}", e.message);
+        }
+    }
+
+    #[test]
+    fn parses_weights() {
+        let w = parse_weights("0.5 0.5\n# c\n1e-1\t0.9\n", 1).unwrap();
+        assert_eq!(w, vec![(1, vec![0.5, 0.5]), (3, vec![0.1, 0.9])]);
+        let e = parse_weights("0.5 0.5\n0.5 inf\n", 1).unwrap_err();
+        assert_eq!(e.line, 2);
+        assert!(e.message.contains("weight 1"));
+    }
+
+    #[test]
+    fn chunks_keep_line_numbers_and_report_the_first_error() {
+        // Many lines, so that several parallel groups and several chunks are involved.
+        let mut text = String::new();
+        for i in 0..10_000 {
+            if i % 7 == 0 {
+                text.push_str("# comment\n");
+            } else {
+                text.push_str(&format!("{i} 0.5\n"));
+            }
+        }
+        let whole = parse_weights(&text, 1).unwrap();
+        let mut chunks = LineChunks::new(text.as_bytes(), 999);
+        let mut streamed = Vec::new();
+        while let Some(c) = chunks.next_chunk().unwrap() {
+            streamed.extend(parse_weights(&c.text, c.first_line).unwrap());
+        }
+        assert_eq!(streamed, whole);
+        assert_eq!(whole[0], (2, vec![1.0, 0.5]));
+        // Two bad lines in different groups: the first is reported.
+        let mut bad: Vec<&str> = text.lines().collect();
+        bad[8000] = "x";
+        bad[5000] = "y";
+        let e = parse_weights(&bad.join("\n"), 1).unwrap_err();
+        assert_eq!(e.line, 5001);
+    }
+
+    #[test]
+    fn non_utf8_is_an_error() {
+        let mut chunks = LineChunks::new(&b"0.5 0.5\n\xff\n"[..], 10);
+        assert!(chunks.next_chunk().is_err());
+    }
+
+    #[test]
+    fn writes_lines_in_order() {
+        let items: Vec<f64> = (0..5000).map(|i| i as f64 * 0.5).collect();
+        let mut out = Vec::new();
+        write_lines(&mut out, &items, |x, b| push_number(b, *x)).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let back: Vec<f64> = text.lines().map(|l| l.parse().unwrap()).collect();
+        assert_eq!(back, items);
+    }
+
+    #[test]
+    fn numbers_as_debug_at_the_edges() {
+        for x in [
+            0.0,
+            -0.0,
+            1.0,
+            0.1,
+            1e-4,
+            9.999e-5,
+            1e15,
+            1e16,
+            9.99e15,
+            1e-300,
+            5e-324,
+            1e300,
+            f64::MAX,
+            -1.5,
+            123456.789,
+            1e21,
+            1e22,
+        ] {
+            let mut out = Vec::new();
+            push_number(&mut out, x);
+            assert_eq!(String::from_utf8(out).unwrap(), format!("{x:?}"));
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn numbers_as_debug(bits in any::<u64>(), scale in -30i32..30) {
+            let x = f64::from_bits(bits);
+            let y = (bits as f64 / u64::MAX as f64) * 10f64.powi(scale);
+            for v in [x, y, -y] {
+                let mut out = Vec::new();
+                push_number(&mut out, v);
+                prop_assert_eq!(String::from_utf8(out).unwrap(), format!("{v:?}"));
+            }
+        }
+    }
+}
