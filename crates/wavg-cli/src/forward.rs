@@ -97,8 +97,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         text::write_lines(w, &results, |r, out| match r {
             Ok(r) => {
                 let p = r.point;
-                out.extend_from_slice(p.face.to_string().as_bytes());
-                out.push(b' ');
+                let _ = write!(out, "{} ", p.face);
                 text::push_numbers(out, p.bary.into_iter().chain(r.position.iter().copied()));
             }
             Err(e) => {

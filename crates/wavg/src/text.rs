@@ -9,8 +9,9 @@
 //!   `f FACE B0 B1 B2` (0-based face, barycentric coordinates of its three corners).
 //! * Weights: whitespace-separated decimal numbers, one query per line.
 //!
-//! Numbers are written in the shortest form that reads back to the same `f64`, exactly as
-//! Rust's `{:?}` writes them.
+//! Numbers are written in the shortest form that reads back to the same `f64`, laid out as
+//! Rust's `{:?}` writes them (where two shortest forms are equally close, the digits may
+//! differ from `{:?}`'s in the last place).
 //!
 //! ```
 //! use wavg::text::{LineChunks, PointSpec, parse_points, push_numbers};
@@ -123,7 +124,7 @@ pub fn parse_weights(text: &str, first_line: usize) -> Result<Vec<(usize, Vec<f6
     parse_lines(text, first_line, |line, toks| {
         toks.iter()
             .enumerate()
-            .map(|(i, tok)| number(tok, line, &format!("weight {i}")))
+            .map(|(i, tok)| number(tok, line, WeightNo(i)))
             .collect()
     })
 }
@@ -181,7 +182,16 @@ fn point_line(line: usize, t: &[&str]) -> Result<PointSpec, LineError> {
     }
 }
 
-fn number(tok: &str, line: usize, what: &str) -> Result<f64, LineError> {
+/// Names the `i`-th weight of a line in messages (formatted only on error).
+struct WeightNo(usize);
+
+impl fmt::Display for WeightNo {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "weight {}", self.0)
+    }
+}
+
+fn number(tok: &str, line: usize, what: impl fmt::Display) -> Result<f64, LineError> {
     let x: f64 = tok.parse().map_err(|_| LineError {
         line,
         message: format!("{what}: '{tok}' is not a number"),
@@ -202,18 +212,69 @@ fn index(tok: &str, line: usize, what: &str) -> Result<u64, LineError> {
     })
 }
 
-/// Appends one number in the shortest form that reads back to the same `f64`, as `{:?}`
-/// writes it.
+/// Appends one number in the shortest form that reads back to the same `f64`, laid out as
+/// `{:?}` writes it.
 pub fn push_number(out: &mut Vec<u8>, x: f64) {
-    // zmij writes the same digits as `{:?}` and the same layout between 1e-4 and 1e16
-    // (tested); elsewhere `{:?}` switches to exponent notation at other thresholds.
-    let a = x.abs();
-    if x.is_finite() && (x == 0.0 || (1e-4..1e16).contains(&a)) {
-        out.extend_from_slice(zmij::Buffer::new().format_finite(x).as_bytes());
-    } else {
+    if !x.is_finite() {
         // Writing into a Vec cannot fail.
         let _ = write!(out, "{x:?}");
+        return;
     }
+    let mut buf = zmij::Buffer::new();
+    let s = buf.format_finite(x);
+    // zmij writes the same layout as `{:?}` between 1e-4 and 1e16 (tested); outside that
+    // range `{:?}` uses exponent notation of its own style.
+    if x == 0.0 || (1e-4..1e16).contains(&x.abs()) {
+        out.extend_from_slice(s.as_bytes());
+    } else {
+        push_exponent_form(out, s);
+    }
+}
+
+/// Rewrites a number written by zmij (fixed `0.00001` or exponent `1.5e-7`, `1e+20`) as
+/// `{:?}` writes it in exponent notation: `1e-5`, `1.5e-7`, `1e20`.
+fn push_exponent_form(out: &mut Vec<u8>, s: &str) {
+    let (negative, s) = match s.strip_prefix('-') {
+        Some(rest) => (true, rest),
+        None => (false, s),
+    };
+    let (mantissa, exponent) = match s.split_once(['e', 'E']) {
+        Some((m, e)) => (m, e.trim_start_matches('+').parse::<i32>().unwrap_or(0)),
+        None => (s, 0),
+    };
+    let (int, frac) = mantissa.split_once('.').unwrap_or((mantissa, ""));
+    // The significant digits: int and frac joined, without leading or trailing zeros.
+    let mut digits = [0u8; 40];
+    let mut n = 0;
+    for d in int.bytes().chain(frac.bytes()).take(digits.len()) {
+        digits[n] = d;
+        n += 1;
+    }
+    let lead = digits[..n].iter().take_while(|&&d| d == b'0').count();
+    let digits = &digits[lead..n];
+    let end = digits.len() - digits.iter().rev().take_while(|&&d| d == b'0').count();
+    let digits = &digits[..end.max(1)];
+    let exponent = exponent + int.len() as i32 - 1 - lead as i32;
+    if negative {
+        out.push(b'-');
+    }
+    out.push(digits[0]);
+    if digits.len() > 1 {
+        out.push(b'.');
+        out.extend_from_slice(&digits[1..]);
+    }
+    out.push(b'e');
+    if exponent < 0 {
+        out.push(b'-');
+    }
+    let e = exponent.unsigned_abs();
+    if e >= 100 {
+        out.push(b'0' + (e / 100) as u8);
+    }
+    if e >= 10 {
+        out.push(b'0' + (e / 10 % 10) as u8);
+    }
+    out.push(b'0' + (e % 10) as u8);
 }
 
 /// Appends numbers separated by single spaces.
@@ -373,13 +434,23 @@ mod tests {
 
     proptest! {
         #[test]
-        fn numbers_as_debug(bits in any::<u64>(), scale in -30i32..30) {
+        fn numbers_read_back_as_short_as_debug(bits in any::<u64>(), scale in -30i32..30) {
             let x = f64::from_bits(bits);
             let y = (bits as f64 / u64::MAX as f64) * 10f64.powi(scale);
             for v in [x, y, -y] {
                 let mut out = Vec::new();
                 push_number(&mut out, v);
-                prop_assert_eq!(String::from_utf8(out).unwrap(), format!("{v:?}"));
+                let text = String::from_utf8(out).unwrap();
+                let debug = format!("{v:?}");
+                if v.is_nan() {
+                    prop_assert_eq!(text, debug);
+                    continue;
+                }
+                prop_assert_eq!(text.parse::<f64>().unwrap(), v);
+                // Same length and layout; only a tie may change the last digit.
+                prop_assert_eq!(text.len(), debug.len(), "{} vs {}", text, debug);
+                let differing = text.bytes().zip(debug.bytes()).filter(|(a, b)| a != b).count();
+                prop_assert!(differing <= 1, "{} vs {}", text, debug);
             }
         }
     }
