@@ -5,6 +5,7 @@ mod bench_load;
 mod bench_project;
 mod bench_roundtrip;
 mod common;
+mod correspond;
 mod demo;
 mod error;
 mod forward;
@@ -48,6 +49,8 @@ enum Command {
     Spline(spline::Args),
     /// Loop subdivision: make a larger mesh from a smaller one.
     Subdivide(subdivide::Args),
+    /// Map every vertex of one surface onto another through paired anchors.
+    Correspond(correspond::Args),
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -74,6 +77,7 @@ fn main() -> ExitCode {
         Command::Inverse(a) => inverse::run(a),
         Command::Spline(a) => spline::run(a),
         Command::Subdivide(a) => subdivide::run(a),
+        Command::Correspond(a) => correspond::run(a),
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),
