@@ -145,21 +145,7 @@ pub fn map_points(
             })
             .unzip()
     } else {
-        let batch = source.inverse_batch(points);
-        let rows: Vec<&[f64]> = batch.iter().map(|r| r.unwrap_or(&[])).collect();
-        let back = source.forward_batch(&rows, &ForwardOptions::default());
-        let mesh = source.mesh();
-        let tol = ROUND_TRIP_TOLERANCE * source.mean_edge_length();
-        let trips = back
-            .par_iter()
-            .zip(points)
-            .map(|(b, p)| {
-                // A point whose inverse failed has no weights, so no forward answer: the
-                // point is only read after a successful inverse checked it.
-                b.as_ref()
-                    .is_ok_and(|b| (b.position - p.position(mesh)).norm() <= tol)
-            })
-            .collect();
+        let (batch, trips) = paper_round_trip(source, points);
         let weights = batch
             .iter()
             .map(|r| r.map(<[f64]>::to_vec).map_err(Clone::clone))
@@ -188,6 +174,31 @@ pub fn map_points(
             },
         })
         .collect())
+}
+
+/// The paper's inverse weights of `points` and whether each returns to its point
+/// (forward problem on the same solver, within [`ROUND_TRIP_TOLERANCE`] mean edge
+/// lengths), both in parallel batches.
+pub(crate) fn paper_round_trip(
+    solver: &Solver,
+    points: &[SurfacePoint],
+) -> (wavg_solve::BatchWeights, Vec<bool>) {
+    let batch = solver.inverse_batch(points);
+    let rows: Vec<&[f64]> = batch.iter().map(|r| r.unwrap_or(&[])).collect();
+    let back = solver.forward_batch(&rows, &ForwardOptions::default());
+    let mesh = solver.mesh();
+    let tol = ROUND_TRIP_TOLERANCE * solver.mean_edge_length();
+    let trips = back
+        .par_iter()
+        .zip(points)
+        // A point whose inverse failed has no weights, so no forward answer: the point is
+        // only read after a successful inverse checked it.
+        .map(|(b, p)| {
+            b.as_ref()
+                .is_ok_and(|b| (b.position - p.position(mesh)).norm() <= tol)
+        })
+        .collect();
+    (batch, trips)
 }
 
 /// A map of every source vertex onto the target, with each vertex's validity and the
@@ -321,26 +332,40 @@ pub fn vertex_points(mesh: &ValidMesh) -> Vec<SurfacePoint> {
         .collect()
 }
 
-/// Per source face: the target's normal where its corners land (the sum of the normals
-/// of the target faces holding the three images), `None` when a corner has no image.
+/// Per source face: the target's normal where its corners land (the sum of the target's
+/// area-weighted vertex normals interpolated at the three images, which is smooth across
+/// the target's edges, unlike face normals at creases), `None` when a corner has no image.
 fn mapped_normals(
     source: &ValidMesh,
     target: &ValidMesh,
     mapped: &[Mapped],
 ) -> Vec<Option<Vector3<f64>>> {
+    let normals = vertex_normals(target);
     source
         .triangles
         .par_iter()
         .map(|t| {
             let mut n = Vector3::zeros();
             for &v in t {
-                let img = mapped.get(v as usize)?.target.as_ref().ok()?;
-                let [a, b, c] = target.corners(img.point.face as usize);
-                n += (b - a).cross(&(c - a)).normalize();
+                let p = mapped.get(v as usize)?.target.as_ref().ok()?.point;
+                n += p.interpolate(target, &normals);
             }
             Some(n)
         })
         .collect()
+}
+
+/// Area-weighted vertex normals (unnormalised sums of the incident faces' cross products).
+pub(crate) fn vertex_normals(mesh: &ValidMesh) -> Vec<Vector3<f64>> {
+    let mut n = vec![Vector3::zeros(); mesh.n_vertices()];
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        let [a, b, c] = mesh.corners(f);
+        let fnormal = (b - a).cross(&(c - a));
+        for &v in t {
+            n[v as usize] += fnormal;
+        }
+    }
+    n
 }
 
 #[cfg(test)]

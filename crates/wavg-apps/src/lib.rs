@@ -20,3 +20,9 @@ pub use correspond::{
     correspond_vertices, map_points, vertex_points,
 };
 pub use metrics::{Distortion, distortion};
+
+mod decal;
+mod morph;
+
+pub use decal::{Decal, DecalUv, decal_uv, decal_vertices};
+pub use morph::{harmonic_fill, morph_frames};
