@@ -83,7 +83,8 @@ Output: one line per source vertex, `FACE B0 B1 B2 X Y Z` on the target, or `non
 (unanswered, no-round-trip, negative-weight, inconsistent). --json prints one object:
 source_vertices, valid_fraction, flipped_faces, flipped_area_fraction, stretch (symmetrised
 L2 stretch over the valid part), stretch_best95, seconds, vertices_per_s (precomputation
-excluded), plus counts per reason and, with --ground-truth, the error of the images against
+excluded), plus cpu_seconds and vertices_per_cpu_s (CPU time of the map, all threads), counts
+per reason and, with --ground-truth, the error of the images against
 vertex i of the target as fractions of the target's bounding-box diagonal.")]
 pub struct Args {
     #[command(flatten)]
@@ -112,6 +113,9 @@ pub struct Computed {
     pub seconds: f64,
     /// Seconds of loading and precomputation.
     pub setup_seconds: f64,
+    /// CPU seconds of all threads during the map (`None` where unavailable): on a busy
+    /// machine the wall time overstates the work.
+    pub cpu_seconds: Option<f64>,
 }
 
 /// Reads both meshes and anchor files (checking them before any precomputation), embeds
@@ -154,6 +158,7 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
         max_stretch: a.max_stretch,
     };
     let t = Instant::now();
+    let cpu0 = crate::common::cpu_seconds(false);
     let map = textio::with_threads(a.threads, || correspond_vertices(&ss, &ts, &opts))?
         .map_err(|e| CliError::input(one_line(&e)))?;
     Ok(Computed {
@@ -162,6 +167,9 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
         map,
         seconds: t.elapsed().as_secs_f64(),
         setup_seconds,
+        cpu_seconds: crate::common::cpu_seconds(false)
+            .zip(cpu0)
+            .map(|(b, a)| b - a),
     })
 }
 
@@ -251,6 +259,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "seconds": c.seconds,
             "setup_seconds": c.setup_seconds,
             "vertices_per_s": per_s,
+            "cpu_seconds": c.cpu_seconds,
+            "vertices_per_cpu_s": c.cpu_seconds.map(|s| n as f64 / s.max(1e-12)),
             "ground_truth": truth,
         });
         println!("{j}");
