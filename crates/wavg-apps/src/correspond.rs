@@ -274,26 +274,7 @@ pub fn correspond_vertices(
             .iter()
             .map(|m| m.target.as_ref().ok().map(|t| t.position))
             .collect();
-        let d = distortion(&mesh.positions, &mesh.triangles, &answered, &normals);
-        let bad: Vec<bool> = d
-            .flipped
-            .iter()
-            .zip(&d.face_stretch)
-            .map(|(&f, s)| f || s.is_some_and(|s| s > opts.max_stretch * d.stretch))
-            .collect();
-        let topo = mesh.topology();
-        let inconsistent: Vec<bool> = (0..mesh.n_vertices())
-            .into_par_iter()
-            .map(|v| {
-                let faces = topo.ring_faces(v as u32);
-                let measured = faces
-                    .iter()
-                    .filter(|&&f| d.flipped[f as usize] || d.face_stretch[f as usize].is_some())
-                    .count();
-                let n_bad = faces.iter().filter(|&&f| bad[f as usize]).count();
-                2 * n_bad > measured
-            })
-            .collect();
+        let inconsistent = inconsistent_vertices(mesh, &answered, &normals, opts.max_stretch);
         for (v, bad) in validity.iter_mut().zip(inconsistent) {
             if bad && *v == Validity::Valid {
                 *v = Validity::Inconsistent;
@@ -314,6 +295,37 @@ pub fn correspond_vertices(
         validity,
         distortion,
     })
+}
+
+/// The local test (see the module docs): per vertex, whether most of its measured
+/// triangles map flipped (against `normals`, per face) or stretched beyond `max_stretch`
+/// times the overall symmetrised stretch, with `answered[v]` the image of vertex `v`.
+fn inconsistent_vertices(
+    mesh: &ValidMesh,
+    answered: &[Option<Vector3<f64>>],
+    normals: &[Option<Vector3<f64>>],
+    max_stretch: f64,
+) -> Vec<bool> {
+    let d = distortion(&mesh.positions, &mesh.triangles, answered, normals);
+    let bad: Vec<bool> = d
+        .flipped
+        .iter()
+        .zip(&d.face_stretch)
+        .map(|(&f, s)| f || s.is_some_and(|s| s > max_stretch * d.stretch))
+        .collect();
+    let topo = mesh.topology();
+    (0..mesh.n_vertices())
+        .into_par_iter()
+        .map(|v| {
+            let faces = topo.ring_faces(v as u32);
+            let measured = faces
+                .iter()
+                .filter(|&&f| d.flipped[f as usize] || d.face_stretch[f as usize].is_some())
+                .count();
+            let n_bad = faces.iter().filter(|&&f| bad[f as usize]).count();
+            2 * n_bad > measured
+        })
+        .collect()
 }
 
 /// Every vertex as a surface point (a corner of one of its faces; every vertex of a
@@ -457,53 +469,24 @@ mod tests {
     #[test]
     fn a_wrong_vertex_is_rejected_by_the_local_test_but_not_its_neighbours() {
         let s = solver(procedural::icosphere(4), &anchors());
+        let mesh = s.mesh();
         let c = correspond_vertices(&s, &s, &CorrespondOptions::default()).unwrap();
-        // Corrupt one image: send vertex 500 to the antipode, then re-judge.
-        let mut mapped = c.mapped.clone();
-        let far = mapped[1000].target.clone().unwrap();
-        let anti = (0..s.mesh().n_vertices())
-            .max_by(|&a, &b| {
-                let d = |v: usize| (s.mesh().positions[v] - far.position).norm();
-                d(a).total_cmp(&d(b))
-            })
-            .unwrap();
-        let ring: Vec<u32> = s.mesh().topology().ring(anti as u32).to_vec();
-        let mut bad = mapped[1000].clone();
-        if let Ok(t) = &mut bad.target {
-            t.position = s.mesh().positions[anti] * 1.0;
-        }
-        let _ = &mut mapped;
-        // The check itself: with the local rule, vertex `anti` (whose image is replaced by
-        // a far point) gets a majority of bad triangles, its neighbours a minority.
         let mut answered: Vec<Option<Vector3<f64>>> = c
             .mapped
             .iter()
             .map(|m| m.target.as_ref().ok().map(|t| t.position))
             .collect();
-        answered[anti] = Some(far.position);
-        let normals = mapped_normals(s.mesh(), s.mesh(), &c.mapped);
-        let d = distortion(
-            &s.mesh().positions,
-            &s.mesh().triangles,
-            &answered,
-            &normals,
-        );
-        let topo = s.mesh().topology();
-        let bad_faces = |v: u32| {
-            topo.ring_faces(v)
-                .iter()
-                .filter(|&&f| {
-                    d.flipped[f as usize]
-                        || d.face_stretch[f as usize].is_some_and(|x| x > 4.0 * d.stretch)
-                })
-                .count()
-        };
-        assert_eq!(bad_faces(anti as u32), topo.ring_faces(anti as u32).len());
-        for &u in &ring {
-            assert!(
-                2 * bad_faces(u) <= topo.ring_faces(u).len(),
-                "neighbour {u}"
-            );
+        let normals = mapped_normals(mesh, mesh, &c.mapped);
+        let before = inconsistent_vertices(mesh, &answered, &normals, 4.0);
+        assert!(before.iter().all(|b| !b));
+        // Send vertex 1000's image to the far side of the sphere.
+        let v = 1000;
+        answered[v] = Some(-mesh.positions[v]);
+        let after = inconsistent_vertices(mesh, &answered, &normals, 4.0);
+        assert!(after[v]);
+        for &u in mesh.topology().ring(v as u32) {
+            assert!(!after[u as usize], "neighbour {u} rejected too");
         }
+        assert_eq!(after.iter().filter(|b| **b).count(), 1);
     }
 }
