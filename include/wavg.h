@@ -181,6 +181,80 @@ enum wavg_status wavg_surface_decimate(const struct wavg_surface *surface,
                                        uint32_t *out_original,
                                        struct wavg_surface **out);
 
+// Maps `n` points of the source surface onto the target: the inverse problem on
+// `source` (with `verified`, weights checked to return to the point, with an offset
+// penalty where the paper's do not), the forward problem on `target` with the same
+// weights. Anchor `i` of `source` is paired with anchor `i` of `target`. Writes the image
+// to `out[i]` and, unless NULL, its position to `out_xyz[3*i..3*i+3]` (target units) and
+// a status to `out_statuses[i]`: `WAVG_STATUS_OK` when the image passes the paper's test
+// (the weights return to the point and none is below `max_negative`, e.g. -0.1);
+// `WAVG_STATUS_NO_SOLUTION` when an image exists but fails it (the image is still
+// written: a per-point test cannot judge the image by its neighbours, see
+// `wavg_correspond_vertices`); another failure status with `face = UINT32_MAX` and NaN
+// where there is no image. Returns the first non-OK point's status (with its message) or
+// `WAVG_STATUS_OK`. Call-level errors (`WAVG_STATUS_INVALID_ARGUMENT`: NULL solvers,
+// points or `out`, `n == 0`, different anchor counts, a non-finite `max_negative`) write
+// nothing. Runs in parallel; thread-safe on shared solvers.
+//
+// # Safety
+// The solvers must be NULL or live; `points` and `out` must hold `n` elements,
+// `out_xyz` (unless NULL) `3 * n`, `out_statuses` (unless NULL) `n`.
+enum wavg_status wavg_correspond(const struct wavg_solver *source,
+                                 const struct wavg_solver *target,
+                                 const struct wavg_point *points,
+                                 size_t n,
+                                 bool verified,
+                                 double max_negative,
+                                 struct wavg_point *out,
+                                 double *out_xyz,
+                                 enum wavg_status *out_statuses);
+
+// Maps every vertex of the source surface onto the target (as `wavg_correspond`) and
+// judges each vertex: with `local`, by local consistency (its weights return to it and
+// most triangles around it land neither flipped against the target's normals nor
+// stretched beyond 4 times the map's overall symmetrised L2 stretch); otherwise by the
+// paper's test (round trip, no weight below `max_negative`). Writes `out[v]`, and unless
+// NULL `out_xyz[3*v..3*v+3]` and `out_statuses[v]`, for each of the source's
+// `n_vertices` vertices (the arrays must hold that many): `WAVG_STATUS_OK` for a kept
+// vertex, `WAVG_STATUS_NO_SOLUTION` for a rejected one (the image is still written when
+// it exists; `face = UINT32_MAX` and NaN otherwise). Returns the first non-OK vertex's
+// status or `WAVG_STATUS_OK`; call-level errors (`WAVG_STATUS_INVALID_ARGUMENT`) write
+// nothing. Runs in parallel; thread-safe on shared solvers.
+//
+// # Safety
+// The solvers must be NULL or live; `out` must hold `n_vertices` elements of the source,
+// `out_xyz` (unless NULL) three times that, `out_statuses` (unless NULL) `n_vertices`.
+enum wavg_status wavg_correspond_vertices(const struct wavg_solver *source,
+                                          const struct wavg_solver *target,
+                                          bool verified,
+                                          bool local,
+                                          double max_negative,
+                                          struct wavg_point *out,
+                                          double *out_xyz,
+                                          enum wavg_status *out_statuses);
+
+// Decal coordinates of `n` surface points: the anchors of `solver` carry
+// `anchor_uv[2*i], anchor_uv[2*i+1]` (one pair per anchor), and a point with the
+// paper's inverse weights `w` gets `(u, v) = sum_i w_i uv_i`, written to
+// `out_uv[2*k..2*k+2]`. `out_statuses[k]` (unless NULL): `WAVG_STATUS_OK`;
+// `WAVG_STATUS_NO_SOLUTION` where the weights are not meaningful (they do not return to
+// the point through the forward problem, or one is below `max_negative`), the
+// coordinates still written; another failure status, with NaN, where the inverse problem
+// fails. Returns the first non-OK point's status or `WAVG_STATUS_OK`. Call-level errors
+// (`WAVG_STATUS_INVALID_ARGUMENT`: NULL pointers, `n == 0`, non-finite coordinates or
+// `max_negative`) write nothing. Runs in parallel; thread-safe on a shared solver.
+//
+// # Safety
+// `solver` must be NULL or live; `anchor_uv` must hold `2 * n_anchors` doubles,
+// `points` `n` points, `out_uv` `2 * n` doubles, `out_statuses` (unless NULL) `n`.
+enum wavg_status wavg_decal_uv(const struct wavg_solver *solver,
+                               const double *anchor_uv,
+                               const struct wavg_point *points,
+                               size_t n,
+                               double max_negative,
+                               double *out_uv,
+                               enum wavg_status *out_statuses);
+
 // The default precomputation settings (the paper's: 1000 landmarks), with `struct_size`
 // set. Thread-safe; cannot fail.
 struct wavg_precompute_options wavg_precompute_options_default(void);

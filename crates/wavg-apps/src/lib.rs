@@ -1,7 +1,8 @@
 //! Applications of weighted averages on surfaces (paper Section 4), as library functions
 //! over a [`wavg_solve::Solver`]: splines on surfaces (B-splines of any degree, open or
 //! closed, and Bézier curves) whose samples are forward problems warm-started along the
-//! curve.
+//! curve; maps between surfaces (correspondence with a validity test, morphing) and on a
+//! surface (decals), and their distortion (symmetrised L2 stretch, flipped faces).
 #![forbid(unsafe_code)]
 #![deny(unreachable_pub)]
 
@@ -10,3 +11,18 @@ mod spline;
 
 pub use basis::{SplineKind, spline_weights};
 pub use spline::{Curve, evaluate_spline};
+
+mod correspond;
+mod metrics;
+
+pub use correspond::{
+    CorrespondOptions, Correspondence, Mapped, ROUND_TRIP_TOLERANCE, Validity, ValidityTest,
+    correspond_vertices, map_points, vertex_points,
+};
+pub use metrics::{Distortion, distortion};
+
+mod decal;
+mod morph;
+
+pub use decal::{Decal, DecalUv, decal_uv, decal_vertices};
+pub use morph::{harmonic_fill, morph_frames};

@@ -1,12 +1,17 @@
 //! What the application commands share: a solver for control points or anchors given in
-//! the anchors format, on a mesh with a loaded or freshly precomputed embedding.
+//! the anchors format, on a mesh with a loaded or freshly precomputed embedding (with a
+//! progress bar on a terminal).
 
+use std::io::IsTerminal;
 use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
-use wavg::{NoProgress, PrecomputeOptions, Solver, Surface};
+use wavg::{Anchor, PrecomputeOptions, Solver, Surface};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
+use crate::precompute::Bars;
 use crate::textio::{located, read_points, spec_anchor};
 
 /// Loads the mesh, the embedding (`.wavg`, or precomputed in memory with a tenth of the
@@ -16,6 +21,16 @@ pub fn solver_for(
     embedding: Option<&Path>,
     anchors: &Path,
 ) -> Result<Solver, CliError> {
+    let (mut surface, list) = surface_and_anchors(mesh, anchors)?;
+    embed(&mut surface, embedding)?;
+    surface
+        .solver(list)
+        .map_err(|e| CliError::input(one_line(&e)))
+}
+
+/// The surface (no embedding yet: see [`embed`]) and the anchors of `anchors`, checked
+/// against the mesh, so bad input fails before any precomputation.
+pub fn surface_and_anchors(mesh: &str, anchors: &Path) -> Result<(Surface, Vec<Anchor>), CliError> {
     let specs = read_points(anchors)?;
     if specs.is_empty() {
         return Err(CliError::input(format!("{}: no points", anchors.display())));
@@ -28,11 +43,17 @@ pub fn solver_for(
     for (&(line, _), a) in specs.iter().zip(&list) {
         wavg::solve::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
-    let mut surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    let surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    Ok((surface, list))
+}
+
+/// Loads `embedding` into the surface or precomputes one in memory (a tenth of the
+/// vertices as landmarks, 50 to 1000), with progress bars on stderr when it is a terminal.
+pub fn embed(surface: &mut Surface, embedding: Option<&Path>) -> Result<(), CliError> {
     match embedding {
         Some(path) => surface
             .load_embedding(path)
-            .map_err(|e| CliError::input(one_line(&e)))?,
+            .map_err(|e| CliError::input(one_line(&e))),
         None => {
             let landmarks = (surface.n_vertices() / 10).clamp(50, 1000);
             let opts = PrecomputeOptions {
@@ -40,12 +61,13 @@ pub fn solver_for(
                 quality_pairs: 0,
                 ..Default::default()
             };
-            surface
-                .precompute(&opts, &NoProgress)
-                .map_err(|e| CliError::failure(one_line(&e)))?;
+            let bars = Bars::new(
+                std::io::stderr().is_terminal(),
+                Arc::new(AtomicBool::new(false)),
+            );
+            let r = surface.precompute(&opts, &bars).map(|_| ());
+            bars.clear();
+            r.map_err(|e| CliError::failure(one_line(&e)))
         }
     }
-    surface
-        .solver(list)
-        .map_err(|e| CliError::input(one_line(&e)))
 }

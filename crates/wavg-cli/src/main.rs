@@ -7,11 +7,14 @@ mod bench_load;
 mod bench_project;
 mod bench_roundtrip;
 mod common;
+mod correspond;
+mod decal;
 mod demo;
 mod error;
 mod forward;
 mod info;
 mod inverse;
+mod morph;
 mod precompute;
 mod repair;
 mod spline;
@@ -50,6 +53,12 @@ enum Command {
     Spline(spline::Args),
     /// Loop subdivision: make a larger mesh from a smaller one.
     Subdivide(subdivide::Args),
+    /// Map every vertex of one surface onto another through paired anchors.
+    Correspond(correspond::Args),
+    /// A decal: (u, v) coordinates for every vertex from anchors that carry them.
+    Decal(decal::Args),
+    /// Morph one surface into another: the source's mesh moved onto the target, in frames.
+    Morph(morph::Args),
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -76,6 +85,9 @@ fn main() -> ExitCode {
         Command::Inverse(a) => inverse::run(a),
         Command::Spline(a) => spline::run(a),
         Command::Subdivide(a) => subdivide::run(a),
+        Command::Correspond(a) => correspond::run(a),
+        Command::Decal(a) => decal::run(a),
+        Command::Morph(a) => morph::run(a),
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),

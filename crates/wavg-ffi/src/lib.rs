@@ -10,6 +10,7 @@
 mod apps;
 mod boundary;
 mod decimate;
+mod maps;
 mod options;
 mod solver;
 mod surface;
@@ -18,6 +19,7 @@ mod types;
 pub use apps::wavg_spline;
 pub use boundary::{wavg_abi_version, wavg_last_error};
 pub use decimate::wavg_surface_decimate;
+pub use maps::{wavg_correspond, wavg_correspond_vertices, wavg_decal_uv};
 pub use options::{wavg_precompute_options, wavg_precompute_options_default};
 pub use solver::{
     wavg_forward, wavg_inverse, wavg_solver, wavg_solver_anchor_count, wavg_solver_free,

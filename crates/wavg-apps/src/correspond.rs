@@ -1,0 +1,492 @@
+//! Correspondence between two surfaces with paired anchors (paper Section 4.4): a point of
+//! the source has weights with respect to the source's anchors (inverse problem); the same
+//! weights averaged over the target's anchors give its image (forward problem).
+//!
+//! Which images to trust. The paper keeps a point when its weights are meaningful: the
+//! forward problem on the source brings them back to the point (the round trip) and no
+//! weight is strongly negative ([`ValidityTest::Paper`]). That test judges the *weights*,
+//! not the *image*: on two poses of one shape most rejected points still land within a
+//! fraction of a percent of the truth, while a wrong image (one that lands on another
+//! part of the target) can have harmless-looking weights. [`ValidityTest::Local`] judges
+//! the image by its neighbourhood instead: a continuous, orientation-preserving map sends
+//! the triangles around a vertex to small triangles of the same orientation, so a vertex
+//! is rejected when most of the triangles around it are flipped on the target (their
+//! normal disagrees with the target's normal there) or stretched beyond `max_stretch`
+//! times the map's typical stretch, or when its image is not answered or does not round
+//! trip. A single wrongly mapped vertex spoils all its triangles but only a minority of
+//! each neighbour's, so the rejection does not spread to correct neighbours.
+
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use wavg_mesh::{SurfacePoint, ValidMesh};
+use wavg_solve::{ForwardOptions, ForwardResult, RoundTrip, SolveError, Solver};
+
+use crate::metrics::{Distortion, distortion};
+
+/// Round-trip tolerance of the paper's weights, in mean edge lengths of the source.
+pub const ROUND_TRIP_TOLERANCE: f64 = 1e-3;
+
+/// Which points of a map are kept (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ValidityTest {
+    /// The paper's: the weights round-trip on the source and none is below
+    /// `max_negative`.
+    Paper,
+    /// The image is consistent with its neighbours' (no majority of flipped or
+    /// over-stretched triangles around the vertex) and the weights round-trip.
+    Local,
+}
+
+/// Options of a correspondence.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CorrespondOptions {
+    /// Verified inverse weights (the paper's where they round-trip, else the smallest
+    /// offset penalty that does) instead of the paper's weights alone.
+    pub verified: bool,
+    /// The most negative weight the paper's test accepts.
+    pub max_negative: f64,
+    /// How points are judged.
+    pub test: ValidityTest,
+    /// Local test: a triangle is over-stretched above this many times the map's overall
+    /// symmetrised stretch.
+    pub max_stretch: f64,
+}
+
+impl Default for CorrespondOptions {
+    fn default() -> Self {
+        Self {
+            verified: true,
+            max_negative: -0.1,
+            test: ValidityTest::Local,
+            max_stretch: 4.0,
+        }
+    }
+}
+
+/// The image of one source point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mapped {
+    /// The point on the target (or why there is none).
+    pub target: Result<ForwardResult, SolveError>,
+    /// Whether the weights return to the source point.
+    pub round_trip: bool,
+    /// The smallest weight (NaN when the inverse failed).
+    pub min_weight: f64,
+}
+
+/// Why a source vertex is kept or not.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Validity {
+    /// Kept.
+    Valid,
+    /// No image: the inverse or the forward problem failed.
+    Unanswered(SolveError),
+    /// The weights do not return to the source point.
+    NoRoundTrip,
+    /// A weight is below the limit (paper test).
+    NegativeWeight(f64),
+    /// Most triangles around the vertex are flipped or over-stretched (local test).
+    Inconsistent,
+}
+
+impl Validity {
+    /// A short reason for output files (`valid`, `unanswered`, `no-round-trip`,
+    /// `negative-weight`, `inconsistent`).
+    pub fn reason(&self) -> &'static str {
+        match self {
+            Validity::Valid => "valid",
+            Validity::Unanswered(_) => "unanswered",
+            Validity::NoRoundTrip => "no-round-trip",
+            Validity::NegativeWeight(_) => "negative-weight",
+            Validity::Inconsistent => "inconsistent",
+        }
+    }
+}
+
+/// Maps source points onto the target: the inverse problem on `source`, the forward
+/// problem on `target` with the same weights, in parallel batches (results in input
+/// order, independent of the thread count). The two solvers must have the same number of
+/// anchors (anchor `i` of one corresponds to anchor `i` of the other).
+///
+/// ```
+/// use std::sync::Arc;
+/// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+/// use wavg_project::{EmbeddedMesh, Projector};
+/// use wavg_solve::{Anchor, Solver};
+/// use wavg_apps::map_points;
+/// let mesh = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
+/// let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
+/// let solver = Solver::new(proj, (0..12).map(Anchor::Vertex)).unwrap();
+/// let p = SurfacePoint::new(100, [0.2, 0.3, 0.5]);
+/// let m = map_points(&solver, &solver, &[p], true).unwrap();
+/// let back = m[0].target.as_ref().unwrap().position;
+/// assert!((back - p.position(solver.mesh())).norm() < 1e-6); // onto itself: the identity
+/// ```
+pub fn map_points(
+    source: &Solver,
+    target: &Solver,
+    points: &[SurfacePoint],
+    verified: bool,
+) -> Result<Vec<Mapped>, SolveError> {
+    if source.n_anchors() != target.n_anchors() {
+        return Err(SolveError::InvalidParameter(format!(
+            "the source has {} anchors and the target {}; they must be paired one to one",
+            source.n_anchors(),
+            target.n_anchors()
+        )));
+    }
+    let (weights, trips): (Vec<Result<Vec<f64>, SolveError>>, Vec<bool>) = if verified {
+        source
+            .inverse_verified_batch(points, ROUND_TRIP_TOLERANCE)
+            .into_iter()
+            .map(|r| match r {
+                Ok(v) => (Ok(v.weights), v.round_trip != RoundTrip::NotReached),
+                Err(e) => (Err(e), false),
+            })
+            .unzip()
+    } else {
+        let (batch, trips) = paper_round_trip(source, points);
+        let weights = batch
+            .iter()
+            .map(|r| r.map(<[f64]>::to_vec).map_err(Clone::clone))
+            .collect();
+        (weights, trips)
+    };
+    let rows: Vec<&[f64]> = weights
+        .iter()
+        .map(|r| r.as_deref().unwrap_or(&[]))
+        .collect();
+    let images = target.forward_batch(&rows, &ForwardOptions::default());
+    Ok(weights
+        .iter()
+        .zip(images)
+        .zip(trips)
+        .map(|((w, img), round_trip)| match w {
+            Ok(w) => Mapped {
+                target: img,
+                round_trip,
+                min_weight: w.iter().copied().fold(f64::INFINITY, f64::min),
+            },
+            Err(e) => Mapped {
+                target: Err(e.clone()),
+                round_trip: false,
+                min_weight: f64::NAN,
+            },
+        })
+        .collect())
+}
+
+/// The paper's inverse weights of `points` and whether each returns to its point
+/// (forward problem on the same solver, within [`ROUND_TRIP_TOLERANCE`] mean edge
+/// lengths), both in parallel batches.
+pub(crate) fn paper_round_trip(
+    solver: &Solver,
+    points: &[SurfacePoint],
+) -> (wavg_solve::BatchWeights, Vec<bool>) {
+    let batch = solver.inverse_batch(points);
+    let rows: Vec<&[f64]> = batch.iter().map(|r| r.unwrap_or(&[])).collect();
+    let back = solver.forward_batch(&rows, &ForwardOptions::default());
+    let mesh = solver.mesh();
+    let tol = ROUND_TRIP_TOLERANCE * solver.mean_edge_length();
+    let trips = back
+        .par_iter()
+        .zip(points)
+        // A point whose inverse failed has no weights, so no forward answer: the point is
+        // only read after a successful inverse checked it.
+        .map(|(b, p)| {
+            b.as_ref()
+                .is_ok_and(|b| (b.position - p.position(mesh)).norm() <= tol)
+        })
+        .collect();
+    (batch, trips)
+}
+
+/// A map of every source vertex onto the target, with each vertex's validity and the
+/// map's distortion.
+#[derive(Clone, Debug)]
+pub struct Correspondence {
+    /// Per source vertex: its image.
+    pub mapped: Vec<Mapped>,
+    /// Per source vertex: kept or why not.
+    pub validity: Vec<Validity>,
+    /// Distortion of the map restricted to valid vertices (faces with three valid
+    /// corners); flips are judged against the target's normals where the corners land.
+    pub distortion: Distortion,
+}
+
+impl Correspondence {
+    /// Valid vertices.
+    pub fn valid(&self) -> usize {
+        self.validity
+            .iter()
+            .filter(|v| **v == Validity::Valid)
+            .count()
+    }
+
+    /// Valid vertices over all vertices (0 for an empty mesh).
+    pub fn valid_fraction(&self) -> f64 {
+        self.valid() as f64 / self.validity.len().max(1) as f64
+    }
+
+    /// The target position of every valid vertex (`None` elsewhere).
+    pub fn valid_positions(&self) -> Vec<Option<Vector3<f64>>> {
+        self.mapped
+            .iter()
+            .zip(&self.validity)
+            .map(|(m, v)| match (v, &m.target) {
+                (Validity::Valid, Ok(t)) => Some(t.position),
+                _ => None,
+            })
+            .collect()
+    }
+}
+
+/// Maps every vertex of the source onto the target ([`map_points`]) and judges each with
+/// `opts.test` (see the module docs).
+pub fn correspond_vertices(
+    source: &Solver,
+    target: &Solver,
+    opts: &CorrespondOptions,
+) -> Result<Correspondence, SolveError> {
+    if !(opts.max_negative.is_finite() && opts.max_stretch.is_finite() && opts.max_stretch > 1.0) {
+        return Err(SolveError::InvalidParameter(format!(
+            "max_negative must be finite and max_stretch finite and above 1 (got {} and {})",
+            opts.max_negative, opts.max_stretch
+        )));
+    }
+    let mesh = source.mesh();
+    let points = vertex_points(mesh);
+    let mapped = map_points(source, target, &points, opts.verified)?;
+    let mut validity: Vec<Validity> = mapped
+        .iter()
+        .map(|m| match &m.target {
+            Err(e) => Validity::Unanswered(e.clone()),
+            Ok(_) if !m.round_trip => Validity::NoRoundTrip,
+            Ok(_) if opts.test == ValidityTest::Paper && m.min_weight < opts.max_negative => {
+                Validity::NegativeWeight(m.min_weight)
+            }
+            Ok(_) => Validity::Valid,
+        })
+        .collect();
+    let normals = mapped_normals(mesh, target.mesh(), &mapped);
+    if opts.test == ValidityTest::Local {
+        let answered: Vec<Option<Vector3<f64>>> = mapped
+            .iter()
+            .map(|m| m.target.as_ref().ok().map(|t| t.position))
+            .collect();
+        let inconsistent = inconsistent_vertices(mesh, &answered, &normals, opts.max_stretch);
+        for (v, bad) in validity.iter_mut().zip(inconsistent) {
+            if bad && *v == Validity::Valid {
+                *v = Validity::Inconsistent;
+            }
+        }
+    }
+    let valid: Vec<Option<Vector3<f64>>> = mapped
+        .iter()
+        .zip(&validity)
+        .map(|(m, v)| match (v, &m.target) {
+            (Validity::Valid, Ok(t)) => Some(t.position),
+            _ => None,
+        })
+        .collect();
+    let distortion = distortion(&mesh.positions, &mesh.triangles, &valid, &normals);
+    Ok(Correspondence {
+        mapped,
+        validity,
+        distortion,
+    })
+}
+
+/// The local test (see the module docs): per vertex, whether most of its measured
+/// triangles map flipped (against `normals`, per face) or stretched beyond `max_stretch`
+/// times the overall symmetrised stretch, with `answered[v]` the image of vertex `v`.
+fn inconsistent_vertices(
+    mesh: &ValidMesh,
+    answered: &[Option<Vector3<f64>>],
+    normals: &[Option<Vector3<f64>>],
+    max_stretch: f64,
+) -> Vec<bool> {
+    let d = distortion(&mesh.positions, &mesh.triangles, answered, normals);
+    let bad: Vec<bool> = d
+        .flipped
+        .iter()
+        .zip(&d.face_stretch)
+        .map(|(&f, s)| f || s.is_some_and(|s| s > max_stretch * d.stretch))
+        .collect();
+    let topo = mesh.topology();
+    (0..mesh.n_vertices())
+        .into_par_iter()
+        .map(|v| {
+            let faces = topo.ring_faces(v as u32);
+            let measured = faces
+                .iter()
+                .filter(|&&f| d.flipped[f as usize] || d.face_stretch[f as usize].is_some())
+                .count();
+            let n_bad = faces.iter().filter(|&&f| bad[f as usize]).count();
+            2 * n_bad > measured
+        })
+        .collect()
+}
+
+/// Every vertex as a surface point (a corner of one of its faces; every vertex of a
+/// valid mesh has one).
+pub fn vertex_points(mesh: &ValidMesh) -> Vec<SurfacePoint> {
+    let topo = mesh.topology();
+    (0..mesh.n_vertices() as u32)
+        .map(|v| {
+            let f = topo.ring_faces(v).first().copied().unwrap_or(0);
+            let k = mesh.triangles[f as usize]
+                .iter()
+                .position(|&c| c == v)
+                .unwrap_or(0);
+            SurfacePoint::at_corner(f, k)
+        })
+        .collect()
+}
+
+/// Per source face: the target's normal where its corners land (the sum of the target's
+/// area-weighted vertex normals interpolated at the three images, which is smooth across
+/// the target's edges, unlike face normals at creases), `None` when a corner has no image.
+fn mapped_normals(
+    source: &ValidMesh,
+    target: &ValidMesh,
+    mapped: &[Mapped],
+) -> Vec<Option<Vector3<f64>>> {
+    let normals = vertex_normals(target);
+    source
+        .triangles
+        .par_iter()
+        .map(|t| {
+            let mut n = Vector3::zeros();
+            for &v in t {
+                let p = mapped.get(v as usize)?.target.as_ref().ok()?.point;
+                n += p.interpolate(target, &normals);
+            }
+            Some(n)
+        })
+        .collect()
+}
+
+/// Area-weighted vertex normals (unnormalised sums of the incident faces' cross products).
+pub(crate) fn vertex_normals(mesh: &ValidMesh) -> Vec<Vector3<f64>> {
+    let mut n = vec![Vector3::zeros(); mesh.n_vertices()];
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        let [a, b, c] = mesh.corners(f);
+        let fnormal = (b - a).cross(&(c - a));
+        for &v in t {
+            n[v as usize] += fnormal;
+        }
+    }
+    n
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use wavg_mesh::procedural;
+    use wavg_project::{EmbeddedMesh, Projector};
+    use wavg_solve::Anchor;
+
+    use super::*;
+
+    fn solver(mesh: wavg_mesh::TriMesh, anchors: &[u32]) -> Solver {
+        let mesh = Arc::new(ValidMesh::new(mesh).unwrap());
+        let proj = Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap();
+        Solver::new(Arc::new(proj), anchors.iter().map(|&v| Anchor::Vertex(v))).unwrap()
+    }
+
+    fn anchors() -> Vec<u32> {
+        (0..40).map(|i| i * 61).collect()
+    }
+
+    #[test]
+    fn a_surface_onto_itself_is_the_identity_and_all_valid() {
+        let s = solver(procedural::icosphere(4), &anchors());
+        for test in [ValidityTest::Local, ValidityTest::Paper] {
+            let opts = CorrespondOptions {
+                test,
+                ..Default::default()
+            };
+            let c = correspond_vertices(&s, &s, &opts).unwrap();
+            // The paper's test also rejects correct images with negative weights.
+            let want = if test == ValidityTest::Local {
+                0.99
+            } else {
+                0.5
+            };
+            assert!(
+                c.valid_fraction() > want,
+                "{test:?}: {}",
+                c.valid_fraction()
+            );
+            for (v, p) in c.valid_positions().iter().enumerate() {
+                if let Some(p) = p {
+                    assert!((p - s.mesh().positions[v]).norm() < 1e-6);
+                }
+            }
+            assert!((c.distortion.stretch - 1.0).abs() < 1e-6);
+            assert_eq!(c.distortion.flipped_faces, 0);
+        }
+    }
+
+    #[test]
+    fn a_scaled_copy_maps_vertex_to_vertex() {
+        let a = procedural::icosphere(4);
+        let b = a
+            .clone()
+            .map_positions(|p| Vector3::new(2.0 * p.x, p.y, p.z));
+        let (sa, sb) = (solver(a, &anchors()), solver(b, &anchors()));
+        let c = correspond_vertices(&sa, &sb, &CorrespondOptions::default()).unwrap();
+        assert!(c.valid_fraction() > 0.95, "{}", c.valid_fraction());
+        let diag = sb.mesh().bounding_box_diagonal();
+        let mut err = 0.0;
+        for (v, p) in c.valid_positions().iter().enumerate() {
+            if let Some(p) = p {
+                err += (p - sb.mesh().positions[v]).norm() / diag;
+            }
+        }
+        assert!(
+            err / (c.valid() as f64) < 0.02,
+            "mean error {}",
+            err / c.valid() as f64
+        );
+        // Scaling by 2 along x: the stretch is near sqrt(5/4) on the whole sphere's faces
+        // whose planes are not perpendicular to x, and 1 on others; between the two.
+        assert!(c.distortion.stretch > 1.0 && c.distortion.stretch < 1.2);
+    }
+
+    #[test]
+    fn anchor_counts_must_agree() {
+        let s = solver(procedural::icosphere(3), &[0, 1, 2, 3, 4]);
+        let t = solver(procedural::icosphere(3), &[0, 1, 2, 3]);
+        assert!(matches!(
+            map_points(&s, &t, &[SurfacePoint::new(0, [1.0, 0.0, 0.0])], true),
+            Err(SolveError::InvalidParameter(_))
+        ));
+    }
+
+    #[test]
+    fn a_wrong_vertex_is_rejected_by_the_local_test_but_not_its_neighbours() {
+        let s = solver(procedural::icosphere(4), &anchors());
+        let mesh = s.mesh();
+        let c = correspond_vertices(&s, &s, &CorrespondOptions::default()).unwrap();
+        let mut answered: Vec<Option<Vector3<f64>>> = c
+            .mapped
+            .iter()
+            .map(|m| m.target.as_ref().ok().map(|t| t.position))
+            .collect();
+        let normals = mapped_normals(mesh, mesh, &c.mapped);
+        let before = inconsistent_vertices(mesh, &answered, &normals, 4.0);
+        assert!(before.iter().all(|b| !b));
+        // Send vertex 1000's image to the far side of the sphere.
+        let v = 1000;
+        answered[v] = Some(-mesh.positions[v]);
+        let after = inconsistent_vertices(mesh, &answered, &normals, 4.0);
+        assert!(after[v]);
+        for &u in mesh.topology().ring(v as u32) {
+            assert!(!after[u as usize], "neighbour {u} rejected too");
+        }
+        assert_eq!(after.iter().filter(|b| **b).count(), 1);
+    }
+}

@@ -1,0 +1,195 @@
+//! Decals (local parametrisation, paper Section 4): anchors carry plane coordinates
+//! `(u, v)`; a surface point with weights `w` (inverse problem, the paper's weights, which
+//! vary continuously over the surface) gets `uv = sum_i w_i uv_i`. Where the weights are not
+//! meaningful (they do not return to the point through the forward problem, or one is
+//! strongly negative) the coordinates are still computed but the point is marked.
+
+use nalgebra::Vector3;
+use wavg_mesh::SurfacePoint;
+use wavg_solve::{SolveError, Solver};
+
+use crate::correspond::{paper_round_trip, vertex_points};
+use crate::metrics::{Distortion, distortion};
+
+/// The coordinates of surface points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DecalUv {
+    /// Per point: `(u, v)` (`[0, 0]` where the inverse problem failed).
+    pub uv: Vec<[f64; 2]>,
+    /// Per point: the weights are not meaningful (inverse failed, no round trip, or a
+    /// weight below the limit).
+    pub marked: Vec<bool>,
+}
+
+/// `(u, v)` of each point from the anchors' `uv` (one per anchor); points are marked as
+/// described in the module docs with `max_negative` the most negative weight accepted.
+///
+/// ```
+/// use std::sync::Arc;
+/// use wavg_mesh::{ValidMesh, procedural};
+/// use wavg_project::{EmbeddedMesh, Projector};
+/// use wavg_solve::{Anchor, Solver};
+/// use wavg_apps::decal_uv;
+/// let mesh = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
+/// let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
+/// let solver = Solver::new(proj, [0u32, 1, 2].map(Anchor::Vertex)).unwrap();
+/// let at = solver.anchors().point(1).unwrap();
+/// let d = decal_uv(&solver, &[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], &[at], -0.1).unwrap();
+/// assert!((d.uv[0][0] - 1.0).abs() < 1e-6 && d.uv[0][1].abs() < 1e-6); // an anchor's own uv
+/// ```
+pub fn decal_uv(
+    solver: &Solver,
+    uv: &[[f64; 2]],
+    points: &[SurfacePoint],
+    max_negative: f64,
+) -> Result<DecalUv, SolveError> {
+    if uv.len() != solver.n_anchors() {
+        return Err(SolveError::InvalidParameter(format!(
+            "{} (u, v) pairs for {} anchors; give one per anchor",
+            uv.len(),
+            solver.n_anchors()
+        )));
+    }
+    if let Some(bad) = uv.iter().flatten().find(|x| !x.is_finite()) {
+        return Err(SolveError::InvalidParameter(format!(
+            "the (u, v) coordinates must be finite, got {bad}"
+        )));
+    }
+    if !max_negative.is_finite() {
+        return Err(SolveError::InvalidParameter(format!(
+            "max_negative must be finite, got {max_negative}"
+        )));
+    }
+    let (batch, trips) = paper_round_trip(solver, points);
+    let (mut out, mut marked) = (Vec::with_capacity(points.len()), Vec::new());
+    for (w, trip) in batch.iter().zip(trips) {
+        match w {
+            Ok(w) => {
+                let mut p = [0.0; 2];
+                for (wi, c) in w.iter().zip(uv) {
+                    p[0] += wi * c[0];
+                    p[1] += wi * c[1];
+                }
+                let min = w.iter().copied().fold(f64::INFINITY, f64::min);
+                out.push(p);
+                marked.push(!trip || min < max_negative);
+            }
+            Err(_) => {
+                out.push([0.0, 0.0]);
+                marked.push(true);
+            }
+        }
+    }
+    Ok(DecalUv { uv: out, marked })
+}
+
+/// A decal over every vertex of the solver's mesh, with the distortion of the map from
+/// the surface to the plane over the unmarked vertices (flips judged against the
+/// orientation of most of the decal's area).
+#[derive(Clone, Debug)]
+pub struct Decal {
+    /// Per vertex coordinates and marks.
+    pub uv: DecalUv,
+    /// Distortion of the surface-to-plane map on faces with three unmarked corners.
+    pub distortion: Distortion,
+}
+
+/// [`decal_uv`] at every vertex of the solver's mesh, with the map's [`Distortion`].
+pub fn decal_vertices(
+    solver: &Solver,
+    uv: &[[f64; 2]],
+    max_negative: f64,
+) -> Result<Decal, SolveError> {
+    let mesh = solver.mesh();
+    let d = decal_uv(solver, uv, &vertex_points(mesh), max_negative)?;
+    let plane: Vec<Option<Vector3<f64>>> =
+        d.uv.iter()
+            .zip(&d.marked)
+            .map(|(p, &m)| (!m).then_some(Vector3::new(p[0], p[1], 0.0)))
+            .collect();
+    // The decal's orientation: the sign of its total signed area.
+    let signed: f64 = mesh
+        .triangles
+        .iter()
+        .filter_map(|t| {
+            let [a, b, c] = t.map(|v| plane[v as usize]);
+            Some((b? - a?).cross(&(c? - a?)).z)
+        })
+        .sum();
+    let up = Vector3::z() * if signed < 0.0 { -1.0 } else { 1.0 };
+    let normals = vec![Some(up); mesh.n_faces()];
+    let distortion = distortion(&mesh.positions, &mesh.triangles, &plane, &normals);
+    Ok(Decal { uv: d, distortion })
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use wavg_mesh::{TriMesh, ValidMesh};
+    use wavg_project::{EmbeddedMesh, Projector};
+    use wavg_solve::Anchor;
+
+    use super::*;
+
+    /// A flat grid in the z = 0 plane, `n` by `n` squares of side 1/n.
+    fn grid(n: u32) -> TriMesh {
+        let mut pts = Vec::new();
+        let mut tris = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                pts.push(Vector3::new(f64::from(i), f64::from(j), 0.0) / f64::from(n));
+            }
+        }
+        for j in 0..n {
+            for i in 0..n {
+                let a = j * (n + 1) + i;
+                tris.push([a, a + 1, a + n + 2]);
+                tris.push([a, a + n + 2, a + n + 1]);
+            }
+        }
+        TriMesh::new(pts, tris)
+    }
+
+    #[test]
+    fn anchors_with_their_own_xy_reproduce_a_flat_grid() {
+        let n = 20;
+        let mesh = Arc::new(ValidMesh::new(grid(n)).unwrap());
+        let proj = Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh.clone()))).unwrap();
+        let ids: Vec<u32> = (0..(n + 1) * (n + 1)).step_by(37).collect();
+        let solver = Solver::new(Arc::new(proj), ids.iter().map(|&v| Anchor::Vertex(v))).unwrap();
+        let uv: Vec<[f64; 2]> = ids
+            .iter()
+            .map(|&v| [mesh.positions[v as usize].x, mesh.positions[v as usize].y])
+            .collect();
+        let d = decal_vertices(&solver, &uv, -0.1).unwrap();
+        // Weights reproduce affine functions on a plane: uv = xy wherever they return.
+        for (v, (p, &m)) in d.uv.uv.iter().zip(&d.uv.marked).enumerate() {
+            if !m {
+                let q = mesh.positions[v];
+                assert!(
+                    (p[0] - q.x).abs() < 1e-6 && (p[1] - q.y).abs() < 1e-6,
+                    "{v}"
+                );
+            }
+        }
+        let valid = d.uv.marked.iter().filter(|m| !**m).count();
+        assert!(valid as f64 > 0.5 * mesh.n_vertices() as f64, "{valid}");
+        assert!((d.distortion.stretch - 1.0).abs() < 1e-6);
+        assert_eq!(d.distortion.flipped_faces, 0);
+        // Mirrored uv: the same, all orientation-consistent (the decal's own orientation).
+        let mirrored: Vec<[f64; 2]> = uv.iter().map(|p| [-p[0], p[1]]).collect();
+        let m = decal_vertices(&solver, &mirrored, -0.1).unwrap();
+        assert_eq!(m.distortion.flipped_faces, 0);
+    }
+
+    #[test]
+    fn uv_count_must_match() {
+        let mesh = Arc::new(ValidMesh::new(grid(4)).unwrap());
+        let proj = Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap();
+        let solver = Solver::new(Arc::new(proj), [0u32, 4, 24].map(Anchor::Vertex)).unwrap();
+        assert!(decal_vertices(&solver, &[[0.0, 0.0]], -0.1).is_err());
+        let nan = [[f64::NAN, 0.0], [0.0, 0.0], [1.0, 1.0]];
+        assert!(decal_vertices(&solver, &nan, -0.1).is_err());
+    }
+}

@@ -1,0 +1,304 @@
+//! `wavg correspond`: a map of every source vertex onto the target through paired anchors
+//! (inverse problem on the source, forward problem on the target), each vertex judged by a
+//! validity test.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use wavg::apps::{CorrespondOptions, Correspondence, Validity, ValidityTest, correspond_vertices};
+use wavg::{Anchor, Solver, Surface};
+
+use crate::CliError;
+use crate::apps_common::{embed, surface_and_anchors};
+use crate::common::one_line;
+use crate::textio::{self, write_numbers};
+
+/// The validity test, on the command line.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Test {
+    /// Local consistency: rejects vertices whose surrounding triangles mostly land flipped
+    /// or over-stretched on the target, or whose weights do not round-trip.
+    Local,
+    /// The paper's: the weights round-trip and none is below --max-negative.
+    Paper,
+}
+
+/// Arguments shared by the commands that map one surface onto another.
+#[derive(clap::Args)]
+pub struct MapArgs {
+    /// Source mesh (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    #[arg(long)]
+    pub source: String,
+    /// Target mesh.
+    #[arg(long)]
+    pub target: String,
+    /// Anchors on the source (`v VERTEX` or `f FACE B0 B1 B2` per line).
+    #[arg(long)]
+    pub source_anchors: PathBuf,
+    /// Anchors on the target, paired line by line with the source's (same count).
+    #[arg(long)]
+    pub target_anchors: PathBuf,
+    /// A .wavg embedding of the source (default: precompute one in memory).
+    #[arg(long)]
+    pub source_embedding: Option<PathBuf>,
+    /// A .wavg embedding of the target (default: precompute one in memory).
+    #[arg(long)]
+    pub target_embedding: Option<PathBuf>,
+    /// Use the paper's inverse weights only (default: verified weights, the paper's where
+    /// they round-trip, else the smallest offset penalty that does).
+    #[arg(long)]
+    pub paper_weights: bool,
+    /// The most negative weight the paper's validity test accepts.
+    #[arg(long, default_value_t = -0.1, allow_negative_numbers = true)]
+    pub max_negative: f64,
+    /// Validity test.
+    #[arg(long, value_enum, default_value_t = Test::Local)]
+    pub validity: Test,
+    /// Local test: a triangle is over-stretched above this many times the map's overall
+    /// symmetrised stretch.
+    #[arg(long, default_value_t = 4.0)]
+    pub max_stretch: f64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+/// Arguments.
+#[derive(clap::Args)]
+#[command(after_long_help = "\
+Maps every vertex of the source onto the target. Anchor i of --source-anchors corresponds to
+anchor i of --target-anchors. A vertex's weights come from the inverse problem on the source
+(verified weights by default, --paper-weights for the paper's alone), its image from the
+forward problem on the target with the same weights.
+
+Validity (--validity): `local` (default) keeps a vertex when its weights round-trip on the
+source and most triangles around it land neither flipped (orientation against the target's
+normal) nor stretched beyond --max-stretch times the map's overall stretch: it judges the
+image, so correct images with negative weights are kept and wrong images with harmless
+weights are not. `paper` is the paper's test: the weights round-trip and none is below
+--max-negative.
+
+Output: one line per source vertex, `FACE B0 B1 B2 X Y Z` on the target, or `none REASON`
+(unanswered, no-round-trip, negative-weight, inconsistent). --json prints one object:
+source_vertices, valid_fraction, flipped_faces, flipped_area_fraction, stretch (symmetrised
+L2 stretch over the valid part), stretch_best95, seconds, vertices_per_s (precomputation
+excluded), plus cpu_seconds and vertices_per_cpu_s (CPU time of the map, all threads), counts
+per reason and, with --ground-truth, the error of the images against
+vertex i of the target as fractions of the target's bounding-box diagonal.")]
+pub struct Args {
+    #[command(flatten)]
+    pub map: MapArgs,
+    /// Output map file (`-` for standard output).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// The two meshes share connectivity (vertex i corresponds to vertex i): report the
+    /// error of the map against that ground truth.
+    #[arg(long)]
+    pub ground_truth: bool,
+    /// Print one JSON object on standard output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A computed correspondence and what it took.
+pub struct Computed {
+    /// The source and target surfaces.
+    pub source: Surface,
+    /// The target surface.
+    pub target: Surface,
+    /// The map.
+    pub map: Correspondence,
+    /// Seconds of the map (precomputation excluded).
+    pub seconds: f64,
+    /// Seconds of loading and precomputation.
+    pub setup_seconds: f64,
+    /// CPU seconds of all threads during the map (`None` where unavailable): on a busy
+    /// machine the wall time overstates the work.
+    pub cpu_seconds: Option<f64>,
+}
+
+/// Reads both meshes and anchor files (checking them before any precomputation), embeds
+/// both surfaces and maps every source vertex.
+pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
+    let t0 = Instant::now();
+    let (mut source, sa) = surface_and_anchors(&a.source, &a.source_anchors)?;
+    let (mut target, ta) = surface_and_anchors(&a.target, &a.target_anchors)?;
+    if sa.len() != ta.len() {
+        return Err(CliError::input(format!(
+            "{} has {} anchors and {} has {}; they are paired line by line and must agree",
+            a.source_anchors.display(),
+            sa.len(),
+            a.target_anchors.display(),
+            ta.len()
+        )));
+    }
+    if !a.max_negative.is_finite() {
+        return Err(CliError::input("--max-negative must be a finite number"));
+    }
+    if !(a.max_stretch.is_finite() && a.max_stretch > 1.0) {
+        return Err(CliError::input(
+            "--max-stretch must be a finite number above 1",
+        ));
+    }
+    embed(&mut source, a.source_embedding.as_deref())?;
+    embed(&mut target, a.target_embedding.as_deref())?;
+    let solver = |s: &Surface, l: Vec<Anchor>| -> Result<Solver, CliError> {
+        s.solver(l).map_err(|e| CliError::input(one_line(&e)))
+    };
+    let (ss, ts) = (solver(&source, sa)?, solver(&target, ta)?);
+    let setup_seconds = t0.elapsed().as_secs_f64();
+    let opts = CorrespondOptions {
+        verified: !a.paper_weights,
+        max_negative: a.max_negative,
+        test: match a.validity {
+            Test::Local => ValidityTest::Local,
+            Test::Paper => ValidityTest::Paper,
+        },
+        max_stretch: a.max_stretch,
+    };
+    let t = Instant::now();
+    let cpu0 = crate::common::cpu_seconds(false);
+    let map = textio::with_threads(a.threads, || correspond_vertices(&ss, &ts, &opts))?
+        .map_err(|e| CliError::input(one_line(&e)))?;
+    Ok(Computed {
+        source,
+        target,
+        map,
+        seconds: t.elapsed().as_secs_f64(),
+        setup_seconds,
+        cpu_seconds: crate::common::cpu_seconds(false)
+            .zip(cpu0)
+            .map(|(b, a)| b - a),
+    })
+}
+
+/// Counts per validity reason, as a JSON object.
+pub fn reason_counts(map: &Correspondence) -> serde_json::Value {
+    let mut o = serde_json::Map::new();
+    for r in [
+        "valid",
+        "unanswered",
+        "no-round-trip",
+        "negative-weight",
+        "inconsistent",
+    ] {
+        let n = map.validity.iter().filter(|v| v.reason() == r).count();
+        o.insert(r.to_string(), n.into());
+    }
+    o.into()
+}
+
+/// Mean, 95th percentile and maximum of the errors (0 when empty).
+fn stats(mut e: Vec<f64>) -> serde_json::Value {
+    e.sort_by(f64::total_cmp);
+    let n = e.len();
+    let mean = if n == 0 {
+        0.0
+    } else {
+        e.iter().sum::<f64>() / n as f64
+    };
+    let p95 = e
+        .get(((n as f64 * 0.95) as usize).min(n.saturating_sub(1)))
+        .copied()
+        .unwrap_or(0.0);
+    serde_json::json!({"count": n, "mean": mean, "p95": p95, "max": e.last().copied().unwrap_or(0.0)})
+}
+
+/// Errors of the images against vertex `i` of the target, in bounding-box diagonals of
+/// the target: over the valid vertices and over every answered one.
+fn ground_truth(c: &Computed) -> Result<serde_json::Value, CliError> {
+    let (s, t) = (c.source.mesh(), c.target.mesh());
+    if s.n_vertices() != t.n_vertices() || s.triangles != t.triangles {
+        return Err(CliError::input(
+            "--ground-truth: the source and target do not share connectivity",
+        ));
+    }
+    let diag = t.bounding_box_diagonal();
+    let (mut valid, mut answered) = (Vec::new(), Vec::new());
+    for (v, (m, ok)) in c.map.mapped.iter().zip(&c.map.validity).enumerate() {
+        if let Ok(img) = &m.target {
+            let e = (img.position - t.positions[v]).norm() / diag;
+            answered.push(e);
+            if *ok == Validity::Valid {
+                valid.push(e);
+            }
+        }
+    }
+    Ok(serde_json::json!({"valid": stats(valid), "answered": stats(answered)}))
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let c = compute(&args.map)?;
+    let truth = if args.ground_truth {
+        Some(ground_truth(&c)?)
+    } else {
+        None
+    };
+    write_map(&args.output, &c.map)?;
+    let n = c.map.validity.len();
+    let d = &c.map.distortion;
+    let per_s = n as f64 / c.seconds.max(1e-12);
+    if args.json {
+        let j = serde_json::json!({
+            "source": args.map.source,
+            "target": args.map.target,
+            "anchors": anchors_of(&args.map)?,
+            "source_vertices": n,
+            "valid": c.map.valid(),
+            "valid_fraction": c.map.valid_fraction(),
+            "validity": format!("{:?}", args.map.validity).to_lowercase(),
+            "verified": !args.map.paper_weights,
+            "reasons": reason_counts(&c.map),
+            "flipped_faces": d.flipped_faces,
+            "flipped_area_fraction": d.flipped_area_fraction,
+            "measured_faces": d.measured_faces,
+            "stretch": d.stretch,
+            "stretch_best95": d.stretch_best95,
+            "seconds": c.seconds,
+            "setup_seconds": c.setup_seconds,
+            "vertices_per_s": per_s,
+            "cpu_seconds": c.cpu_seconds,
+            "vertices_per_cpu_s": c.cpu_seconds.map(|s| n as f64 / s.max(1e-12)),
+            "ground_truth": truth,
+        });
+        println!("{j}");
+    } else if args.output != Path::new("-") {
+        println!(
+            "{} of {n} vertices valid ({:.1}%), stretch {:.4}, {} flipped faces, {:.0} vertices/s -> {}",
+            c.map.valid(),
+            100.0 * c.map.valid_fraction(),
+            d.stretch,
+            d.flipped_faces,
+            per_s,
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+/// Anchor count (the source's; the pairing was checked).
+fn anchors_of(a: &MapArgs) -> Result<usize, CliError> {
+    Ok(textio::read_points(&a.source_anchors)?.len())
+}
+
+/// Writes one line per source vertex: its image or `none REASON`.
+pub fn write_map(path: &Path, map: &Correspondence) -> Result<(), CliError> {
+    textio::write_atomic(path, |w: &mut dyn Write| {
+        for (m, v) in map.mapped.iter().zip(&map.validity) {
+            match (v, &m.target) {
+                (Validity::Valid, Ok(r)) => {
+                    write!(w, "{} ", r.point.face)?;
+                    write_numbers(
+                        w,
+                        r.point.bary.into_iter().chain(r.position.iter().copied()),
+                    )?;
+                }
+                (v, _) => write!(w, "none {}", v.reason())?,
+            }
+            writeln!(w)?;
+        }
+        Ok(())
+    })
+}

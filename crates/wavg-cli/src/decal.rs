@@ -1,0 +1,140 @@
+//! `wavg decal`: a local parametrisation from anchors that carry `(u, v)` coordinates;
+//! every vertex gets `uv = sum_i w_i uv_i` with the paper's inverse weights.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use wavg::apps::decal_vertices;
+
+use crate::CliError;
+use crate::apps_common::{embed, surface_and_anchors};
+use crate::common::one_line;
+use crate::textio::{self, located, write_numbers};
+
+/// Arguments.
+#[derive(clap::Args)]
+#[command(after_long_help = "\
+Gives every vertex (u, v) coordinates: the anchors (--anchors, `v VERTEX` or `f FACE B0 B1
+B2` per line) carry the coordinates of --uv (`U V` per line, one line per anchor, in the
+same order), and a vertex with inverse-problem weights w (the paper's weights, continuous
+over the surface) gets uv = sum_i w_i uv_i. A vertex is marked where its weights are not
+meaningful: they do not return to it through the forward problem, or one is below
+--max-negative (its uv is still written; 0 0 where the inverse problem failed).
+
+Output: an OBJ of the mesh with one `vt` per vertex and faces `f a/a b/b c/c`. --json prints
+one object: vertices, valid_fraction (unmarked vertices), stretch (symmetrised L2 stretch of
+the surface-to-plane map over faces with three unmarked corners), flipped_faces (against the
+decal's own orientation), seconds, marked (the marked vertex ids), plus mesh and anchors.")]
+pub struct Args {
+    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    #[arg(long)]
+    pub mesh: String,
+    /// A .wavg embedding of the mesh (default: precompute one in memory).
+    #[arg(long)]
+    pub embedding: Option<PathBuf>,
+    /// Anchors, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
+    #[arg(long)]
+    pub anchors: PathBuf,
+    /// The anchors' coordinates, `U V` per line, as many lines as anchors.
+    #[arg(long)]
+    pub uv: PathBuf,
+    /// The most negative weight a vertex may have without being marked.
+    #[arg(long, default_value_t = -0.1, allow_negative_numbers = true)]
+    pub max_negative: f64,
+    /// Output OBJ file (`-` for standard output).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Print one JSON object on standard output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let text = textio::read_text(&args.uv)?;
+    let lines = textio::parse_weights(&text).map_err(|e| located(&args.uv, e.line, &e.message))?;
+    let mut uv = Vec::with_capacity(lines.len());
+    for (line, v) in &lines {
+        match v[..] {
+            [u, v] => uv.push([u, v]),
+            _ => {
+                return Err(located(
+                    &args.uv,
+                    *line,
+                    &format!("expected `U V` (2 numbers), found {}", v.len()),
+                ));
+            }
+        }
+    }
+    if !args.max_negative.is_finite() {
+        return Err(CliError::input("--max-negative must be a finite number"));
+    }
+    let (mut surface, anchors) = surface_and_anchors(&args.mesh, &args.anchors)?;
+    if uv.len() != anchors.len() {
+        return Err(CliError::input(format!(
+            "{} has {} (u, v) lines but {} has {} anchors; give one per anchor",
+            args.uv.display(),
+            uv.len(),
+            args.anchors.display(),
+            anchors.len()
+        )));
+    }
+    embed(&mut surface, args.embedding.as_deref())?;
+    let solver = surface
+        .solver(anchors)
+        .map_err(|e| CliError::input(one_line(&e)))?;
+    let t = Instant::now();
+    let decal = decal_vertices(&solver, &uv, args.max_negative)
+        .map_err(|e| CliError::input(one_line(&e)))?;
+    let seconds = t.elapsed().as_secs_f64();
+    let mesh = surface.mesh();
+    textio::write_atomic(&args.output, |w: &mut dyn Write| {
+        for p in &mesh.positions {
+            write!(w, "v ")?;
+            write_numbers(w, p.iter().copied())?;
+            writeln!(w)?;
+        }
+        for p in &decal.uv.uv {
+            write!(w, "vt ")?;
+            write_numbers(w, p.iter().copied())?;
+            writeln!(w)?;
+        }
+        for t in &mesh.triangles {
+            let [a, b, c] = t.map(|v| v + 1);
+            writeln!(w, "f {a}/{a} {b}/{b} {c}/{c}")?;
+        }
+        Ok(())
+    })?;
+    let marked: Vec<usize> = (0..mesh.n_vertices())
+        .filter(|&v| decal.uv.marked[v])
+        .collect();
+    let n = mesh.n_vertices();
+    let valid_fraction = (n - marked.len()) as f64 / n.max(1) as f64;
+    let d = &decal.distortion;
+    if args.json {
+        let j = serde_json::json!({
+            "mesh": args.mesh,
+            "anchors": uv.len(),
+            "vertices": n,
+            "valid_fraction": valid_fraction,
+            "stretch": d.stretch,
+            "stretch_best95": d.stretch_best95,
+            "flipped_faces": d.flipped_faces,
+            "flipped_area_fraction": d.flipped_area_fraction,
+            "seconds": seconds,
+            "marked": marked,
+        });
+        println!("{j}");
+    } else if args.output != std::path::Path::new("-") {
+        println!(
+            "{} of {n} vertices unmarked ({:.1}%), stretch {:.4}, {} flipped faces -> {}",
+            n - marked.len(),
+            100.0 * valid_fraction,
+            d.stretch,
+            d.flipped_faces,
+            args.output.display()
+        );
+    }
+    Ok(())
+}

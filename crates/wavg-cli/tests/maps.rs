@@ -1,0 +1,286 @@
+//! `wavg correspond`, `wavg decal` and `wavg morph` run as processes: JSON keys, output
+//! files, the identity map of a surface onto itself, a real pose pair against its ground
+//! truth, and bad input that writes nothing.
+
+mod common;
+
+use std::path::Path;
+
+use common::{json_object, wavg, wavg_ok};
+
+fn s(p: &Path) -> String {
+    p.to_str().unwrap().to_string()
+}
+
+fn has_keys(keys: &[String], want: &[&str]) {
+    for k in want {
+        assert!(keys.iter().any(|x| x == k), "missing {k} in {keys:?}");
+    }
+}
+
+/// Every 85th vertex of the level-4 icosphere (2562 vertices): 31 anchors.
+fn sphere_anchors(dir: &Path) -> std::path::PathBuf {
+    let p = dir.join("a.txt");
+    let text: String = (0..2562).step_by(85).map(|v| format!("v {v}\n")).collect();
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn correspond_a_surface_onto_itself() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = s(&sphere_anchors(dir.path()));
+    let out = dir.path().join("map.txt");
+    let m = "builtin:icosphere";
+    let base = [
+        "correspond",
+        "--source",
+        m,
+        "--target",
+        m,
+        "--source-anchors",
+        &a,
+        "--target-anchors",
+        &a,
+        "-o",
+        &s(&out),
+        "--json",
+        "--ground-truth",
+    ];
+    for extra in [&[][..], &["--validity", "paper"], &["--paper-weights"]] {
+        let (o, keys) = json_object(&wavg_ok(&[&base[..], extra].concat()));
+        has_keys(
+            &keys,
+            &[
+                "source_vertices",
+                "valid_fraction",
+                "flipped_faces",
+                "flipped_area_fraction",
+                "stretch",
+                "stretch_best95",
+                "seconds",
+                "vertices_per_s",
+            ],
+        );
+        assert_eq!(o["source_vertices"], 2562);
+        let map = std::fs::read_to_string(&out).unwrap();
+        assert_eq!(map.lines().count(), 2562);
+        let valid = map.lines().filter(|l| !l.starts_with("none ")).count();
+        let frac = o["valid_fraction"].as_f64().unwrap();
+        assert!((frac - valid as f64 / 2562.0).abs() < 1e-12);
+        assert!(frac > 0.5, "{extra:?}: {frac}");
+        let err = o["ground_truth"]["valid"]["max"].as_f64().unwrap();
+        assert!(err < 1e-6, "{extra:?}: {err}");
+        if extra.is_empty() {
+            // The default local test keeps the exact images the paper's test rejects.
+            assert!(frac > 0.99, "{frac}");
+            assert!((o["stretch"].as_f64().unwrap() - 1.0).abs() < 1e-6);
+        }
+    }
+}
+
+#[test]
+fn decal_writes_one_vt_per_vertex() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.txt");
+    std::fs::write(&a, "v 0\nv 1\nv 2\nv 3\n").unwrap();
+    let uv = dir.path().join("uv.txt");
+    std::fs::write(&uv, "0 0\n1 0\n0 1\n1 1\n").unwrap();
+    let out = dir.path().join("d.obj");
+    let r = wavg_ok(&[
+        "decal",
+        "--mesh",
+        "builtin:icosphere",
+        "--anchors",
+        &s(&a),
+        "--uv",
+        &s(&uv),
+        "-o",
+        &s(&out),
+        "--json",
+    ]);
+    let (o, keys) = json_object(&r);
+    has_keys(
+        &keys,
+        &[
+            "vertices",
+            "valid_fraction",
+            "stretch",
+            "flipped_faces",
+            "seconds",
+            "marked",
+        ],
+    );
+    assert_eq!(o["vertices"], 2562);
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(text.lines().filter(|l| l.starts_with("vt ")).count(), 2562);
+    assert_eq!(text.lines().filter(|l| l.starts_with("v ")).count(), 2562);
+    let f = text.lines().find(|l| l.starts_with("f ")).unwrap();
+    assert!(f.contains('/'), "{f}");
+    // Anchor 1 (vertex 1) gets its own coordinates.
+    let vt: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| l.starts_with("vt "))
+        .map(|l| l[3..].split(' ').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert!(
+        (vt[1][0] - 1.0).abs() < 1e-6 && vt[1][1].abs() < 1e-6,
+        "{:?}",
+        vt[1]
+    );
+    let marked = o["marked"].as_array().unwrap().len();
+    let frac = o["valid_fraction"].as_f64().unwrap();
+    assert!((frac - (2562 - marked) as f64 / 2562.0).abs() < 1e-12);
+}
+
+#[test]
+fn morph_writes_the_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = s(&sphere_anchors(dir.path()));
+    let out = dir.path().join("frames");
+    let r = wavg_ok(&[
+        "morph",
+        "--source",
+        "builtin:icosphere",
+        "--target",
+        "builtin:icosphere",
+        "--source-anchors",
+        &a,
+        "--target-anchors",
+        &a,
+        "--frames",
+        "4",
+        "-o",
+        &s(&out),
+        "--json",
+    ]);
+    let (o, keys) = json_object(&r);
+    has_keys(&keys, &["frames", "valid_fraction", "seconds"]);
+    assert_eq!(o["frames"], 4);
+    for k in 0..4 {
+        let f = std::fs::read_to_string(out.join(format!("frame_{k:03}.obj"))).unwrap();
+        assert_eq!(f.lines().filter(|l| l.starts_with("v ")).count(), 2562);
+    }
+    assert!(!out.join("frame_004.obj").exists());
+}
+
+#[test]
+fn a_pose_pair_maps_close_to_its_ground_truth() {
+    let Some(f0) = wavg_testdata::require_data_file(
+        "a_pose_pair_maps_close_to_its_ground_truth",
+        "correspondence/goast_finger/finger0.off",
+    ) else {
+        return;
+    };
+    let f1 = f0.with_file_name("finger1.off");
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.txt");
+    let text: String = (0..2046).step_by(51).map(|v| format!("v {v}\n")).collect();
+    std::fs::write(&a, text).unwrap();
+    let out = dir.path().join("map.txt");
+    let r = wavg_ok(&[
+        "correspond",
+        "--source",
+        &s(&f0),
+        "--target",
+        &s(&f1),
+        "--source-anchors",
+        &s(&a),
+        "--target-anchors",
+        &s(&a),
+        "-o",
+        &s(&out),
+        "--json",
+        "--ground-truth",
+    ]);
+    let (o, _) = json_object(&r);
+    let frac = o["valid_fraction"].as_f64().unwrap();
+    let err = o["ground_truth"]["valid"]["mean"].as_f64().unwrap();
+    assert!(frac > 0.9, "valid fraction {frac}");
+    assert!(err < 0.01, "mean error {err} of the diagonal");
+}
+
+#[test]
+fn bad_input_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = sphere_anchors(dir.path());
+    let short = dir.path().join("short.txt");
+    std::fs::write(&short, "v 0\nv 85\n").unwrap();
+    let far = dir.path().join("far.txt");
+    std::fs::write(&far, "v 0\nv 99999\n").unwrap();
+    let out = dir.path().join("out.txt");
+    let frames = dir.path().join("frames");
+    let m = "builtin:icosphere";
+    let expect_2 = |args: &[&str], what: &str| {
+        let r = wavg(args);
+        assert_eq!(
+            r.status.code(),
+            Some(2),
+            "{what}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+        assert!(!String::from_utf8_lossy(&r.stderr).trim().is_empty());
+        assert!(!out.exists() && !frames.exists(), "{what} wrote output");
+    };
+    let (a, short, far, o) = (s(&a), s(&short), s(&far), s(&out));
+    let pair = |sa: &str, ta: &str, cmd: &str| -> Vec<String> {
+        let mut v: Vec<String> = [
+            cmd,
+            "--source",
+            m,
+            "--target",
+            m,
+            "--source-anchors",
+            sa,
+            "--target-anchors",
+            ta,
+            "-o",
+        ]
+        .iter()
+        .map(|x| x.to_string())
+        .collect();
+        v.push(if cmd == "morph" {
+            s(&frames)
+        } else {
+            o.clone()
+        });
+        v
+    };
+    for cmd in ["correspond", "morph"] {
+        let v = pair(&a, &short, cmd);
+        let args: Vec<&str> = v.iter().map(String::as_str).collect();
+        expect_2(&args, "anchor counts differ");
+        let v = pair(&far, &far, cmd);
+        let args: Vec<&str> = v.iter().map(String::as_str).collect();
+        expect_2(&args, "anchor out of range");
+        let v = pair("/nonexistent/a.txt", &a, cmd);
+        let args: Vec<&str> = v.iter().map(String::as_str).collect();
+        expect_2(&args, "unreadable anchors");
+    }
+    let uv = dir.path().join("uv.txt");
+    std::fs::write(&uv, "0 0\n1 0\n").unwrap();
+    let uv = s(&uv);
+    let decal = |anchors: &str, uv: &str, mesh: &str| {
+        [
+            "decal",
+            "--mesh",
+            mesh,
+            "--anchors",
+            anchors,
+            "--uv",
+            uv,
+            "-o",
+            o.as_str(),
+        ]
+        .map(str::to_string)
+    };
+    for (args, what) in [
+        (decal(&a, &uv, m), "uv count differs"),
+        (decal(&far, &uv, m), "anchor out of range"),
+        (decal(&short, &uv, "/nonexistent.obj"), "unreadable mesh"),
+        (decal(&short, "/nonexistent.txt", m), "unreadable uv"),
+    ] {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        expect_2(&args, what);
+    }
+}
