@@ -53,7 +53,8 @@ pub struct Args {
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let text = textio::read_text(&args.uv)?;
-    let lines = textio::parse_weights(&text).map_err(|e| located(&args.uv, e.line, &e.message))?;
+    let lines =
+        wavg::text::parse_weights(&text, 1).map_err(|e| located(&args.uv, e.line, &e.message))?;
     let mut uv = Vec::with_capacity(lines.len());
     for (line, v) in &lines {
         match v[..] {
