@@ -8,6 +8,7 @@ use wavg::text;
 use wavg_solve::{ForwardOptions, Normalization, SearchMode, SolveError};
 
 use crate::CliError;
+use crate::stream::{Format, Sink, stream_queries};
 use crate::textio::{self, located};
 
 const LONG_ABOUT: &str = "\
@@ -76,7 +77,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 .map_err(|e| located(&args.weights, *line, &e))
         })
     };
-    let solve = |rows: Vec<(usize, Vec<f64>)>, w: &mut dyn Write| -> Result<(), CliError> {
+    let solve = |rows: Vec<(usize, Vec<f64>)>, sink: &mut Sink| -> Result<(), CliError> {
         let weights: Vec<&[f64]> = rows.iter().map(|(_, w)| &w[..]).collect();
         let results = if args.warm {
             solver.forward_batch_warm(&weights, &opts, 256)
@@ -94,25 +95,34 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 )));
             }
         }
-        text::write_lines(w, &results, |r, out| match r {
-            Ok(r) => {
-                let p = r.point;
-                let _ = write!(out, "{} ", p.face);
-                text::push_numbers(out, p.bary.into_iter().chain(r.position.iter().copied()));
-            }
-            Err(e) => {
-                out.extend_from_slice(format!("none {}", crate::common::one_line(e)).as_bytes())
-            }
-        })
+        sink.write(
+            &results,
+            |r, out| match r {
+                Ok(r) => {
+                    let p = r.point;
+                    let _ = write!(out, "{} ", p.face);
+                    text::push_numbers(out, p.bary.into_iter().chain(r.position.iter().copied()));
+                }
+                Err(e) => {
+                    out.extend_from_slice(format!("none {}", crate::common::one_line(e)).as_bytes())
+                }
+            },
+            |r, row| match r {
+                Ok(r) => {
+                    row[0] = f64::from(r.point.face);
+                    row[1..4].copy_from_slice(&r.point.bary);
+                    row[4..7].copy_from_slice(r.position.as_slice());
+                }
+                Err(_) => row[0] = -1.0,
+            },
+        )
         .map_err(|e| CliError::failure(format!("{}: {e}", args.problem.output.display())))
     };
     textio::with_threads(args.problem.threads, || {
-        textio::stream_queries(
-            &args.weights,
-            &args.problem.output,
-            text::parse_weights,
-            check,
-            solve,
-        )
+        let format = Format {
+            text: text::parse_weights,
+            npy: |_, row| Ok(row.to_vec()),
+        };
+        stream_queries(&args.weights, &args.problem.output, format, 7, check, solve)
     })?
 }

@@ -1,12 +1,12 @@
 //! `wavg inverse`: anchors + surface points -> weights.
 
-use std::io::Write;
 use std::path::PathBuf;
 
 use wavg::text::{self, PointSpec};
 use wavg_solve::{BatchWeights, DEFAULT_TOLERANCE, RoundTrip, Verified};
 
 use crate::CliError;
+use crate::stream::{Format, Sink, stream_queries};
 use crate::textio;
 
 const LONG_ABOUT: &str = "\
@@ -63,39 +63,77 @@ pub fn run(args: Args) -> Result<(), CliError> {
         |rows: &[(usize, PointSpec)]| textio::resolve_points(solver.mesh(), rows, &args.points);
     let mut summary = VerifiedSummary::default();
     let mut weights = BatchWeights::default();
-    let solve = |rows: Vec<(usize, PointSpec)>, w: &mut dyn Write| -> Result<(), CliError> {
+    let solve = |rows: Vec<(usize, PointSpec)>, sink: &mut Sink| -> Result<(), CliError> {
         let points = resolve(&rows)?;
         let written = if args.verified {
             let batch = solver.inverse_verified_batch(&points, DEFAULT_TOLERANCE);
             summary.add(&batch);
-            text::write_lines(w, &batch, |r, out| match r {
-                Ok(v) => text::push_numbers(out, v.weights.iter().copied()),
-                Err(e) => none(out, e),
-            })
+            sink.write(
+                &batch,
+                |r, out| match r {
+                    Ok(v) => text::push_numbers(out, v.weights.iter().copied()),
+                    Err(e) => none(out, e),
+                },
+                |r, row| {
+                    if let Ok(v) = r {
+                        row.copy_from_slice(&v.weights);
+                    }
+                },
+            )
         } else {
             solver.inverse_batch_into(&points, &mut weights);
             let rows: Vec<usize> = (0..weights.len()).collect();
-            text::write_lines(w, &rows, |&i, out| match weights.get(i) {
-                Ok(ws) => text::push_numbers(out, ws.iter().copied()),
-                Err(e) => none(out, e),
-            })
+            sink.write(
+                &rows,
+                |&i, out| match weights.get(i) {
+                    Ok(ws) => text::push_numbers(out, ws.iter().copied()),
+                    Err(e) => none(out, e),
+                },
+                |&i, row| {
+                    if let Ok(ws) = weights.get(i) {
+                        row.copy_from_slice(ws);
+                    }
+                },
+            )
         };
         written.map_err(|e| CliError::failure(format!("{}: {e}", args.problem.output.display())))
     };
     let check = |rows: &[(usize, PointSpec)]| resolve(rows).map(|_| ());
     textio::with_threads(args.problem.threads, || {
-        textio::stream_queries(
-            &args.points,
-            &args.problem.output,
-            text::parse_points,
-            check,
-            solve,
-        )
+        let format = Format {
+            text: text::parse_points,
+            npy: npy_point,
+        };
+        let k = solver.n_anchors();
+        stream_queries(&args.points, &args.problem.output, format, k, check, solve)
     })??;
     if args.verified {
         summary.report();
     }
     Ok(())
+}
+
+/// A `.npy` point row: `FACE B0 B1 B2` (the face index as a float holding an integer).
+fn npy_point(line: usize, row: &[f64]) -> Result<PointSpec, wavg::text::LineError> {
+    let err = |message: String| wavg::text::LineError { line, message };
+    let [face, b0, b1, b2] = row else {
+        return Err(err(format!(
+            "a point row has 4 values (FACE B0 B1 B2), got {}",
+            row.len()
+        )));
+    };
+    if !(*face >= 0.0 && face.fract() == 0.0 && *face < 4_294_967_296.0) {
+        return Err(err(format!(
+            "face index {face} is not a non-negative integer"
+        )));
+    }
+    if let Some(b) = [b0, b1, b2].into_iter().find(|b| !b.is_finite()) {
+        return Err(err(format!("barycentric coordinate {b} is not finite")));
+    }
+    Ok(PointSpec::Face {
+        face: *face as u64,
+        bary: [*b0, *b1, *b2],
+    })
 }
 
 /// `none REASON` for a point without weights.

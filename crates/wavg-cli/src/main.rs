@@ -18,6 +18,7 @@ mod morph;
 mod precompute;
 mod repair;
 mod spline;
+mod stream;
 mod subdivide;
 mod textio;
 

@@ -71,68 +71,6 @@ pub fn write_atomic(
     Ok(())
 }
 
-/// A chunk parser of `wavg::text`: the chunk's text and first line number to numbered rows.
-pub type ParseChunk<T> = fn(&str, usize) -> Result<Vec<(usize, T)>, wavg::text::LineError>;
-
-/// Lines read, checked, computed and written per round when streaming a query file.
-const STREAM_LINES: usize = 1 << 16;
-
-/// Streams the query file `input` through bounded memory: each chunk of lines is parsed by
-/// `parse` (in parallel), checked by `check` (errors name their line), and handed to
-/// `each`, which writes its answers. The output goes to a temporary file renamed on
-/// success, so a bad line anywhere leaves nothing; for stdout (`-`) a first pass parses and
-/// checks the whole file before anything is written, for the same guarantee.
-pub fn stream_queries<T: Send>(
-    input: &Path,
-    output: &Path,
-    parse: ParseChunk<T>,
-    check: impl Fn(&[(usize, T)]) -> Result<(), CliError>,
-    mut each: impl FnMut(Vec<(usize, T)>, &mut dyn Write) -> Result<(), CliError>,
-) -> Result<(), CliError> {
-    let open = || -> Result<_, CliError> {
-        let file = std::fs::File::open(input)
-            .map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
-        Ok(wavg::text::LineChunks::new(
-            std::io::BufReader::with_capacity(1 << 20, file),
-            STREAM_LINES,
-        ))
-    };
-    let next = |chunks: &mut wavg::text::LineChunks<_>| -> Result<_, CliError> {
-        let Some(chunk) = chunks
-            .next_chunk()
-            .map_err(|e| CliError::input(format!("{}: {e}", input.display())))?
-        else {
-            return Ok(None);
-        };
-        let rows =
-            parse(&chunk.text, chunk.first_line).map_err(|e| located(input, e.line, &e.message))?;
-        check(&rows)?;
-        Ok(Some(rows))
-    };
-    if output == Path::new("-") {
-        let mut chunks = open()?;
-        while next(&mut chunks)?.is_some() {}
-    }
-    let mut chunks = open()?;
-    let mut failure = None;
-    let written = write_atomic(output, |w: &mut dyn Write| {
-        let mut round = || -> Result<(), CliError> {
-            while let Some(rows) = next(&mut chunks)? {
-                each(rows, w)?;
-            }
-            Ok(())
-        };
-        round().map_err(|e| {
-            failure = Some(e);
-            std::io::Error::other("stopped")
-        })
-    });
-    match failure {
-        Some(e) => Err(e),
-        None => written,
-    }
-}
-
 /// Arguments shared by `wavg forward` and `wavg inverse`: the mesh, its embedding, the
 /// anchors, the output and the thread count.
 #[derive(clap::Args)]

@@ -464,3 +464,106 @@ fn long_files_stream_in_chunks() {
         "stdout got output before the bad line"
     );
 }
+
+/// Writes a row-major `rows x cols` array as `.npy`.
+fn write_npy(path: &Path, cols: usize, data: &[f64]) {
+    let mut bytes = Vec::new();
+    let mut w = wavg::npy::NpyWriter::new(&mut bytes, data.len() / cols, cols).unwrap();
+    for row in data.chunks(cols) {
+        w.write_row(row).unwrap();
+    }
+    w.finish().unwrap();
+    std::fs::write(path, bytes).unwrap();
+}
+
+fn read_npy(path: &Path) -> (usize, usize, Vec<f64>) {
+    wavg::npy::read_matrix(std::fs::File::open(path).unwrap()).unwrap()
+}
+
+/// `.npy` inputs and outputs carry the same numbers as the text formats, in any mix;
+/// rows without an answer are NaN (face -1 for forward); bad rows name their row.
+#[test]
+fn npy_files_match_the_text_formats() {
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = write(dir.path(), "anchors.txt", ANCHORS);
+    let faces = [
+        (3u32, [0.2, 0.3, 0.5]),
+        (77, [1.0, 0.0, 0.0]),
+        (300, [0.6, 0.2, 0.2]),
+    ];
+    let text: String = faces
+        .iter()
+        .map(|(f, b)| format!("f {f} {} {} {}\n", b[0], b[1], b[2]))
+        .collect();
+    let pts_txt = write(dir.path(), "points.txt", &text);
+    let pts_npy = dir.path().join("points.npy");
+    let flat: Vec<f64> = faces
+        .iter()
+        .flat_map(|(f, b)| [f64::from(*f), b[0], b[1], b[2]])
+        .collect();
+    write_npy(&pts_npy, 4, &flat);
+    let j = |n: &str| dir.path().join(n);
+    for (input, output) in [
+        (&pts_txt, j("w.txt")),
+        (&pts_npy, j("w.npy")),
+        (&pts_txt, j("w2.npy")),
+    ] {
+        wavg_ok(&solve_args(
+            "inverse",
+            s(&anchors),
+            s(input),
+            s(&output),
+            &[],
+        ));
+    }
+    let text_rows: Vec<f64> = read_rows(&j("w.txt")).concat();
+    for f in ["w.npy", "w2.npy"] {
+        let (rows, cols, data) = read_npy(&j(f));
+        assert_eq!((rows, cols), (3, 12));
+        assert_eq!(data, text_rows, "{f}");
+    }
+    wavg_ok(&solve_args(
+        "forward",
+        s(&anchors),
+        s(&j("w.npy")),
+        s(&j("b.npy")),
+        &[],
+    ));
+    wavg_ok(&solve_args(
+        "forward",
+        s(&anchors),
+        s(&j("w.txt")),
+        s(&j("b.txt")),
+        &[],
+    ));
+    let (rows, cols, data) = read_npy(&j("b.npy"));
+    assert_eq!((rows, cols), (3, 7));
+    assert_eq!(data, read_rows(&j("b.txt")).concat());
+    assert_eq!(data[0], 3.0);
+    // A row with a fractional face and a truncated file are input errors naming the file.
+    write_npy(&j("bad.npy"), 4, &[3.0, 0.2, 0.3, 0.5, 1.5, 0.2, 0.3, 0.5]);
+    expect_input_error(
+        &solve_args(
+            "inverse",
+            s(&anchors),
+            s(&j("bad.npy")),
+            s(&j("w.npy")),
+            &[],
+        ),
+        &j("w.npy"),
+        "bad.npy:2: face index 1.5",
+    );
+    let bytes = std::fs::read(&pts_npy).unwrap();
+    std::fs::write(j("cut.npy"), &bytes[..bytes.len() - 8]).unwrap();
+    expect_input_error(
+        &solve_args(
+            "inverse",
+            s(&anchors),
+            s(&j("cut.npy")),
+            s(&j("w.npy")),
+            &[],
+        ),
+        &j("w.npy"),
+        "cut.npy",
+    );
+}

@@ -308,6 +308,11 @@ impl<W: Write> NpyWriter<W> {
         })
     }
 
+    /// Values per row.
+    pub fn cols(&self) -> usize {
+        self.cols
+    }
+
     /// Writes the next row (`cols` values).
     pub fn write_row(&mut self, row: &[f64]) -> std::io::Result<()> {
         if row.len() != self.cols || self.written == self.rows {
