@@ -233,6 +233,34 @@ impl Solver {
         self.forward_prepared(&prepared, opts)
     }
 
+    /// Forward problem for an average the caller formed: projects `ybar` (a point of R^8,
+    /// typically `sum w_i y_i` over embedded surface points that change from query to query,
+    /// such as the 2-4 corners of a remeshing stencil, where rebuilding an anchor set per
+    /// query would cost more than the query) onto the surface. The search starts at the
+    /// nearest corner of `opts.warm_start` when given, else of `near` (a point expected
+    /// close to the answer, e.g. the highest-weight input point). The solver's own anchors
+    /// are not used. A non-finite `ybar` is [`SolveError::InvalidParameter`].
+    pub fn forward_embedded(
+        &self,
+        ybar: &Vec8,
+        near: &SurfacePoint,
+        opts: &ForwardOptions,
+    ) -> Result<ForwardResult, SolveError> {
+        if !ybar.iter().all(|v| v.is_finite()) {
+            return Err(SolveError::InvalidParameter(
+                "the averaged point is not finite".into(),
+            ));
+        }
+        let start = match opts.mode {
+            SearchMode::Exact => Start::Exhaustive,
+            _ => {
+                let p = check_point(self.mesh(), &opts.warm_start.unwrap_or(*near))?;
+                Start::Warm(nearest_corner(self.mesh(), &p))
+            }
+        };
+        self.forward_prepared(&Prepared { ybar: *ybar, start }, opts)
+    }
+
     /// The part of the forward problem that reads the weights: validation, the average and
     /// the start vertex. Split off so a batch can read every weight row once, in input
     /// order, and then search in the order of the averages' positions.
