@@ -122,7 +122,7 @@ pub struct Remesher {
     diag: f64,
     faces: Vec<Vec<u32>>,
     base_points: Vec<SurfacePoint>,
-    plan: Option<(usize, Arc<Plan>, Arc<Vec<Vec<u32>>>)>,
+    plan: Option<CachedPlan>,
     /// The previous run's answers per stage (each level's new vertices, then every
     /// smoothing step's vertices), with its levels and smoothing steps.
     warm: Option<(usize, usize, Vec<Vec<SurfacePoint>>)>,
@@ -172,7 +172,7 @@ impl Remesher {
         for (v, p) in base.positions.iter().enumerate() {
             let (sp, d) = me.closest_point(p);
             let distance = d / me.diag;
-            if !(distance <= limit) {
+            if distance.is_nan() || distance > limit {
                 return Err(RemeshError::FarFromSurface {
                     vertex: v,
                     distance,
@@ -352,7 +352,7 @@ impl Remesher {
         smoothing: bool,
     ) -> Result<StageOut, (usize, SolveError)> {
         let opts = ForwardOptions::default();
-        let out: Vec<Result<(SurfacePoint, Vec8, u8), (usize, SolveError)>> = (0..stencils.len())
+        let out: Vec<Result<Answer, (usize, SolveError)>> = (0..stencils.len())
             .into_par_iter()
             .with_min_len(64)
             .map(|i| {
@@ -398,6 +398,13 @@ impl Remesher {
         Ok(st)
     }
 }
+
+/// The plan for a number of levels, with its faces shared with every result.
+type CachedPlan = (usize, Arc<Plan>, Arc<Vec<Vec<u32>>>);
+
+/// One stencil's answer: the point, its embedded point, and 0 (kept), 1 (solved) or 2
+/// (solved by the fallback search).
+type Answer = (SurfacePoint, Vec8, u8);
 
 /// What one stage computed.
 struct StageOut {
