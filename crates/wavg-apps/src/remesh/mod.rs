@@ -37,8 +37,10 @@ use plan::{Plan, Stencils};
 pub const MAX_LEVELS: usize = 8;
 
 /// Default largest distance of a base vertex from the surface, over the surface's
-/// bounding-box diagonal.
-pub const DEFAULT_MAX_BASE_DISTANCE: f64 = 0.05;
+/// bounding-box diagonal: generous, since the control cage of a subdivision surface lies
+/// several percent of the diagonal off the surface, yet a base in other coordinates (or
+/// scaled) is refused.
+pub const DEFAULT_MAX_BASE_DISTANCE: f64 = 0.15;
 
 /// The refined mesh of one run.
 #[derive(Clone, Debug)]
