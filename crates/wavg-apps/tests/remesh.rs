@@ -85,6 +85,13 @@ fn brute_offsurface(mesh: &ValidMesh, out: &RemeshResult, diag: f64) -> f64 {
     worst / diag
 }
 
+/// How far apart two answers to the same forward problem may lie: the projector accepts a
+/// root up to `BARY_EPS` outside a triangle and clamps it onto the edge, so a point near
+/// an edge found from either side differs by up to that fraction of an edge.
+fn same_point_tolerance(proj: &Projector) -> f64 {
+    wavg_project::triangle::BARY_EPS * wavg_mesh::geometry::mean_edge_length(proj.embedded().mesh())
+}
+
 fn max_difference(a: &RemeshResult, b: &RemeshResult) -> f64 {
     assert_eq!(a.positions.len(), b.positions.len());
     a.positions
@@ -170,7 +177,7 @@ fn warm_recompute_after_moving_a_vertex_equals_cold() {
             .remesh(2, 3)
             .unwrap();
         let worst = max_difference(&w, &c);
-        assert!(worst < 1e-9, "step {step}: {worst}");
+        assert!(worst < same_point_tolerance(&proj), "step {step}: {worst}");
         assert!((w.positions[5] - c.positions[5]).norm() < 1e-12);
     }
     // Bad edits are refused and leave the remesher usable.
@@ -294,5 +301,5 @@ fn spot_control_cage_on_the_quadrangulated_spot() {
         .remesh(3, 5)
         .unwrap();
     let worst = max_difference(&w, &c);
-    assert!(worst < 1e-9, "{worst}");
+    assert!(worst < same_point_tolerance(&proj), "{worst}");
 }

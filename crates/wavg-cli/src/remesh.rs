@@ -32,7 +32,8 @@ Output: the refined mesh as OBJ (quads where the base had polygons of 4 or more 
 triangles where it had triangles). --json prints one object: base_faces, base_vertices,
 vertices, faces, levels, smooth_steps, seconds (the first, cold remeshing), warm_seconds
 (median of --frames recomputations while base vertex --drag moves, each warm-started from
-the previous frame; null with --frames 0), warm_seconds_max, frames, max_offsurface
+the previous frame; null with --frames 0), warm_seconds_max, warm_cpu_seconds (mean CPU
+time of all threads per frame), frames, max_offsurface
 (largest 3-D distance of an output vertex from the mesh over its bounding-box diagonal),
 roughness (mean umbrella length over mean edge length), problems, fallbacks, threads,
 precompute_seconds, plus mesh and base.")]
@@ -111,7 +112,8 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
         .remesh(args.levels, args.smooth)
         .map_err(|e| CliError::failure(one_line(&e)))?;
     let seconds = t.elapsed().as_secs_f64();
-    let (warm, warm_max) = drag_frames(&mut r, &base, &args)?;
+    let drag = drag_frames(&mut r, &base, &args)?;
+    let warm = drag.median;
     // The file is the first (undragged) result.
     let max_offsurface = r.max_offsurface(&out.positions);
     let obj = polygons_to_obj(&out.positions, &out.faces);
@@ -130,7 +132,8 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
             "smooth_steps": out.smooth_steps,
             "seconds": seconds,
             "warm_seconds": warm,
-            "warm_seconds_max": warm_max,
+            "warm_seconds_max": drag.max,
+            "warm_cpu_seconds": drag.cpu,
             "frames": args.frames,
             "max_offsurface": max_offsurface,
             "roughness": out.roughness(),
@@ -160,31 +163,45 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
 
 /// Drags base vertex `--drag` over `--frames` frames (a small circle of radius 2% of the
 /// diagonal around its start, each position put on the surface), recomputing warm each
-/// time; the median and largest frame times.
-fn drag_frames(
-    r: &mut Remesher,
-    base: &BaseMesh,
-    args: &Args,
-) -> Result<(Option<f64>, Option<f64>), CliError> {
+/// time.
+fn drag_frames(r: &mut Remesher, base: &BaseMesh, args: &Args) -> Result<Drag, CliError> {
     if args.frames == 0 {
-        return Ok((None, None));
+        return Ok(Drag::default());
     }
     let start = base.positions[args.drag];
     let radius = 0.02 * r.diagonal();
     let mut times = Vec::with_capacity(args.frames);
+    let mut cpu = 0.0;
     for k in 0..args.frames {
         let a = std::f64::consts::TAU * (k + 1) as f64 / args.frames as f64;
         let target = start + radius * Vector3::new(a.cos() - 1.0, a.sin(), 0.0);
         let (p, _) = r.closest_point(&target);
         let t = Instant::now();
+        let c = crate::common::cpu_seconds(false);
         r.move_base_vertex(args.drag, p)
             .and_then(|()| r.remesh(args.levels, args.smooth))
             .map_err(|e| CliError::failure(format!("dragged frame {}: {}", k + 1, one_line(&e))))?;
         times.push(t.elapsed().as_secs_f64());
+        if let (Some(a), Some(b)) = (c, crate::common::cpu_seconds(false)) {
+            cpu += b - a;
+        }
     }
     let max = times.iter().copied().fold(0.0, f64::max);
     times.sort_by(f64::total_cmp);
-    Ok((Some(times[times.len() / 2]), Some(max)))
+    Ok(Drag {
+        median: Some(times[times.len() / 2]),
+        max: Some(max),
+        cpu: Some(cpu / args.frames as f64),
+    })
+}
+
+/// Times of the dragged frames (none without frames): median and largest wall time, and
+/// the mean CPU time of the whole process (all threads) per frame.
+#[derive(Default)]
+struct Drag {
+    median: Option<f64>,
+    max: Option<f64>,
+    cpu: Option<f64>,
 }
 
 /// The surface with its embedding: loaded, or precomputed in memory (a tenth of the

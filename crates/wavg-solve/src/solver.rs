@@ -16,6 +16,10 @@ use crate::search::LocalSearch;
 use crate::weights::{Normalization, validate};
 use crate::{Mat2x8, Projector, Vec8};
 
+/// Faces [`Solver::forward_embedded`] walks through from its start face (following
+/// Newton's exits) before the full local search.
+pub const FACE_WALK: usize = 4;
+
 /// How the forward problem searches for the projection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SearchMode {
@@ -238,7 +242,10 @@ impl Solver {
     /// such as the 2-4 corners of a remeshing stencil, where rebuilding an anchor set per
     /// query would cost more than the query) onto the surface. The search starts at the
     /// nearest corner of `opts.warm_start` when given, else of `near` (a point expected
-    /// close to the answer, e.g. the highest-weight input point). The solver's own anchors
+    /// close to the answer, e.g. the highest-weight input point). With a warm start in
+    /// [`SearchMode::Fast`], its face is tried first, then up to [`FACE_WALK`] faces that
+    /// Newton's method exits into (a previous answer's face usually holds the new one when
+    /// the inputs moved a little), before that search. The solver's own anchors
     /// are not used. A non-finite `ybar` is [`SolveError::InvalidParameter`].
     pub fn forward_embedded(
         &self,
@@ -255,7 +262,27 @@ impl Solver {
             SearchMode::Exact => Start::Exhaustive,
             _ => {
                 let p = check_point(self.mesh(), &opts.warm_start.unwrap_or(*near))?;
-                Start::Warm(nearest_corner(self.mesh(), &p))
+                let start = Start::Warm(nearest_corner(self.mesh(), &p));
+                if opts.mode == SearchMode::Fast && opts.warm_start.is_some() {
+                    let mut f = p.face;
+                    for _ in 0..FACE_WALK {
+                        match self.projector.project_onto_face_or_exit(ybar, f) {
+                            Ok((xi, distance)) => {
+                                let point = SurfacePoint::new(f, xi);
+                                return Ok(ForwardResult {
+                                    point,
+                                    position: point.position(self.mesh()),
+                                    distance,
+                                    path: ProjectionPath::Local,
+                                    start,
+                                });
+                            }
+                            Err(g) if g != wavg_mesh::NONE => f = g,
+                            Err(_) => break,
+                        }
+                    }
+                }
+                start
             }
         };
         self.forward_prepared(&Prepared { ybar: *ybar, start }, opts)

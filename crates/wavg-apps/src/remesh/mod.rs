@@ -12,9 +12,10 @@
 //! Every average is a forward problem over its own 2 to `n` points, which change from
 //! query to query: the embedded points `y(p)` of the surface points are averaged in R^8
 //! and projected with [`Solver::forward_embedded`]. A first run starts each search at
-//! the stencil's first point (smoothing: at the vertex itself); later runs (after
+//! the stencil's first point (smoothing: in the vertex's own face); later runs (after
 //! [`Remesher::move_base_vertex`]) start every vertex of every stage from its own answer
-//! in the previous run, so dragging a base vertex recomputes interactively.
+//! (its face first) in the previous run, so dragging a base vertex recomputes
+//! interactively.
 
 mod base;
 mod obj;
@@ -367,13 +368,11 @@ impl Remesher {
                     y += ys[c as usize];
                 }
                 y /= s.len() as f64;
-                let near = if smoothing {
-                    pts[i]
-                } else {
-                    pts[s[0] as usize]
-                };
+                let near = pts[s[0] as usize];
+                // A smoothed vertex moves little: its own point is a warm start.
                 let o = match warm.and_then(|w| w.get(i)) {
                     Some(&w) => opts.warm(w),
+                    None if smoothing => opts.warm(pts[i]),
                     None => opts,
                 };
                 let r = self
