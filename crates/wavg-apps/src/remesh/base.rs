@@ -37,7 +37,9 @@ pub enum RemeshError {
         vertex: usize,
     },
     /// A face refers to a vertex that does not exist.
-    #[error("base face {face} refers to vertex {index}, but the base has {count} vertices")]
+    #[error(
+        "base face {face} refers to vertex {index} (0-based), but the base has {count} vertices"
+    )]
     IndexOutOfRange {
         /// The face.
         face: usize,
