@@ -614,6 +614,43 @@ mod tests {
     use super::*;
 
     #[test]
+    fn forward_embedded_equals_forward_with_the_same_average() {
+        use crate::{Anchor, EmbeddedMesh};
+        use wavg_mesh::{ValidMesh, procedural};
+        let mesh = Arc::new(ValidMesh::new(procedural::torus(48, 16, 1.0, 0.35)).unwrap());
+        let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
+        let pts = [
+            SurfacePoint::new(10, [0.2, 0.3, 0.5]),
+            SurfacePoint::new(40, [0.6, 0.2, 0.2]),
+            SurfacePoint::new(75, [0.1, 0.1, 0.8]),
+        ];
+        let solver = Solver::new(proj.clone(), pts.map(Anchor::Point)).unwrap();
+        let plain = Solver::new(proj.clone(), std::iter::empty()).unwrap();
+        let w = [0.5, 0.3, 0.2];
+        let want = solver.forward(&w, &ForwardOptions::default()).unwrap();
+        let y: Vec8 = pts
+            .iter()
+            .zip(w)
+            .map(|(p, w)| proj.embedded().point(p) * w)
+            .sum();
+        let opts = ForwardOptions::default();
+        let cold = plain.forward_embedded(&y, &pts[0], &opts).unwrap();
+        let warm = plain
+            .forward_embedded(&y, &pts[0], &opts.warm(want.point))
+            .unwrap();
+        for r in [cold, warm] {
+            assert!((r.position - want.position).norm() < 1e-9);
+        }
+        assert_eq!(warm.point.face, want.point.face);
+        let mut bad = y;
+        bad[0] = f64::NAN;
+        assert!(matches!(
+            plain.forward_embedded(&bad, &pts[0], &opts),
+            Err(SolveError::InvalidParameter(_))
+        ));
+    }
+
+    #[test]
     fn batch_ordering_helpers() {
         assert_eq!(
             sorted_order(vec![(3, 0), (1, 1), (3, 2), (0, 3)]),
