@@ -70,6 +70,16 @@ typedef enum wavg_stage {
   WAVG_STAGE_QUALITY = 4,
 } wavg_stage;
 
+// A coarse polygon mesh put on a surface, refined on request. Create it with
+// `wavg_remesher_new`, run it with `wavg_remesher_run`, read the refined mesh with the
+// count functions and `wavg_remesher_get`, move base vertices with
+// `wavg_remesher_move_vertex` (the next run starts every search from the previous run's
+// answers), free it with `wavg_remesher_free`.
+//
+// Thread safety: one remesher must not be used by two threads at once (runs already use
+// the library's worker threads); different remeshers are independent.
+typedef struct wavg_remesher wavg_remesher;
+
 // A set of anchors on a surface, ready for forward and inverse problems. Create it with
 // `wavg_solver_new`, free it with `wavg_solver_free`.
 //
@@ -258,6 +268,96 @@ enum wavg_status wavg_decal_uv(const struct wavg_solver *solver,
 // The default precomputation settings (the paper's: 1000 landmarks), with `struct_size`
 // set. Thread-safe; cannot fail.
 struct wavg_precompute_options wavg_precompute_options_default(void);
+
+// Makes a remesher for a base mesh of `n_base` vertices (`base_xyz`: `3 * n_base`
+// doubles, in the surface's units) and `n_faces` polygons: `face_sizes[f]` corners each
+// (3 to 64), their 0-based vertex indices one after another in `face_indices`,
+// counter-clockwise. The base must be an oriented manifold along its edges with every
+// vertex used. Each base vertex is put at its closest point of the surface in 3-D;
+// one farther than `max_distance` bounding-box diagonals is refused (`max_distance <= 0`
+// means the default, 0.15). Everything is copied; the remesher shares the surface's
+// current embedding and stays valid after the surface is changed or freed. On failure
+// `*out` is unchanged. Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL pointers, no
+// vertices or faces, non-finite coordinates, an index out of range, a vertex too far
+// from the surface), `WAVG_STATUS_INVALID_MESH` (a face with under 3 or over 64
+// corners or a repeated corner, an edge in more than two faces or two of the same
+// orientation, an unused vertex).
+//
+// # Safety
+// `surface` must be NULL or live; `base_xyz` NULL or `3 * n_base` readable doubles;
+// `face_sizes` NULL or `n_faces` readable values; `face_indices` NULL or as many
+// readable values as the sizes add up to; `out` NULL or writable.
+enum wavg_status wavg_remesher_new(const struct wavg_surface *surface,
+                                   const double *base_xyz,
+                                   size_t n_base,
+                                   const uint32_t *face_sizes,
+                                   size_t n_faces,
+                                   const uint32_t *face_indices,
+                                   double max_distance,
+                                   struct wavg_remesher **out);
+
+// Refines the base `levels` times (0 to 8) and smooths `smooth` steps; the result is
+// kept for the count functions and `wavg_remesher_get`. With the same `levels` and
+// `smooth` as the previous successful run, every search starts from that run's answer
+// (the interactive case). Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL, `levels > 8`),
+// `WAVG_STATUS_NO_SOLUTION` (an average without a projection; the previous result is
+// kept).
+//
+// # Safety
+// `remesher` must be NULL or live and not used by other threads during the call.
+enum wavg_status wavg_remesher_run(struct wavg_remesher *remesher,
+                                   uint32_t levels,
+                                   uint32_t smooth);
+
+// Moves base vertex `index` (0-based) to the surface point `point`; on failure nothing
+// changes. Call `wavg_remesher_run` to recompute. Errors: `WAVG_STATUS_INVALID_ARGUMENT`
+// (NULL, index out of range, a face out of range or bad barycentric coordinates).
+//
+// # Safety
+// `remesher` must be NULL or live and not used by other threads during the call.
+enum wavg_status wavg_remesher_move_vertex(struct wavg_remesher *remesher,
+                                           size_t index,
+                                           struct wavg_point point);
+
+// Base vertex `index` (0-based) on the surface: where `wavg_remesher_new` put it, or
+// where it was moved. Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL, index out of
+// range).
+//
+// # Safety
+// `remesher` must be NULL or live; `out` NULL or writable.
+enum wavg_status wavg_remesher_base_point(const struct wavg_remesher *remesher,
+                                          size_t index,
+                                          struct wavg_point *out);
+
+// Counts of the last run's refined mesh: `what` 0 = vertices, 1 = faces, 2 = face
+// corner indices (the length of `wavg_remesher_get`'s `out_face_indices`). 0 for NULL,
+// before the first successful run, or another `what`. Thread-safe with other reads.
+//
+// # Safety
+// `remesher` must be NULL or live.
+size_t wavg_remesher_count(const struct wavg_remesher *remesher, uint32_t what);
+
+// Copies the last run's refined mesh into the non-NULL arrays: `out_points` (one
+// surface point per vertex), `out_xyz` (`3 *` vertices doubles), `out_face_sizes` (one
+// per face: 4 for quads, 3 for triangles) and `out_face_indices` (0-based,
+// counter-clockwise, face after face); sizes from `wavg_remesher_count`. Base vertices
+// come first, in base order. Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL remesher, no
+// successful run yet), writing nothing.
+//
+// # Safety
+// `remesher` must be NULL or live; every non-NULL array must hold the number of
+// elements `wavg_remesher_count` gives.
+enum wavg_status wavg_remesher_get(const struct wavg_remesher *remesher,
+                                   struct wavg_point *out_points,
+                                   double *out_xyz,
+                                   uint32_t *out_face_sizes,
+                                   uint32_t *out_face_indices);
+
+// Frees a remesher (NULL is fine). Not to be called while another thread uses it.
+//
+// # Safety
+// `remesher` must be NULL or a remesher from this library not freed before.
+void wavg_remesher_free(struct wavg_remesher *remesher);
 
 // Makes a solver for `n_anchors` anchor points on `surface` (each a triangle and
 // barycentric coordinates; use `wavg_surface_vertex_point` for vertices). The anchors

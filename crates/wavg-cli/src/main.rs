@@ -16,6 +16,7 @@ mod info;
 mod inverse;
 mod morph;
 mod precompute;
+mod remesh;
 mod repair;
 mod spline;
 mod stream;
@@ -60,6 +61,8 @@ enum Command {
     Decal(decal::Args),
     /// Morph one surface into another: the source's mesh moved onto the target, in frames.
     Morph(morph::Args),
+    /// Semiregular remeshing of a coarse polygon mesh on the surface, with smoothing.
+    Remesh(remesh::Args),
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Command::Correspond(a) => correspond::run(a),
         Command::Decal(a) => decal::run(a),
         Command::Morph(a) => morph::run(a),
+        Command::Remesh(a) => remesh::run(a),
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),

@@ -14,12 +14,15 @@ use crate::textio::{located, write_atomic};
 /// Rows read, checked, computed and written per round.
 const CHUNK_ROWS: usize = 1 << 16;
 
+/// A text chunk parser: the chunk's text and first line number to numbered rows.
+pub type ParseChunk<T> = fn(&str, usize) -> Result<Vec<(usize, T)>, LineError>;
+
 /// How a command reads its query rows: a text chunk parser of `wavg::text` (the chunk's
 /// text and first line number to numbered rows) and the meaning of one `.npy` row (its
 /// 1-based number and values).
 pub struct Format<T> {
     /// Parses a chunk of text lines.
-    pub text: fn(&str, usize) -> Result<Vec<(usize, T)>, LineError>,
+    pub text: ParseChunk<T>,
     /// Reads one `.npy` row.
     pub npy: fn(usize, &[f64]) -> Result<T, LineError>,
 }

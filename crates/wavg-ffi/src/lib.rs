@@ -12,6 +12,7 @@ mod boundary;
 mod decimate;
 mod maps;
 mod options;
+mod remesh;
 mod solver;
 mod surface;
 mod types;
@@ -21,6 +22,10 @@ pub use boundary::{wavg_abi_version, wavg_last_error};
 pub use decimate::wavg_surface_decimate;
 pub use maps::{wavg_correspond, wavg_correspond_vertices, wavg_decal_uv};
 pub use options::{wavg_precompute_options, wavg_precompute_options_default};
+pub use remesh::{
+    wavg_remesher, wavg_remesher_base_point, wavg_remesher_count, wavg_remesher_free,
+    wavg_remesher_get, wavg_remesher_move_vertex, wavg_remesher_new, wavg_remesher_run,
+};
 pub use solver::{
     wavg_forward, wavg_inverse, wavg_solver, wavg_solver_anchor_count, wavg_solver_free,
     wavg_solver_new, wavg_solver_set_anchor,

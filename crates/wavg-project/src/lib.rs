@@ -49,6 +49,7 @@ pub use projector::{Projection, ProjectionPath, Projector};
 // Tangent frames and geometry in R^8.
 pub use euclid::closest_point_barycentric;
 pub use frames::{FrameKind, vertex_frame, vertex_frames};
+pub use triangle::BARY_EPS;
 
 // Errors.
 pub use error::ProjectError;

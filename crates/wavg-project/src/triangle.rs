@@ -24,8 +24,9 @@ pub(crate) const PROCRUSTES_SWEEPS: usize = 10;
 /// Maximum Newton iterations per triangle.
 pub(crate) const MAX_NEWTON: usize = 16;
 
-/// Barycentric tolerance of a valid projection (the reference's `eps`).
-pub(crate) const BARY_EPS: f64 = 1e-4;
+/// Barycentric tolerance of a valid projection: a projection up to this far outside its
+/// triangle (in barycentric coordinates) is accepted and clamped onto the edge.
+pub const BARY_EPS: f64 = 1e-4;
 
 /// `S` below which a point counts as a vertex and `Psi` takes its limit there.
 const S_MIN: f64 = 1e-12;

@@ -16,6 +16,10 @@ use crate::search::LocalSearch;
 use crate::weights::{Normalization, validate_weights};
 use crate::{Mat2x8, Projector, Vec8};
 
+/// Faces [`Solver::forward_embedded`] walks through from its start face (following
+/// Newton's exits) before the full local search.
+pub(crate) const FACE_WALK: usize = 4;
+
 /// How the forward problem searches for the projection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SearchMode {
@@ -233,6 +237,57 @@ impl Solver {
     ) -> Result<ForwardResult, SolveError> {
         let prepared = self.prepare(weights, opts)?;
         self.forward_prepared(&prepared, opts)
+    }
+
+    /// Forward problem for an average the caller formed: projects `ybar` (a point of R^8,
+    /// typically `sum w_i y_i` over embedded surface points that change from query to query,
+    /// such as the 2-4 corners of a remeshing stencil, where rebuilding an anchor set per
+    /// query would cost more than the query) onto the surface. The search starts at the
+    /// nearest corner of `opts.warm_start` when given, else of `near` (a point expected
+    /// close to the answer, e.g. the highest-weight input point). With a warm start in
+    /// [`SearchMode::Fast`], its face is tried first, then up to [`FACE_WALK`] faces that
+    /// Newton's method exits into (a previous answer's face usually holds the new one when
+    /// the inputs moved a little), before that search. The solver's own anchors
+    /// are not used. A non-finite `ybar` is [`SolveError::InvalidParameter`].
+    pub fn forward_embedded(
+        &self,
+        ybar: &Vec8,
+        near: &SurfacePoint,
+        opts: &ForwardOptions,
+    ) -> Result<ForwardResult, SolveError> {
+        if !ybar.iter().all(|v| v.is_finite()) {
+            return Err(SolveError::InvalidParameter(
+                "the averaged point is not finite".into(),
+            ));
+        }
+        let start = match opts.mode {
+            SearchMode::Exact => Start::Exhaustive,
+            _ => {
+                let p = check_point(self.mesh(), &opts.warm_start.unwrap_or(*near))?;
+                let start = Start::Warm(nearest_corner(self.mesh(), &p));
+                if opts.mode == SearchMode::Fast && opts.warm_start.is_some() {
+                    let mut f = p.face;
+                    for _ in 0..FACE_WALK {
+                        match self.projector.project_onto_face_or_exit(ybar, f) {
+                            Ok((xi, distance)) => {
+                                let point = SurfacePoint::new(f, xi);
+                                return Ok(ForwardResult {
+                                    point,
+                                    position: point.position(self.mesh()),
+                                    distance,
+                                    path: ProjectionPath::Local,
+                                    start,
+                                });
+                            }
+                            Err(g) if g != wavg_mesh::NONE => f = g,
+                            Err(_) => break,
+                        }
+                    }
+                }
+                start
+            }
+        };
+        self.forward_prepared(&Prepared { ybar: *ybar, start }, opts)
     }
 
     /// The part of the forward problem that reads the weights: validation, the average and
@@ -562,6 +617,43 @@ impl BatchWeights {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn forward_embedded_equals_forward_with_the_same_average() {
+        use crate::{Anchor, EmbeddedMesh};
+        use wavg_mesh::{ValidMesh, procedural};
+        let mesh = Arc::new(ValidMesh::new(procedural::torus(48, 16, 1.0, 0.35)).unwrap());
+        let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
+        let pts = [
+            SurfacePoint::new(10, [0.2, 0.3, 0.5]),
+            SurfacePoint::new(40, [0.6, 0.2, 0.2]),
+            SurfacePoint::new(75, [0.1, 0.1, 0.8]),
+        ];
+        let solver = Solver::new(proj.clone(), pts.map(Anchor::Point)).unwrap();
+        let plain = Solver::new(proj.clone(), std::iter::empty()).unwrap();
+        let w = [0.5, 0.3, 0.2];
+        let want = solver.forward(&w, &ForwardOptions::default()).unwrap();
+        let y: Vec8 = pts
+            .iter()
+            .zip(w)
+            .map(|(p, w)| proj.embedded().point(p) * w)
+            .sum();
+        let opts = ForwardOptions::default();
+        let cold = plain.forward_embedded(&y, &pts[0], &opts).unwrap();
+        let warm = plain
+            .forward_embedded(&y, &pts[0], &opts.warm(want.point))
+            .unwrap();
+        for r in [cold, warm] {
+            assert!((r.position - want.position).norm() < 1e-9);
+        }
+        assert_eq!(warm.point.face, want.point.face);
+        let mut bad = y;
+        bad[0] = f64::NAN;
+        assert!(matches!(
+            plain.forward_embedded(&bad, &pts[0], &opts),
+            Err(SolveError::InvalidParameter(_))
+        ));
+    }
 
     #[test]
     fn batch_ordering_helpers() {

@@ -1,0 +1,235 @@
+//! `wavg remesh`: semiregular remeshing of a coarse polygon base mesh on the surface, with
+//! Laplacian smoothing on the surface; optionally times interactive recomputation while a
+//! base vertex is dragged.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use wavg::apps::{BaseMesh, Remesher, polygons_to_obj};
+use wavg::{NoProgress, PrecomputeOptions, Surface, Vector3};
+
+use crate::CliError;
+use crate::common::{load_valid, one_line};
+use crate::textio;
+
+/// Arguments.
+#[derive(clap::Args)]
+#[command(after_long_help = "\
+Refines the coarse polygon mesh --base (an OBJ of triangles, quads and larger polygons,
+in the coordinates of --mesh) on the surface --mesh. Each base vertex is first put at its
+closest point of the surface (refused when farther than --max-distance bounding-box
+diagonals). Each of --levels splits every edge at the weighted average of its ends
+(weights 1/2, 1/2) and every polygon of n >= 4 corners at the average of its corners
+(weights 1/n) into n quads; a triangle becomes four triangles. Then --smooth steps of
+uniform Laplacian smoothing move every interior vertex to the average of its neighbours;
+vertices on the boundary of an open base stay. Every average is a forward problem on the
+surface over its own 2 to n points.
+
+Output: the refined mesh as OBJ (quads where the base had polygons of 4 or more corners,
+triangles where it had triangles). --json prints one object: base_faces, base_vertices,
+vertices, faces, levels, smooth_steps, seconds (the first, cold remeshing), warm_seconds
+(median of --frames recomputations while base vertex --drag moves, each warm-started from
+the previous frame; null with --frames 0), warm_seconds_max, warm_cpu_seconds (mean CPU
+time of all threads per frame), frames, max_offsurface
+(largest 3-D distance of an output vertex from the mesh over its bounding-box diagonal),
+roughness (mean umbrella length over mean edge length), problems, fallbacks, threads,
+precompute_seconds, plus mesh and base.")]
+pub struct Args {
+    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    #[arg(long)]
+    pub mesh: String,
+    /// The coarse base mesh (OBJ with polygons).
+    #[arg(long)]
+    pub base: PathBuf,
+    /// A .wavg embedding of the mesh (default: precompute one in memory).
+    #[arg(long)]
+    pub embedding: Option<PathBuf>,
+    /// Levels of splitting (each multiplies the face count by about four).
+    #[arg(long, default_value_t = 2)]
+    pub levels: usize,
+    /// Laplacian smoothing steps after splitting.
+    #[arg(long, default_value_t = 3)]
+    pub smooth: usize,
+    /// Largest distance of a base vertex from the surface, over the bounding-box diagonal.
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_BASE_DISTANCE)]
+    pub max_distance: f64,
+    /// Recomputations to time while dragging a base vertex (0: none).
+    #[arg(long, default_value_t = 10)]
+    pub frames: usize,
+    /// The base vertex dragged by --frames.
+    #[arg(long, default_value_t = 0)]
+    pub drag: usize,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Output OBJ file (`-` for standard output; written atomically).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Print one JSON object on standard output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let text = std::fs::read_to_string(&args.base)
+        .map_err(|e| CliError::input(format!("{}: {e}", args.base.display())))?;
+    let base = BaseMesh::from_obj_str(&text)
+        .map_err(|e| CliError::input(format!("{}: {}", args.base.display(), one_line(&e))))?;
+    base.validate()
+        .map_err(|e| CliError::input(format!("{}: {}", args.base.display(), one_line(&e))))?;
+    if args.levels > wavg::apps::MAX_LEVELS {
+        return Err(CliError::input(format!(
+            "--levels is at most {}",
+            wavg::apps::MAX_LEVELS
+        )));
+    }
+    if args.frames > 0 && args.drag >= base.positions.len() {
+        return Err(CliError::input(format!(
+            "--drag {} is not a base vertex ({} vertices)",
+            args.drag,
+            base.positions.len()
+        )));
+    }
+    let threads = args.threads;
+    textio::with_threads(threads, move || run_in_pool(args, base))?
+}
+
+fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
+    let t = Instant::now();
+    let surface = surface_for(&args)?;
+    let precompute_seconds = args.embedding.is_none().then(|| t.elapsed().as_secs_f64());
+    let bad_base = |e: &dyn std::fmt::Display| {
+        CliError::input(format!("{}: {}", args.base.display(), one_line(e)))
+    };
+    let mut r = Remesher::with_max_distance(surface.projector().clone(), &base, args.max_distance)
+        .map_err(|e| bad_base(&e))?;
+    let t = Instant::now();
+    let out = r
+        .remesh(args.levels, args.smooth)
+        .map_err(|e| CliError::failure(one_line(&e)))?;
+    let seconds = t.elapsed().as_secs_f64();
+    let drag = drag_frames(&mut r, &base, &args)?;
+    let warm = drag.median;
+    // The file is the first (undragged) result.
+    let max_offsurface = r.max_offsurface(&out.positions);
+    let obj = polygons_to_obj(&out.positions, &out.faces);
+    textio::write_atomic(&args.output, |w: &mut dyn Write| {
+        w.write_all(obj.as_bytes())
+    })?;
+    if args.json {
+        let j = serde_json::json!({
+            "mesh": args.mesh,
+            "base": args.base,
+            "base_vertices": base.positions.len(),
+            "base_faces": base.faces.len(),
+            "vertices": out.positions.len(),
+            "faces": out.faces.len(),
+            "levels": out.levels,
+            "smooth_steps": out.smooth_steps,
+            "seconds": seconds,
+            "warm_seconds": warm,
+            "warm_seconds_max": drag.max,
+            "warm_cpu_seconds": drag.cpu,
+            "frames": args.frames,
+            "max_offsurface": max_offsurface,
+            "roughness": out.roughness(),
+            "problems": out.problems,
+            "fallbacks": out.fallbacks,
+            "threads": rayon::current_num_threads(),
+            "precompute_seconds": precompute_seconds,
+        });
+        println!("{j}");
+    } else if args.output != std::path::Path::new("-") {
+        println!(
+            "{} vertices, {} faces ({} levels, {} smoothing steps) in {:.1} ms{} -> {}",
+            out.positions.len(),
+            out.faces.len(),
+            out.levels,
+            out.smooth_steps,
+            seconds * 1e3,
+            warm.map_or(String::new(), |w| format!(
+                ", {:.1} ms per dragged frame",
+                w * 1e3
+            )),
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+/// Drags base vertex `--drag` over `--frames` frames (a small circle of radius 2% of the
+/// diagonal around its start, each position put on the surface), recomputing warm each
+/// time.
+fn drag_frames(r: &mut Remesher, base: &BaseMesh, args: &Args) -> Result<Drag, CliError> {
+    if args.frames == 0 {
+        return Ok(Drag::default());
+    }
+    let start = base.positions[args.drag];
+    let radius = 0.02 * r.diagonal();
+    let mut times = Vec::with_capacity(args.frames);
+    let mut cpu = 0.0;
+    for k in 0..args.frames {
+        let a = std::f64::consts::TAU * (k + 1) as f64 / args.frames as f64;
+        let target = start + radius * Vector3::new(a.cos() - 1.0, a.sin(), 0.0);
+        let (p, _) = r.closest_point(&target);
+        let t = Instant::now();
+        let c = crate::common::cpu_seconds(false);
+        r.move_base_vertex(args.drag, p)
+            .and_then(|()| r.remesh(args.levels, args.smooth))
+            .map_err(|e| CliError::failure(format!("dragged frame {}: {}", k + 1, one_line(&e))))?;
+        times.push(t.elapsed().as_secs_f64());
+        if let (Some(a), Some(b)) = (c, crate::common::cpu_seconds(false)) {
+            cpu += b - a;
+        }
+    }
+    let max = times.iter().copied().fold(0.0, f64::max);
+    times.sort_by(f64::total_cmp);
+    Ok(Drag {
+        median: Some(times[times.len() / 2]),
+        max: Some(max),
+        cpu: Some(cpu / args.frames as f64),
+    })
+}
+
+/// Times of the dragged frames (none without frames): median and largest wall time, and
+/// the mean CPU time of the whole process (all threads) per frame.
+#[derive(Default)]
+struct Drag {
+    median: Option<f64>,
+    max: Option<f64>,
+    cpu: Option<f64>,
+}
+
+/// The surface with its embedding: loaded, or precomputed in memory (a tenth of the
+/// vertices as landmarks, 50 to 1000) with a progress bar when stderr is a terminal.
+fn surface_for(args: &Args) -> Result<Surface, CliError> {
+    let mesh = load_valid(&args.mesh)?;
+    let mut surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    match &args.embedding {
+        Some(path) => surface
+            .load_embedding(path)
+            .map_err(|e| CliError::input(one_line(&e)))?,
+        None => {
+            let landmarks = (surface.n_vertices() / 10).clamp(50, 1000);
+            let opts = PrecomputeOptions {
+                landmarks,
+                quality_pairs: 0,
+                ..Default::default()
+            };
+            let result = if std::io::stderr().is_terminal() {
+                let bars = crate::precompute::Bars::new(true, Arc::new(AtomicBool::new(false)));
+                let r = surface.precompute(&opts, &bars);
+                bars.clear();
+                r
+            } else {
+                surface.precompute(&opts, &NoProgress)
+            };
+            result.map_err(|e| CliError::failure(one_line(&e)))?;
+        }
+    }
+    Ok(surface)
+}
