@@ -32,7 +32,11 @@ blank lines are skipped; errors name the 1-based physical line):
 Output lines correspond one-to-one, in order, to the input's non-blank, non-comment lines.
 Numbers are written in the shortest form that reads back to the same f64.
 Malformed input exits with status 2 and nothing is written (the output file is written to
-a temporary file beside it and renamed only on success); '-o -' writes to stdout.";
+a temporary file beside it and renamed only on success); '-o -' writes to stdout.
+Files stream through in chunks of 65,536 lines (bounded memory).
+NUMPY: an input or output whose name ends in .npy is a NumPy array instead: weights n x K
+(inverse output: NaN rows where there are no weights); points n x 4 'FACE B0 B1 B2';
+forward output n x 7 'FACE B0 B1 B2 X Y Z' (face -1 and NaN where there is no answer).";
 
 pub use wavg::text::PointSpec;
 
