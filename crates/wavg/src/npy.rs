@@ -324,8 +324,12 @@ impl<W: Write> NpyWriter<W> {
                 self.cols
             )));
         }
-        for v in row {
-            self.inner.write_all(&v.to_le_bytes())?;
+        let mut bytes = [0u8; 8 * 64];
+        for part in row.chunks(64) {
+            for (b, v) in bytes.chunks_exact_mut(8).zip(part) {
+                b.copy_from_slice(&v.to_le_bytes());
+            }
+            self.inner.write_all(&bytes[..8 * part.len()])?;
         }
         self.written += 1;
         Ok(())
