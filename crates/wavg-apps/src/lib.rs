@@ -10,3 +10,11 @@ mod spline;
 
 pub use basis::{SplineKind, spline_weights};
 pub use spline::{Curve, evaluate_spline};
+
+mod error;
+mod render;
+
+pub use error::AppError;
+pub use render::{
+    Camera, Colouring, FOV_DEGREES, Image, MAX_SIDE, Overlays, RenderOptions, View, render, viridis,
+};

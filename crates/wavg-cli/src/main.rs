@@ -11,6 +11,7 @@ mod forward;
 mod info;
 mod inverse;
 mod precompute;
+mod render;
 mod repair;
 mod spline;
 mod subdivide;
@@ -48,6 +49,8 @@ enum Command {
     Spline(spline::Args),
     /// Loop subdivision: make a larger mesh from a smaller one.
     Subdivide(subdivide::Args),
+    /// A picture (PNG) of a mesh: shaded, textured or scalar-coloured, with curves and dots.
+    Render(render::Args),
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -74,6 +77,7 @@ fn main() -> ExitCode {
         Command::Inverse(a) => inverse::run(a),
         Command::Spline(a) => spline::run(a),
         Command::Subdivide(a) => subdivide::run(a),
+        Command::Render(a) => render::run(a),
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),
