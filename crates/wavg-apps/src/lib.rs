@@ -13,8 +13,12 @@ pub use spline::{Curve, evaluate_spline};
 
 mod error;
 mod render;
+mod transfer;
 
 pub use error::AppError;
 pub use render::{
     Camera, Colouring, FOV_DEGREES, Image, MAX_SIDE, Overlays, RenderOptions, View, render, viridis,
+};
+pub use transfer::{
+    TextureTransfer, TransferOptions, check_uv, dilate, rasterize_uv, transfer_texture,
 };

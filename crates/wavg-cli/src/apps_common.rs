@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use wavg::{NoProgress, PrecomputeOptions, Solver, Surface};
+use wavg::{NoProgress, PrecomputeOptions, Progress, Solver, Surface};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
@@ -15,6 +15,16 @@ pub fn solver_for(
     mesh: &str,
     embedding: Option<&Path>,
     anchors: &Path,
+) -> Result<Solver, CliError> {
+    solver_with_progress(mesh, embedding, anchors, &NoProgress)
+}
+
+/// [`solver_for`], reporting the precomputation's stages to `progress`.
+pub fn solver_with_progress(
+    mesh: &str,
+    embedding: Option<&Path>,
+    anchors: &Path,
+    progress: &dyn Progress,
 ) -> Result<Solver, CliError> {
     let specs = read_points(anchors)?;
     if specs.is_empty() {
@@ -41,7 +51,7 @@ pub fn solver_for(
                 ..Default::default()
             };
             surface
-                .precompute(&opts, &NoProgress)
+                .precompute(&opts, progress)
                 .map_err(|e| CliError::failure(one_line(&e)))?;
         }
     }

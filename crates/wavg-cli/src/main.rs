@@ -16,6 +16,7 @@ mod repair;
 mod spline;
 mod subdivide;
 mod textio;
+mod transfer_texture;
 
 use std::process::ExitCode;
 
@@ -51,6 +52,8 @@ enum Command {
     Subdivide(subdivide::Args),
     /// A picture (PNG) of a mesh: shaded, textured or scalar-coloured, with curves and dots.
     Render(render::Args),
+    /// Carry a texture from one mesh to another through corresponding anchors.
+    TransferTexture(transfer_texture::Args),
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -78,6 +81,7 @@ fn main() -> ExitCode {
         Command::Spline(a) => spline::run(a),
         Command::Subdivide(a) => subdivide::run(a),
         Command::Render(a) => render::run(a),
+        Command::TransferTexture(a) => transfer_texture::run(a),
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),

@@ -224,7 +224,7 @@ fn validate(name: &str, mesh: wavg_mesh::TriMesh) -> Result<ValidMesh, CliError>
 
 /// One progress bar per stage on stderr (hidden when stderr is not a terminal); also
 /// carries the Ctrl-C flag to the pipeline's cancellation checks.
-struct Bars {
+pub(crate) struct Bars {
     multi: MultiProgress,
     bars: Mutex<HashMap<Stage, ProgressBar>>,
     interrupted: Arc<AtomicBool>,
@@ -233,7 +233,7 @@ struct Bars {
 const TICKS: u64 = 1000;
 
 impl Bars {
-    fn new(visible: bool, interrupted: Arc<AtomicBool>) -> Self {
+    pub(crate) fn new(visible: bool, interrupted: Arc<AtomicBool>) -> Self {
         let target = if visible {
             ProgressDrawTarget::stderr()
         } else {
@@ -246,7 +246,7 @@ impl Bars {
         }
     }
 
-    fn clear(&self) {
+    pub(crate) fn clear(&self) {
         let _ = self.multi.clear();
     }
 }
