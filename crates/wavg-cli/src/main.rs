@@ -6,6 +6,7 @@ mod bench_project;
 mod bench_roundtrip;
 mod common;
 mod demo;
+mod demo_pictures;
 mod error;
 mod forward;
 mod info;

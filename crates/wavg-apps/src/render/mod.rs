@@ -80,7 +80,7 @@ const DOT: [[f64; 3]; 2] = [[20.0, 20.0, 20.0], [255.0, 200.0, 40.0]];
 /// Wireframe colour.
 const WIRE: [f64; 3] = [40.0, 40.0, 50.0];
 /// Ambient share of the light.
-const AMBIENT: f64 = 0.22;
+const AMBIENT: f64 = 0.3;
 
 /// Checks that the inputs fit together (finite positions, indices in range, UVs for a
 /// texture, one finite scalar per vertex) before anything is drawn.
@@ -198,7 +198,7 @@ pub fn render(
         vis.triangle(f as u32, t.map(|v| screen[v as usize]));
     }
     let normals = vertex_normals(mesh);
-    let light = (-cam.forward + cam.up * 0.55 - cam.right * 0.35).normalize();
+    let light = (-cam.forward + cam.up * 0.4 - cam.right * 0.25).normalize();
     let (smin, smax) = match colouring {
         Colouring::Scalars(s) => s
             .iter()
@@ -230,8 +230,10 @@ pub fn render(
                 let uv = mesh.uv.as_ref().expect("checked");
                 let c = uv.faces[f as usize].map(|k| uv.coords[k as usize]);
                 let q = c[0] * b[0] + c[1] * b[1] + c[2] * b[2];
+                // Transparent texels (nothing transferred there) show the plain colour.
                 let s = img.sample_bilinear(q.x, q.y);
-                [s[0], s[1], s[2]]
+                let a = s[3] / 255.0;
+                [0, 1, 2].map(|k| s[k] * a + PLAIN[k] * (1.0 - a))
             }
             Colouring::Scalars(s) => {
                 let v: f64 = (0..3).map(|k| s[t[k] as usize] * b[k]).sum();
