@@ -8,6 +8,7 @@
 //! texels just outside the charts, so that bilinear sampling at seams sees no background.
 
 use nalgebra::Vector2;
+use rayon::prelude::*;
 use wavg_mesh::{SurfacePoint, TexCoords, TriMesh};
 use wavg_solve::{BatchWeights, ForwardOptions, RoundTrip, Solver};
 
@@ -234,14 +235,18 @@ pub fn transfer_texture(
         uvs[*i as usize] = uv;
     }
     let not_reached = solver.not_reached;
-    let mut valid = 0;
-    for (px, uv) in image.pixels.iter_mut().zip(&uvs) {
-        if let Some(q) = uv {
-            let s = source_texture.sample_bilinear(q.x, q.y);
-            *px = s.map(|v| v.round().clamp(0.0, 255.0) as u8);
-            valid += 1;
-        }
-    }
+    let valid = uvs.iter().filter(|u| u.is_some()).count();
+    image
+        .pixels
+        .par_iter_mut()
+        .zip(uvs.par_iter())
+        .with_min_len(4096)
+        .for_each(|(px, uv)| {
+            if let Some(q) = uv {
+                let s = source_texture.sample_bilinear(q.x, q.y);
+                *px = s.map(|v| v.round().clamp(0.0, 255.0) as u8);
+            }
+        });
     let points = texels;
     let dilated = dilate(&mut image, opts.dilation);
     Ok(TextureTransfer {
@@ -305,23 +310,24 @@ impl Solve<'_> {
 /// Fills transparent texels next to opaque ones with the mean of their opaque
 /// 8-neighbours, `rings` times; returns how many were filled.
 pub fn dilate(img: &mut Image, rings: u32) -> usize {
-    let (w, h) = (img.width as i64, img.height as i64);
+    let (w, h) = (img.width as usize, img.height as usize);
     let mut filled = 0;
     for _ in 0..rings {
         let before = img.pixels.clone();
-        let mut any = false;
-        for y in 0..h {
-            for x in 0..w {
-                let i = (y * w + x) as usize;
-                if before[i][3] != 0 {
-                    continue;
-                }
-                let (mut acc, mut n) = ([0u32; 3], 0u32);
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        let (nx, ny) = (x + dx, y + dy);
-                        if (0..w).contains(&nx) && (0..h).contains(&ny) {
-                            let p = before[(ny * w + nx) as usize];
+        let ring: usize = img
+            .pixels
+            .par_chunks_mut(w)
+            .enumerate()
+            .map(|(y, row)| {
+                let mut n_filled = 0;
+                for (x, px) in row.iter_mut().enumerate() {
+                    if px[3] != 0 {
+                        continue;
+                    }
+                    let (mut acc, mut n) = ([0u32; 3], 0u32);
+                    for ny in y.saturating_sub(1)..(y + 2).min(h) {
+                        for nx in x.saturating_sub(1)..(x + 2).min(w) {
+                            let p = before[ny * w + nx];
                             if p[3] != 0 {
                                 for k in 0..3 {
                                     acc[k] += p[k] as u32;
@@ -330,16 +336,17 @@ pub fn dilate(img: &mut Image, rings: u32) -> usize {
                             }
                         }
                     }
+                    if n > 0 {
+                        let c = acc.map(|a| ((a + n / 2) / n) as u8);
+                        *px = [c[0], c[1], c[2], 255];
+                        n_filled += 1;
+                    }
                 }
-                if n > 0 {
-                    let c = acc.map(|a| ((a + n / 2) / n) as u8);
-                    img.pixels[i] = [c[0], c[1], c[2], 255];
-                    filled += 1;
-                    any = true;
-                }
-            }
-        }
-        if !any {
+                n_filled
+            })
+            .sum();
+        filled += ring;
+        if ring == 0 {
             break;
         }
     }
@@ -350,6 +357,7 @@ pub fn dilate(img: &mut Image, rings: u32) -> usize {
 mod tests {
     use super::*;
     use nalgebra::Vector2;
+    use rayon::prelude::*;
 
     #[test]
     fn rasterized_texels_cover_the_uv_triangles_once() {
