@@ -21,4 +21,5 @@ pub use render::{
 };
 pub use transfer::{
     TextureTransfer, TransferOptions, check_uv, dilate, rasterize_uv, transfer_texture,
+    transfer_texture_with_uv,
 };

@@ -77,7 +77,13 @@ pub fn check_uv<'a>(mesh: &'a TriMesh, what: &str) -> Result<&'a TexCoords, AppE
             "the {what} mesh has no texture coordinates (OBJ `vt`)"
         ))
     })?;
-    if uv.faces.len() != mesh.triangles.len()
+    check_layout(uv, mesh.triangles.len(), what)?;
+    Ok(uv)
+}
+
+/// Checks that texture coordinates have one UV triple per face, in range and finite.
+fn check_layout(uv: &TexCoords, n_faces: usize, what: &str) -> Result<(), AppError> {
+    if uv.faces.len() != n_faces
         || uv
             .faces
             .iter()
@@ -86,10 +92,13 @@ pub fn check_uv<'a>(mesh: &'a TriMesh, what: &str) -> Result<&'a TexCoords, AppE
         || !uv.coords.iter().flatten().all(|c| c.is_finite())
     {
         return Err(AppError::Input(format!(
-            "the {what} mesh's texture coordinates are inconsistent"
+            "the {what} texture coordinates are inconsistent ({} UV triangles for {n_faces} \
+             faces, {} UVs; indices must be in range and UVs finite)",
+            uv.faces.len(),
+            uv.coords.len()
         )));
     }
-    Ok(uv)
+    Ok(())
 }
 
 /// The texels whose centres lie in a target triangle in UV space, as (texel index, point
@@ -152,6 +161,24 @@ pub fn transfer_texture(
     opts: &TransferOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<TextureTransfer, AppError> {
+    let suv = check_uv(source.mesh().mesh(), "source")?;
+    let tuv = check_uv(target.mesh().mesh(), "target")?;
+    transfer_texture_with_uv(source, suv, source_texture, target, tuv, opts, progress)
+}
+
+/// [`transfer_texture`] with the texture coordinates given apart from the meshes (one UV
+/// triple per triangle of each solver's mesh), e.g. for callers whose meshes carry none.
+pub fn transfer_texture_with_uv(
+    source: &Solver,
+    suv: &TexCoords,
+    source_texture: &Image,
+    target: &Solver,
+    tuv: &TexCoords,
+    opts: &TransferOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<TextureTransfer, AppError> {
+    check_layout(suv, source.mesh().n_faces(), "source")?;
+    check_layout(tuv, target.mesh().n_faces(), "target")?;
     if source.n_anchors() != target.n_anchors() {
         return Err(AppError::Input(format!(
             "the source has {} anchors and the target {}: they must correspond one to one",
@@ -159,8 +186,6 @@ pub fn transfer_texture(
             target.n_anchors()
         )));
     }
-    let suv = check_uv(source.mesh().mesh(), "source")?;
-    let tuv = check_uv(target.mesh().mesh(), "target")?;
     let mut image = Image::new(opts.width, opts.height, [0, 0, 0, 0])?;
     if !(opts.tolerance.is_finite() && opts.tolerance > 0.0) {
         return Err(AppError::Input(format!(
@@ -357,7 +382,6 @@ pub fn dilate(img: &mut Image, rings: u32) -> usize {
 mod tests {
     use super::*;
     use nalgebra::Vector2;
-    use rayon::prelude::*;
 
     #[test]
     fn rasterized_texels_cover_the_uv_triangles_once() {
