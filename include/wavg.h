@@ -568,6 +568,43 @@ enum wavg_status wavg_surface_landmarks(const struct wavg_surface *surface,
 // `surface` must be NULL or a surface from this library not freed before.
 void wavg_surface_free(struct wavg_surface *surface);
 
+// Carries a texture from the source surface to the target surface through their
+// solvers' anchors (anchor `i` of one corresponds to anchor `i` of the other; the counts
+// must match). For every texel of the `out_width` x `out_height` target atlas covered by
+// a target triangle in the target's UV layout: the verified inverse on the target, the
+// forward problem on the source, and the source image sampled bilinearly at the source
+// UV. Texels on every `stride`-th row and column are solved exactly and the texels
+// between four of them inside one source chart interpolate them (`stride` 1 solves every
+// texel). Uncovered texels and texels without a source point get alpha 0; 4 rings of
+// seam dilation follow. UVs: `n_*_uv` (u, v) pairs (v = 0 is the image's bottom row) and
+// one index triple per face of each solver's mesh (`*_uv_faces`, `3 * n_faces`). Images
+// are RGBA8, rows from the top (`source_rgba`: `4 * source_width * source_height` bytes,
+// `out_rgba`: `4 * out_width * out_height`). Writes `out_rgba` and, unless NULL,
+// `*out_valid` (covered texels with a source point) and `*out_covered`. Errors:
+// `WAVG_STATUS_INVALID_ARGUMENT` (NULL inputs, zero sizes, anchor counts that differ, UV
+// arrays that do not fit the meshes), writing nothing. Thread-safe on shared solvers.
+//
+// # Safety
+// `source` and `target` must be NULL or live; every non-NULL array must hold the stated
+// number of elements (faces: the solver's mesh's face count).
+enum wavg_status wavg_transfer_texture(const struct wavg_solver *source,
+                                       const double *source_uv,
+                                       size_t n_source_uv,
+                                       const uint32_t *source_uv_faces,
+                                       const uint8_t *source_rgba,
+                                       uint32_t source_width,
+                                       uint32_t source_height,
+                                       const struct wavg_solver *target,
+                                       const double *target_uv,
+                                       size_t n_target_uv,
+                                       const uint32_t *target_uv_faces,
+                                       uint32_t out_width,
+                                       uint32_t out_height,
+                                       uint32_t stride,
+                                       uint8_t *out_rgba,
+                                       size_t *out_valid,
+                                       size_t *out_covered);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

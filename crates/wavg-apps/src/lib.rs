@@ -33,3 +33,15 @@ mod morph;
 
 pub use decal::{Decal, DecalUv, decal_uv, decal_vertices};
 pub use morph::{harmonic_fill, morph_frames};
+mod error;
+mod render;
+mod transfer;
+
+pub use error::AppError;
+pub use render::{
+    Camera, Colouring, FOV_DEGREES, Image, MAX_SIDE, Overlays, RenderOptions, View, render, viridis,
+};
+pub use transfer::{
+    TextureTransfer, TransferOptions, check_uv, dilate, rasterize_uv, transfer_texture,
+    transfer_texture_with_uv,
+};

@@ -30,7 +30,10 @@ trips on random surface points with the paper's and the verified inverse.
 
 With --out DIR it writes DIR/mesh.obj, DIR/mesh.wavg, DIR/anchors.txt, DIR/curve.txt
 (FACE B0 B1 B2 X Y Z per sample, as `wavg forward` writes) and DIR/curve.obj (the curve
-as an OBJ polyline, to view over mesh.obj).
+as an OBJ polyline, to view over mesh.obj), and pictures (PNG): spline.png (the curve and
+anchors over the mesh), distance.png (distance in the embedding from the first anchor,
+viridis), texture_source.png and texture_target.png (a checkerboard on a generated
+UV-mapped sheet, carried by texture transfer onto a bent, stretched copy).
 
 --json prints one object: mesh, vertices, faces, landmarks, precompute_s, stress,
 geodesic_rel_err_p50, geodesic_rel_err_p90, anchors, curve_points, curve_ok, curve_us,
@@ -169,8 +172,23 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let vok = points.iter().zip(&vfwd).filter(|(p, r)| back(p, r)).count();
     let n = points.len() as f64;
 
+    let mut pictures = Vec::new();
     if let Some(dir) = &args.out {
         write_outputs(dir, &mesh, &emb, &anchor_ids, &curve)?;
+        let t0 = Instant::now();
+        let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
+        pictures = crate::demo_pictures::write_pictures(
+            dir,
+            &mesh,
+            &coords,
+            &anchor_ids,
+            &curve,
+            args.seed,
+        )?;
+        say(&format!(
+            "pictures drawn in {:.2} s",
+            t0.elapsed().as_secs_f64()
+        ));
     }
     if args.json {
         let j = serde_json::json!({
@@ -214,10 +232,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         vok as f64 / n
     );
     match &args.out {
-        Some(d) => println!(
-            "written        {0}/mesh.obj, mesh.wavg, anchors.txt, curve.txt, curve.obj",
-            d.display()
-        ),
+        Some(d) => {
+            println!(
+                "written        {0}/mesh.obj, mesh.wavg, anchors.txt, curve.txt, curve.obj",
+                d.display()
+            );
+            for p in &pictures {
+                println!("picture        {}", p.display());
+            }
+        }
         None => println!("(pass --out DIR to keep the mesh, embedding, anchors and curve)"),
     }
     Ok(())

@@ -10,6 +10,7 @@ mod common;
 mod correspond;
 mod decal;
 mod demo;
+mod demo_pictures;
 mod error;
 mod forward;
 mod info;
@@ -17,11 +18,13 @@ mod inverse;
 mod morph;
 mod precompute;
 mod remesh;
+mod render;
 mod repair;
 mod spline;
 mod stream;
 mod subdivide;
 mod textio;
+mod transfer_texture;
 
 use std::process::ExitCode;
 
@@ -63,6 +66,10 @@ enum Command {
     Morph(morph::Args),
     /// Semiregular remeshing of a coarse polygon mesh on the surface, with smoothing.
     Remesh(remesh::Args),
+    /// A picture (PNG) of a mesh: shaded, textured or scalar-coloured, with curves and dots.
+    Render(render::Args),
+    /// Carry a texture from one mesh to another through corresponding anchors.
+    TransferTexture(transfer_texture::Args),
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -93,6 +100,8 @@ fn main() -> ExitCode {
         Command::Decal(a) => decal::run(a),
         Command::Morph(a) => morph::run(a),
         Command::Remesh(a) => remesh::run(a),
+        Command::Render(a) => render::run(a),
+        Command::TransferTexture(a) => transfer_texture::run(a),
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),

@@ -68,6 +68,15 @@ fn demo_reports_and_writes_its_outputs() {
             .count(),
         8
     );
+    for png in [
+        "spline.png",
+        "distance.png",
+        "texture_source.png",
+        "texture_target.png",
+    ] {
+        let bytes = std::fs::read(out_dir.join(png)).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG", "{png}");
+    }
 }
 
 #[test]

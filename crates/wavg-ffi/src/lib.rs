@@ -15,6 +15,7 @@ mod options;
 mod remesh;
 mod solver;
 mod surface;
+mod transfer;
 mod types;
 
 pub use apps::wavg_spline;
@@ -37,6 +38,7 @@ pub use surface::{
     wavg_surface_save_embedding, wavg_surface_triangles, wavg_surface_vertex_count,
     wavg_surface_vertex_point,
 };
+pub use transfer::wavg_transfer_texture;
 pub use types::{wavg_point, wavg_progress_fn, wavg_stage, wavg_status};
 
 /// Major version of the library (incompatible API changes).

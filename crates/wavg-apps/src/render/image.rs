@@ -1,0 +1,210 @@
+//! RGBA8 images: PNG reading and writing (through the `png` crate) and bilinear sampling
+//! in texture coordinates.
+
+use std::io::{BufRead, Seek, Write};
+use std::path::Path;
+
+use crate::AppError;
+
+/// An RGBA image with 8 bits per channel, rows from the top, non-premultiplied alpha.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width * height` pixels, row by row from the top.
+    pub pixels: Vec<[u8; 4]>,
+}
+
+/// Largest accepted side of an image (decoded or created), to bound memory.
+pub const MAX_SIDE: u32 = 16384;
+
+impl Image {
+    /// A `width` x `height` image filled with `fill`; both sides must be 1 to [`MAX_SIDE`].
+    pub fn new(width: u32, height: u32, fill: [u8; 4]) -> Result<Self, AppError> {
+        if !(1..=MAX_SIDE).contains(&width) || !(1..=MAX_SIDE).contains(&height) {
+            return Err(AppError::Input(format!(
+                "image size {width}x{height}: each side must be 1 to {MAX_SIDE}"
+            )));
+        }
+        Ok(Self {
+            width,
+            height,
+            pixels: vec![fill; width as usize * height as usize],
+        })
+    }
+
+    /// The pixel at column `x`, row `y` (from the top).
+    pub fn get(&self, x: u32, y: u32) -> [u8; 4] {
+        self.pixels[y as usize * self.width as usize + x as usize]
+    }
+
+    /// Sets the pixel at column `x`, row `y` (from the top).
+    pub fn set(&mut self, x: u32, y: u32, c: [u8; 4]) {
+        let w = self.width as usize;
+        self.pixels[y as usize * w + x as usize] = c;
+    }
+
+    /// Bilinear sample at texture coordinates (u, v) in [0, 1]^2 (v = 0 is the bottom row,
+    /// as OBJ `vt` has it); coordinates outside are clamped to the border. Channels in
+    /// [0, 255] as floats.
+    pub fn sample_bilinear(&self, u: f64, v: f64) -> [f64; 4] {
+        let (w, h) = (self.width as f64, self.height as f64);
+        let x = (u.clamp(0.0, 1.0) * w - 0.5).clamp(0.0, w - 1.0);
+        let y = ((1.0 - v.clamp(0.0, 1.0)) * h - 0.5).clamp(0.0, h - 1.0);
+        let (x0, y0) = (x.floor() as u32, y.floor() as u32);
+        let (x1, y1) = ((x0 + 1).min(self.width - 1), (y0 + 1).min(self.height - 1));
+        let (fx, fy) = (x - x0 as f64, y - y0 as f64);
+        let mut out = [0.0; 4];
+        let corners = [
+            (x0, y0, (1.0 - fx) * (1.0 - fy)),
+            (x1, y0, fx * (1.0 - fy)),
+            (x0, y1, (1.0 - fx) * fy),
+            (x1, y1, fx * fy),
+        ];
+        for (cx, cy, wgt) in corners {
+            let p = self.get(cx, cy);
+            for (o, c) in out.iter_mut().zip(p) {
+                *o += wgt * c as f64;
+            }
+        }
+        out
+    }
+
+    /// Decodes a PNG of any colour type and bit depth into RGBA8.
+    pub fn decode_png(reader: impl BufRead + Seek) -> Result<Self, AppError> {
+        let err = |e: &dyn std::fmt::Display| AppError::Image(format!("PNG: {e}"));
+        let mut dec = png::Decoder::new(reader);
+        dec.set_transformations(png::Transformations::normalize_to_color8());
+        let mut r = dec.read_info().map_err(|e| err(&e))?;
+        let (w, h) = (r.info().width, r.info().height);
+        if w > MAX_SIDE || h > MAX_SIDE {
+            return Err(AppError::Image(format!(
+                "PNG of {w}x{h} pixels: each side must be at most {MAX_SIDE}"
+            )));
+        }
+        let size = r
+            .output_buffer_size()
+            .ok_or_else(|| err(&"image too large"))?;
+        let mut buf = vec![0; size];
+        let info = r.next_frame(&mut buf).map_err(|e| err(&e))?;
+        let data = &buf[..info.buffer_size()];
+        let n = w as usize * h as usize;
+        let pixels: Vec<[u8; 4]> = match info.color_type {
+            png::ColorType::Rgba => data
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2], c[3]])
+                .collect(),
+            png::ColorType::Rgb => data
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2], 255])
+                .collect(),
+            png::ColorType::GrayscaleAlpha => data
+                .chunks_exact(2)
+                .map(|c| [c[0], c[0], c[0], c[1]])
+                .collect(),
+            png::ColorType::Grayscale => data.iter().map(|&g| [g, g, g, 255]).collect(),
+            png::ColorType::Indexed => return Err(err(&"palette not expanded")),
+        };
+        if pixels.len() != n || info.bit_depth != png::BitDepth::Eight {
+            return Err(err(&"unexpected decoded layout"));
+        }
+        Ok(Self {
+            width: w,
+            height: h,
+            pixels,
+        })
+    }
+
+    /// Reads a PNG file; the error names the file.
+    pub fn read_png(path: &Path) -> Result<Self, AppError> {
+        let f = std::fs::File::open(path)
+            .map_err(|e| AppError::Image(format!("{}: {e}", path.display())))?;
+        Self::decode_png(std::io::BufReader::new(f)).map_err(|e| match e {
+            AppError::Image(m) => AppError::Image(format!("{}: {m}", path.display())),
+            other => other,
+        })
+    }
+
+    /// Encodes the image as an RGBA8 PNG.
+    pub fn encode_png(&self, w: impl Write) -> Result<(), AppError> {
+        let err = |e: png::EncodingError| AppError::Image(format!("PNG: {e}"));
+        let mut enc = png::Encoder::new(w, self.width, self.height);
+        enc.set_color(png::ColorType::Rgba);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut wr = enc.write_header().map_err(err)?;
+        wr.write_image_data(self.pixels.as_flattened())
+            .map_err(err)?;
+        wr.finish().map_err(err)
+    }
+
+    /// Halves-or-more downsampling by an integer `factor` (box filter), used for
+    /// supersampled anti-aliasing.
+    pub fn downsample(&self, factor: u32) -> Self {
+        if factor <= 1 {
+            return self.clone();
+        }
+        let (w, h) = (self.width / factor, self.height / factor);
+        let mut pixels = Vec::with_capacity(w as usize * h as usize);
+        let n = factor * factor;
+        for y in 0..h {
+            for x in 0..w {
+                let mut acc = [0u32; 4];
+                for dy in 0..factor {
+                    for dx in 0..factor {
+                        let p = self.get(x * factor + dx, y * factor + dy);
+                        for (a, c) in acc.iter_mut().zip(p) {
+                            *a += c as u32;
+                        }
+                    }
+                }
+                pixels.push(acc.map(|a| ((a + n / 2) / n) as u8));
+            }
+        }
+        Self {
+            width: w,
+            height: h,
+            pixels,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png_round_trip_is_exact() {
+        let mut img = Image::new(7, 5, [0, 0, 0, 0]).unwrap();
+        for y in 0..5 {
+            for x in 0..7 {
+                img.set(x, y, [x as u8 * 30, y as u8 * 50, 200, (x * y) as u8 * 9]);
+            }
+        }
+        let mut bytes = Vec::new();
+        img.encode_png(&mut bytes).unwrap();
+        let back = Image::decode_png(std::io::Cursor::new(bytes)).unwrap();
+        assert_eq!(back, img);
+    }
+
+    #[test]
+    fn garbage_is_an_image_error() {
+        let e = Image::decode_png(std::io::Cursor::new(b"not a png".to_vec())).unwrap_err();
+        assert!(matches!(e, AppError::Image(_)));
+    }
+
+    #[test]
+    fn bilinear_hits_texel_centres_and_averages_between() {
+        let mut img = Image::new(2, 1, [0, 0, 0, 255]).unwrap();
+        img.set(1, 0, [200, 100, 50, 255]);
+        assert_eq!(img.sample_bilinear(0.25, 0.5)[0], 0.0);
+        assert_eq!(img.sample_bilinear(0.75, 0.5)[0], 200.0);
+        assert!((img.sample_bilinear(0.5, 0.5)[0] - 100.0).abs() < 1e-9);
+        // v = 1 is the top row.
+        let mut tall = Image::new(1, 2, [0, 0, 0, 255]).unwrap();
+        tall.set(0, 0, [255, 0, 0, 255]);
+        assert_eq!(tall.sample_bilinear(0.5, 0.9)[0], 255.0);
+        assert_eq!(tall.sample_bilinear(0.5, 0.1)[0], 0.0);
+    }
+}

@@ -1,0 +1,237 @@
+//! `wavg render`: a picture of a mesh (PNG), shaded, optionally textured or coloured by
+//! per-vertex scalars, with curves, dots and a wireframe drawn over it.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use wavg::Vector3;
+use wavg::apps::{Colouring, Image, Overlays, RenderOptions, View, render};
+use wavg::mesh::TriMesh;
+
+use crate::CliError;
+use crate::common::{load_mesh, one_line};
+use crate::textio::{self, read_points, read_text, resolve_points};
+
+/// Arguments.
+#[derive(clap::Args)]
+#[command(after_long_help = "\
+Draws the mesh with a z-buffered software rasteriser: Lambert shading plus a little ambient
+light on smooth vertex normals, a perspective camera looking at the mesh's centre from
+--view AZIMUTH,ELEVATION (degrees; y is up; default 35,20), white background, 2x2
+supersampling.
+
+Colour: light grey, or --texture T.png through the mesh's OBJ texture coordinates (`vt`,
+bilinear), or --scalar S.txt (one number per vertex and line) through the viridis colour map
+with a legend bar labelled with the minimum and maximum.
+Overlays: --curve C.txt (the output of `wavg spline`: `FACE B0 B1 B2 X Y Z` per sample,
+`none ...` lines break the curve) as a thick red line, --points P.txt (the anchors
+format: `v VERTEX` or `f FACE B0 B1 B2`) as dots, --wireframe the triangle edges. Curves and
+dots are depth-tested against the surface with a small bias, so parts behind it are hidden.
+
+Bad input (a missing texture, --texture on a mesh without UVs, a scalar count that differs
+from the vertex count) is an error and nothing is written. --json prints one object:
+output, width, height, vertices, faces, covered_fraction (of pixels showing the mesh),
+seconds, plus scalar_min and scalar_max with --scalar.")]
+pub struct Args {
+    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    pub mesh: String,
+    /// Output PNG.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Picture size WIDTHxHEIGHT in pixels.
+    #[arg(long, default_value = "800x600")]
+    pub size: String,
+    /// Camera direction AZIMUTH,ELEVATION in degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    pub view: Option<String>,
+    /// A curve to draw (`wavg spline` output).
+    #[arg(long)]
+    pub curve: Vec<PathBuf>,
+    /// Points to draw as dots (anchors format).
+    #[arg(long)]
+    pub points: Option<PathBuf>,
+    /// A texture (PNG) mapped through the mesh's UVs.
+    #[arg(long, conflicts_with = "scalar")]
+    pub texture: Option<PathBuf>,
+    /// Per-vertex scalars (one number per line), coloured with viridis.
+    #[arg(long)]
+    pub scalar: Option<PathBuf>,
+    /// Draw the triangle edges.
+    #[arg(long)]
+    pub wireframe: bool,
+    /// Print one JSON object on standard output.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Parses `WxH` (or a single `N` for a square).
+pub fn parse_size(s: &str, what: &str) -> Result<(u32, u32), CliError> {
+    let bad = || CliError::input(format!("{what} {s:?}: expected WIDTHxHEIGHT, e.g. 800x600"));
+    let (w, h) = match s.split_once(['x', 'X']) {
+        Some((w, h)) => (w, h),
+        None => (s, s),
+    };
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if w == 0 || h == 0 {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+/// Parses `AZIMUTH,ELEVATION` in degrees.
+fn parse_view(s: &str) -> Result<View, CliError> {
+    let bad = || {
+        CliError::input(format!(
+            "--view {s:?}: expected AZIMUTH,ELEVATION in degrees"
+        ))
+    };
+    let (a, e) = s.split_once(',').ok_or_else(bad)?;
+    let azimuth: f64 = a.trim().parse().map_err(|_| bad())?;
+    let elevation: f64 = e.trim().parse().map_err(|_| bad())?;
+    if !azimuth.is_finite() || !(-90.0..=90.0).contains(&elevation) {
+        return Err(bad());
+    }
+    Ok(View { azimuth, elevation })
+}
+
+/// Reads a curve file (`FACE B0 B1 B2 X Y Z` or `none ...` per line) into polylines of its
+/// 3-D positions, broken at `none` lines.
+pub fn read_curve(path: &Path) -> Result<Vec<Vec<Vector3<f64>>>, CliError> {
+    let text = read_text(path)?;
+    let mut out = vec![Vec::new()];
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        if line.starts_with("none") {
+            out.push(Vec::new());
+            continue;
+        }
+        let xs: Vec<f64> = line
+            .split_whitespace()
+            .map(|t| t.parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| textio::located(path, i + 1, &"expected FACE B0 B1 B2 X Y Z or none"))?;
+        if xs.len() != 7 || !xs.iter().all(|x| x.is_finite()) {
+            return Err(textio::located(path, i + 1, &"expected 7 finite numbers"));
+        }
+        out.last_mut()
+            .expect("non-empty")
+            .push(Vector3::new(xs[4], xs[5], xs[6]));
+    }
+    out.retain(|c| !c.is_empty());
+    Ok(out)
+}
+
+/// Reads one number per line.
+pub fn read_scalars(path: &Path) -> Result<Vec<f64>, CliError> {
+    let text = read_text(path)?;
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        match line.parse::<f64>() {
+            Ok(x) if x.is_finite() => out.push(x),
+            _ => return Err(textio::located(path, i + 1, &"expected one finite number")),
+        }
+    }
+    Ok(out)
+}
+
+/// Writes an image as PNG atomically (nothing is left at `path` on error).
+pub fn write_png(path: &Path, img: &Image) -> Result<(), CliError> {
+    textio::write_atomic(path, |w: &mut dyn Write| {
+        img.encode_png(w).map_err(std::io::Error::other)
+    })
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<(), CliError> {
+    let (width, height) = parse_size(&args.size, "--size")?;
+    let view = args
+        .view
+        .as_deref()
+        .map(parse_view)
+        .transpose()?
+        .unwrap_or_default();
+    let t = Instant::now();
+    let mesh: TriMesh = load_mesh(&args.mesh)?;
+    let mut overlays = Overlays::default();
+    for c in &args.curve {
+        overlays.curves.extend(read_curve(c)?);
+    }
+    if let Some(p) = &args.points {
+        let specs = read_points(p)?;
+        let valid = crate::common::load_valid(&args.mesh)?;
+        let pts = resolve_points(&valid, &specs, p)?;
+        overlays.points = pts.iter().map(|q| q.position(&mesh)).collect();
+    }
+    let texture = args.texture.as_deref().map(Image::read_png).transpose();
+    let texture = texture.map_err(|e| CliError::input(one_line(&e)))?;
+    let scalars = args.scalar.as_deref().map(read_scalars).transpose()?;
+    let colouring = match (&texture, &scalars) {
+        (Some(t), _) => Colouring::Texture(t),
+        (None, Some(s)) => Colouring::Scalars(s),
+        (None, None) => Colouring::Plain,
+    };
+    let opts = RenderOptions {
+        width,
+        height,
+        view,
+        wireframe: args.wireframe,
+        ..Default::default()
+    };
+    let what = |e: &dyn std::fmt::Display| {
+        let file = match colouring {
+            Colouring::Texture(_) => {
+                format!(" with {}", args.texture.as_ref().expect("set").display())
+            }
+            Colouring::Scalars(_) => {
+                format!(" with {}", args.scalar.as_ref().expect("set").display())
+            }
+            Colouring::Plain => String::new(),
+        };
+        CliError::input(format!("{}{file}: {}", args.mesh, one_line(e)))
+    };
+    let img = render(&mesh, &colouring, &overlays, &opts).map_err(|e| what(&e))?;
+    write_png(&args.output, &img)?;
+    let seconds = t.elapsed().as_secs_f64();
+    let covered = img
+        .pixels
+        .iter()
+        .filter(|p| **p != [255, 255, 255, 255])
+        .count() as f64
+        / img.pixels.len() as f64;
+    if args.json {
+        let mut j = serde_json::json!({
+            "output": args.output,
+            "width": width,
+            "height": height,
+            "vertices": mesh.n_vertices(),
+            "faces": mesh.n_faces(),
+            "covered_fraction": covered,
+            "seconds": seconds,
+        });
+        if let Some(s) = &scalars {
+            let (lo, hi) = s
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                    (a.min(x), b.max(x))
+                });
+            j["scalar_min"] = lo.into();
+            j["scalar_max"] = hi.into();
+        }
+        println!("{j}");
+    } else {
+        println!(
+            "{width}x{height} picture in {seconds:.2} s -> {}",
+            args.output.display()
+        );
+    }
+    Ok(())
+}
