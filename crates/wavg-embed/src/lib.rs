@@ -28,6 +28,7 @@ mod mds;
 mod near_field;
 mod pipeline;
 mod quality;
+mod simd;
 
 // The precomputation and its settings.
 pub use decimate::{DecimateOptions, Decimated, decimate, select_landmarks};
