@@ -335,7 +335,7 @@ impl PairPass {
     /// `(B x)_i = Σ_j (x_i - x_j) / (Q_ij d_ij)`.
     ///
     /// Distances come from the Gram matrix `x xᵀ` (one matrix product, then an elementwise
-    /// pass and a second product `C x`), which is several times faster than a pairwise loop;
+    /// pass and a second product `C x`), which uses matrix products instead of a pairwise loop;
     /// `x` is kept centred, so the cancellation in `|x_i|² + |x_j|² - 2 x_i·x_j` is harmless
     /// at landmark spacings.
     fn run(&mut self, inv: &[f64], x: MatRef<'_, f64>, bx: MatMut<'_, f64>) -> f64 {

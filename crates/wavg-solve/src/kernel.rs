@@ -1,5 +1,5 @@
 //! The inverse problem's linear algebra, given the tangent plane `Psi` and the embedded
-//! point `yhat` (algorithm notes, section 6), over anchors stored structure-of-arrays so
+//! point `yhat`, over anchors stored structure-of-arrays so
 //! the per-anchor loop vectorises.
 //!
 //! For anchor `j` with `v_j = y_j - yhat`, `a_j = Psi v_j` (2-vector),

@@ -29,23 +29,18 @@
 //!
 //! # Cost, and geodesics on a coarser mesh
 //!
-//! One run costs roughly 150-350 ns per vertex on this project's shared 2-core machine
-//! (on-CPU time: 1.1-1.4 ms on the 7.5k-vertex pig, 12 ms on the 48k horse, 13-17 ms on
-//! the 43k armadillo, 36-38 ms on the 134k igea), so 1000 landmark runs at full
-//! resolution take about 38 CPU-seconds on igea. For large meshes,
-//! compute the landmark distances on an intermediate decimation of about
-//! [`DEFAULT_GEODESIC_VERTICES`] vertices that contains every landmark: either
-//! [`landmark_distances_coarse`] (decimates again with the landmarks locked), or, cheaper,
-//! a snapshot of the landmark decimation itself
-//! ([`crate::decimate::decimate_with_snapshots`]) passed to
+//! One run costs time linear in the vertex count (times a logarithm for the heap), and
+//! the precomputation needs one run per landmark. For large meshes, compute the landmark
+//! distances on an intermediate decimation of about [`DEFAULT_GEODESIC_VERTICES`]
+//! vertices that contains every landmark: either [`landmark_distances_coarse`]
+//! (decimates again with the landmarks locked), or, cheaper, a snapshot of the landmark
+//! decimation itself ([`crate::decimate::decimate_with_snapshots`]) passed to
 //! [`landmark_distances_two_level`]. Both use the coarse mesh for every pair and then
-//! recompute the pairs closer than [`NEAR_PAIR_RADIUS_EDGES`](landmarks::NEAR_PAIR_RADIUS_EDGES) coarse edges on the fine
-//! mesh with radius-limited runs ([`FastMarching::run_within`]): on the coarse mesh alone
-//! those close pairs were off by up to 20-80%. Measured against full-resolution fast
-//! marching (1000 landmarks, 15k-vertex snapshot, two-level): mean relative difference
-//! +0.25% (horse), +0.36% (armadillo), +0.52% (igea); 90th percentile 0.58-0.88%; largest
-//! 6.4-7.5%. A run on the 15k-vertex mesh costs 3.6-4.8 ms, so the geodesic stage of igea
-//! drops from about 38 to about 5 CPU-seconds.
+//! recompute the pairs closer than
+//! [`NEAR_PAIR_RADIUS_EDGES`](landmarks::NEAR_PAIR_RADIUS_EDGES) coarse edges on the fine
+//! mesh with radius-limited runs ([`FastMarching::run_within`]), because on the coarse
+//! mesh alone those close pairs are the least accurate. The measured differences from
+//! full-resolution fast marching are in `BENCHMARKS.md`.
 //!
 //! **Near the source** the front is strongly curved and a plane wave fits it worst, so each
 //! run starts with exact polyhedral distances within [`crate::near_field::NEAR_FIELD_EDGES`]
