@@ -3,7 +3,8 @@
 
 use super::*;
 
-/// Faces around a vertex in the order [`Projector::faces_by_promise`] gives them.
+/// Faces around a vertex, most promising for a query first (from
+/// `internal::faces_by_promise`).
 #[derive(Clone, Copy, Debug)]
 pub struct FaceOrder {
     pub(super) faces: [FaceId; 64],
