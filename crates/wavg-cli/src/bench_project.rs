@@ -1,6 +1,6 @@
 //! `wavg bench project`: Phong projection speed and accuracy on random surface points.
 //!
-//! Protocol (issue 3): build the projector (`init_s`, `bytes_per_face`); (a) project N
+//! Protocol: build the projector (`init_s`, `bytes_per_face`); (a) project N
 //! random on-surface points (uniform by area, seeded), each from a start vertex three
 //! rings away, on one thread: mean time and the fraction that return to themselves
 //! (same face within 1e-5 in barycentrics, or the same position within 1e-5 mean edge

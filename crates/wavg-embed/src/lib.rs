@@ -29,6 +29,7 @@ mod near_field;
 mod ordering;
 mod pipeline;
 mod quality;
+mod simd;
 
 // The precomputation and its settings.
 pub use decimate::{DecimateOptions, Decimated, decimate, select_landmarks};

@@ -31,17 +31,13 @@ pub struct PrecomputeOptions {
     /// the landmark decimation's intermediate state with this many vertices (its vertices
     /// are original vertices and include every landmark) instead of the full mesh; 0 means
     /// always the full mesh (the paper's choice). Fast-marching time is proportional to the
-    /// vertex count; the quality check always uses the full mesh. Default 10 000: measured
-    /// on igea (134k vertices), horse (48k) and armadillo (43k) with 1000 landmarks, the
-    /// geodesic relative errors (p50, p90) change by at most 0.003 against full-resolution
-    /// geodesics, for 4-10x less geodesic time.
+    /// vertex count; the quality check always uses the full mesh. Default 10 000, where the
+    /// geodesic errors stay close to full resolution's (figures in `BENCHMARKS.md`).
     pub geodesic_vertices: usize,
     /// With an intermediate mesh, replace the distances of close landmark pairs by
     /// full-mesh values from short radius-limited runs
-    /// ([`crate::geodesic::landmark_distances_two_level`]). Measured on the horse (48k
-    /// vertices, 10k intermediate): the median relative error of vertex pairs closer than
-    /// 3% of the bounding-box diagonal drops from 0.097 to 0.091 (full-mesh geodesics:
-    /// 0.087); random-pair errors are unchanged.
+    /// ([`crate::geodesic::landmark_distances_two_level`]): close pairs are where the
+    /// intermediate mesh is least accurate; distant pairs are unchanged.
     pub refine_near_pairs: bool,
     /// MDS settings (`mds.dim` is the embedding dimension, 8 in wavg).
     pub mds: MdsOptions,

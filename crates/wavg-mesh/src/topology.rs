@@ -6,7 +6,8 @@ use std::ops::Range;
 use crate::mesh::{FaceId, NONE, TriMesh, VertexId};
 
 /// Undirected edges as sorted groups of halfedges (`face * 3 + corner`, the edge from
-/// corner `c` to corner `c + 1`). Sorting is faster than hashing at 1M halfedges.
+/// corner `c` to corner `c + 1`). Sorted rather than hashed: a sort of large arrays is
+/// cache-friendly where hashing is not.
 pub(crate) struct EdgeTable {
     keys: Vec<u64>,
     pub(crate) halfedges: Vec<u32>,
@@ -81,8 +82,8 @@ impl EdgeTable {
 
 /// `(key, payload)` pairs sorted by key then payload, where the key's high 32 bits are a
 /// vertex index: a counting sort on the vertex, then a sort of each (small) bucket. Same
-/// order as a full sort, several times faster on meshes (comparison sorts of ~1M items
-/// dominated validation time).
+/// order as a full sort, in linear time for the first key (comparison sorts of the
+/// halfedges would otherwise dominate validation).
 pub(crate) fn bucket_sorted(items: impl Iterator<Item = (u64, u32)> + Clone) -> Vec<(u64, u32)> {
     let n_buckets = items
         .clone()

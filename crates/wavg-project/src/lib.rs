@@ -1,8 +1,8 @@
 //! Phong projection onto meshes embedded in R^8 (paper Sections 3.2-3.3).
 //!
 //! The pipeline: an [`EmbeddedMesh`] (a valid mesh with per-vertex coordinates in R^8),
-//! per-vertex tangent frames ([`frames`]), per-triangle interpolated tangent planes `Psi`
-//! ([`triangle`]), and a [`Projector`] that finds the closest valid Phong projection of a
+//! per-vertex tangent frames ([`vertex_frames`]), per-triangle interpolated tangent planes
+//! `Psi` ([`Projector::psi`]), and a [`Projector`] that finds the closest valid Phong projection of a
 //! point of R^8 onto the mesh: a fast local search that is certified against a bounding
 //! volume hierarchy, an exhaustive (branch and bound) search, a literal brute force, and
 //! the Euclidean closest point as a baseline.

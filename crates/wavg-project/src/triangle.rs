@@ -222,7 +222,8 @@ impl TriData {
         Self::new_batch([frames])[0]
     }
 
-    /// [`TriData::new`] for `N` triangles at once (faster: see `rotations_batch`).
+    /// [`TriData::new`] for `N` triangles at once (their rotations interleaved, see
+    /// `rotations_batch`).
     pub(crate) fn new_batch<const N: usize>(frames: [[&Frame32; 3]; N]) -> [Self; N] {
         let ps: [Procrustes; N] =
             std::array::from_fn(|n| Procrustes::from_products(frame_products32(&frames[n])));

@@ -1,5 +1,5 @@
 //! The inverse problem's linear algebra, given the tangent plane `Psi` and the embedded
-//! point `yhat` (algorithm notes, section 6), over anchors stored structure-of-arrays so
+//! point `yhat`, over anchors stored structure-of-arrays so
 //! the per-anchor loop vectorises.
 //!
 //! For anchor `j` with `v_j = y_j - yhat`, `a_j = Psi v_j` (2-vector),
@@ -27,7 +27,7 @@ pub const DEFAULT_GAMMA: f64 = 10.0;
 pub(crate) const LANES: usize = 4;
 
 /// Anchor coordinates in R^8, one array per coordinate (structure of arrays) so the
-/// per-anchor loops vectorise; each array is padded with zeros to a multiple of [`LANES`].
+/// per-anchor loops vectorise; each array is padded with zeros to a multiple of the SIMD lane count (4).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AnchorCoords {
     dims: [Vec<f64>; DIM],

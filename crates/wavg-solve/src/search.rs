@@ -1,10 +1,9 @@
-//! The paper's local search for the forward problem (Section 3.3; algorithm notes section
-//! 5): a greedy walk over the vertex graph towards the averaged point, then a breadth-first
+//! The paper's local search for the forward problem (Section 3.3): a greedy walk over the vertex graph towards the averaged point, then a breadth-first
 //! search over triangles from the walk's end; the first triangle holding a valid Phong
 //! projection wins (within each ring of the search, triangles are tried in order of how
 //! close the Euclidean projection onto their plane falls to them, and when Newton's method
-//! leaves a triangle across an edge, the triangle beyond is tried next: 8% faster on
-//! armadillo, where 15% of queries need more than one triangle).
+//! leaves a triangle across an edge, the triangle beyond is tried next, as the projection
+//! more likely lies there).
 //!
 //! It is not certified: when the average is ambiguous a closer projection may exist
 //! elsewhere (the paper measured this as rare and meaningful only for ill-posed averages).

@@ -422,8 +422,7 @@ impl Solver {
     /// `weights[i]`. Every query is independent, so the results do not depend on the
     /// number of threads. The weight rows are read once, in input order, into their averages;
     /// the searches then run in the Morton order of the averages (nearby queries together,
-    /// so they share cached mesh data: 20-25% faster than grouping by highest-weight
-    /// anchors). Each still starts from its own highest-weight anchor (or warm start), so
+    /// so they share cached mesh data). Each still starts from its own highest-weight anchor (or warm start), so
     /// the results equal [`Solver::forward`]'s.
     pub fn forward_batch<W: AsRef<[f64]> + Sync>(
         &self,

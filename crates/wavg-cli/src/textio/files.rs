@@ -1,0 +1,63 @@
+//! Reading input files, output files written atomically (or to stdout), and errors that
+//! name `file:line`.
+
+use std::fmt;
+use std::io::Write;
+use std::path::Path;
+
+use crate::CliError;
+use crate::common::one_line;
+
+use super::PointSpec;
+
+/// Reads a whole text file, mapping failures to exit status 2.
+pub fn read_text(path: &Path) -> Result<String, CliError> {
+    std::fs::read_to_string(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))
+}
+
+/// Writes `body`'s output to `path` atomically (temporary file in the same folder, renamed
+/// on success) or to stdout when `path` is `-`. On any error nothing is left at `path`.
+pub fn write_atomic(
+    path: &Path,
+    body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), CliError> {
+    let fail = |e: &dyn fmt::Display| CliError::failure(format!("{}: {e}", path.display()));
+    if path == Path::new("-") {
+        let stdout = std::io::stdout();
+        let mut w = std::io::BufWriter::new(stdout.lock());
+        body(&mut w)
+            .and_then(|()| w.flush())
+            .map_err(|e| fail(&e))?;
+        return Ok(());
+    }
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| fail(&e))?;
+    {
+        let mut w = std::io::BufWriter::new(tmp.as_file());
+        body(&mut w)
+            .and_then(|()| w.flush())
+            .map_err(|e| fail(&e))?;
+    }
+    tmp.persist(path).map_err(|e| fail(&e.error))?;
+    Ok(())
+}
+
+/// An input error at `file:line` (exit status 2).
+pub fn located(file: &Path, line: usize, msg: &dyn fmt::Display) -> CliError {
+    CliError::input(format!("{}:{line}: {}", file.display(), one_line(msg)))
+}
+
+/// Reads and parses a point file, mapping errors to `file:line` input errors.
+pub fn read_points(file: &Path) -> Result<Vec<(usize, PointSpec)>, CliError> {
+    wavg::text::parse_points(&read_text(file)?, 1).map_err(|e| located(file, e.line, &e.message))
+}
+
+/// Writes numbers separated by single spaces.
+pub fn write_numbers(w: &mut dyn Write, xs: impl IntoIterator<Item = f64>) -> std::io::Result<()> {
+    let mut buf = Vec::new();
+    wavg::text::push_numbers(&mut buf, xs);
+    w.write_all(&buf)
+}

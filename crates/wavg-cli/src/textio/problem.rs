@@ -1,0 +1,126 @@
+//! From the forward/inverse arguments to a solver: the mesh, its embedding, the anchors and
+//! the thread pool.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use wavg_mesh::{SurfacePoint, ValidMesh};
+use wavg_solve::{Anchor, EmbeddedMesh, Projector, Solver, Vec8};
+
+use crate::CliError;
+use crate::common::{load_valid, one_line};
+
+use super::{PointSpec, located, read_points};
+
+/// Arguments shared by `wavg forward` and `wavg inverse`: the mesh, its embedding, the
+/// anchors, the output and the thread count.
+#[derive(clap::Args)]
+pub struct ProblemArgs {
+    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    #[arg(long)]
+    pub mesh: String,
+    /// Embedding (.wavg from `wavg precompute`); default: the mesh's 3-D positions.
+    #[arg(long)]
+    pub embedding: Option<PathBuf>,
+    /// Anchors file ('v VERTEX' or 'f FACE B0 B1 B2' per line).
+    #[arg(long)]
+    pub anchors: PathBuf,
+    /// Output file ('-' for stdout).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+/// The embedded mesh: the `.wavg` embedding when given, else the 3-D positions.
+pub fn load_embedded(
+    mesh: Arc<ValidMesh>,
+    embedding: Option<&Path>,
+) -> Result<Arc<EmbeddedMesh>, CliError> {
+    let Some(path) = embedding else {
+        return Ok(Arc::new(EmbeddedMesh::from_positions(mesh)));
+    };
+    let e = wavg_embed::file::load(path, &mesh).map_err(|e| CliError::input(one_line(&e)))?;
+    let coords: Vec<Vec8> = e.coords.iter().map(|c| Vec8::from(*c)).collect();
+    let emb = EmbeddedMesh::new(mesh, coords)
+        .map_err(|e| CliError::input(format!("{}: {}", path.display(), one_line(&e))))?;
+    Ok(Arc::new(emb))
+}
+
+/// Builds the projector (tangent frames, per-triangle data) for an embedded mesh.
+pub fn build_projector(emb: Arc<EmbeddedMesh>) -> Result<Arc<Projector>, CliError> {
+    Projector::new(emb)
+        .map(Arc::new)
+        .map_err(|e| CliError::failure(one_line(&e)))
+}
+
+/// Resolves parsed point specs against `mesh`; errors name `file` and the line.
+pub fn resolve_points(
+    mesh: &ValidMesh,
+    specs: &[(usize, PointSpec)],
+    file: &Path,
+) -> Result<Vec<SurfacePoint>, CliError> {
+    specs
+        .iter()
+        .map(|&(line, spec)| {
+            let a = spec_anchor(spec).map_err(|m| located(file, line, &m))?;
+            wavg_solve::resolve_anchor(mesh, &a).map_err(|e| located(file, line, &e))
+        })
+        .collect()
+}
+
+/// A spec as an [`Anchor`] (indices must fit in 32 bits).
+pub fn spec_anchor(spec: PointSpec) -> Result<Anchor, String> {
+    let idx =
+        |i: u64, what: &str| u32::try_from(i).map_err(|_| format!("{what} {i} is out of range"));
+    Ok(match spec {
+        PointSpec::Vertex(v) => Anchor::Vertex(idx(v, "vertex")?),
+        PointSpec::Face { face, bary } => {
+            Anchor::Point(SurfacePoint::new(idx(face, "face")?, bary))
+        }
+    })
+}
+
+/// Loads mesh, embedding and anchors, and makes the solver (shared by forward/inverse).
+pub fn load_solver(
+    mesh: &str,
+    embedding: Option<&Path>,
+    anchors: &Path,
+) -> Result<Solver, CliError> {
+    let specs = read_points(anchors)?;
+    if specs.is_empty() {
+        return Err(CliError::input(format!(
+            "{}: no anchors",
+            anchors.display()
+        )));
+    }
+    let mesh = load_valid(mesh)?;
+    let anchor_list = specs
+        .iter()
+        .map(|&(line, s)| spec_anchor(s).map_err(|m| located(anchors, line, &m)))
+        .collect::<Result<Vec<_>, _>>()?;
+    // Validate each anchor with its line number before building anything expensive.
+    for (&(line, _), a) in specs.iter().zip(&anchor_list) {
+        wavg_solve::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
+    }
+    let emb = load_embedded(mesh, embedding)?;
+    let proj = build_projector(emb)?;
+    Solver::new(proj, anchor_list).map_err(|e| CliError::input(one_line(&e)))
+}
+
+/// Runs `f` on a pool of `threads` threads (rayon's default when `None`).
+pub fn with_threads<T: Send>(
+    threads: Option<usize>,
+    f: impl FnOnce() -> T + Send,
+) -> Result<T, CliError> {
+    match threads {
+        None => Ok(f()),
+        Some(0) => Err(CliError::input("--threads must be at least 1")),
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .map(|p| p.install(f))
+            .map_err(|e| CliError::failure(format!("cannot start {t} threads: {e}"))),
+    }
+}

@@ -1,0 +1,95 @@
+//! Certification and the global searches: branch and bound over the bounding volume
+//! hierarchy (the exhaustive search), the literal brute force, and the Euclidean closest
+//! point baseline.
+
+use super::*;
+
+impl Projector {
+    /// `try_face` if the triangle's own box is closer than `sqrt(bound)` and the answer
+    /// is strictly closer than that.
+    #[inline]
+    pub(super) fn try_face_bounded(&self, f: FaceId, y: &Vec8, bound: f64) -> Option<Best> {
+        let [a, b, c] = self.corners(f);
+        let lo = a.inf(&b).inf(&c);
+        let hi = a.sup(&b).sup(&c);
+        let mut s = 0.0;
+        for k in 0..8 {
+            let d = (lo[k] - y[k]).max(y[k] - hi[k]).max(0.0);
+            s += d * d;
+        }
+        if s >= bound {
+            return None;
+        }
+        // The (clamped) Phong point lies in the triangle, so the Euclidean distance is a
+        // lower bound too, tighter than the box and cheaper than Newton.
+        let w = closest_point_barycentric(y, &a, &b, &c);
+        if (a * w[0] + b * w[1] + c * w[2] - y).norm_squared() >= bound {
+            return None;
+        }
+        self.try_face(f, y).filter(|r| r.d2 < bound)
+    }
+
+    pub(super) fn exhaustive(&self, y: &Vec8) -> Option<Best> {
+        let mut bound = f64::INFINITY;
+        let mut best = None;
+        self.bvh.search(y, &mut bound, |f, bound| {
+            if let Some(b) = self.try_face_bounded(f, y, *bound) {
+                *bound = b.d2;
+                best = Some(b);
+            }
+        });
+        best
+    }
+
+    /// Guaranteed path: the closest valid Phong projection over all triangles (branch and
+    /// bound over the bounding volume hierarchy, exact).
+    pub fn project_exhaustive(&self, y: &Vec8) -> Result<Projection, ProjectError> {
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(ProjectError::NonFiniteQuery);
+        }
+        self.exhaustive(y)
+            .map(|b| Self::finish(b, ProjectionPath::Exhaustive))
+            .ok_or(ProjectError::NoProjection)
+    }
+
+    /// The closest valid Phong projection by a literal scan over every triangle (skipping
+    /// only triangles whose bounding box is farther than the best so far). Slow; for tests
+    /// and for checking the other two paths.
+    pub fn project_brute_force(&self, y: &Vec8) -> Result<Projection, ProjectError> {
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(ProjectError::NonFiniteQuery);
+        }
+        let mut best: Option<Best> = None;
+        for f in 0..self.faces.len() as u32 {
+            let bound = best.map_or(f64::INFINITY, |b| b.d2);
+            if let Some(b) = self.try_face_bounded(f, y, bound) {
+                best = Some(b);
+            }
+        }
+        best.map(|b| Self::finish(b, ProjectionPath::Exhaustive))
+            .ok_or(ProjectError::NoProjection)
+    }
+
+    /// Euclidean closest point on the embedded mesh (baseline; discontinuous). A
+    /// non-finite query gives a point of face 0 at infinite distance.
+    pub fn project_euclidean(&self, y: &Vec8) -> Projection {
+        let mut best = Best {
+            face: 0,
+            xi: [1.0 / 3.0; 3],
+            d2: f64::INFINITY,
+        };
+        if y.iter().all(|v| v.is_finite()) {
+            let mut bound = f64::INFINITY;
+            self.bvh.search(y, &mut bound, |f, bound| {
+                let [a, b, c] = self.corners(f);
+                let xi = closest_point_barycentric(y, &a, &b, &c);
+                let d2 = (a * xi[0] + b * xi[1] + c * xi[2] - y).norm_squared();
+                if d2 < *bound {
+                    *bound = d2;
+                    best = Best { face: f, xi, d2 };
+                }
+            });
+        }
+        Self::finish(best, ProjectionPath::Euclidean)
+    }
+}
