@@ -6,7 +6,14 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The fuzz targets, in the order they run.
-pub const TARGETS: &[&str] = &["mesh_read", "wavg_file", "validate_repair", "solver"];
+pub const TARGETS: &[&str] = &[
+    "mesh_read",
+    "wavg_file",
+    "validate_repair",
+    "solver",
+    "text_formats",
+    "png_texture",
+];
 
 /// Runs every target for `seconds` each; `Err` names the first failure.
 pub fn run(root: &Path, seconds: u64) -> Result<(), String> {
@@ -66,7 +73,7 @@ fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
     let seeds = fuzz_dir.join("corpus");
     let mesh_dir = seeds.join("mesh_read");
     let file_dir = seeds.join("wavg_file");
-    if mesh_dir.is_dir() && file_dir.is_dir() {
+    if mesh_dir.is_dir() && file_dir.is_dir() && seeds.join("png_texture").is_dir() {
         return Ok(());
     }
     let status = Command::new("cargo")
@@ -134,6 +141,22 @@ fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
         emb.to_str().unwrap_or_default(),
         "--landmarks",
         "20",
+    ])?;
+    let text_dir = seeds.join("text_formats");
+    std::fs::create_dir_all(&text_dir).map_err(|e| format!("{}: {e}", text_dir.display()))?;
+    let text = "# anchors and weights\nv 1\nf 2 0.2 0.3 0.5\n0.5 0.25 0.25\n1e-7 -3.5e20 0.0\n";
+    let dst = text_dir.join("seed-text");
+    std::fs::write(&dst, text).map_err(|e| format!("{}: {e}", dst.display()))?;
+    let png_dir = seeds.join("png_texture");
+    std::fs::create_dir_all(&png_dir).map_err(|e| format!("{}: {e}", png_dir.display()))?;
+    let png = png_dir.join("seed-sphere.png");
+    run(&[
+        "render",
+        "builtin:sphere-small",
+        "-o",
+        png.to_str().unwrap_or_default(),
+        "--size",
+        "16x12",
     ])?;
     let _ = std::fs::remove_dir_all(&tmp);
     Ok(())

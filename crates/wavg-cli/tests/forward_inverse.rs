@@ -126,7 +126,7 @@ fn expect_input_error(args: &[&str], out_file: &Path, needle: &str) {
                 .unwrap()
                 .file_name()
                 .to_string_lossy()
-                .starts_with(".tmp")
+                .starts_with(".wavg-tmp")
         })
         .count();
     assert_eq!(leftovers, 0, "temporary file left behind");

@@ -15,8 +15,8 @@ pub fn read_text(path: &Path) -> Result<String, CliError> {
     std::fs::read_to_string(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))
 }
 
-/// Writes `body`'s output to `path` atomically (temporary file in the same folder, renamed
-/// on success) or to stdout when `path` is `-`. On any error nothing is left at `path`.
+/// Writes `body`'s output to `path` atomically (`wavg::mesh::io::write_atomic`: a
+/// temporary file in the same folder, renamed on success) or to stdout when `path` is `-`. On any error nothing is left at `path`.
 pub fn write_atomic(
     path: &Path,
     body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
@@ -30,19 +30,7 @@ pub fn write_atomic(
             .map_err(|e| fail(&e))?;
         return Ok(());
     }
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| fail(&e))?;
-    {
-        let mut w = std::io::BufWriter::new(tmp.as_file());
-        body(&mut w)
-            .and_then(|()| w.flush())
-            .map_err(|e| fail(&e))?;
-    }
-    tmp.persist(path).map_err(|e| fail(&e.error))?;
-    Ok(())
+    wavg::mesh::io::write_atomic(path, body).map_err(|e| fail(&e))
 }
 
 /// An input error at `file:line` (exit status 2).
