@@ -183,6 +183,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             &coords,
             &anchor_ids,
             &curve,
+            &solver,
             args.seed,
         )?;
         say(&format!(

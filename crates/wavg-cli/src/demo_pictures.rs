@@ -1,7 +1,8 @@
 //! The pictures `wavg demo --out DIR` draws of its results: the spline over the mesh, a
 //! per-vertex scalar (distance in the embedding from the first anchor, which behaves like
 //! a geodesic distance), and a checkerboard carried from a generated UV-mapped sheet to a
-//! bent and stretched copy of it (texture transfer through corresponding anchors).
+//! bent and stretched copy of it (texture transfer through corresponding anchors), and
+//! the remeshing and decal pictures of `demo_apps`.
 
 use std::path::{Path, PathBuf};
 
@@ -26,6 +27,7 @@ pub fn write_pictures(
     coords: &[Vec8],
     anchors: &[u32],
     curve: &[Result<ForwardResult, SolveError>],
+    solver: &wavg::Solver,
     seed: u64,
 ) -> Result<Vec<PathBuf>, CliError> {
     let fail = |what: &str, e: &dyn std::fmt::Display| {
@@ -81,7 +83,7 @@ pub fn write_pictures(
     let src_valid = ValidMesh::new(src.clone()).map_err(|e| fail("sheet", &e))?;
     let ids = farthest_point_vertices(&src_valid, 16, seed, FpsMetric::EdgeGraph)
         .map_err(|e| fail("sheet anchors", &e))?;
-    let solver = |m: &TriMesh| -> Result<wavg::Solver, CliError> {
+    let sheet_solver = |m: &TriMesh| -> Result<wavg::Solver, CliError> {
         let mut s = Surface::from_mesh(m.clone()).map_err(|e| fail("sheet", &e))?;
         let opts = PrecomputeOptions {
             landmarks: 40,
@@ -93,7 +95,7 @@ pub fn write_pictures(
             .map_err(|e| fail("sheet", &e))?;
         s.solver(ids.iter().copied()).map_err(|e| fail("sheet", &e))
     };
-    let (s_src, s_dst) = (solver(&src)?, solver(&dst)?);
+    let (s_src, s_dst) = (sheet_solver(&src)?, sheet_solver(&dst)?);
     let topts = TransferOptions {
         width: 256,
         height: 256,
@@ -116,7 +118,19 @@ pub fn write_pictures(
         .map_err(|e| fail("texture_target.png", &e))?;
     save("texture_target.png", &img)?;
 
-    // Remeshing and decal pictures go here (added when those applications land).
+    // Remeshing: a cube's quads on the surface, three levels, five smoothing steps.
+    let img = crate::demo_apps::remesh_picture(solver, &opts)?;
+    save("remesh.png", &img)?;
+
+    // A decal around the first anchor; outside the square the board is transparent.
+    let mut board = checkerboard(256, 8).map_err(|e| fail("checkerboard", &e))?;
+    for i in 0..256 {
+        for (x, y) in [(i, 0), (i, 255), (0, i), (255, i)] {
+            board.set(x, y, [0; 4]);
+        }
+    }
+    let img = crate::demo_apps::decal_picture(solver, anchors[0], &board, &opts)?;
+    save("decal.png", &img)?;
     Ok(written)
 }
 

@@ -10,6 +10,7 @@ mod common;
 mod correspond;
 mod decal;
 mod demo;
+mod demo_apps;
 mod demo_pictures;
 mod error;
 mod forward;

@@ -73,6 +73,8 @@ fn demo_reports_and_writes_its_outputs() {
         "distance.png",
         "texture_source.png",
         "texture_target.png",
+        "remesh.png",
+        "decal.png",
     ] {
         let bytes = std::fs::read(out_dir.join(png)).unwrap();
         assert_eq!(&bytes[1..4], b"PNG", "{png}");
