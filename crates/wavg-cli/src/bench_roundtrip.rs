@@ -1,35 +1,20 @@
-//! `wavg bench roundtrip`: the paper's Table 1 protocol.
+//! `wavg bench roundtrip`: the paper's Table 1 protocol ([`wavg_solve::round_trip`]).
 //!
-//! K anchors by farthest-point sampling (edge-graph distance, seeded); N surface points
-//! uniform by area (seeded); for each, weights by the inverse problem, then the forward
-//! problem with those weights and no initial guess. Times are wall time of the whole
-//! batch on T threads divided by N (amortised over the threads, as in the paper), best of
-//! `--repeat` runs. `forward_warm_us` runs the same forward problems visited in spatial
-//! (Morton) order, each warm-started from the previous answer.
+//! K anchors by farthest-point sampling (edge-graph distance, seeded) and the solver are set
+//! up here; the library samples N surface points uniform by area (seed + 1), times the
+//! inverse and forward batches on T threads and compares. This file prints its report as a
+//! table or, with `--json`, serialises it with the mesh argument added.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use serde::Serialize;
-use wavg_mesh::geometry::mean_edge_length;
-use wavg_solve::sampling::{
-    FpsMetric, farthest_point_vertices, spatial_order, uniform_surface_points,
-};
-use wavg_solve::{
-    Anchor, ForwardOptions, ForwardResult, ProjectionPath, SearchMode, SolveError, Solver,
-};
+use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
+use wavg_solve::{Anchor, RoundTripOptions, RoundTripReport, SearchMode, SolveError, Solver};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
 use crate::textio;
-
-/// A forward result within this many mean edge lengths of the original point counts as a
-/// successful round trip.
-const OK_TOLERANCE: f64 = 1e-3;
-/// A query "has negative weights" when some weight is below this.
-const NEGATIVE: f64 = -0.1;
-/// Queries per warm-started chain (fixed, so results do not depend on the thread count).
-const WARM_CHUNK: usize = 1024;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -102,47 +87,12 @@ pub enum Search {
     Exact,
 }
 
-/// The JSON report (keys as documented).
+/// The JSON report: the protocol's report and the mesh argument.
 #[derive(Serialize)]
-struct Report {
-    inverse_us: f64,
-    forward_us: f64,
-    forward_warm_us: f64,
-    roundtrip_ok_fraction: f64,
-    roundtrip_err_p50: f64,
-    roundtrip_err_p99: f64,
-    negative_weight_fraction: f64,
-    mesh: String,
-    vertices: usize,
-    faces: usize,
-    anchors: usize,
-    queries: usize,
-    threads: usize,
-    #[serde(flatten, skip_serializing_if = "Option::is_none")]
-    verified: Option<VerifiedReport>,
-}
-
-/// The `--verified` keys.
-#[derive(Serialize)]
-struct VerifiedReport {
-    verified_inverse_us: f64,
-    verified_roundtrip_ok_fraction: f64,
-    verified_negative_weight_fraction: f64,
-    verified_penalized_fraction: f64,
-    verified_not_reached_fraction: f64,
-}
-
-/// Best wall time of `repeat` runs of `f`, and the last result.
-fn best_of<T>(repeat: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let mut best = f64::INFINITY;
-    let mut out = None;
-    for _ in 0..repeat.max(1) {
-        let t = Instant::now();
-        let r = f();
-        best = best.min(t.elapsed().as_secs_f64());
-        out = Some(r);
-    }
-    (best, out.expect("at least one run"))
+struct JsonReport<'a> {
+    #[serde(flatten)]
+    report: &'a RoundTripReport,
+    mesh: &'a str,
 }
 
 /// The 1-minute load average (Linux), to judge how busy the machine was.
@@ -153,24 +103,9 @@ fn load_average() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
-/// Runs `f` and returns its result with the CPU seconds it used (NaN when unknown).
-fn with_cpu<T>(f: impl FnOnce() -> T) -> (T, f64) {
-    let c0 = crate::common::cpu_seconds(false);
-    let r = f();
-    let dt = match (c0, crate::common::cpu_seconds(false)) {
-        (Some(a), Some(b)) => b - a,
-        _ => f64::NAN,
-    };
-    (r, dt)
-}
-
-/// Value at quantile `q` of sorted `xs` (nearest rank).
-fn quantile(xs: &[f64], q: f64) -> f64 {
-    if xs.is_empty() {
-        return f64::NAN;
-    }
-    let i = ((q * xs.len() as f64).ceil() as usize).clamp(1, xs.len()) - 1;
-    xs[i]
+/// The process CPU-time clock of the report's CPU figures.
+fn process_cpu_seconds() -> Option<f64> {
+    crate::common::cpu_seconds(false)
 }
 
 /// Runs the command.
@@ -197,104 +132,29 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map_err(|e| CliError::input(one_line(&e)))?;
     let solver = Solver::new(proj, anchors.into_iter().map(Anchor::Vertex))
         .map_err(|e| CliError::failure(one_line(&e)))?;
-    let points = uniform_surface_points(&mesh, args.queries, args.seed.wrapping_add(1))
-        .map_err(|e| CliError::input(one_line(&e)))?;
-    let n = points.len();
-
-    // The result buffers are reused across the repeats, as an application would.
-    let mut weights = wavg_solve::BatchWeights::default();
-    let (t_inv, cpu_inv) = with_cpu(|| {
-        textio::with_threads(Some(threads), || {
-            best_of(args.repeat, || {
-                solver.inverse_batch_into(&points, &mut weights)
-            })
-            .0
-        })
-    });
-    let t_inv = t_inv?;
-    let k = solver.n_anchors();
-    // Failed inverses get a placeholder that fails validation, so forward reports it.
-    let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
-    let opts = ForwardOptions {
-        mode: match args.search {
+    let opts = RoundTripOptions {
+        queries: args.queries,
+        seed: args.seed.wrapping_add(1),
+        repeat: args.repeat,
+        search: match args.search {
             Search::Fast => SearchMode::Fast,
             Search::Certified => SearchMode::Certified,
             Search::Exact => SearchMode::Exact,
         },
-        ..Default::default()
+        verified: args.verified,
+        cpu_clock: Some(process_cpu_seconds),
     };
-    let (r, cpu_fwd) = with_cpu(|| {
-        textio::with_threads(Some(threads), || {
-            best_of(args.repeat, || solver.forward_batch(&rows, &opts))
-        })
-    });
-    let (t_fwd, fwd) = r?;
-    let order = spatial_order(&points.iter().map(|p| p.position(&mesh)).collect::<Vec<_>>());
-    let ordered: Vec<&[f64]> = order.iter().map(|&i| rows[i]).collect();
-    let (r, cpu_warm) = with_cpu(|| {
-        textio::with_threads(Some(threads), || {
-            best_of(args.repeat, || {
-                solver.forward_batch_warm(&ordered, &opts, WARM_CHUNK)
-            })
-        })
-    });
-    let (t_warm, warm) = r?;
-    // CPU microseconds per query (mean over the repeats, summed over threads).
-    let cpu_us = |c: f64| c / (n * args.repeat.max(1)) as f64 * 1e6;
-
-    let mel = mean_edge_length(&mesh);
-    let err = |p: &wavg_mesh::SurfacePoint, r: &Result<ForwardResult, SolveError>| match r {
-        Ok(r) => (r.position - p.position(&mesh)).norm() / mel,
-        Err(_) => f64::INFINITY,
-    };
-    let mut errs: Vec<f64> = points.iter().zip(&fwd).map(|(p, r)| err(p, r)).collect();
-    let warm_ok = order
-        .iter()
-        .zip(&warm)
-        .filter(|(i, r)| err(&points[**i], r) < OK_TOLERANCE)
-        .count();
-    errs.sort_by(f64::total_cmp);
-    let ok = errs.iter().filter(|&&e| e < OK_TOLERANCE).count();
-    let negative = weights
-        .iter()
-        .filter(|r| r.is_ok_and(|w| w.iter().any(|&x| x < NEGATIVE)))
-        .count();
-    let inverse_failed = weights.iter().filter(|r| r.is_err()).count();
-    let path_count = |p: ProjectionPath| {
-        fwd.iter()
-            .filter(|r| r.as_ref().is_ok_and(|r| r.path == p))
-            .count()
-    };
-    let verified = if args.verified {
-        Some(run_verified(
-            &solver,
-            &points,
-            threads,
-            args.repeat,
-            &opts,
-            mel,
-        )?)
-    } else {
-        None
-    };
-    let report = Report {
-        inverse_us: t_inv / n as f64 * 1e6,
-        forward_us: t_fwd / n as f64 * 1e6,
-        forward_warm_us: t_warm / n as f64 * 1e6,
-        roundtrip_ok_fraction: ok as f64 / n as f64,
-        roundtrip_err_p50: quantile(&errs, 0.5),
-        roundtrip_err_p99: quantile(&errs, 0.99),
-        negative_weight_fraction: negative as f64 / n as f64,
-        mesh: args.mesh.clone(),
-        vertices: mesh.n_vertices(),
-        faces: mesh.n_faces(),
-        anchors: k,
-        queries: n,
-        threads,
-        verified,
-    };
+    let report = textio::with_threads(Some(threads), || wavg_solve::round_trip(&solver, &opts))?
+        .map_err(|e| match e {
+            SolveError::InvalidParameter(_) => CliError::input(one_line(&e)),
+            e => CliError::failure(one_line(&e)),
+        })?;
     if args.json {
-        let s = serde_json::to_string(&report).map_err(CliError::failure)?;
+        let json = JsonReport {
+            report: &report,
+            mesh: &args.mesh,
+        };
+        let s = serde_json::to_string(&json).map_err(CliError::failure)?;
         println!("{s}");
         return Ok(());
     }
@@ -303,39 +163,37 @@ pub fn run(args: Args) -> Result<(), CliError> {
         (None, true) => "computed (--precompute)".into(),
         (None, false) => "3-D positions".into(),
     };
+    // CPU per query is NaN where the platform has no process CPU clock.
+    let cpu = |c: Option<f64>| c.unwrap_or(f64::NAN);
     println!(
         "mesh                      {} ({} vertices, {} faces)",
-        report.mesh, report.vertices, report.faces
+        args.mesh, report.vertices, report.faces
     );
     println!("embedding                 {source} ({t_emb:.2} s)");
     println!("projector                 {t_proj:.2} s");
     println!(
         "anchors / queries         {} / {} ({} threads, best of {})",
-        k,
-        n,
-        threads,
-        args.repeat.max(1)
+        report.anchors, report.queries, report.threads, report.repeat
     );
     println!(
         "inverse_us                {:.3}  (CPU per query {:.3})",
         report.inverse_us,
-        cpu_us(cpu_inv)
+        cpu(report.inverse_cpu_us)
     );
     println!(
         "forward_us                {:.3}  (CPU per query {:.3})",
         report.forward_us,
-        cpu_us(cpu_fwd)
+        cpu(report.forward_cpu_us)
     );
     println!(
         "forward_warm_us           {:.3}  (CPU per query {:.3})",
         report.forward_warm_us,
-        cpu_us(cpu_warm)
+        cpu(report.forward_warm_cpu_us)
     );
     println!("load average              {}", load_average());
     println!(
         "roundtrip_ok_fraction     {:.5}  (warm: {:.5})",
-        report.roundtrip_ok_fraction,
-        warm_ok as f64 / n as f64
+        report.roundtrip_ok_fraction, report.roundtrip_warm_ok_fraction
     );
     println!(
         "roundtrip_err_p50 / p99   {:.3e} / {:.3e} mean edge lengths",
@@ -347,10 +205,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     );
     println!(
         "forward paths             local {}  fallback {}  failed {}  (inverse failed {})",
-        path_count(ProjectionPath::Local),
-        path_count(ProjectionPath::Fallback),
-        fwd.iter().filter(|r| r.is_err()).count(),
-        inverse_failed
+        report.forward_local, report.forward_fallback, report.forward_failed, report.inverse_failed
     );
     if let Some(v) = &report.verified {
         println!(
@@ -366,53 +221,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
         );
     }
     Ok(())
-}
-
-/// `--verified`: the checked inverse, then the same forward protocol on its weights.
-fn run_verified(
-    solver: &Solver,
-    points: &[wavg_mesh::SurfacePoint],
-    threads: usize,
-    repeat: usize,
-    opts: &ForwardOptions,
-    mel: f64,
-) -> Result<VerifiedReport, CliError> {
-    use wavg_solve::RoundTrip;
-    let n = points.len() as f64;
-    // Buffers reused across the repeats, as for inverse_us.
-    let mut weights = wavg_solve::BatchWeights::default();
-    let mut trips = Vec::new();
-    let t = textio::with_threads(Some(threads), || {
-        best_of(repeat, || {
-            solver.inverse_verified_batch_into(points, OK_TOLERANCE, &mut weights, &mut trips)
-        })
-        .0
-    })?;
-    let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
-    let fwd = textio::with_threads(Some(threads), || solver.forward_batch(&rows, opts))?;
-    let mesh = solver.mesh();
-    let ok = points
-        .iter()
-        .zip(&fwd)
-        .filter(|(p, r)| {
-            r.as_ref()
-                .is_ok_and(|r| (r.position - p.position(mesh)).norm() / mel < OK_TOLERANCE)
-        })
-        .count();
-    let count = |f: &dyn Fn(&[f64], RoundTrip) -> bool| {
-        rows.iter()
-            .zip(&trips)
-            .filter(|(w, t)| t.as_ref().is_ok_and(|t| f(w, *t)))
-            .count() as f64
-            / n
-    };
-    Ok(VerifiedReport {
-        verified_inverse_us: t / n * 1e6,
-        verified_roundtrip_ok_fraction: ok as f64 / n,
-        verified_negative_weight_fraction: count(&|w, _| w.iter().any(|&x| x < NEGATIVE)),
-        verified_penalized_fraction: count(&|_, t| matches!(t, RoundTrip::Penalized(_))),
-        verified_not_reached_fraction: count(&|_, t| t == RoundTrip::NotReached),
-    })
 }
 
 /// `--precompute`: the embedding pipeline with default parameters.

@@ -9,8 +9,9 @@
 //!
 //! Also: [`AnchorSet`] (editable anchor sets), [`resolve_anchor`] and [`check_point`]
 //! (validating user locations), [`validate_weights`], [`inverse_weights`] (the inverse
-//! problem's kernel on its own), and [`sampling`] (seeded anchors and query points for
-//! benchmarks and tests).
+//! problem's kernel on its own), [`sampling`] (seeded anchors and query points for
+//! benchmarks and tests), and [`round_trip`] (the paper's Table 1 round-trip protocol;
+//! its report serialises with the `serde` feature).
 //!
 //! ```
 //! use std::sync::Arc;
@@ -36,6 +37,7 @@ mod anchors;
 mod error;
 mod kernel;
 mod points;
+pub mod roundtrip;
 pub mod sampling;
 mod search;
 mod simd;
@@ -54,6 +56,11 @@ pub use points::{
     Anchor, BARY_TOLERANCE, check_point, nearest_corner, resolve_anchor, vertex_point,
 };
 pub use weights::{Normalization, WEIGHT_SUM_TOLERANCE, validate_weights};
+
+// The Table 1 round-trip protocol.
+pub use roundtrip::{
+    RoundTripOptions, RoundTripReport, VerifiedRoundTripReport, round_trip, round_trip_at,
+};
 
 // The embedded mesh and projector the solver works on.
 pub use wavg_project::{DIM, EmbeddedMesh, Mat2x8, ProjectError, ProjectionPath, Projector, Vec8};

@@ -45,6 +45,7 @@ pub use wavg_solve::{
     Anchor, BatchWeights, ForwardOptions, ForwardResult, Normalization, RoundTrip, SearchMode,
     Solver, Verified,
 };
+pub use wavg_solve::{RoundTripOptions, RoundTripReport, VerifiedRoundTripReport, round_trip};
 
 pub use wavg_apps as apps;
 pub use wavg_embed as embed;
