@@ -11,7 +11,9 @@
 //! same with the points offset from the
 //! surface by 0.1 mean edge length along the face normal (with `--embedding`: a seeded
 //! random direction of R^8 orthogonal to the embedded face), timed, and on the first
-//! 1,000 compared with the brute-force search.
+//! 1,000 compared with the brute-force search; (c) the fraction of each kind of query that
+//! needed the global search (path `Fallback`), and the mean wall time of one global search
+//! (`Projector::project_exhaustive`, the fallback alone) on those queries.
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -20,7 +22,7 @@ use std::time::Instant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use wavg::mesh::{SurfacePoint, ValidMesh, VertexId};
-use wavg::project::{EmbeddedMesh, Projection, Projector, Vec8};
+use wavg::project::{EmbeddedMesh, Projection, ProjectionPath, Projector, Vec8};
 
 use crate::CliError;
 use crate::common::load_valid;
@@ -33,8 +35,11 @@ Builds the projector (init_s, bytes_per_face), then (a) projects N random on-sur
 points (uniform by area, seeded), each from a start vertex three rings away:
 onsurface_us and onsurface_self_fraction; (b) the same points offset by 0.1 mean edge
 lengths off the surface: offset_us, and on the first 1,000 the fraction equal to the
-brute-force answer (offset_bruteforce_agree_fraction). --json prints exactly those keys
-plus mesh, vertices, faces, queries.
+brute-force answer (offset_bruteforce_agree_fraction); (c) onsurface_fallback_fraction and
+offset_fallback_fraction, the fraction of each kind of query that needed the global search
+(the local search found nothing or was beaten), and fallback_us, the mean wall time of one
+global search (Projector::project_exhaustive) on those queries (null when none needed it).
+--json prints exactly those keys plus mesh, vertices, faces, queries.
 
 Times are the calling thread's CPU time per query, best of three passes, on one thread
 through Projector::project_batch (queries visited in spatial order, the greedy walks of 8
@@ -126,6 +131,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let agree = brute_force_agreement(&projector, &offset[..n_check], &off[..n_check], mean_edge);
     let offset_bruteforce_agree_fraction = agree as f64 / n_check as f64;
 
+    // (c) the queries that needed the global search, and its cost alone on them.
+    let needed: Vec<Vec8> = (ys.iter().zip(&on))
+        .chain(offset.iter().zip(&off))
+        .filter(|(_, r)| used_fallback(r))
+        .map(|(y, _)| *y)
+        .collect();
+    let fraction =
+        |v: &[Answer]| v.iter().filter(|r| used_fallback(r)).count() as f64 / v.len() as f64;
+    let (onsurface_fallback_fraction, offset_fallback_fraction) = (fraction(&on), fraction(&off));
+    let fallback_us = fallback_wall_us(&projector, &needed);
+
     let name = args.mesh.display().to_string();
     if args.json {
         let j = serde_json::json!({
@@ -139,6 +155,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "onsurface_self_fraction": onsurface_self_fraction,
             "offset_us": offset_us,
             "offset_bruteforce_agree_fraction": offset_bruteforce_agree_fraction,
+            "onsurface_fallback_fraction": onsurface_fallback_fraction,
+            "offset_fallback_fraction": offset_fallback_fraction,
+            "fallback_us": fallback_us,
         });
         println!("{j}");
     } else {
@@ -187,6 +206,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             pb[1],
             off.len() - pb[0] - pb[1]
         );
+        println!(
+            "fallback on/offset, fallback_us   {onsurface_fallback_fraction:.6} / {offset_fallback_fraction:.6}, {} (wall, {} calls)",
+            fallback_us.map_or("-".to_string(), |t| format!("{t:.3}")),
+            needed.len()
+        );
     }
     Ok(())
 }
@@ -233,6 +257,29 @@ fn timed(p: &Projector, ys: &[Vec8], starts: &[VertexId], batch: bool) -> (Vec<A
         best.wall_us = best.wall_us.min(wall * 1e6 / n);
     }
     (out, best)
+}
+
+/// Whether the query needed the global search.
+fn used_fallback(r: &Answer) -> bool {
+    matches!(r, Ok(p) if p.path == ProjectionPath::Fallback)
+}
+
+/// Mean wall microseconds of one global search (`project_exhaustive`) over `ys`, the best
+/// of [`REPEATS`] passes; `None` for no queries.
+fn fallback_wall_us(p: &Projector, ys: &[Vec8]) -> Option<f64> {
+    if ys.is_empty() {
+        return None;
+    }
+    let mut best = f64::INFINITY;
+    for _ in 0..REPEATS {
+        let t = Instant::now();
+        for y in ys {
+            // The answer itself was checked above; only the time matters here.
+            let _ = std::hint::black_box(p.project_exhaustive(std::hint::black_box(y)));
+        }
+        best = best.min(t.elapsed().as_secs_f64() * 1e6 / ys.len() as f64);
+    }
+    Some(best)
 }
 
 /// Whether projection `r` of `y = e(p)` is `p` itself.

@@ -14,10 +14,13 @@ fn bench_project_reports_the_documented_json() {
         [
             "bytes_per_face",
             "faces",
+            "fallback_us",
             "init_s",
             "mesh",
             "offset_bruteforce_agree_fraction",
+            "offset_fallback_fraction",
             "offset_us",
+            "onsurface_fallback_fraction",
             "onsurface_self_fraction",
             "onsurface_us",
             "queries",
@@ -30,6 +33,18 @@ fn bench_project_reports_the_documented_json() {
     assert!(o["offset_bruteforce_agree_fraction"].as_f64().unwrap() >= 0.999);
     for k in ["init_s", "bytes_per_face", "onsurface_us", "offset_us"] {
         assert!(o[k].as_f64().unwrap() > 0.0, "{k}");
+    }
+    for k in ["onsurface_fallback_fraction", "offset_fallback_fraction"] {
+        let f = o[k].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&f), "{k}: {f}");
+    }
+    // A mean time, or null when no query needed the global search.
+    let any = o["onsurface_fallback_fraction"].as_f64().unwrap() > 0.0
+        || o["offset_fallback_fraction"].as_f64().unwrap() > 0.0;
+    if any {
+        assert!(o["fallback_us"].as_f64().unwrap() > 0.0);
+    } else {
+        assert!(o["fallback_us"].is_null());
     }
     let bad = wavg(&[&args[..], &["--queries", "0"]].concat());
     assert_eq!(bad.status.code(), Some(2));

@@ -136,6 +136,46 @@ impl Bvh {
         }
     }
 
+    /// Best-first branch and bound: visits the leaves in increasing order of their box's
+    /// distance to `y`, and stops at the first box not closer than `sqrt(*best)`;
+    /// `visit(face, best)` may lower `*best`. A box's distance bounds from below the
+    /// distance of every point in the convex hull of its triangles' corners, so every face
+    /// not visited is at least `sqrt(*best)` away. Visits fewer faces than
+    /// [`Bvh::search`] when the first leaves reached depth first are far from the answer.
+    pub(crate) fn search_best_first(
+        &self,
+        y: &Vec8,
+        best: &mut f64,
+        mut visit: impl FnMut(u32, &mut f64),
+    ) {
+        use std::cmp::Reverse;
+        use std::collections::BinaryHeap;
+        if self.nodes.is_empty() {
+            return;
+        }
+        // Squared distances are non-negative, so their bit patterns sort like the values.
+        let mut heap = BinaryHeap::with_capacity(2 * STACK);
+        heap.push(Reverse((box_dist2(&self.nodes[0], y).to_bits(), 0u32)));
+        while let Some(Reverse((d, ni))) = heap.pop() {
+            if f64::from_bits(d) >= *best {
+                break;
+            }
+            let node = &self.nodes[ni as usize];
+            if node.n > 0 {
+                for &f in &self.items[node.a as usize..(node.a + node.n) as usize] {
+                    visit(f, best);
+                }
+                continue;
+            }
+            for c in [ni + 1, node.a] {
+                let dc = box_dist2(&self.nodes[c as usize], y);
+                if dc < *best {
+                    heap.push(Reverse((dc.to_bits(), c)));
+                }
+            }
+        }
+    }
+
     fn visit_all(&self, ni: usize, visit: &mut impl FnMut(u32, &mut f64), best: &mut f64) {
         let node = &self.nodes[ni];
         if node.n > 0 {

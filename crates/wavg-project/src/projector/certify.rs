@@ -29,20 +29,34 @@ impl Projector {
         self.try_face(f, y).filter(|r| r.d2 < bound)
     }
 
+    /// The closest valid Phong projection over all triangles, with the brute force's
+    /// answer: the least distance, ties to the lowest face index. Best-first branch and
+    /// bound over the hierarchy: the Phong point of a triangle is a convex combination of
+    /// its embedded corners, so a box's distance bounds from below the distance of every
+    /// triangle under it; nodes are opened nearest first and the search stops at the
+    /// first box farther than the best valid projection so far. Boxes at exactly that
+    /// distance are still opened (the bound is the next float up), as they may hold an
+    /// equally close face of lower index.
     pub(super) fn exhaustive(&self, y: &Vec8) -> Option<Best> {
         let mut bound = f64::INFINITY;
-        let mut best = None;
-        self.bvh.search(y, &mut bound, |f, bound| {
+        let mut best: Option<Best> = None;
+        self.bvh.search_best_first(y, &mut bound, |f, bound| {
+            // `try_face_bounded` keeps answers below the bound: not farther than the best.
             if let Some(b) = self.try_face_bounded(f, y, *bound) {
-                *bound = b.d2;
-                best = Some(b);
+                let better = best.is_none_or(|x| b.d2 < x.d2 || (b.d2 == x.d2 && f < x.face));
+                if better {
+                    best = Some(b);
+                    // The next float up (d2 >= 0): keep boxes at exactly this distance.
+                    *bound = f64::from_bits(b.d2.to_bits() + 1);
+                }
             }
         });
         best
     }
 
-    /// Guaranteed path: the closest valid Phong projection over all triangles (branch and
-    /// bound over the bounding volume hierarchy, exact).
+    /// Guaranteed path: the closest valid Phong projection over all triangles (best-first
+    /// branch and bound over the bounding volume hierarchy, exact: the same answer as
+    /// [`Projector::project_brute_force`], ties to the lowest face index).
     pub fn project_exhaustive(&self, y: &Vec8) -> Result<Projection, ProjectError> {
         if !y.iter().all(|v| v.is_finite()) {
             return Err(ProjectError::NonFiniteQuery);
