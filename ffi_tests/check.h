@@ -86,6 +86,20 @@ static inline void make_torus(size_t nu, size_t nv, double r, double **xyz, size
   }
 }
 
+/* The 48 x 16 test torus as a surface with a small precomputed embedding (60 landmarks,
+ * no quality check); its arrays are returned for the caller to free. */
+static inline wavg_surface *precomputed_torus(double **xyz, size_t *n_vertices, uint32_t **tris,
+                                              size_t *n_triangles) {
+  make_torus(48, 16, 0.35, xyz, n_vertices, tris, n_triangles);
+  wavg_surface *s = NULL;
+  CHECK_OK(wavg_surface_from_arrays(*xyz, *n_vertices, *tris, *n_triangles, &s));
+  wavg_precompute_options opts = wavg_precompute_options_default();
+  opts.landmarks = 60;
+  opts.quality_pairs = 0;
+  CHECK_OK(wavg_surface_precompute(s, &opts, NULL, NULL));
+  return s;
+}
+
 /* The 3-D position of a surface point from the mesh arrays. */
 static inline void point_position(const double *xyz, const uint32_t *tris, wavg_point p,
                            double out[3]) {

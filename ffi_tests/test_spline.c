@@ -8,13 +8,7 @@ int main(void) {
   double *xyz;
   uint32_t *tris;
   size_t nv, nt;
-  make_torus(48, 16, 0.35, &xyz, &nv, &tris, &nt);
-  wavg_surface *s = NULL;
-  CHECK_OK(wavg_surface_from_arrays(xyz, nv, tris, nt, &s));
-  wavg_precompute_options opts = wavg_precompute_options_default();
-  opts.landmarks = 60;
-  opts.quality_pairs = 0;
-  CHECK_OK(wavg_surface_precompute(s, &opts, NULL, NULL));
+  wavg_surface *s = precomputed_torus(&xyz, &nv, &tris, &nt);
 
   uint32_t ids[NA] = {0, 120, 250, 380, 500, 640};
   wavg_point anchors[NA];
