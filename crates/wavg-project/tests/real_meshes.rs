@@ -155,6 +155,16 @@ fn embedding_errors_are_typed() {
         p.project(&z, n as u32),
         Err(wavg_project::ProjectError::StartOutOfRange { .. })
     ));
+    let nf = p.embedded().mesh().n_faces() as u32;
+    for goal in [wavg_project::SearchGoal::Closest, wavg_project::SearchGoal::FirstHit] {
+        assert_eq!(
+            p.project_with(&z, 0, Some(nf), goal),
+            Err(wavg_project::ProjectError::FaceOutOfRange {
+                face: nf,
+                n_faces: nf as usize
+            })
+        );
+    }
     // The centre of a sphere has no Phong projection only by accident; far away it has one.
     let far = wavg_project::Vec8::from_fn(|i, _| if i == 0 { 10.0 } else { 0.0 });
     let r = p.project(&far, 0).unwrap();

@@ -6,8 +6,8 @@ use wavg_mesh::geometry::mean_edge_length;
 use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, procedural};
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
 use wavg_solve::{
-    Anchor, EmbeddedMesh, ForwardOptions, Normalization, Projector, SearchMode, SolveError, Solver,
-    Start,
+    Anchor, EmbeddedMesh, ForwardOptions, Normalization, ProjectionPath, Projector, SearchGoal,
+    SearchMode, SolveError, Solver, Start,
 };
 
 fn solver_on(mesh: TriMesh, k: usize, seed: u64) -> Solver {
@@ -454,13 +454,14 @@ fn local_search_finds_points_on_the_surface_from_anywhere() {
     for (i, p) in pts.iter().enumerate() {
         let y = proj.embedded().point(p);
         let start = (i * 37 % s.mesh().n_vertices()) as u32;
-        let v = s.local_search().walk(&y, start);
+        let v = proj.walk(&y, start);
         let near = s.mesh().triangles[p.face as usize].contains(&v);
-        let hit = s.local_search().search(&y, start);
+        let hit = proj.project_with(&y, start, None, SearchGoal::FirstHit);
         // On a convex-ish sphere the walk reaches a corner of the face (or a neighbour).
         if near {
             n_near += 1;
             let h = hit.expect("a point on the surface has a projection next to it");
+            assert_eq!(h.path, ProjectionPath::Local);
             assert!(h.distance < 1e-6, "{}", h.distance);
             assert!((h.point.position(s.mesh()) - p.position(s.mesh())).norm() < 1e-6);
         }
@@ -524,16 +525,15 @@ fn nearest_vertex_second_chance() {
                 })
                 .unwrap();
             assert_eq!(
-                s.local_search().nearest_vertex(&y) as usize,
+                proj.nearest_vertex(&y) as usize,
                 brute,
                 "{i} {scale}"
             );
         }
         let yhat = proj.embedded().point(p);
-        let h = s
-            .local_search()
-            .search_at(&yhat, s.local_search().nearest_vertex(&yhat))
+        let h = proj
+            .project_with(&yhat, proj.nearest_vertex(&yhat), None, SearchGoal::FirstHit)
             .unwrap();
-        assert!(h.distance < 1e-6);
+        assert!(h.distance < 1e-6 && h.path == ProjectionPath::Local);
     }
 }
