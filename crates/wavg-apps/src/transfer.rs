@@ -316,7 +316,9 @@ impl Solve<'_> {
                     .count();
             } else {
                 // `Par::Rayon` always starts.
-                let _ = self.target.inverse_batch_into(chunk, &mut weights, Par::Rayon);
+                let _ = self
+                    .target
+                    .inverse_batch_into(chunk, &mut weights, Par::Rayon);
             }
             let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
             let found = self.source.forward_batch(&rows, &fwd);

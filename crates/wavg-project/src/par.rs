@@ -168,8 +168,10 @@ mod tests {
         let mut want = None;
         for par in [Par::Seq, Par::Rayon, three] {
             let mut out = vec![u64::MAX];
-            par.map_chunks(&items, 37, &mut out, |c| c.iter().map(|&x| u64::from(x) * 2).collect())
-                .unwrap();
+            par.map_chunks(&items, 37, &mut out, |c| {
+                c.iter().map(|&x| u64::from(x) * 2).collect()
+            })
+            .unwrap();
             let mut sorted = items.clone();
             par.sort(&mut sorted).unwrap();
             let got = (out, sorted);

@@ -41,7 +41,7 @@ pub struct ForwardOptions {
     /// Reject (default) or normalise weights that do not sum to 1.
     pub normalization: Normalization,
     /// The previous answer, if any: the search starts from its nearest corner instead of
-    /// the highest-weight anchor.
+    /// the highest-weight anchor, and [`SearchMode::Fast`] tries its face first.
     pub warm_start: Option<SurfacePoint>,
 }
 
@@ -268,7 +268,11 @@ impl Solver {
     /// The part of the forward problem that reads the weights: validation, the average and
     /// the start vertex. Split off so a batch can read every weight row once, in input
     /// order, and then search in the order of the averages' positions.
-    pub(crate) fn prepare(&self, weights: &[f64], opts: &ForwardOptions) -> Result<Prepared, SolveError> {
+    pub(crate) fn prepare(
+        &self,
+        weights: &[f64],
+        opts: &ForwardOptions,
+    ) -> Result<Prepared, SolveError> {
         let ybar = self.average(weights, opts.normalization)?;
         let mut hint = None;
         let start = match (opts.mode, opts.warm_start) {

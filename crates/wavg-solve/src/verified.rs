@@ -15,10 +15,10 @@
 
 use wavg_mesh::SurfacePoint;
 
+use crate::batch::BatchWeights;
 use crate::error::SolveError;
 use crate::kernel::AnchorCoords;
 use crate::points::check_point;
-use crate::batch::BatchWeights;
 use crate::solver::{ForwardOptions, ForwardResult, Solver};
 use crate::{DIM, Mat2x8, Vec8};
 

@@ -116,6 +116,5 @@ pub fn with_threads<T: Send>(
 ) -> Result<T, CliError> {
     let par = wavg::Par::from_threads(threads)
         .map_err(|_| CliError::input("--threads must be at least 1"))?;
-    par.install(f)
-        .map_err(|e| CliError::failure(one_line(&e)))
+    par.install(f).map_err(|e| CliError::failure(one_line(&e)))
 }

@@ -12,6 +12,10 @@ pub const LOCAL_BUDGET: usize = 96;
 /// the vertex search.
 pub const FACE_WALK: usize = 4;
 
+/// How far outside a warm start's hint face (in barycentric units) the query's
+/// Euclidean projection onto its plane may fall for the face walk to be tried.
+const HINT_MARGIN: f64 = 0.5;
+
 /// What the caller wants from [`Projector::project_with`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SearchGoal {
@@ -251,10 +255,29 @@ impl Projector {
     /// curved surface can have several); the full search decides then.
     pub(super) fn face_walk(&self, y: &Vec8, mut f: FaceId) -> Option<Best> {
         let topo = self.emb.mesh().topology();
+        // Newton's method is worth trying only when the query is over or next to the hint:
+        // the Euclidean projection onto its plane falls inside or close outside.
+        let [a, b, c] = self.corners(f);
+        let (e1, e2, r) = (b - a, c - a, y - a);
+        let (aa, ab, bb, d, e) = (
+            e1.dot(&e1),
+            e1.dot(&e2),
+            e2.dot(&e2),
+            e1.dot(&r),
+            e2.dot(&r),
+        );
+        let det = aa * bb - ab * ab;
+        let (l1, l2) = ((bb * d - ab * e) / det, (aa * e - ab * d) / det);
+        if !(l1.min(l2).min(1.0 - l1 - l2) >= -HINT_MARGIN) {
+            return None;
+        }
         for _ in 0..FACE_WALK {
             match self.try_face_or_exit(f, y) {
                 Ok(b) => {
-                    let near = self.corners(f).iter().all(|c| b.d2 <= (c - y).norm_squared());
+                    let near = self
+                        .corners(f)
+                        .iter()
+                        .all(|c| b.d2 <= (c - y).norm_squared());
                     return near.then_some(b);
                 }
                 Err(Some(k)) => f = topo.face_neighbors(f)[(k + 1) % 3],
