@@ -91,6 +91,32 @@ impl Par {
         }
     }
 
+    /// `out` becomes `[f(0), f(1), .., f(n - 1)]`, computed in parallel (runs of at least
+    /// `min_len` indices per task) unless [`Par::Seq`]. Written in place, no intermediate
+    /// lists.
+    pub fn map_range<T: Send>(
+        self,
+        n: usize,
+        min_len: usize,
+        out: &mut Vec<T>,
+        f: impl Fn(usize) -> T + Sync + Send,
+    ) -> Result<(), ProjectError> {
+        match self {
+            Par::Seq => {
+                out.clear();
+                out.extend((0..n).map(f));
+                Ok(())
+            }
+            _ => self.install(|| {
+                (0..n)
+                    .into_par_iter()
+                    .with_min_len(min_len.max(1))
+                    .map(f)
+                    .collect_into_vec(out)
+            }),
+        }
+    }
+
     /// [`Par::map_chunks`] over `items` and, in step, the chunks of `chunk_a` items of
     /// `a` that `f` may write (the rows a chunk of queries fills in place).
     pub fn zip_chunks_mut<A: Send, I: Sync, T: Send>(
@@ -174,6 +200,9 @@ mod tests {
             .unwrap();
             let mut sorted = items.clone();
             par.sort(&mut sorted).unwrap();
+            let mut squares = vec![7];
+            par.map_range(1000, 16, &mut squares, |i| i * i).unwrap();
+            assert!(squares.iter().enumerate().all(|(i, &x)| x == i * i) && squares.len() == 1000);
             let got = (out, sorted);
             assert_eq!(got.0.len(), 1001);
             assert_eq!(*want.get_or_insert_with(|| got.clone()), got);

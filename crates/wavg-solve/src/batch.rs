@@ -62,21 +62,16 @@ impl Solver {
             pos,
         } = scratch;
         // A failed validation is the query's answer (sorted last).
-        prepared.clear();
-        par.map_chunks(weights, PREPARE_CHUNK, prepared, |c| {
-            c.iter()
-                .map(|w| {
-                    let p = self.prepare(w.as_ref(), opts);
-                    let key = match &p {
-                        Ok(p) => u64::from(wavg_project::internal::locality_key(
-                            self.projector(),
-                            &p.ybar,
-                        )),
-                        Err(_) => u64::MAX,
-                    };
-                    (key, p)
-                })
-                .collect()
+        par.map_range(weights.len(), PREPARE_CHUNK, prepared, |i| {
+            let p = self.prepare(weights[i].as_ref(), opts);
+            let key = match &p {
+                Ok(p) => u64::from(wavg_project::internal::locality_key(
+                    self.projector(),
+                    &p.ybar,
+                )),
+                Err(_) => u64::MAX,
+            };
+            (key, p)
         })?;
         order.clear();
         order.extend(prepared.iter().enumerate().map(|(i, p)| (p.0, i as u32)));
@@ -84,19 +79,14 @@ impl Solver {
         // In this order the prepared queries are read at random: each query first waits
         // for its record, so the record two queries ahead is requested early.
         const AHEAD: usize = 2;
-        done.clear();
-        par.map_chunks(order, SEARCH_CHUNK, done, |c| {
-            (0..c.len())
-                .map(|k| {
-                    if let Some(&(_, j)) = c.get(k + AHEAD) {
-                        wavg_project::internal::prefetch(&prepared[j as usize]);
-                    }
-                    match &prepared[c[k].1 as usize].1 {
-                        Ok(p) => self.forward_prepared(p, opts),
-                        Err(e) => Err(e.clone()),
-                    }
-                })
-                .collect()
+        par.map_range(order.len(), SEARCH_CHUNK, done, |k| {
+            if let Some(&(_, j)) = order.get(k + AHEAD) {
+                wavg_project::internal::prefetch(&prepared[j as usize]);
+            }
+            match &prepared[order[k].1 as usize].1 {
+                Ok(p) => self.forward_prepared(p, opts),
+                Err(e) => Err(e.clone()),
+            }
         })?;
         // Back in input order: one gather, no intermediate lists.
         pos.clear();
@@ -104,10 +94,7 @@ impl Solver {
         for (k, &(_, i)) in order.iter().enumerate() {
             pos[i as usize] = k as u32;
         }
-        out.clear();
-        par.map_chunks(pos, 4096, out, |c| {
-            c.iter().map(|&k| done[k as usize].clone()).collect()
-        })?;
+        par.map_range(pos.len(), 4096, out, |i| done[pos[i] as usize].clone())?;
         Ok(())
     }
 

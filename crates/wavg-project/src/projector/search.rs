@@ -14,7 +14,7 @@ pub const FACE_WALK: usize = 4;
 
 /// How far outside a warm start's hint face (in barycentric units) the query's
 /// Euclidean projection onto its plane may fall for the face walk to be tried.
-const HINT_MARGIN: f64 = 0.5;
+const HINT_MARGIN: f64 = 0.1;
 
 /// What the caller wants from [`Projector::project_with`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
