@@ -13,8 +13,9 @@ pub const LOCAL_BUDGET: usize = 96;
 pub const FACE_WALK: usize = 4;
 
 /// How far outside a warm start's hint face (in barycentric units) the query's
-/// Euclidean projection onto its plane may fall for the face walk to be tried.
-const HINT_MARGIN: f64 = 0.1;
+/// Euclidean projection onto its plane may fall for the face walk to be tried: none, so a
+/// hint that does not hold the query costs a few dot products, not Newton solves.
+const HINT_MARGIN: f64 = 0.0;
 
 /// What the caller wants from [`Projector::project_with`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -255,8 +256,8 @@ impl Projector {
     /// curved surface can have several); the full search decides then.
     pub(super) fn face_walk(&self, y: &Vec8, mut f: FaceId) -> Option<Best> {
         let topo = self.emb.mesh().topology();
-        // Newton's method is worth trying only when the query is over or next to the hint:
-        // the Euclidean projection onto its plane falls inside or close outside.
+        // Newton's method is worth trying only when the query is over the hint: the
+        // Euclidean projection onto its plane falls inside.
         let [a, b, c] = self.corners(f);
         let (e1, e2, r) = (b - a, c - a, y - a);
         let (aa, ab, bb, d, e) = (
