@@ -315,8 +315,8 @@ impl Projector {
 
     /// The projection of `y` that `goal` asks for, searching from vertex `start`. With a
     /// `hint` face (a warm start: the previous answer's face when the query moved a
-    /// little), the hint and up to [`FACE_WALK`] faces Newton's method exits into are
-    /// tried first: for [`SearchGoal::FirstHit`] a valid projection there is the answer;
+    /// little), if the query lies over it, the hint and up to [`FACE_WALK`] faces in all
+    /// that Newton's method exits into are tried first: for [`SearchGoal::FirstHit`] a valid projection there is the answer;
     /// for [`SearchGoal::Closest`] only one at (numerically) zero distance is, since
     /// anything else still needs certifying.
     ///
