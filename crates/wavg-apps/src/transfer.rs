@@ -10,7 +10,7 @@
 use nalgebra::Vector2;
 use rayon::prelude::*;
 use wavg_mesh::{SurfacePoint, TexCoords, TriMesh};
-use wavg_solve::{BatchWeights, ForwardOptions, RoundTrip, Solver};
+use wavg_solve::{BatchWeights, ForwardOptions, Par, RoundTrip, Solver};
 
 use crate::{AppError, Image};
 
@@ -315,7 +315,10 @@ impl Solve<'_> {
                     .filter(|t| matches!(t, Ok(RoundTrip::NotReached)))
                     .count();
             } else {
-                self.target.inverse_batch_into(chunk, &mut weights);
+                // `Par::Rayon` always starts.
+                let _ = self
+                    .target
+                    .inverse_batch_into(chunk, &mut weights, Par::Rayon);
             }
             let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
             let found = self.source.forward_batch(&rows, &fwd);

@@ -22,7 +22,9 @@ use std::time::Instant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use wavg::mesh::{SurfacePoint, ValidMesh, VertexId};
-use wavg::project::{EmbeddedMesh, Projection, ProjectionPath, Projector, Vec8};
+use wavg::project::{
+    EmbeddedMesh, Par, ProjectScratch, Projection, ProjectionPath, Projector, Vec8,
+};
 
 use crate::CliError;
 use crate::common::load_valid;
@@ -164,7 +166,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let paths = |v: &[Result<Projection, _>]| {
             let mut n = [0usize; 3];
             for r in v.iter().flatten() {
-                n[(r.path as usize).min(2)] += 1;
+                n[match r.path {
+                    ProjectionPath::Certified | ProjectionPath::Local => 0,
+                    ProjectionPath::Fallback => 1,
+                    _ => 2,
+                }] += 1;
             }
             n
         };
@@ -232,6 +238,7 @@ struct Timing {
 /// shown alongside in the table.
 fn timed(p: &Projector, ys: &[Vec8], starts: &[VertexId], batch: bool) -> (Vec<Answer>, Timing) {
     let mut out = Vec::with_capacity(ys.len());
+    let mut scratch = ProjectScratch::default();
     let mut best = Timing {
         cpu_us: f64::INFINITY,
         wall_us: f64::INFINITY,
@@ -242,7 +249,8 @@ fn timed(p: &Projector, ys: &[Vec8], starts: &[VertexId], batch: bool) -> (Vec<A
         let c0 = crate::common::cpu_seconds(true);
         let t = Instant::now();
         if batch {
-            out = p.project_batch(ys, starts);
+            // On this thread (`Par::Seq` never fails).
+            let _ = p.project_batch_into(ys, starts, &mut scratch, &mut out, Par::Seq);
         } else {
             for (y, &s) in ys.iter().zip(starts) {
                 out.push(p.project(y, s));

@@ -81,7 +81,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 },
             )
         } else {
-            solver.inverse_batch_into(&points, &mut weights);
+            // `Par::Rayon` always starts.
+            let _ = solver.inverse_batch_into(&points, &mut weights, wavg::Par::Rayon);
             let rows: Vec<usize> = (0..weights.len()).collect();
             sink.write(
                 &rows,

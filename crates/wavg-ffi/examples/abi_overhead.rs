@@ -210,7 +210,9 @@ fn main() {
     );
     report(
         "inverse",
-        &mut || solver.inverse_batch_into(&points, &mut rust_batch),
+        &mut || {
+            let _ = solver.inverse_batch_into(&points, &mut rust_batch, wavg::solve::Par::Rayon);
+        },
         // SAFETY: as above.
         &mut || unsafe {
             inverse(

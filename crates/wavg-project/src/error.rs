@@ -1,6 +1,6 @@
 //! Errors of the projection crate.
 
-use wavg_mesh::VertexId;
+use wavg_mesh::{FaceId, VertexId};
 
 /// Why an embedding could not be used or a point could not be projected.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -33,6 +33,20 @@ pub enum ProjectError {
         /// Vertices of the mesh.
         n_vertices: usize,
     },
+    /// A hint face is not a face of the mesh.
+    #[error("hint face {face} is out of range (the mesh has {n_faces} faces)")]
+    FaceOutOfRange {
+        /// The given face.
+        face: FaceId,
+        /// Faces of the mesh.
+        n_faces: usize,
+    },
+    /// A thread count of zero.
+    #[error("the thread count must be at least 1")]
+    InvalidThreads,
+    /// The threads of a batch could not start.
+    #[error("{0}")]
+    ThreadPool(String),
     /// No triangle of the mesh has a valid Phong projection of the point.
     #[error("no triangle has a valid Phong projection of the point")]
     NoProjection,

@@ -4,7 +4,8 @@
 //! per-vertex tangent frames ([`vertex_frames`]), per-triangle interpolated tangent planes
 //! `Psi` ([`Projector::psi`]), and a [`Projector`] that finds the closest valid Phong projection of a
 //! point of R^8 onto the mesh: a fast local search that is certified against a bounding
-//! volume hierarchy, an exhaustive (branch and bound) search, a literal brute force, and
+//! volume hierarchy (or, for the paper's forward problem, returns its first valid hit:
+//! [`SearchGoal`]), an exhaustive (branch and bound) search, a literal brute force, and
 //! the Euclidean closest point as a baseline.
 //!
 //! ```
@@ -39,12 +40,18 @@ mod euclid;
 mod frames;
 mod hugepage;
 mod ort;
+mod par;
 mod projector;
 mod triangle;
 
 // The embedded mesh and its projector.
 pub use embedded::EmbeddedMesh;
-pub use projector::{Projection, ProjectionPath, Projector};
+pub use projector::{
+    FACE_WALK, LOCAL_BUDGET, ProjectScratch, Projection, ProjectionPath, Projector, SearchGoal,
+};
+
+// How batches run.
+pub use par::Par;
 
 // Tangent frames and geometry in R^8.
 pub use euclid::closest_point_barycentric;

@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use proptest::prelude::*;
 use wavg_mesh::{NONE, SurfacePoint};
-use wavg_project::{ProjectError, ProjectionPath};
+use wavg_project::{ProjectError, ProjectionPath, SearchGoal};
 
 fn fixture() -> impl Strategy<Value = usize> {
     0..fixtures().len()
@@ -147,7 +147,7 @@ proptest! {
         let brute = fx.proj.project_brute_force(&y);
         match (&fast, &exh, &brute) {
             (Ok(x), Ok(e), Ok(bf)) => {
-                prop_assert!(x.path == ProjectionPath::Local || x.path == ProjectionPath::Fallback);
+                prop_assert!(x.path == ProjectionPath::Certified || x.path == ProjectionPath::Fallback);
                 for other in [e, bf] {
                     let same = (fx.emb.point(&x.point) - fx.emb.point(&other.point)).norm() <= 1e-6 * fx.mean_edge;
                     let tie = (x.distance - other.distance).abs() <= 1e-9 * (other.distance + fx.mean_edge);
@@ -160,6 +160,44 @@ proptest! {
     }
 
     /// `dPsi/dxi` is the derivative of `Psi` (central differences along the triangle).
+    /// The two goals of the one local search: the first hit (the forward problem's fast
+    /// mode, with or without a warm-start face) is a valid Phong projection, never closer
+    /// than the brute force's; the closest goal equals the brute force.
+    #[test]
+    fn first_hit_is_valid_and_closest_is_the_brute_force(
+        fx in fixture(), f in 0.0f64..1.0, a in 0.0f64..1.0, b in 0.0f64..1.0,
+        s in 0.0f64..1.0, off in 0.0f64..1.5, seed in 0u64..10000, warm in proptest::bool::ANY,
+    ) {
+        let fx = &fixtures()[fx];
+        let p = fx.point(f, a, b);
+        let dir = normal_to(&wavg_project::Mat2x8::zeros(), seed);
+        let y = fx.emb.point(&p) + dir * (off * fx.mean_edge);
+        let hint = warm.then_some(p.face);
+        let first = fx.proj.project_with(&y, fx.vertex(s), hint, SearchGoal::FirstHit);
+        let closest = fx.proj.project_with(&y, fx.vertex(s), None, SearchGoal::Closest);
+        let brute = fx.proj.project_brute_force(&y);
+        match (&first, &closest, &brute) {
+            (Ok(x), Ok(c), Ok(bf)) => {
+                prop_assert!(x.path == ProjectionPath::Local || x.path == ProjectionPath::Fallback);
+                prop_assert!(c.path == ProjectionPath::Certified || c.path == ProjectionPath::Fallback);
+                // Valid: barycentrics on the triangle, the residual normal to Psi there,
+                // and Newton on that face alone finds the same point.
+                let bary = x.point.bary;
+                prop_assert!(bary.iter().all(|&t| t >= 0.0) && (bary.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+                let r = fx.proj.psi(&x.point) * (y - fx.emb.point(&x.point));
+                prop_assert!(r.norm() <= 1e-6 * (x.distance + fx.mean_edge), "{}: residual {}", fx.name, r.norm());
+                let again = fx.proj.project_onto_face_with_distance(&y, x.point.face);
+                prop_assert!(again.is_some_and(|(_, d)| (d - x.distance).abs() <= 1e-9 * (d + fx.mean_edge)));
+                prop_assert!(x.distance >= bf.distance - 1e-9 * (bf.distance + fx.mean_edge));
+                let same = (fx.emb.point(&c.point) - fx.emb.point(&bf.point)).norm() <= 1e-6 * fx.mean_edge;
+                let tie = (c.distance - bf.distance).abs() <= 1e-9 * (bf.distance + fx.mean_edge);
+                prop_assert!(same || tie, "{}: closest {:?} vs brute force {:?}", fx.name, c, bf);
+            }
+            (Err(ProjectError::NoProjection), Err(ProjectError::NoProjection), Err(ProjectError::NoProjection)) => {}
+            _ => prop_assert!(false, "{}: {:?} / {:?} / {:?}", fx.name, first, closest, brute),
+        }
+    }
+
     #[test]
     fn psi_derivative_matches_finite_differences(fx in fixture(), f in 0.0f64..1.0, a in 0.05f64..0.9, b in 0.05f64..0.9) {
         let fx = &fixtures()[fx];

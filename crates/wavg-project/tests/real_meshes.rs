@@ -67,7 +67,8 @@ fn check(rel: &str, queries: usize, brute: usize) {
     }
 }
 
-/// `project_batch` gives exactly `project`'s answers, on- and off-surface, including
+/// `project_batch` (and `project_batch_into` for any parallelism) gives exactly `project`'s
+/// answers, on- and off-surface, including
 /// per-query errors (a NaN query, a start out of range) inside a group.
 fn batch_equals_single(rel: &str, queries: usize) {
     let Some(path) = data::require_data_file("wavg-project batches", rel) else {
@@ -102,6 +103,15 @@ fn batch_equals_single(rel: &str, queries: usize) {
         assert_eq!(b, &proj.project(y, s), "{rel}: query {k}");
     }
     assert!(batch[5].is_err() && batch[13].is_err());
+    // The explicit layer, for every parallelism, with its buffers reused.
+    let mut scratch = wavg_project::ProjectScratch::default();
+    let mut out = Vec::new();
+    let three = wavg_project::Par::Threads(std::num::NonZeroUsize::new(3).unwrap());
+    for par in [wavg_project::Par::Seq, three, wavg_project::Par::Rayon] {
+        proj.project_batch_into(&ys, &starts, &mut scratch, &mut out, par)
+            .unwrap();
+        assert_eq!(out, batch, "{rel}: {par:?}");
+    }
 }
 
 #[test]
@@ -155,6 +165,19 @@ fn embedding_errors_are_typed() {
         p.project(&z, n as u32),
         Err(wavg_project::ProjectError::StartOutOfRange { .. })
     ));
+    let nf = p.embedded().mesh().n_faces() as u32;
+    for goal in [
+        wavg_project::SearchGoal::Closest,
+        wavg_project::SearchGoal::FirstHit,
+    ] {
+        assert_eq!(
+            p.project_with(&z, 0, Some(nf), goal),
+            Err(wavg_project::ProjectError::FaceOutOfRange {
+                face: nf,
+                n_faces: nf as usize
+            })
+        );
+    }
     // The centre of a sphere has no Phong projection only by accident; far away it has one.
     let far = wavg_project::Vec8::from_fn(|i, _| if i == 0 { 10.0 } else { 0.0 });
     let r = p.project(&far, 0).unwrap();

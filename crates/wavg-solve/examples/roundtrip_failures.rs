@@ -195,7 +195,7 @@ fn main() {
         let amax = (0..w.len())
             .max_by(|&a, &b| w[a].total_cmp(&w[b]).then(b.cmp(&a)))
             .unwrap();
-        let v0 = solver.local_search().walk(&ybar, anchors[amax]);
+        let v0 = proj.walk(&ybar, anchors[amax]);
         let paper = paper_search(&proj, &ybar, v0);
         let paper_ok = paper.is_some_and(|q| okf(&q));
         n_fail_fast += !fast_ok as usize;

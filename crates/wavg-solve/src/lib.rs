@@ -34,19 +34,20 @@
 #![forbid(unsafe_code)]
 
 mod anchors;
+mod batch;
 mod error;
 mod kernel;
 mod points;
 pub mod roundtrip;
 pub mod sampling;
-mod search;
 mod simd;
 mod solver;
 mod verified;
 mod weights;
 
 // The solver and its problems.
-pub use solver::{BatchWeights, ForwardOptions, ForwardResult, SearchMode, Solver, Start};
+pub use batch::{BatchWeights, ForwardScratch};
+pub use solver::{ForwardOptions, ForwardResult, SearchMode, Solver, Start};
 pub use verified::{DEFAULT_TOLERANCE, PENALTY_LADDER, RoundTrip, Verified};
 
 // Anchors, points and weights.
@@ -63,18 +64,19 @@ pub use roundtrip::{
 };
 
 // The embedded mesh and projector the solver works on.
-pub use wavg_project::{DIM, EmbeddedMesh, Mat2x8, ProjectError, ProjectionPath, Projector, Vec8};
+pub use wavg_project::{
+    DIM, EmbeddedMesh, Mat2x8, Par, ProjectError, ProjectionPath, Projector, SearchGoal, Vec8,
+};
 
 // Errors.
 pub use error::SolveError;
 
-/// The forward problem's local search and the verified inverse's penalised weights, for
-/// this workspace's tests, experiments and C ABI.
+/// The verified inverse's penalised weights, for this workspace's tests, experiments and
+/// C ABI.
 ///
 /// **Unstable**: not part of the public API; anything here may change or disappear in any
 /// release.
 #[doc(hidden)]
 pub mod internal {
-    pub use crate::search::{LOCAL_BUDGET, LocalHit, LocalSearch};
     pub use crate::verified::penalized_weights;
 }

@@ -110,7 +110,7 @@ pub struct RoundTripReport {
     pub roundtrip_err_p99: f64,
     /// Fraction of queries whose weights have some weight below [`NEGATIVE_WEIGHT`].
     pub negative_weight_fraction: f64,
-    /// Forward answers found by the local search. Not serialised.
+    /// Forward answers found by the local search (certified or not). Not serialised.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub forward_local: usize,
     /// Forward answers found by the certified fallback. Not serialised.
@@ -200,7 +200,10 @@ pub fn round_trip_at(
     // The result buffers are reused across the repeats, as an application would.
     let mut weights = BatchWeights::default();
     let ((t_inv, ()), cpu_inv) = with_cpu(opts, || {
-        best_of(repeat, || solver.inverse_batch_into(points, &mut weights))
+        best_of(repeat, || {
+            // `Par::Rayon` always starts.
+            let _ = solver.inverse_batch_into(points, &mut weights, wavg_project::Par::Rayon);
+        })
     });
     // Failed inverses get a placeholder that fails validation, so forward reports it.
     let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
@@ -232,9 +235,9 @@ pub fn round_trip_at(
         .iter()
         .filter(|r| r.is_ok_and(|w| w.iter().any(|&x| x < NEGATIVE_WEIGHT)))
         .count();
-    let path_count = |p: ProjectionPath| {
+    let path_count = |p: &[ProjectionPath]| {
         fwd.iter()
-            .filter(|r| r.as_ref().is_ok_and(|r| r.path == p))
+            .filter(|r| r.as_ref().is_ok_and(|r| p.contains(&r.path)))
             .count()
     };
     let verified = if opts.verified {
@@ -254,8 +257,8 @@ pub fn round_trip_at(
         roundtrip_err_p50: quantile(&errs, 0.5),
         roundtrip_err_p99: quantile(&errs, 0.99),
         negative_weight_fraction: negative as f64 / n as f64,
-        forward_local: path_count(ProjectionPath::Local),
-        forward_fallback: path_count(ProjectionPath::Fallback),
+        forward_local: path_count(&[ProjectionPath::Local, ProjectionPath::Certified]),
+        forward_fallback: path_count(&[ProjectionPath::Fallback]),
         forward_failed: fwd.iter().filter(|r| r.is_err()).count(),
         inverse_failed: weights.iter().filter(|r| r.is_err()).count(),
         vertices: mesh.n_vertices(),

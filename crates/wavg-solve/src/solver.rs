@@ -4,34 +4,30 @@
 use std::sync::Arc;
 
 use nalgebra::Vector3;
-use rayon::prelude::*;
-use wavg_mesh::{SurfacePoint, VertexId};
-use wavg_project::{ProjectError, Projection, ProjectionPath};
+use wavg_mesh::{FaceId, SurfacePoint, VertexId};
+use wavg_project::{ProjectError, ProjectionPath, SearchGoal};
 
 use crate::anchors::AnchorSet;
 use crate::error::SolveError;
 use crate::kernel::{DEFAULT_GAMMA, InverseScratch, inverse_weights};
 use crate::points::{check_point, nearest_corner};
-use crate::search::LocalSearch;
 use crate::weights::{Normalization, validate_weights};
 use crate::{Mat2x8, Projector, Vec8};
-
-/// Faces [`Solver::forward_embedded`] walks through from its start face (following
-/// Newton's exits) before the full local search.
-pub(crate) const FACE_WALK: usize = 4;
 
 /// How the forward problem searches for the projection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SearchMode {
-    /// The paper's method (the local search): greedy walk from a start vertex, then a
-    /// breadth-first search over triangles; the first triangle holding a valid projection
-    /// wins. When none is found within `LOCAL_BUDGET` (96) triangles, the same
-    /// search runs once more from the vertex nearest to the average; if that fails too, the
-    /// projector's certified search is used (reported as [`ProjectionPath::Fallback`]).
+    /// The paper's method: the projector's local search for the first valid projection
+    /// ([`SearchGoal::FirstHit`]): greedy walk from a start vertex, then a breadth-first
+    /// search over triangles; with a warm start, the previous answer's face and the faces
+    /// Newton's method exits into are tried first. Answers are
+    /// [`ProjectionPath::Local`], or [`ProjectionPath::Fallback`] when the global search
+    /// had to answer.
     #[default]
     Fast,
-    /// The projector's fast path certified against its bounding volume hierarchy: always
-    /// the closest valid projection (slower when the average lies far off the surface).
+    /// The projector's local search certified against its bounding volume hierarchy
+    /// ([`SearchGoal::Closest`]): always the closest valid projection (slower when the
+    /// average lies far off the surface).
     Certified,
     /// Exhaustive search over all triangles for the closest valid projection.
     Exact,
@@ -45,7 +41,7 @@ pub struct ForwardOptions {
     /// Reject (default) or normalise weights that do not sum to 1.
     pub normalization: Normalization,
     /// The previous answer, if any: the search starts from its nearest corner instead of
-    /// the highest-weight anchor.
+    /// the highest-weight anchor, and [`SearchMode::Fast`] tries its face first.
     pub warm_start: Option<SurfacePoint>,
 }
 
@@ -77,9 +73,11 @@ pub enum Start {
 
 /// A validated forward query: the weighted average and where its search starts.
 #[derive(Clone, Copy, Debug)]
-struct Prepared {
-    ybar: Vec8,
+pub(crate) struct Prepared {
+    pub(crate) ybar: Vec8,
     start: Start,
+    /// The warm start's face, tried first by the fast search.
+    hint: Option<FaceId>,
 }
 
 /// Answer of the forward problem.
@@ -116,7 +114,6 @@ pub struct ForwardResult {
 #[derive(Clone)]
 pub struct Solver {
     projector: Arc<Projector>,
-    local: Arc<LocalSearch>,
     anchors: AnchorSet,
     gamma: f64,
     /// Mean 3-D edge length of the mesh (the unit of round-trip tolerances).
@@ -131,7 +128,6 @@ impl Solver {
     ) -> Result<Self, SolveError> {
         let set = AnchorSet::with_anchors(projector.embedded().clone(), anchors)?;
         Ok(Self {
-            local: Arc::new(LocalSearch::new(projector.clone())),
             mean_edge: wavg_mesh::geometry::mean_edge_length(projector.embedded().mesh()),
             projector,
             anchors: set,
@@ -150,7 +146,6 @@ impl Solver {
             ));
         }
         Ok(Self {
-            local: Arc::new(LocalSearch::new(projector.clone())),
             mean_edge: wavg_mesh::geometry::mean_edge_length(projector.embedded().mesh()),
             projector,
             anchors,
@@ -192,13 +187,6 @@ impl Solver {
     /// The projector.
     pub fn projector(&self) -> &Arc<Projector> {
         &self.projector
-    }
-
-    /// The local search used by [`SearchMode::Fast`] (for tests and experiments;
-    /// **unstable**, like the crate's `internal` module).
-    #[doc(hidden)]
-    pub fn local_search(&self) -> &LocalSearch {
-        &self.local
     }
 
     /// The mesh.
@@ -245,10 +233,11 @@ impl Solver {
     /// query would cost more than the query) onto the surface. The search starts at the
     /// nearest corner of `opts.warm_start` when given, else of `near` (a point expected
     /// close to the answer, e.g. the highest-weight input point). With a warm start in
-    /// [`SearchMode::Fast`], its face is tried first, then up to four faces that
-    /// Newton's method exits into (a previous answer's face usually holds the new one when
-    /// the inputs moved a little), before that search. The solver's own anchors
-    /// are not used. A non-finite `ybar` is [`SolveError::InvalidParameter`].
+    /// [`SearchMode::Fast`], its face is tried first, then up to
+    /// [`wavg_project::FACE_WALK`] faces in all that Newton's method exits into (a
+    /// previous answer's face usually holds the new one when the inputs moved a little),
+    /// before that search. The solver's own anchors are not used. A non-finite `ybar` is
+    /// [`SolveError::InvalidParameter`].
     pub fn forward_embedded(
         &self,
         ybar: &Vec8,
@@ -260,45 +249,38 @@ impl Solver {
                 "the averaged point is not finite".into(),
             ));
         }
-        let start = match opts.mode {
-            SearchMode::Exact => Start::Exhaustive,
+        let (start, hint) = match opts.mode {
+            SearchMode::Exact => (Start::Exhaustive, None),
             _ => {
                 let p = check_point(self.mesh(), &opts.warm_start.unwrap_or(*near))?;
-                let start = Start::Warm(nearest_corner(self.mesh(), &p));
-                if opts.mode == SearchMode::Fast && opts.warm_start.is_some() {
-                    let mut f = p.face;
-                    for _ in 0..FACE_WALK {
-                        match self.projector.project_onto_face_or_exit(ybar, f) {
-                            Ok((xi, distance)) => {
-                                let point = SurfacePoint::new(f, xi);
-                                return Ok(ForwardResult {
-                                    point,
-                                    position: point.position(self.mesh()),
-                                    distance,
-                                    path: ProjectionPath::Local,
-                                    start,
-                                });
-                            }
-                            Err(g) if g != wavg_mesh::NONE => f = g,
-                            Err(_) => break,
-                        }
-                    }
-                }
-                start
+                let hint = opts.warm_start.map(|_| p.face);
+                (Start::Warm(nearest_corner(self.mesh(), &p)), hint)
             }
         };
-        self.forward_prepared(&Prepared { ybar: *ybar, start }, opts)
+        let prepared = Prepared {
+            ybar: *ybar,
+            start,
+            hint,
+        };
+        self.forward_prepared(&prepared, opts)
     }
 
     /// The part of the forward problem that reads the weights: validation, the average and
     /// the start vertex. Split off so a batch can read every weight row once, in input
     /// order, and then search in the order of the averages' positions.
-    fn prepare(&self, weights: &[f64], opts: &ForwardOptions) -> Result<Prepared, SolveError> {
+    pub(crate) fn prepare(
+        &self,
+        weights: &[f64],
+        opts: &ForwardOptions,
+    ) -> Result<Prepared, SolveError> {
         let ybar = self.average(weights, opts.normalization)?;
+        let mut hint = None;
         let start = match (opts.mode, opts.warm_start) {
             (SearchMode::Exact, _) => Start::Exhaustive,
             (_, Some(p)) => {
-                Start::Warm(nearest_corner(self.mesh(), &check_point(self.mesh(), &p)?))
+                let p = check_point(self.mesh(), &p)?;
+                hint = Some(p.face);
+                Start::Warm(nearest_corner(self.mesh(), &p))
             }
             (_, None) => {
                 // Highest weight; ties to the lowest index.
@@ -314,48 +296,26 @@ impl Solver {
                 }
             }
         };
-        Ok(Prepared { ybar, start })
+        Ok(Prepared { ybar, start, hint })
     }
 
     /// The search part of [`Solver::forward`], from a prepared average and start.
-    fn forward_prepared(
+    pub(crate) fn forward_prepared(
         &self,
         prepared: &Prepared,
         opts: &ForwardOptions,
     ) -> Result<ForwardResult, SolveError> {
-        let Prepared { ybar, start } = *prepared;
+        let Prepared { ybar, start, hint } = *prepared;
         let mesh = self.mesh();
         let proj = match start {
             Start::Exhaustive => self.projector.project_exhaustive(&ybar),
-            Start::Warm(v) | Start::HighestWeight { vertex: v, .. } => {
-                let found = match opts.mode {
-                    // The paper's search; when the walk ends in a local minimum with no
-                    // projection nearby, once more from the nearest vertex (much cheaper than
-                    // the certified global search, and usually its answer).
-                    SearchMode::Fast => self
-                        .local
-                        .search(&ybar, v)
-                        .or_else(|| {
-                            let u = self.local.nearest_vertex(&ybar);
-                            self.local.search_at(&ybar, u)
-                        })
-                        .map(|h| Projection {
-                            point: h.point,
-                            distance: h.distance,
-                            path: ProjectionPath::Local,
-                        }),
-                    _ => None,
-                };
-                match found {
-                    Some(p) => Ok(p),
-                    None => self.projector.project(&ybar, v).map(|mut p| {
-                        if opts.mode == SearchMode::Fast {
-                            p.path = ProjectionPath::Fallback;
-                        }
-                        p
-                    }),
+            Start::Warm(v) | Start::HighestWeight { vertex: v, .. } => match opts.mode {
+                SearchMode::Fast => {
+                    self.projector
+                        .project_with(&ybar, v, hint, SearchGoal::FirstHit)
                 }
-            }
+                _ => self.projector.project(&ybar, v),
+            },
         };
         let p = proj.map_err(|e| match e {
             ProjectError::NoProjection => SolveError::NoWeightedAverage,
@@ -417,200 +377,6 @@ impl Solver {
         let v = self.projector.face_corners(p.face)[k];
         (self.projector.frame(v), y)
     }
-
-    /// Forward problem for many weight vectors in parallel; result `i` belongs to
-    /// `weights[i]`. Every query is independent, so the results do not depend on the
-    /// number of threads. The weight rows are read once, in input order, into their averages;
-    /// the searches then run in the Morton order of the averages (nearby queries together,
-    /// so they share cached mesh data). Each still starts from its own highest-weight anchor (or warm start), so
-    /// the results equal [`Solver::forward`]'s.
-    pub fn forward_batch<W: AsRef<[f64]> + Sync>(
-        &self,
-        weights: &[W],
-        opts: &ForwardOptions,
-    ) -> Vec<Result<ForwardResult, SolveError>> {
-        // The weight rows are read once, in input order (streaming), into averages and
-        // start vertices; a failed validation is the query's answer.
-        let mut prepared = Vec::with_capacity(weights.len());
-        weights
-            .par_iter()
-            .with_min_len(256)
-            .map(|w| self.prepare(w.as_ref(), opts))
-            .collect_into_vec(&mut prepared);
-        let keys: Vec<(u64, u32)> = prepared
-            .par_iter()
-            .with_min_len(1024)
-            .enumerate()
-            .map(|(i, p)| {
-                let key = match p {
-                    Ok(p) => u64::from(wavg_project::internal::locality_key(
-                        &self.projector,
-                        &p.ybar,
-                    )),
-                    Err(_) => u64::MAX,
-                };
-                (key, i as u32)
-            })
-            .collect();
-        let order = sorted_order(keys);
-        // In this order the prepared queries are read at random: each query first waits
-        // for its record, so the record two queries ahead is requested early.
-        const AHEAD: usize = 2;
-        let mut done = Vec::with_capacity(order.len());
-        order
-            .par_iter()
-            .enumerate()
-            .with_min_len(64)
-            .map(|(k, &i)| {
-                if let Some(&j) = order.get(k + AHEAD) {
-                    wavg_project::internal::prefetch(&prepared[j as usize]);
-                }
-                match &prepared[i as usize] {
-                    Ok(p) => self.forward_prepared(p, opts),
-                    Err(e) => Err(e.clone()),
-                }
-            })
-            .collect_into_vec(&mut done);
-        unpermute(&order, &done)
-    }
-
-    /// Forward problem for a sequence of nearby queries (e.g. samples along a curve):
-    /// each query warm-starts from the previous answer. For parallelism the sequence is cut
-    /// into chunks of `chunk` queries (independent of the thread count, so the results are
-    /// too); the first query of each chunk starts cold (or from `opts.warm_start`).
-    pub fn forward_batch_warm<W: AsRef<[f64]> + Sync>(
-        &self,
-        weights: &[W],
-        opts: &ForwardOptions,
-        chunk: usize,
-    ) -> Vec<Result<ForwardResult, SolveError>> {
-        weights
-            .par_chunks(chunk.max(1))
-            .flat_map_iter(|c| {
-                let mut o = *opts;
-                c.iter()
-                    .map(move |w| {
-                        let r = self.forward(w.as_ref(), &o);
-                        if let Ok(r) = &r {
-                            o.warm_start = Some(r.point);
-                        }
-                        r
-                    })
-                    .collect::<Vec<_>>()
-            })
-            .collect()
-    }
-
-    /// Inverse problem for many points in parallel (see [`BatchWeights`]); each point is
-    /// independent, so the results equal [`Solver::inverse`]'s for any thread count.
-    pub fn inverse_batch(&self, points: &[SurfacePoint]) -> BatchWeights {
-        let mut out = BatchWeights::default();
-        self.inverse_batch_into(points, &mut out);
-        out
-    }
-
-    /// [`Solver::inverse_batch`] into an existing result, reusing its memory (repeated
-    /// batches then neither allocate nor page-fault).
-    pub fn inverse_batch_into(&self, points: &[SurfacePoint], out: &mut BatchWeights) {
-        let n = self.n_anchors();
-        out.n = n;
-        out.data.resize(points.len() * n.max(1), 0.0);
-        out.status.clear();
-        // Random points read random face records and then their corners' records: request
-        // both a few points ahead (software pipelining), so the waits overlap.
-        const CHUNK: usize = 64;
-        let proj = &self.projector;
-        let status = out
-            .data
-            .par_chunks_mut(n.max(1) * CHUNK)
-            .zip(points.par_chunks(CHUNK))
-            .flat_map_iter(|(rows, pts)| {
-                let mut scratch = InverseScratch::default();
-                let mut buf = Vec::with_capacity(n);
-                let ahead = |k: usize| pts.get(k).map(|p| p.face);
-                for f in (0..4).filter_map(ahead) {
-                    wavg_project::internal::prefetch_point_data(proj, f, false);
-                }
-                let mut status = Vec::with_capacity(pts.len());
-                for (k, (row, p)) in rows.chunks_mut(n.max(1)).zip(pts).enumerate() {
-                    if let Some(f) = ahead(k + 4) {
-                        wavg_project::internal::prefetch_point_data(proj, f, false);
-                    }
-                    if let Some(f) = ahead(k + 2) {
-                        wavg_project::internal::prefetch_point_data(proj, f, true);
-                    }
-                    let r = self.inverse_into(p, &mut scratch, &mut buf);
-                    if r.is_ok() {
-                        row.copy_from_slice(&buf);
-                    }
-                    status.push(r);
-                }
-                status
-            });
-        // In order (`par_extend` keeps the order of an ordered iterator).
-        out.status.par_extend(status);
-    }
-}
-
-/// Indices sorted by key (ties by index, so the order is deterministic).
-fn sorted_order(mut keys: Vec<(u64, u32)>) -> Vec<u32> {
-    keys.par_sort_unstable();
-    keys.into_iter().map(|(_, i)| i).collect()
-}
-
-/// Results computed in `order` (`done[k]` belongs to input `order[k]`), back in input
-/// order: one parallel gather into place, no intermediate lists (which cost about 10% of
-/// a small mesh's forward batch in reallocations and page faults).
-fn unpermute<T: Clone + Send + Sync>(order: &[u32], done: &[T]) -> Vec<T> {
-    let mut pos = vec![0u32; order.len()];
-    for (k, &i) in order.iter().enumerate() {
-        pos[i as usize] = k as u32;
-    }
-    pos.par_iter().map(|&k| done[k as usize].clone()).collect()
-}
-
-/// Weights of a batch of inverse problems: one row of `n_anchors` weights per point.
-#[derive(Clone, Debug, Default)]
-pub struct BatchWeights {
-    n: usize,
-    data: Vec<f64>,
-    status: Vec<Result<(), SolveError>>,
-}
-
-impl BatchWeights {
-    /// Number of points.
-    pub fn len(&self) -> usize {
-        self.status.len()
-    }
-
-    /// Whether the batch is empty.
-    pub fn is_empty(&self) -> bool {
-        self.status.is_empty()
-    }
-
-    /// Weights of point `i`, or why there are none.
-    pub fn get(&self, i: usize) -> Result<&[f64], &SolveError> {
-        match &self.status[i] {
-            Ok(()) => Ok(&self.data[i * self.n..(i + 1) * self.n]),
-            Err(e) => Err(e),
-        }
-    }
-
-    /// All rows in order.
-    pub fn iter(&self) -> impl Iterator<Item = Result<&[f64], &SolveError>> {
-        (0..self.len()).map(|i| self.get(i))
-    }
-
-    /// Replaces row `i` with `w` (the anchor count long) or marks it failed.
-    pub(crate) fn set(&mut self, i: usize, w: Result<&[f64], SolveError>) {
-        match w {
-            Ok(w) => {
-                self.data[i * self.n..(i + 1) * self.n].copy_from_slice(w);
-                self.status[i] = Ok(());
-            }
-            Err(e) => self.status[i] = Err(e),
-        }
-    }
 }
 
 #[cfg(test)]
@@ -652,14 +418,5 @@ mod tests {
             plain.forward_embedded(&bad, &pts[0], &opts),
             Err(SolveError::InvalidParameter(_))
         ));
-    }
-
-    #[test]
-    fn batch_ordering_helpers() {
-        assert_eq!(
-            sorted_order(vec![(3, 0), (1, 1), (3, 2), (0, 3)]),
-            vec![3, 1, 0, 2]
-        );
-        assert_eq!(unpermute(&[2, 0, 1], &['c', 'a', 'b']), vec!['a', 'b', 'c']);
     }
 }

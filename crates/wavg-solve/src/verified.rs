@@ -15,10 +15,11 @@
 
 use wavg_mesh::SurfacePoint;
 
+use crate::batch::BatchWeights;
 use crate::error::SolveError;
 use crate::kernel::AnchorCoords;
 use crate::points::check_point;
-use crate::solver::{BatchWeights, ForwardOptions, ForwardResult, Solver};
+use crate::solver::{ForwardOptions, ForwardResult, Solver};
 use crate::{DIM, Mat2x8, Vec8};
 
 /// The penalties tried, in order, after the paper's weights.
@@ -286,7 +287,8 @@ impl Solver {
         round_trips: &mut Vec<Result<RoundTrip, SolveError>>,
     ) {
         use rayon::prelude::*;
-        self.inverse_batch_into(points, weights);
+        // `Par::Rayon` always starts.
+        let _ = self.inverse_batch_into(points, weights, wavg_project::Par::Rayon);
         round_trips.clear();
         if !(tolerance.is_finite() && tolerance > 0.0) {
             let e = SolveError::InvalidParameter(format!(

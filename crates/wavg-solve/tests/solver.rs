@@ -6,8 +6,8 @@ use wavg_mesh::geometry::mean_edge_length;
 use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, procedural};
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
 use wavg_solve::{
-    Anchor, EmbeddedMesh, ForwardOptions, Normalization, Projector, SearchMode, SolveError, Solver,
-    Start,
+    Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, ForwardScratch, Normalization, Par,
+    ProjectionPath, Projector, SearchGoal, SearchMode, SolveError, Solver, Start,
 };
 
 fn solver_on(mesh: TriMesh, k: usize, seed: u64) -> Solver {
@@ -314,6 +314,24 @@ fn batches_equal_sequential_for_any_thread_count() {
             );
         });
     }
+    // The explicit layer: every parallelism, buffers reused from one call to the next.
+    let mut scratch = ForwardScratch::default();
+    let (mut fb, mut warm, mut bw) = (Vec::new(), Vec::new(), BatchWeights::default());
+    let two = Par::Threads(std::num::NonZeroUsize::new(2).unwrap());
+    let three = Par::Threads(std::num::NonZeroUsize::new(3).unwrap());
+    for par in [Par::Seq, Par::Rayon, two, three, Par::Seq] {
+        s.forward_batch_into(&weights, &opts, &mut scratch, &mut fb, par)
+            .unwrap();
+        assert_eq!(fb, seq_f, "{par:?}");
+        s.forward_batch_warm_into(&weights, &opts, 50, &mut warm, par)
+            .unwrap();
+        assert_eq!(warm, seq_warm, "{par:?}");
+        s.inverse_batch_into(&pts, &mut bw, par).unwrap();
+        assert_eq!(bw.len(), pts.len());
+        for (i, w) in seq_w.iter().enumerate() {
+            assert_eq!(bw.get(i).unwrap(), &w.as_ref().unwrap()[..], "{par:?}");
+        }
+    }
 }
 
 #[test]
@@ -454,13 +472,14 @@ fn local_search_finds_points_on_the_surface_from_anywhere() {
     for (i, p) in pts.iter().enumerate() {
         let y = proj.embedded().point(p);
         let start = (i * 37 % s.mesh().n_vertices()) as u32;
-        let v = s.local_search().walk(&y, start);
+        let v = proj.walk(&y, start);
         let near = s.mesh().triangles[p.face as usize].contains(&v);
-        let hit = s.local_search().search(&y, start);
+        let hit = proj.project_with(&y, start, None, SearchGoal::FirstHit);
         // On a convex-ish sphere the walk reaches a corner of the face (or a neighbour).
         if near {
             n_near += 1;
             let h = hit.expect("a point on the surface has a projection next to it");
+            assert_eq!(h.path, ProjectionPath::Local);
             assert!(h.distance < 1e-6, "{}", h.distance);
             assert!((h.point.position(s.mesh()) - p.position(s.mesh())).norm() < 1e-6);
         }
@@ -523,17 +542,17 @@ fn nearest_vertex_second_chance() {
                         .total_cmp(&(c[b] - y).norm_squared())
                 })
                 .unwrap();
-            assert_eq!(
-                s.local_search().nearest_vertex(&y) as usize,
-                brute,
-                "{i} {scale}"
-            );
+            assert_eq!(proj.nearest_vertex(&y) as usize, brute, "{i} {scale}");
         }
         let yhat = proj.embedded().point(p);
-        let h = s
-            .local_search()
-            .search_at(&yhat, s.local_search().nearest_vertex(&yhat))
+        let h = proj
+            .project_with(
+                &yhat,
+                proj.nearest_vertex(&yhat),
+                None,
+                SearchGoal::FirstHit,
+            )
             .unwrap();
-        assert!(h.distance < 1e-6);
+        assert!(h.distance < 1e-6 && h.path == ProjectionPath::Local);
     }
 }

@@ -3,7 +3,10 @@
 //!
 //! Start from a [`Surface`]: a validated mesh with its 8-D embedding. Make a [`Solver`]
 //! for a set of anchors, then ask the forward problem (weights to a point) or the inverse
-//! problem (a point to weights), one at a time or in parallel batches.
+//! problem (a point to weights), one at a time or in parallel batches. Every batch comes
+//! in two layers: `*_batch` allocates and runs on the current rayon pool; `*_batch_into`
+//! reuses the caller's buffers and takes a [`Par`] (one thread, the current pool, or a
+//! pool of `n` threads; [`Par::install`] runs any closure that way).
 //!
 //! ```
 //! use wavg::{ForwardOptions, NoProgress, PrecomputeOptions, Surface, SurfacePoint};
@@ -42,8 +45,8 @@ pub use surface::Surface;
 pub use wavg_embed::{Embedding, NoProgress, PrecomputeOptions, Progress, Report, Stage};
 pub use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, VertexId};
 pub use wavg_solve::{
-    Anchor, BatchWeights, ForwardOptions, ForwardResult, Normalization, RoundTrip, SearchMode,
-    Solver, Verified,
+    Anchor, BatchWeights, ForwardOptions, ForwardResult, ForwardScratch, Normalization, Par,
+    ProjectionPath, RoundTrip, SearchGoal, SearchMode, Solver, Verified,
 };
 pub use wavg_solve::{RoundTripOptions, RoundTripReport, VerifiedRoundTripReport, round_trip};
 

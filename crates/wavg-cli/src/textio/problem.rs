@@ -114,13 +114,7 @@ pub fn with_threads<T: Send>(
     threads: Option<usize>,
     f: impl FnOnce() -> T + Send,
 ) -> Result<T, CliError> {
-    match threads {
-        None => Ok(f()),
-        Some(0) => Err(CliError::input("--threads must be at least 1")),
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .map(|p| p.install(f))
-            .map_err(|e| CliError::failure(format!("cannot start {t} threads: {e}"))),
-    }
+    let par = wavg::Par::from_threads(threads)
+        .map_err(|_| CliError::input("--threads must be at least 1"))?;
+    par.install(f).map_err(|e| CliError::failure(one_line(&e)))
 }

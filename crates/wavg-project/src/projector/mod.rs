@@ -2,12 +2,15 @@
 //! force) and Euclidean.
 //!
 //! The fast path walks greedily over the vertex graph from a start vertex to a vertex
-//! locally closest to the target, then tests the triangles around it (most promising
-//! first) and their neighbours. A valid projection at (numerically) zero distance is a
-//! global minimum and is returned at once. Any other local answer is *certified*: a
-//! branch and bound over the bounding volume hierarchy visits every triangle whose box is
-//! closer than that answer, so the fast path returns the same closest valid projection as
-//! the exhaustive search, never a far-off triangle. `ProjectionPath` says which happened.
+//! locally closest to the target, then runs the local search (`search.rs`) over the
+//! triangles around it (most promising first) and their neighbours. What happens next
+//! depends on the caller's [`SearchGoal`]. For the closest projection (the default), a
+//! valid projection at (numerically) zero distance is a global minimum and is returned at
+//! once; any other local answer is *certified*: a branch and bound over the bounding
+//! volume hierarchy visits every triangle whose box is closer than that answer, so the
+//! fast path returns the same closest valid projection as the exhaustive search, never a
+//! far-off triangle. For the paper's first hit, the first valid projection met is
+//! returned uncertified. `ProjectionPath` says which happened.
 
 use std::sync::Arc;
 
@@ -20,6 +23,7 @@ use crate::frames::FrameKind;
 use crate::triangle::{Frame32, TriData, frame_to_f32, frame_to_f64};
 use crate::{EmbeddedMesh, Mat2x8, ProjectError, Vec8};
 
+mod batch;
 mod certify;
 mod layout;
 mod nearest;
@@ -29,7 +33,9 @@ mod walk;
 
 use layout::{Face, VertexRec, WalkPoint};
 
+pub use batch::ProjectScratch;
 pub use order::FaceOrder;
+pub use search::{FACE_WALK, LOCAL_BUDGET, SearchGoal};
 pub use walk::WALK_GROUP;
 
 /// A distance below this fraction of the triangle's longest edge counts as zero: such a
@@ -37,13 +43,14 @@ pub use walk::WALK_GROUP;
 /// triangle hold to f64 precision), so the fast path returns it without certification.
 pub const ZERO_DISTANCE: f64 = 1e-10;
 
-/// Faces the local search may test before certifying or falling back.
-const LOCAL_BUDGET: usize = 64;
-
 /// Which search produced a projection.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ProjectionPath {
-    /// The local search around the walk's end found it (certified closest).
+    /// The local search found it and certification proved it the closest
+    /// ([`SearchGoal::Closest`]).
+    Certified,
+    /// The local search found it, not certified: the first valid projection met
+    /// ([`SearchGoal::FirstHit`], the paper's search).
     Local,
     /// The local search found nothing or was beaten; the global search was used.
     Fallback,
@@ -300,99 +307,72 @@ impl Projector {
 
     /// Fast path: greedy vertex walk from `start` towards `y` in R^8, then a local triangle
     /// search, certified against the bounding volume hierarchy; the global search is used
-    /// when the local one finds nothing or is beaten (reported as `Fallback`).
+    /// when the local one finds nothing or is beaten (reported as `Fallback`). The same
+    /// as [`Projector::project_with`] with [`SearchGoal::Closest`] and no hint.
     pub fn project(&self, y: &Vec8, start: VertexId) -> Result<Projection, ProjectError> {
-        let mesh = self.emb.mesh();
-        if !y.iter().all(|v| v.is_finite()) {
-            return Err(ProjectError::NonFiniteQuery);
-        }
-        if start as usize >= mesh.n_vertices() {
-            return Err(ProjectError::StartOutOfRange {
-                vertex: start,
-                n_vertices: mesh.n_vertices(),
-            });
-        }
-        // 1. Greedy walk.
-        let mut ring_d = [0.0f32; 64];
-        let v = self.walk_inner(y, start, &mut ring_d);
-        // 2. Faces around v, most promising first.
-        let cands = self.order_faces(y, v, &ring_d);
-        self.search_around(y, v, &cands)
+        self.project_with(y, start, None, SearchGoal::Closest)
     }
 
-    /// [`Projector::project`] for many queries on the calling thread, with the same
-    /// results (in input order). Queries are visited in Morton order of their first three
-    /// embedded coordinates, so nearby ones share cached data (this alone halves the
-    /// certification cost of off-surface queries), and the greedy walks of [`WALK_GROUP`]
-    /// queries advance in turn, each step
-    /// requesting the records the next step reads, so their memory waits overlap instead
-    /// of adding up; then the first candidate face of every query in the group is
-    /// requested before any is solved. Parallelise over chunks of queries.
+    /// The projection of `y` that `goal` asks for, searching from vertex `start`. With a
+    /// `hint` face (a warm start: the previous answer's face when the query moved a
+    /// little), if the query lies over it, the hint and up to [`FACE_WALK`] faces in all
+    /// that Newton's method exits into are tried first: for [`SearchGoal::FirstHit`] a valid projection there is the answer;
+    /// for [`SearchGoal::Closest`] only one at (numerically) zero distance is, since
+    /// anything else still needs certifying.
     ///
     /// ```
     /// use std::sync::Arc;
     /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
-    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// use wavg_project::{EmbeddedMesh, ProjectionPath, Projector, SearchGoal};
     /// let m = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
     /// let emb = Arc::new(EmbeddedMesh::from_positions(m));
     /// let p = Projector::new(emb.clone()).unwrap();
-    /// let ys: Vec<_> = (0..20).map(|f| emb.point(&SurfacePoint::new(f * 30, [0.2, 0.3, 0.5]))).collect();
-    /// let starts = vec![0; ys.len()];
-    /// let batch = p.project_batch(&ys, &starts);
-    /// for ((y, s), b) in ys.iter().zip(&starts).zip(&batch) {
-    ///     assert_eq!(b, &p.project(y, *s));
-    /// }
+    /// let y = emb.point(&SurfacePoint::new(40, [0.2, 0.3, 0.5])) * 1.01;
+    /// let first = p.project_with(&y, 0, None, SearchGoal::FirstHit).unwrap();
+    /// assert_eq!(first.path, ProjectionPath::Local);
+    /// let warm = p.project_with(&y, 0, Some(40), SearchGoal::FirstHit).unwrap();
+    /// assert_eq!(warm.point.face, 40);
+    /// assert_eq!(p.project_with(&y, 0, None, SearchGoal::Closest), p.project(&y, 0));
     /// ```
-    pub fn project_batch(
+    pub fn project_with(
         &self,
-        ys: &[Vec8],
-        starts: &[VertexId],
-    ) -> Vec<Result<Projection, ProjectError>> {
-        let n = ys.len().min(starts.len());
-        // Nearby queries one after the other (Morton order of the first three embedded
-        // coordinates), so consecutive walks share cached records; results in input order.
-        let mut order: Vec<(u32, u32)> = (0..n)
-            .map(|i| (self.locality_key(&ys[i]), i as u32))
-            .collect();
-        order.sort_unstable();
-        let mut out: Vec<Option<Result<Projection, ProjectError>>> =
-            std::iter::repeat_with(|| None).take(n).collect();
-        // Per group, fixed-size buffers (no allocation per group).
-        let mut yc = [Vec8::zeros(); WALK_GROUP];
-        let mut sc = [0 as VertexId; WALK_GROUP];
-        let mut ends = [0 as VertexId; WALK_GROUP];
-        for group in order.chunks(WALK_GROUP) {
-            let m = group.len();
-            for (k, &(_, i)) in group.iter().enumerate() {
-                (yc[k], sc[k]) = (ys[i as usize], starts[i as usize]);
-            }
-            let (yc, sc, ends) = (&yc[..m], &sc[..m], &mut ends[..m]);
-            let valid = yc.iter().all(|y| y.iter().all(|v| v.is_finite()))
-                && sc.iter().all(|&s| (s as usize) < self.verts.len());
-            if !valid {
-                // The per-query path reports each error.
-                for (k, &(_, i)) in group.iter().enumerate() {
-                    out[i as usize] = Some(self.project(&yc[k], sc[k]));
-                }
-                continue;
-            }
-            self.walk_group(yc, sc, ends);
-            // Every candidate order first (each requests its first face's data), then the
-            // solves, so those requests overlap.
-            let cands: [FaceOrder; WALK_GROUP] = std::array::from_fn(|k| {
-                if k < m {
-                    self.order_faces(&yc[k], ends[k], &self.ring_dists(&yc[k], ends[k]))
-                } else {
-                    FaceOrder::EMPTY
-                }
+        y: &Vec8,
+        start: VertexId,
+        hint: Option<FaceId>,
+        goal: SearchGoal,
+    ) -> Result<Projection, ProjectError> {
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(ProjectError::NonFiniteQuery);
+        }
+        if start as usize >= self.verts.len() {
+            return Err(ProjectError::StartOutOfRange {
+                vertex: start,
+                n_vertices: self.verts.len(),
             });
-            for (k, &(_, i)) in group.iter().enumerate() {
-                out[i as usize] = Some(self.search_around(&yc[k], ends[k], &cands[k]));
+        }
+        if let Some(f) = hint {
+            if f as usize >= self.faces.len() {
+                return Err(ProjectError::FaceOutOfRange {
+                    face: f,
+                    n_faces: self.faces.len(),
+                });
+            }
+            match self.face_walk(y, f) {
+                Some(b) if goal == SearchGoal::FirstHit => {
+                    return Ok(Self::finish(b, ProjectionPath::Local));
+                }
+                Some(b) if self.is_zero(&b) => {
+                    return Ok(Self::finish(b, ProjectionPath::Certified));
+                }
+                _ => {}
             }
         }
-        out.into_iter()
-            .map(|r| r.unwrap_or(Err(ProjectError::NoProjection)))
-            .collect()
+        // 1. Greedy walk.
+        let mut ring_d = [0.0f32; 64];
+        let v = self.walk_inner(y, start, &mut ring_d);
+        // 2. Faces around v, most promising first; the local search and what follows.
+        let cands = self.order_faces(y, v, &ring_d);
+        self.search_from(y, v, &cands, goal)
     }
 }
 

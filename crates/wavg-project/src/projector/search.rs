@@ -1,107 +1,238 @@
-//! The local search around the walk's end: the faces around it, most promising first, and
-//! their neighbours, within a fixed budget; its answer is then certified.
+//! The local search: from the walk's end, the faces around it (most promising first), then
+//! rings of their neighbours across edges, within one budget of faces. One search serves
+//! both goals ([`SearchGoal`]): the closest projection, which is then certified, and the
+//! paper's first valid hit.
 
 use super::*;
 
-/// Small fixed set of face ids (no allocation per query).
-pub(super) struct Tested {
-    pub(super) ids: [u32; LOCAL_BUDGET],
-    pub(super) n: usize,
+/// Faces the local search may test (and enqueue) before it gives up.
+pub const LOCAL_BUDGET: usize = 96;
+
+/// Faces a warm start walks through from its hint face, following Newton's exits, before
+/// the vertex search.
+pub const FACE_WALK: usize = 4;
+
+/// How far outside a warm start's hint face (in barycentric units) the query's
+/// Euclidean projection onto its plane may fall for the face walk to be tried: none, so a
+/// hint that does not hold the query costs a few dot products, not Newton solves.
+const HINT_MARGIN: f64 = 0.0;
+
+/// What the caller wants from [`Projector::project_with`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SearchGoal {
+    /// The closest valid projection: the local search tests the faces around the walk's
+    /// end and their neighbours, then certifies its best answer against the bounding
+    /// volume hierarchy (or searches globally). Path [`ProjectionPath::Certified`] or
+    /// [`ProjectionPath::Fallback`].
+    #[default]
+    Closest,
+    /// The paper's search: the first valid projection met, ring by ring (within a ring,
+    /// faces in order of how far outside each one the Euclidean projection onto its plane
+    /// falls; when Newton's method leaves a face across an edge, the face beyond is tried
+    /// next). Not certified: when the query is ambiguous a closer projection may exist
+    /// elsewhere. When nothing is found within [`LOCAL_BUDGET`] faces, the search runs
+    /// again from the vertex nearest to the query, then the global search answers. Path
+    /// [`ProjectionPath::Local`] or [`ProjectionPath::Fallback`].
+    FirstHit,
 }
 
-impl Tested {
+/// Fixed-capacity set of face ids (no allocation per query).
+pub(super) struct FaceSet {
+    ids: [FaceId; LOCAL_BUDGET],
+    n: usize,
+}
+
+impl FaceSet {
     pub(super) fn new() -> Self {
         Self {
             ids: [0; LOCAL_BUDGET],
             n: 0,
         }
     }
-    pub(super) fn contains(&self, f: u32) -> bool {
+    #[inline]
+    pub(super) fn contains(&self, f: FaceId) -> bool {
         self.ids[..self.n].contains(&f)
     }
+    #[inline]
     pub(super) fn full(&self) -> bool {
         self.n == LOCAL_BUDGET
     }
-    pub(super) fn push(&mut self, f: u32) {
+    #[inline]
+    fn push(&mut self, f: FaceId) {
         self.ids[self.n] = f;
         self.n += 1;
     }
 }
 
+/// How far outside the triangle `(p0, p1, p2)` the Euclidean projection of `y` onto its
+/// plane falls: the smallest barycentric coordinate, negated (negative inside; infinite
+/// for a degenerate triangle). In walk coordinates: it only orders the candidates.
+#[inline]
+fn outside(p: [[f32; 8]; 3], y: &[f32; 8]) -> f32 {
+    let (mut a, mut b, mut cc, mut d, mut e) = (0.0f32, 0.0, 0.0, 0.0, 0.0);
+    for k in 0..8 {
+        let e1 = p[1][k] - p[0][k];
+        let e2 = p[2][k] - p[0][k];
+        let r = y[k] - p[0][k];
+        a += e1 * e1;
+        b += e1 * e2;
+        cc += e2 * e2;
+        d += e1 * r;
+        e += e2 * r;
+    }
+    let det = a * cc - b * b;
+    if det.is_nan() || det <= 0.0 {
+        return f32::INFINITY;
+    }
+    let l1 = (cc * d - b * e) / det;
+    let l2 = (a * e - b * d) / det;
+    let l0 = 1.0 - l1 - l2;
+    (-l0).max(-l1).max(-l2)
+}
+
 impl Projector {
-    /// Steps 2-4 of [`Projector::project`]: the faces around the walk's end `v` in the
-    /// order `cands`, their neighbours, then certification or the global search.
-    pub(super) fn search_around(
+    /// The local search from the walk's end `v`, the faces around it in the order `cands`
+    /// first. For [`SearchGoal::FirstHit`], the first valid projection; for
+    /// [`SearchGoal::Closest`], the closest one among the faces around `v` and, if those
+    /// hold none, their neighbours (a numerically zero distance ends it at once). Every
+    /// face tested is recorded in `tried`.
+    pub(super) fn local_search(
         &self,
         y: &Vec8,
         v: VertexId,
         cands: &FaceOrder,
-    ) -> Result<Projection, ProjectError> {
+        goal: SearchGoal,
+        tried: &mut FaceSet,
+    ) -> Option<Best> {
         let topo = self.emb.mesh().topology();
-        let (order, m) = (&cands.faces, cands.n);
-        let faces = self.walk_coords[v as usize].faces(topo, v);
-        let mut tested = Tested::new();
-        let mut best: Option<Best> = None;
-        let consider = |f: u32, tested: &mut Tested, best: &mut Option<Best>| -> bool {
-            tested.push(f);
-            // Once something is found, only a strictly closer answer matters: the cheap
-            // lower bounds of `try_face_bounded` skip most of the remaining faces.
-            let found = match best {
-                None => self.try_face(f, y),
-                Some(x) => self.try_face_bounded(f, y, x.d2),
-            };
-            if let Some(b) = found {
-                *best = Some(b);
-                return self.is_zero(&b);
-            }
-            false
-        };
-        for &f in &order[..m] {
-            if consider(f, &mut tested, &mut best) {
-                return Ok(Self::finish(
-                    best.unwrap_or_else(|| unreachable!()),
-                    ProjectionPath::Local,
-                ));
-            }
-        }
-        for &f in faces.iter().skip(m) {
-            if tested.full() {
+        let first_hit = goal == SearchGoal::FirstHit;
+        let mut seen = FaceSet::new();
+        let mut order = [(0.0f32, 0 as FaceId); LOCAL_BUDGET];
+        // First ring: the candidates in order, then any faces beyond the 64 they cover.
+        let ring0 = self.walk_coords[v as usize].faces(topo, v);
+        for &f in cands.as_slice().iter().chain(ring0.iter().skip(cands.n)) {
+            if seen.full() {
                 break;
             }
-            if consider(f, &mut tested, &mut best) {
-                return Ok(Self::finish(
-                    best.unwrap_or_else(|| unreachable!()),
-                    ProjectionPath::Local,
-                ));
-            }
+            order[seen.n] = (seen.n as f32, f);
+            seen.push(f);
         }
-        // 3. Their neighbours across edges.
-        if best.is_none() {
-            let n_ring = tested.n;
-            'outer: for i in 0..n_ring {
-                for g in topo.face_neighbors(tested.ids[i]) {
-                    if g == NONE || tested.contains(g) {
-                        continue;
+        let mut level = 0..seen.n;
+        let mut best: Option<Best> = None;
+        for ring in 0.. {
+            for &(_, f) in &order[..level.len()] {
+                if first_hit {
+                    // Newton's exits lead on to the face beyond (a short walk over faces
+                    // towards the projection), then the ring's order resumes.
+                    let mut cur = f;
+                    while !tried.contains(cur) && !tried.full() {
+                        tried.push(cur);
+                        match self.try_face_or_exit(cur, y) {
+                            Ok(b) => return Some(b),
+                            Err(Some(k)) => cur = topo.face_neighbors(cur)[(k + 1) % 3],
+                            Err(None) => break,
+                        }
+                        if cur == NONE {
+                            break;
+                        }
                     }
-                    if tested.full() {
-                        break 'outer;
-                    }
-                    if consider(g, &mut tested, &mut best) {
-                        return Ok(Self::finish(
-                            best.unwrap_or_else(|| unreachable!()),
-                            ProjectionPath::Local,
-                        ));
+                } else if !tried.contains(f) && !tried.full() {
+                    tried.push(f);
+                    // Once something is found, only a strictly closer answer matters: the
+                    // cheap lower bounds of `try_face_bounded` skip most remaining faces.
+                    let found = match &best {
+                        None => self.try_face(f, y),
+                        Some(x) => self.try_face_bounded(f, y, x.d2),
+                    };
+                    if let Some(b) = found {
+                        best = Some(b);
+                        if self.is_zero(&b) {
+                            return best;
+                        }
                     }
                 }
             }
+            // The closest goal certifies what the first two rings found.
+            if !first_hit && (best.is_some() || ring == 1) {
+                return best;
+            }
+            // Next ring: unseen neighbours across edges, in order.
+            let start_next = seen.n;
+            'fill: for i in level {
+                for g in topo.face_neighbors(seen.ids[i]) {
+                    if g == NONE || seen.contains(g) {
+                        continue;
+                    }
+                    if seen.full() {
+                        break 'fill;
+                    }
+                    seen.push(g);
+                }
+            }
+            if seen.n == start_next {
+                return best;
+            }
+            level = start_next..seen.n;
+            for (o, i) in order.iter_mut().zip(level.clone()) {
+                *o = (0.0, seen.ids[i]);
+            }
+            if first_hit {
+                // Try the ring's faces in order of how far outside each one the Euclidean
+                // projection of `y` onto its plane falls: the face holding the projection
+                // is almost always first, so usually a single Newton solve is needed.
+                let yw = self.walk_point(y);
+                let mesh = self.emb.mesh();
+                for o in &mut order[..level.len()] {
+                    let t = mesh.triangles[o.1 as usize];
+                    o.0 = outside(t.map(|u| self.walk_coords[u as usize].unpack()), &yw);
+                }
+                order[..level.len()]
+                    .sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            }
         }
-        // 4. Certify (or search globally).
-        match best {
-            Some(local) => {
+        best
+    }
+
+    /// The search after the walk: the local search from `v` (candidates `cands`), then
+    /// certification or the global search, as `goal` asks.
+    pub(super) fn search_from(
+        &self,
+        y: &Vec8,
+        v: VertexId,
+        cands: &FaceOrder,
+        goal: SearchGoal,
+    ) -> Result<Projection, ProjectError> {
+        let mut tried = FaceSet::new();
+        let local = self.local_search(y, v, cands, goal, &mut tried);
+        let global = |y: &Vec8| {
+            self.exhaustive(y)
+                .map(|b| Self::finish(b, ProjectionPath::Fallback))
+                .ok_or(ProjectError::NoProjection)
+        };
+        match (goal, local) {
+            (SearchGoal::FirstHit, Some(b)) => Ok(Self::finish(b, ProjectionPath::Local)),
+            (SearchGoal::FirstHit, None) => {
+                // The walk may end in a local minimum of the distance with no projection
+                // nearby: once more from the nearest vertex (much cheaper than the global
+                // search, and usually its answer).
+                let u = self.nearest_vertex(y);
+                if u != v {
+                    let cands = self.faces_by_promise(y, u);
+                    let mut tried = FaceSet::new();
+                    if let Some(b) = self.local_search(y, u, &cands, goal, &mut tried) {
+                        return Ok(Self::finish(b, ProjectionPath::Local));
+                    }
+                }
+                global(y)
+            }
+            (SearchGoal::Closest, Some(b)) if self.is_zero(&b) => {
+                Ok(Self::finish(b, ProjectionPath::Certified))
+            }
+            (SearchGoal::Closest, Some(local)) => {
                 let mut improved = None;
                 let mut bound = local.d2;
                 self.bvh.search(y, &mut bound, |f, bound| {
-                    if tested.contains(f) {
+                    if tried.contains(f) {
                         return;
                     }
                     if let Some(b) = self.try_face_bounded(f, y, *bound) {
@@ -111,13 +242,72 @@ impl Projector {
                 });
                 Ok(match improved {
                     Some(b) => Self::finish(b, ProjectionPath::Fallback),
-                    None => Self::finish(local, ProjectionPath::Local),
+                    None => Self::finish(local, ProjectionPath::Certified),
                 })
             }
-            None => self
-                .exhaustive(y)
-                .map(|b| Self::finish(b, ProjectionPath::Fallback))
-                .ok_or(ProjectError::NoProjection),
+            (SearchGoal::Closest, None) => global(y),
         }
+    }
+
+    /// A warm start's face walk: face `f`, then up to [`FACE_WALK`] faces in all that
+    /// Newton's method exits into; the first valid projection, if it is at least as close
+    /// to `y` as the corners of its face. A projection farther than a point of the
+    /// surface next to it is likely not the one the walk would find (a query far off a
+    /// curved surface can have several); the full search decides then.
+    pub(super) fn face_walk(&self, y: &Vec8, mut f: FaceId) -> Option<Best> {
+        let topo = self.emb.mesh().topology();
+        // Newton's method is worth trying only when the query is over the hint: the
+        // Euclidean projection onto its plane falls inside.
+        let [a, b, c] = self.corners(f);
+        let (e1, e2, r) = (b - a, c - a, y - a);
+        let (aa, ab, bb, d, e) = (
+            e1.dot(&e1),
+            e1.dot(&e2),
+            e2.dot(&e2),
+            e1.dot(&r),
+            e2.dot(&r),
+        );
+        let det = aa * bb - ab * ab;
+        let (l1, l2) = ((bb * d - ab * e) / det, (aa * e - ab * d) / det);
+        if !(l1.min(l2).min(1.0 - l1 - l2) >= -HINT_MARGIN) {
+            return None;
+        }
+        for _ in 0..FACE_WALK {
+            match self.try_face_or_exit(f, y) {
+                Ok(b) => {
+                    let near = self
+                        .corners(f)
+                        .iter()
+                        .all(|c| b.d2 <= (c - y).norm_squared());
+                    return near.then_some(b);
+                }
+                Err(Some(k)) => f = topo.face_neighbors(f)[(k + 1) % 3],
+                Err(None) => return None,
+            }
+            if f == NONE {
+                return None;
+            }
+        }
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outside_orders_by_the_smallest_barycentric() {
+        let mut p = [[0.0f32; 8]; 3];
+        p[1][0] = 1.0;
+        p[2][1] = 1.0;
+        let at = |x: f32, z: f32| {
+            let mut y = [0.0f32; 8];
+            (y[0], y[1]) = (x, z);
+            y
+        };
+        assert!((outside(p, &at(0.25, 0.25)) + 0.25).abs() < 1e-6);
+        assert!((outside(p, &at(2.0, 0.0)) - 1.0).abs() < 1e-6);
+        assert_eq!(outside([[0.0; 8]; 3], &at(1.0, 1.0)), f32::INFINITY);
     }
 }

@@ -1,0 +1,245 @@
+//! Batches of forward and inverse problems, in two layers: `*_batch` allocates and runs on
+//! the current rayon pool; `*_batch_into` takes its buffers and a [`Par`] (how to spread
+//! the work over threads, chosen as for the projector's batches). Every query is
+//! independent, so the results never depend on the parallelism.
+
+use wavg_mesh::SurfacePoint;
+use wavg_project::Par;
+
+use crate::error::SolveError;
+use crate::kernel::InverseScratch;
+use crate::solver::{ForwardOptions, ForwardResult, Prepared, Solver};
+
+/// Buffers of [`Solver::forward_batch_into`], reused from batch to batch.
+#[derive(Debug, Default)]
+pub struct ForwardScratch {
+    prepared: Vec<(u64, Result<Prepared, SolveError>)>,
+    order: Vec<(u64, u32)>,
+    done: Vec<Result<ForwardResult, SolveError>>,
+    pos: Vec<u32>,
+}
+
+/// Weight rows one parallel task reads.
+const PREPARE_CHUNK: usize = 256;
+/// Sorted queries one parallel task solves.
+const SEARCH_CHUNK: usize = 64;
+/// Points one parallel task of the inverse batch handles.
+const INVERSE_CHUNK: usize = 64;
+
+impl Solver {
+    /// Forward problem for many weight vectors in parallel; result `i` belongs to
+    /// `weights[i]` and equals [`Solver::forward`]'s. See [`Solver::forward_batch_into`].
+    pub fn forward_batch<W: AsRef<[f64]> + Sync>(
+        &self,
+        weights: &[W],
+        opts: &ForwardOptions,
+    ) -> Vec<Result<ForwardResult, SolveError>> {
+        let mut out = Vec::new();
+        let mut scratch = ForwardScratch::default();
+        // `Par::Rayon` always starts.
+        let _ = self.forward_batch_into(weights, opts, &mut scratch, &mut out, Par::Rayon);
+        out
+    }
+
+    /// [`Solver::forward_batch`] into `out`, with explicit buffers and parallelism. The
+    /// weight rows are read once, in input order, into their averages; the searches then
+    /// run in the Morton order of the averages (nearby queries together, so they share
+    /// cached mesh data). Each still starts from its own highest-weight anchor (or warm
+    /// start), so the results equal [`Solver::forward`]'s for any `par`. Fails only when
+    /// `par`'s threads cannot start.
+    pub fn forward_batch_into<W: AsRef<[f64]> + Sync>(
+        &self,
+        weights: &[W],
+        opts: &ForwardOptions,
+        scratch: &mut ForwardScratch,
+        out: &mut Vec<Result<ForwardResult, SolveError>>,
+        par: Par,
+    ) -> Result<(), SolveError> {
+        let ForwardScratch {
+            prepared,
+            order,
+            done,
+            pos,
+        } = scratch;
+        // A failed validation is the query's answer (sorted last).
+        par.map_range(weights.len(), PREPARE_CHUNK, prepared, |i| {
+            let p = self.prepare(weights[i].as_ref(), opts);
+            let key = match &p {
+                Ok(p) => u64::from(wavg_project::internal::locality_key(
+                    self.projector(),
+                    &p.ybar,
+                )),
+                Err(_) => u64::MAX,
+            };
+            (key, p)
+        })?;
+        order.clear();
+        order.extend(prepared.iter().enumerate().map(|(i, p)| (p.0, i as u32)));
+        par.sort(order)?;
+        // In this order the prepared queries are read at random: each query first waits
+        // for its record, so the record two queries ahead is requested early.
+        const AHEAD: usize = 2;
+        par.map_range(order.len(), SEARCH_CHUNK, done, |k| {
+            if let Some(&(_, j)) = order.get(k + AHEAD) {
+                wavg_project::internal::prefetch(&prepared[j as usize]);
+            }
+            match &prepared[order[k].1 as usize].1 {
+                Ok(p) => self.forward_prepared(p, opts),
+                Err(e) => Err(e.clone()),
+            }
+        })?;
+        // Back in input order: one gather, no intermediate lists.
+        pos.clear();
+        pos.resize(order.len(), 0);
+        for (k, &(_, i)) in order.iter().enumerate() {
+            pos[i as usize] = k as u32;
+        }
+        par.map_range(pos.len(), 4096, out, |i| done[pos[i] as usize].clone())?;
+        Ok(())
+    }
+
+    /// Forward problem for a sequence of nearby queries (e.g. samples along a curve):
+    /// each query warm-starts from the previous answer. For parallelism the sequence is cut
+    /// into chunks of `chunk` queries (independent of the thread count, so the results are
+    /// too); the first query of each chunk starts cold (or from `opts.warm_start`).
+    pub fn forward_batch_warm<W: AsRef<[f64]> + Sync>(
+        &self,
+        weights: &[W],
+        opts: &ForwardOptions,
+        chunk: usize,
+    ) -> Vec<Result<ForwardResult, SolveError>> {
+        let mut out = Vec::new();
+        // `Par::Rayon` always starts.
+        let _ = self.forward_batch_warm_into(weights, opts, chunk, &mut out, Par::Rayon);
+        out
+    }
+
+    /// [`Solver::forward_batch_warm`] into `out`, with explicit parallelism (the results
+    /// do not depend on it). Fails only when `par`'s threads cannot start.
+    pub fn forward_batch_warm_into<W: AsRef<[f64]> + Sync>(
+        &self,
+        weights: &[W],
+        opts: &ForwardOptions,
+        chunk: usize,
+        out: &mut Vec<Result<ForwardResult, SolveError>>,
+        par: Par,
+    ) -> Result<(), SolveError> {
+        out.clear();
+        par.map_chunks(weights, chunk, out, |c| {
+            let mut o = *opts;
+            c.iter()
+                .map(|w| {
+                    let r = self.forward(w.as_ref(), &o);
+                    if let Ok(r) = &r {
+                        o.warm_start = Some(r.point);
+                    }
+                    r
+                })
+                .collect()
+        })?;
+        Ok(())
+    }
+
+    /// Inverse problem for many points in parallel (see [`BatchWeights`]); each point is
+    /// independent, so the results equal [`Solver::inverse`]'s for any thread count.
+    pub fn inverse_batch(&self, points: &[SurfacePoint]) -> BatchWeights {
+        let mut out = BatchWeights::default();
+        // `Par::Rayon` always starts.
+        let _ = self.inverse_batch_into(points, &mut out, Par::Rayon);
+        out
+    }
+
+    /// [`Solver::inverse_batch`] into an existing result, reusing its memory (repeated
+    /// batches then neither allocate nor page-fault), with explicit parallelism (the
+    /// results do not depend on it). Fails only when `par`'s threads cannot start.
+    pub fn inverse_batch_into(
+        &self,
+        points: &[SurfacePoint],
+        out: &mut BatchWeights,
+        par: Par,
+    ) -> Result<(), SolveError> {
+        let n = self.n_anchors();
+        out.n = n;
+        out.data.resize(points.len() * n.max(1), 0.0);
+        out.status.clear();
+        // Random points read random face records and then their corners' records: request
+        // both a few points ahead (software pipelining), so the waits overlap.
+        let proj = self.projector();
+        let rows_per = n.max(1) * INVERSE_CHUNK;
+        par.zip_chunks_mut(
+            &mut out.data,
+            rows_per,
+            points,
+            INVERSE_CHUNK,
+            &mut out.status,
+            |rows, pts| {
+                let mut scratch = InverseScratch::default();
+                let mut buf = Vec::with_capacity(n);
+                let ahead = |k: usize| pts.get(k).map(|p| p.face);
+                for f in (0..4).filter_map(ahead) {
+                    wavg_project::internal::prefetch_point_data(proj, f, false);
+                }
+                let mut status = Vec::with_capacity(pts.len());
+                for (k, (row, p)) in rows.chunks_mut(n.max(1)).zip(pts).enumerate() {
+                    if let Some(f) = ahead(k + 4) {
+                        wavg_project::internal::prefetch_point_data(proj, f, false);
+                    }
+                    if let Some(f) = ahead(k + 2) {
+                        wavg_project::internal::prefetch_point_data(proj, f, true);
+                    }
+                    let r = self.inverse_into(p, &mut scratch, &mut buf);
+                    if r.is_ok() {
+                        row.copy_from_slice(&buf);
+                    }
+                    status.push(r);
+                }
+                status
+            },
+        )?;
+        Ok(())
+    }
+}
+
+/// Weights of a batch of inverse problems: one row of `n_anchors` weights per point.
+#[derive(Clone, Debug, Default)]
+pub struct BatchWeights {
+    n: usize,
+    data: Vec<f64>,
+    status: Vec<Result<(), SolveError>>,
+}
+
+impl BatchWeights {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.status.len()
+    }
+
+    /// Whether the batch is empty.
+    pub fn is_empty(&self) -> bool {
+        self.status.is_empty()
+    }
+
+    /// Weights of point `i`, or why there are none.
+    pub fn get(&self, i: usize) -> Result<&[f64], &SolveError> {
+        match &self.status[i] {
+            Ok(()) => Ok(&self.data[i * self.n..(i + 1) * self.n]),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// All rows in order.
+    pub fn iter(&self) -> impl Iterator<Item = Result<&[f64], &SolveError>> {
+        (0..self.len()).map(|i| self.get(i))
+    }
+
+    /// Replaces row `i` with `w` (the anchor count long) or marks it failed.
+    pub(crate) fn set(&mut self, i: usize, w: Result<&[f64], SolveError>) {
+        match w {
+            Ok(w) => {
+                self.data[i * self.n..(i + 1) * self.n].copy_from_slice(w);
+                self.status[i] = Ok(());
+            }
+            Err(e) => self.status[i] = Err(e),
+        }
+    }
+}
