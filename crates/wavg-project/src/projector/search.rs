@@ -21,7 +21,7 @@ const HINT_MARGIN: f64 = 0.0;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SearchGoal {
     /// The closest valid projection: the local search tests the faces around the walk's
-    /// end and their neighbours, then certifies its best answer against the bounding
+    /// end, then rings of their neighbours until one holds a projection, then certifies its best answer against the bounding
     /// volume hierarchy (or searches globally). Path [`ProjectionPath::Certified`] or
     /// [`ProjectionPath::Fallback`].
     #[default]
@@ -93,9 +93,10 @@ fn outside(p: [[f32; 8]; 3], y: &[f32; 8]) -> f32 {
 impl Projector {
     /// The local search from the walk's end `v`, the faces around it in the order `cands`
     /// first. For [`SearchGoal::FirstHit`], the first valid projection; for
-    /// [`SearchGoal::Closest`], the closest one among the faces around `v` and, if those
-    /// hold none, their neighbours (a numerically zero distance ends it at once). Every
-    /// face tested is recorded in `tried`.
+    /// [`SearchGoal::Closest`], the closest one in the first ring of faces (around `v`,
+    /// then rings of neighbours across edges, within the budget) that holds any (a
+    /// numerically zero distance ends it at once). Every face tested is recorded in
+    /// `tried`.
     pub(super) fn local_search(
         &self,
         y: &Vec8,
@@ -152,8 +153,11 @@ impl Projector {
                     }
                 }
             }
-            // The closest goal certifies what the first two rings found.
-            if !first_hit && (best.is_some() || ring == 1) {
+            // The closest goal certifies the first ring that holds a projection. Rings
+            // go on until the budget: the walk's end is often not a corner of the face
+            // holding the projection (a point of a long triangle can be nearer to a vertex
+            // of its neighbour), and that face may touch its ring only at a vertex.
+            if !first_hit && best.is_some() {
                 return best;
             }
             // Next ring: unseen neighbours across edges, in order.
