@@ -1,6 +1,6 @@
 //! Runs the whole precomputation on meshes and prints the per-stage table (markdown).
 //!
-//! `cargo run --release -p wavg-embed --example precompute_table -- [MESH...]
+//! `cargo run --release -p wavg-bench --bin precompute_table -- [MESH...]
 //! [--no-refine] [--geodesic-vertices N]`
 //! (default: pig, armadillo, horse, igea from the shared data folder).
 
