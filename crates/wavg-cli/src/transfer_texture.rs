@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use wavg::apps::{Image, TransferOptions, check_uv, transfer_texture};
 
 use crate::CliError;
-use crate::apps_common::solver_for;
+use crate::apps_common::{PairArgs, solver_for};
 use crate::common::{load_mesh, one_line};
 use crate::render::{parse_size, write_png};
 use crate::textio::read_points;
@@ -42,33 +42,17 @@ a texel between four of them whose source UVs lie close together (one chart, no 
 between) takes their bilinear interpolation; every other covered texel is solved exactly.
 --stride 1 solves every texel.")]
 pub struct Args {
-    /// Source mesh (with UVs).
-    #[arg(long)]
-    pub source: String,
+    #[command(flatten)]
+    pub pair: PairArgs,
     /// Source texture (PNG).
     #[arg(long)]
     pub source_texture: PathBuf,
-    /// Target mesh (with UVs).
-    #[arg(long)]
-    pub target: String,
-    /// Source anchors, one per line.
-    #[arg(long)]
-    pub source_anchors: PathBuf,
-    /// Target anchors, one per line, corresponding to the source's.
-    #[arg(long)]
-    pub target_anchors: PathBuf,
     /// Output size W or WxH (default: the source texture's).
     #[arg(long)]
     pub size: Option<String>,
     /// Output PNG (RGBA).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
-    /// .wavg embedding of the source.
-    #[arg(long)]
-    pub source_embedding: Option<PathBuf>,
-    /// .wavg embedding of the target.
-    #[arg(long)]
-    pub target_embedding: Option<PathBuf>,
     /// Use the paper's inverse only (faster; weights need not lead back to the point).
     #[arg(long)]
     pub paper: bool,
@@ -76,9 +60,6 @@ pub struct Args {
     /// inside a chart (1: solve every texel).
     #[arg(long, default_value_t = 4)]
     pub stride: u32,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
     /// Print one JSON object on standard output.
     #[arg(long)]
     pub json: bool,
@@ -86,25 +67,25 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    crate::textio::with_threads(args.threads, || run_inner(args))?
+    crate::textio::with_threads(args.pair.threads, || run_inner(args))?
 }
 
 fn run_inner(args: Args) -> Result<(), CliError> {
     // Cheap checks first: anchors, UVs, texture.
     let (sa, ta) = (
-        read_points(&args.source_anchors)?,
-        read_points(&args.target_anchors)?,
+        read_points(&args.pair.source_anchors)?,
+        read_points(&args.pair.target_anchors)?,
     );
     if sa.len() != ta.len() {
         return Err(CliError::input(format!(
             "{} has {} anchors and {} has {}: they must correspond one to one",
-            args.source_anchors.display(),
+            args.pair.source_anchors.display(),
             sa.len(),
-            args.target_anchors.display(),
+            args.pair.target_anchors.display(),
             ta.len()
         )));
     }
-    for (mesh, what) in [(&args.source, "source"), (&args.target, "target")] {
+    for (mesh, what) in [(&args.pair.source, "source"), (&args.pair.target, "target")] {
         let m = load_mesh(mesh)?;
         check_uv(&m, what).map_err(|e| CliError::input(format!("{mesh}: {e}")))?;
     }
@@ -120,14 +101,14 @@ fn run_inner(args: Args) -> Result<(), CliError> {
     let visible = std::io::stderr().is_terminal() && !args.json;
     let t0 = Instant::now();
     let source = solver_for(
-        &args.source,
-        args.source_embedding.as_deref(),
-        &args.source_anchors,
+        &args.pair.source,
+        args.pair.source_embedding.as_deref(),
+        &args.pair.source_anchors,
     )?;
     let target = solver_for(
-        &args.target,
-        args.target_embedding.as_deref(),
-        &args.target_anchors,
+        &args.pair.target,
+        args.pair.target_embedding.as_deref(),
+        &args.pair.target_anchors,
     )?;
     let precompute_s = t0.elapsed().as_secs_f64();
     let opts = TransferOptions {

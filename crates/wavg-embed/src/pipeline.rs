@@ -61,6 +61,7 @@ impl Default for PrecomputeOptions {
 
 /// Wall-clock seconds per stage.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct StageSeconds {
     /// Landmark selection.
     pub decimate: f64,
@@ -74,8 +75,10 @@ pub struct StageSeconds {
     pub quality: f64,
 }
 
-/// What [`precompute`] measured.
+/// What [`precompute`] measured. With the `serde` feature it serialises to the keys of
+/// `wavg precompute --json` (a NaN error, when not measured, becomes `null` in JSON).
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Report {
     /// Total wall-clock seconds.
     pub seconds: f64,

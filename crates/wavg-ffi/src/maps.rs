@@ -40,14 +40,44 @@ fn finish(
     first.map_or(Ok(()), Err)
 }
 
-fn point_out(r: &wavg::ForwardResult) -> (wavg_point, [f64; 3]) {
-    (
-        wavg_point {
-            face: r.point.face,
-            bary: r.point.bary,
-        },
-        [r.position.x, r.position.y, r.position.z],
-    )
+/// Writes the image of point `i` to `out[i]` and, when given, its position to
+/// `xyz[3*i..3*i+3]`; `face = UINT32_MAX` and NaN where there is no image.
+fn write_image(
+    out: &mut [wavg_point],
+    xyz: Option<&mut [f64]>,
+    i: usize,
+    image: &Result<wavg::ForwardResult, wavg::solve::SolveError>,
+) {
+    let (p, x) = match image {
+        Ok(r) => (
+            wavg_point {
+                face: r.point.face,
+                bary: r.point.bary,
+            },
+            [r.position.x, r.position.y, r.position.z],
+        ),
+        Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
+    };
+    out[i] = p;
+    if let Some(xyz) = xyz {
+        xyz[3 * i..3 * i + 3].copy_from_slice(&x);
+    }
+}
+
+/// The query points of a call (`n` of them, at least one).
+///
+/// # Safety
+/// `points` must be NULL or hold `n` elements.
+unsafe fn queries(points: *const wavg_point, n: usize) -> Result<Vec<SurfacePoint>, Failure> {
+    if n == 0 {
+        return Err(Failure::arg("n is 0"));
+    }
+    // SAFETY: per this function's contract.
+    let pts = unsafe { slice(points, n, "points")? };
+    Ok(pts
+        .iter()
+        .map(|p| SurfacePoint::new(p.face, p.bary))
+        .collect())
 }
 
 fn solve_failure(e: &wavg::solve::SolveError) -> (wavg_status, String) {
@@ -86,9 +116,8 @@ pub unsafe extern "C" fn wavg_correspond(
     out_statuses: *mut wavg_status,
 ) -> wavg_status {
     guard(|| {
-        if n == 0 {
-            return Err(Failure::arg("n is 0"));
-        }
+        // SAFETY: per this function's contract.
+        let query = unsafe { queries(points, n)? };
         if !max_negative.is_finite() {
             return Err(Failure::arg("max_negative must be finite"));
         }
@@ -102,30 +131,18 @@ pub unsafe extern "C" fn wavg_correspond(
             )));
         }
         // SAFETY: per this function's contract.
-        let (pts, out, xyz, statuses) = unsafe {
+        let (out, xyz, statuses) = unsafe {
             (
-                slice(points, n, "points")?,
                 slice_mut(out, n, "out")?,
                 optional(out_xyz, product(n, 3, "n")?),
                 optional(out_statuses, n),
             )
         };
-        let query: Vec<SurfacePoint> = pts
-            .iter()
-            .map(|p| SurfacePoint::new(p.face, p.bary))
-            .collect();
         let mapped = map_points(s.inner(), t.inner(), &query, verified)
             .map_err(|e| Failure::from(wavg::Error::from(e)))?;
         let mut xyz = xyz;
         let each = mapped.iter().enumerate().map(|(i, m)| {
-            let (p, x) = match &m.target {
-                Ok(r) => point_out(r),
-                Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
-            };
-            out[i] = p;
-            if let Some(xyz) = xyz.as_deref_mut() {
-                xyz[3 * i..3 * i + 3].copy_from_slice(&x);
-            }
+            write_image(out, xyz.as_deref_mut(), i, &m.target);
             match &m.target {
                 Err(e) => Err(solve_failure(e)),
                 Ok(_) if !m.round_trip => Err((
@@ -199,14 +216,7 @@ pub unsafe extern "C" fn wavg_correspond_vertices(
         };
         let mut each = Vec::with_capacity(n);
         for (i, (m, v)) in c.mapped.iter().zip(&c.validity).enumerate() {
-            let (p, x) = match &m.target {
-                Ok(r) => point_out(r),
-                Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
-            };
-            out[i] = p;
-            if let Some(xyz) = xyz.as_deref_mut() {
-                xyz[3 * i..3 * i + 3].copy_from_slice(&x);
-            }
+            write_image(out, xyz.as_deref_mut(), i, &m.target);
             each.push(match v {
                 Validity::Valid => Ok(()),
                 Validity::Unanswered(e) => Err(solve_failure(e)),
@@ -242,24 +252,14 @@ pub unsafe extern "C" fn wavg_decal_uv(
     out_statuses: *mut wavg_status,
 ) -> wavg_status {
     guard(|| {
-        if n == 0 {
-            return Err(Failure::arg("n is 0"));
-        }
+        // SAFETY: per this function's contract.
+        let query = unsafe { queries(points, n)? };
         // SAFETY: per this function's contract.
         let s = unsafe { handle(solver, "solver")? };
         let k = s.inner().n_anchors();
         // SAFETY: per this function's contract.
-        let (uv, pts) = unsafe {
-            (
-                slice(anchor_uv, product(k, 2, "anchors")?, "anchor_uv")?,
-                slice(points, n, "points")?,
-            )
-        };
+        let uv = unsafe { slice(anchor_uv, product(k, 2, "anchors")?, "anchor_uv")? };
         let uv: Vec<[f64; 2]> = uv.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-        let query: Vec<SurfacePoint> = pts
-            .iter()
-            .map(|p| SurfacePoint::new(p.face, p.bary))
-            .collect();
         // Checks the coordinates and max_negative before any output is touched.
         let d = decal_uv(s.inner(), &uv, &query, max_negative)
             .map_err(|e| Failure::from(wavg::Error::from(e)))?;

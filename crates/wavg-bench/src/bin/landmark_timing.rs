@@ -43,16 +43,12 @@ fn main() {
     args.retain(|a| a != "--runs-only");
     let decimate_only = args.iter().any(|a| a == "--decimate-only");
     args.retain(|a| a != "--decimate-only");
-    let paths: Vec<std::path::PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_testdata::require_data_dir("landmark_timing") else {
-            return;
-        };
-        ["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"]
-            .iter()
-            .map(|m| dir.join("meshes").join(m))
-            .collect()
-    } else {
-        args.iter().map(Into::into).collect()
+    let Some(paths) = wavg_bench::mesh_paths(
+        &args,
+        &["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"],
+        "landmark_timing",
+    ) else {
+        return;
     };
     println!(
         "| mesh | vertices | decimate (s) | fm build (s) | one run (ms) | {n_landmarks} runs, {} threads (s) | asymmetry % |",

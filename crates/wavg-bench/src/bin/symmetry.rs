@@ -24,16 +24,12 @@ fn main() {
         near_field = args[i + 1].parse().expect("--near-field EDGES");
         args.drain(i..i + 2);
     }
-    let paths: Vec<std::path::PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_testdata::require_data_dir("symmetry") else {
-            return;
-        };
-        ["pig.off", "camelhead.off", "fertility.off"]
-            .iter()
-            .map(|m| dir.join("meshes").join(m))
-            .collect()
-    } else {
-        args.iter().map(Into::into).collect()
+    let Some(paths) = wavg_bench::mesh_paths(
+        &args,
+        &["pig.off", "camelhead.off", "fertility.off"],
+        "symmetry",
+    ) else {
+        return;
     };
     println!("| mesh | landmarks | runs (s) | mean % | max % | pairs above 2% |");
     println!("|---|---:|---:|---:|---:|---:|");

@@ -1,0 +1,203 @@
+//! The exact key sets of the `--json` reports (nested objects included), on small
+//! generated meshes: the reports are serialised from library types, and these keys are a
+//! contract that must not change when those types do.
+
+mod common;
+
+use std::path::Path;
+
+use common::{json_object, wavg_ok};
+use serde_json::Value;
+
+fn s(p: &Path) -> String {
+    p.to_str().unwrap().to_string()
+}
+
+/// Every key of `v`, nested ones as `parent.child`, sorted.
+fn key_paths(v: &Value) -> Vec<String> {
+    fn walk(prefix: &str, v: &Value, out: &mut Vec<String>) {
+        if let Value::Object(o) = v {
+            for (k, x) in o {
+                let path = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                out.push(path.clone());
+                walk(&path, x, out);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk("", v, &mut out);
+    out.sort();
+    out
+}
+
+fn assert_keys(args: &[&str], want: &[&str]) {
+    let (o, _) = json_object(&wavg_ok(args));
+    let mut want: Vec<String> = want.iter().map(|k| k.to_string()).collect();
+    want.sort();
+    assert_eq!(key_paths(&Value::Object(o)), want, "wavg {}", args[0]);
+}
+
+#[test]
+fn precompute_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = s(&dir.path().join("t.wavg"));
+    let keys = [
+        "mesh",
+        "output",
+        "seconds",
+        "stages",
+        "stages.decimate",
+        "stages.geodesics",
+        "stages.mds",
+        "stages.lsmesh",
+        "stages.quality",
+        "load_seconds",
+        "save_seconds",
+        "landmarks",
+        "geodesic_mesh_vertices",
+        "dim",
+        "stress",
+        "initial_stress",
+        "mds_iterations",
+        "mds_converged",
+        "geodesic_rel_err_p50",
+        "geodesic_rel_err_p90",
+        "quality_pairs",
+        "vertices",
+        "faces",
+        "removed_by_largest_component",
+    ];
+    let base = [
+        "precompute",
+        "builtin:torus",
+        "-o",
+        &out,
+        "--landmarks",
+        "60",
+        "--json",
+    ];
+    assert_keys(&base, &keys);
+    let mut with_removed = keys.to_vec();
+    with_removed.extend([
+        "removed_by_largest_component.vertices",
+        "removed_by_largest_component.faces",
+    ]);
+    assert_keys(
+        &[&base[..], &["--largest-component"]].concat(),
+        &with_removed,
+    );
+}
+
+/// Every 85th vertex of the level-4 icosphere (2562 vertices): 31 anchors.
+fn sphere_anchors(dir: &Path) -> String {
+    let p = dir.join("a.txt");
+    let text: String = (0..2562).step_by(85).map(|v| format!("v {v}\n")).collect();
+    std::fs::write(&p, text).unwrap();
+    s(&p)
+}
+
+#[test]
+fn correspond_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = sphere_anchors(dir.path());
+    let out = s(&dir.path().join("map.txt"));
+    let m = "builtin:icosphere";
+    let args = [
+        "correspond",
+        "--source",
+        m,
+        "--target",
+        m,
+        "--source-anchors",
+        &a,
+        "--target-anchors",
+        &a,
+        "-o",
+        &out,
+        "--json",
+    ];
+    let keys = [
+        "source",
+        "target",
+        "anchors",
+        "source_vertices",
+        "valid",
+        "valid_fraction",
+        "validity",
+        "verified",
+        "reasons",
+        "flipped_faces",
+        "flipped_area_fraction",
+        "measured_faces",
+        "stretch",
+        "stretch_best95",
+        "seconds",
+        "setup_seconds",
+        "vertices_per_s",
+        "cpu_seconds",
+        "vertices_per_cpu_s",
+        "ground_truth",
+    ];
+    let (o, _) = json_object(&wavg_ok(&args));
+    let mut want: Vec<String> = keys.iter().map(|k| k.to_string()).collect();
+    // `reasons` counts by reason: its keys depend on the map, not on the format.
+    want.extend(
+        o["reasons"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(|k| format!("reasons.{k}")),
+    );
+    want.sort();
+    assert_eq!(key_paths(&Value::Object(o)), want);
+    let (o, _) = json_object(&wavg_ok(&[&args[..], &["--ground-truth"]].concat()));
+    let truth = key_paths(&o["ground_truth"]);
+    let stats = ["count", "max", "mean", "p95"];
+    let mut want: Vec<String> = ["answered", "valid"]
+        .iter()
+        .flat_map(|g| {
+            std::iter::once(g.to_string()).chain(stats.iter().map(move |k| format!("{g}.{k}")))
+        })
+        .collect();
+    want.sort();
+    assert_eq!(truth, want);
+}
+
+#[test]
+fn decal_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.txt");
+    std::fs::write(&a, "v 0\nv 1\nv 2\nv 3\n").unwrap();
+    let uv = dir.path().join("uv.txt");
+    std::fs::write(&uv, "0 0\n1 0\n0 1\n1 1\n").unwrap();
+    let out = s(&dir.path().join("d.obj"));
+    let args = [
+        "decal",
+        "--mesh",
+        "builtin:icosphere",
+        "--anchors",
+        &s(&a),
+        "--uv",
+        &s(&uv),
+        "-o",
+        &out,
+        "--json",
+    ];
+    let keys = [
+        "mesh",
+        "anchors",
+        "vertices",
+        "valid_fraction",
+        "stretch",
+        "stretch_best95",
+        "flipped_faces",
+        "flipped_area_fraction",
+        "seconds",
+        "marked",
+    ];
+    assert_keys(&args, &keys);
+}
