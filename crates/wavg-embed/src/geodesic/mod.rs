@@ -46,13 +46,9 @@
 //! run starts with exact polyhedral distances within [`crate::near_field::NEAR_FIELD_EDGES`]
 //! mean edge lengths of the source (windows of Chen & Han with pseudo-sources at saddle
 //! vertices and Xin & Wang's pruning, [`crate::near_field`]; the radius is a parameter,
-//! [`FastMarching::with_near_field_edges`]). With straight lines only, on a 40k icosphere
-//! this lowered the mean error from 0.40-0.52% to 0.21-0.26% and the maximum from 3.9-4.5%
-//! to 0.7-0.9%. On pig, camelhead and fertility (1000 landmarks) the largest asymmetry
-//! `|d(i,j) - d(j,i)| / mean` went from 8.7-16% (plain) to 5.3-7.3% (straight lines) and
-//! 2.7-6.4% (with pseudo-sources), and the pairs above 2% from 0.25-0.87% to 0.01-0.06% and
-//! 0.003-0.018%, for 1.1-1.5x the time of a plain run; at 16 edge lengths (3-5x the
-//! time) every pair is within 2% (1.4-1.9% at most).
+//! [`FastMarching::with_near_field_edges`]). It makes close pairs nearly exact and the
+//! landmark matrix far more symmetric for a little more time per run; the figures are in
+//! `BENCHMARKS.md`.
 //!
 //! All geometry is precomputed once per mesh in [`FastMarching`] (a flat list of
 //! update entries per freezing vertex, single precision), so one run only touches the
