@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use wavg::apps::{Image, TransferOptions, check_uv, transfer_texture};
+use wavg::apps::{Image, TextureTransfer, TransferOptions, check_uv, transfer_texture};
 
 use crate::CliError;
 use crate::apps_common::{PairArgs, solver_for};
@@ -63,6 +63,23 @@ pub struct Args {
     /// Print one JSON object on standard output.
     #[arg(long)]
     pub json: bool,
+}
+
+/// The `--json` object: the library's [`TextureTransfer`] counts with the atlas, the
+/// settings and the timings (printed through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    #[serde(flatten)]
+    transfer: &'a TextureTransfer,
+    valid_fraction: f64,
+    seconds: f64,
+    texels_per_s: f64,
+    width: u32,
+    height: u32,
+    atlas_texels: u64,
+    precompute_s: f64,
+    verified: bool,
+    stride: u32,
 }
 
 /// Runs the command.
@@ -147,22 +164,19 @@ fn run_inner(args: Args) -> Result<(), CliError> {
     };
     let rate = out.covered as f64 / seconds.max(1e-12);
     if args.json {
-        let j = serde_json::json!({
-            "texels": out.covered,
-            "valid_fraction": valid_fraction,
-            "seconds": seconds,
-            "texels_per_s": rate,
-            "width": width,
-            "height": height,
-            "atlas_texels": width as u64 * height as u64,
-            "valid_texels": out.valid,
-            "not_reached": out.not_reached,
-            "dilated_texels": out.dilated,
-            "precompute_s": precompute_s,
-            "verified": !args.paper,
-            "stride": args.stride,
-            "interpolated_texels": out.interpolated,
-        });
+        let j = serde_json::to_value(JsonReport {
+            transfer: &out,
+            valid_fraction,
+            seconds,
+            texels_per_s: rate,
+            width,
+            height,
+            atlas_texels: width as u64 * height as u64,
+            precompute_s,
+            verified: !args.paper,
+            stride: args.stride,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else {
         println!(

@@ -201,3 +201,78 @@ fn decal_json_keys() {
     ];
     assert_keys(&args, &keys);
 }
+
+/// A flat 12 x 12 grid in the unit square with its own (x, y) as texture coordinates.
+fn textured_grid(path: &Path) {
+    let n = 12;
+    let mut obj = String::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            obj += &format!("v {x} {y} 0\nvt {x} {y}\n");
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let v = |a: usize, b: usize| (j + b) * (n + 1) + i + a + 1;
+            let (p, q, r, s) = (v(0, 0), v(1, 0), v(1, 1), v(0, 1));
+            obj += &format!("f {p}/{p} {q}/{q} {r}/{r}\nf {p}/{p} {r}/{r} {s}/{s}\n");
+        }
+    }
+    std::fs::write(path, obj).unwrap();
+}
+
+#[test]
+fn transfer_texture_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = dir.path().join("grid.obj");
+    textured_grid(&grid);
+    let texture = s(&dir.path().join("texture.png"));
+    wavg_ok(&[
+        "render",
+        "builtin:icosphere",
+        "-o",
+        &texture,
+        "--size",
+        "32",
+    ]);
+    let a = dir.path().join("a.txt");
+    std::fs::write(&a, "v 0\nv 12\nv 84\nv 156\nv 168\n").unwrap();
+    let (grid, a) = (s(&grid), s(&a));
+    let out = s(&dir.path().join("out.png"));
+    let args = [
+        "transfer-texture",
+        "--source",
+        &grid,
+        "--source-texture",
+        &texture,
+        "--target",
+        &grid,
+        "--source-anchors",
+        &a,
+        "--target-anchors",
+        &a,
+        "-o",
+        &out,
+        "--size",
+        "16",
+        "--json",
+    ];
+    let keys = [
+        "texels",
+        "valid_fraction",
+        "seconds",
+        "texels_per_s",
+        "width",
+        "height",
+        "atlas_texels",
+        "valid_texels",
+        "not_reached",
+        "dilated_texels",
+        "precompute_s",
+        "verified",
+        "stride",
+        "interpolated_texels",
+    ];
+    assert_keys(&args, &keys);
+}
