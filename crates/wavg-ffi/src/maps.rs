@@ -7,7 +7,7 @@ use wavg::apps::{
 };
 
 use crate::boundary::{Failure, guard, handle, product, slice, slice_mut};
-use crate::solver::{optional, wavg_solver};
+use crate::solver::{optional, wavg_solver, write_image};
 use crate::types::{wavg_point, wavg_status};
 
 /// The status of an answered point that fails the validity test.
@@ -38,30 +38,6 @@ fn finish(
         }
     }
     first.map_or(Ok(()), Err)
-}
-
-/// Writes the image of point `i` to `out[i]` and, when given, its position to
-/// `xyz[3*i..3*i+3]`; `face = UINT32_MAX` and NaN where there is no image.
-fn write_image(
-    out: &mut [wavg_point],
-    xyz: Option<&mut [f64]>,
-    i: usize,
-    image: &Result<wavg::ForwardResult, wavg::solve::SolveError>,
-) {
-    let (p, x) = match image {
-        Ok(r) => (
-            wavg_point {
-                face: r.point.face,
-                bary: r.point.bary,
-            },
-            [r.position.x, r.position.y, r.position.z],
-        ),
-        Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
-    };
-    out[i] = p;
-    if let Some(xyz) = xyz {
-        xyz[3 * i..3 * i + 3].copy_from_slice(&x);
-    }
 }
 
 /// The query points of a call (`n` of them, at least one).
