@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{json_object, wavg_ok};
+use common::{json_object, sphere_anchors, wavg_ok};
 use serde_json::Value;
 
 fn s(p: &Path) -> String {
@@ -92,18 +92,10 @@ fn precompute_json_keys() {
     );
 }
 
-/// Every 85th vertex of the level-4 icosphere (2562 vertices): 31 anchors.
-fn sphere_anchors(dir: &Path) -> String {
-    let p = dir.join("a.txt");
-    let text: String = (0..2562).step_by(85).map(|v| format!("v {v}\n")).collect();
-    std::fs::write(&p, text).unwrap();
-    s(&p)
-}
-
 #[test]
 fn correspond_json_keys() {
     let dir = tempfile::tempdir().unwrap();
-    let a = sphere_anchors(dir.path());
+    let a = s(&sphere_anchors(dir.path()));
     let out = s(&dir.path().join("map.txt"));
     let m = "builtin:icosphere";
     let args = [
