@@ -6,6 +6,7 @@
 mod cbuild;
 mod examples;
 mod fuzz;
+mod lines;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -19,18 +20,47 @@ fn main() -> ExitCode {
             Some(seconds) => report(fuzz::run(&workspace_root(), seconds)),
             None => usage(),
         },
+        Some("lines") => report(lines::run(&workspace_root())),
+        Some("bench") if args.len() > 1 => report(bench(&workspace_root(), &args[1..])),
         _ => usage(),
+    }
+}
+
+/// `cargo xtask bench NAME [ARGS...]`: runs the timing script or experiment NAME (a binary
+/// of the `wavg-bench` crate) in release mode with ARGS.
+fn bench(root: &Path, args: &[String]) -> Result<(), String> {
+    let mut cmd = Command::new("cargo");
+    cmd.args([
+        "run",
+        "--release",
+        "--quiet",
+        "-p",
+        "wavg-bench",
+        "--bin",
+        &args[0],
+        "--",
+    ])
+    .args(&args[1..])
+    .current_dir(root);
+    let ok = cmd.status().is_ok_and(|s| s.success());
+    if ok {
+        Ok(())
+    } else {
+        Err(format!("bench {} failed", args[0]))
     }
 }
 
 fn usage() -> ExitCode {
     eprintln!(
-        "usage: cargo xtask test | cargo xtask fuzz [--seconds N]\n\n  \
+        "usage: cargo xtask test | cargo xtask fuzz [--seconds N] | cargo xtask bench NAME [ARGS] | cargo xtask lines\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the examples \
          (and quickstart.rs as a crate outside the workspace), the C/C++ build (CMake: \
          libwavg, C tests, examples, OpenMesh harness) and ctest, a {SMOKE_SECONDS} s smoke \
          run of every fuzz target\n  \
-         fuzz   every fuzz target for N seconds (default 60) each"
+         fuzz   every fuzz target for N seconds (default 60) each\n  \
+         bench  the timing script or experiment NAME (crates/wavg-bench/src/bin/NAME.rs) with ARGS\n  \
+         lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])",
+        MAX = lines::MAX_LINES
     );
     ExitCode::from(2)
 }

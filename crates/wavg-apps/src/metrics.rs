@@ -19,14 +19,18 @@
 
 use nalgebra::Vector3;
 
-/// Distortion of a map (see the module docs).
+/// Distortion of a map (see the module docs). With the `serde` feature it serialises its
+/// totals (not the per-face vectors) to the keys of `wavg correspond --json`.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Distortion {
     /// Per source face: the symmetrised stretch of the face (`None` where a corner is not
     /// mapped or the face is flipped).
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub face_stretch: Vec<Option<f64>>,
     /// Per source face: flipped (mapped orientation disagrees with the reference normal,
     /// or the mapped triangle is degenerate).
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub flipped: Vec<bool>,
     /// Faces whose three corners are mapped.
     pub measured_faces: usize,

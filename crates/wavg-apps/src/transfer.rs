@@ -51,22 +51,29 @@ impl Default for TransferOptions {
     }
 }
 
-/// The transferred texture and what happened to its texels.
+/// The transferred texture and what happened to its texels. With the `serde` feature the
+/// counts (not the image) serialise to the keys of `wavg transfer-texture --json`.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct TextureTransfer {
     /// The target texture (RGBA; alpha 0 where nothing was transferred).
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub image: Image,
     /// Texels covered by a target triangle (each one an inverse and a forward problem).
+    #[cfg_attr(feature = "serde", serde(rename = "texels"))]
     pub covered: usize,
     /// Covered texels with a point on the source (the others are transparent).
+    #[cfg_attr(feature = "serde", serde(rename = "valid_texels"))]
     pub valid: usize,
     /// Covered texels whose verified weights did not lead back to the target point (the
     /// paper's weights are used for them).
     pub not_reached: usize,
     /// Texels filled by the seam dilation.
+    #[cfg_attr(feature = "serde", serde(rename = "dilated_texels"))]
     pub dilated: usize,
     /// Covered texels whose source UV was interpolated between exactly solved lattice
     /// texels (see [`TransferOptions::stride`]) rather than solved themselves.
+    #[cfg_attr(feature = "serde", serde(rename = "interpolated_texels"))]
     pub interpolated: usize,
 }
 

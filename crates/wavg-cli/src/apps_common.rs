@@ -3,7 +3,7 @@
 //! progress bar on a terminal).
 
 use std::io::IsTerminal;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
@@ -13,6 +13,33 @@ use crate::CliError;
 use crate::common::{load_valid, one_line};
 use crate::precompute::Bars;
 use crate::textio::{located, read_points, spec_anchor};
+
+/// Flags of the commands that relate two surfaces through anchors paired line by line
+/// (correspond, morph, transfer-texture).
+#[derive(clap::Args)]
+pub struct PairArgs {
+    /// Source mesh (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    #[arg(long)]
+    pub source: String,
+    /// Target mesh.
+    #[arg(long)]
+    pub target: String,
+    /// Anchors on the source (`v VERTEX` or `f FACE B0 B1 B2` per line).
+    #[arg(long)]
+    pub source_anchors: PathBuf,
+    /// Anchors on the target, paired line by line with the source's (same count).
+    #[arg(long)]
+    pub target_anchors: PathBuf,
+    /// A .wavg embedding of the source (default: precompute one in memory).
+    #[arg(long)]
+    pub source_embedding: Option<PathBuf>,
+    /// A .wavg embedding of the target (default: precompute one in memory).
+    #[arg(long)]
+    pub target_embedding: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
 
 /// Loads the mesh, the embedding (`.wavg`, or precomputed in memory with a tenth of the
 /// vertices as landmarks, 50 to 1000) and the anchors, each error naming its file and line.

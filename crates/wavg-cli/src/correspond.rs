@@ -6,11 +6,13 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use wavg::apps::{CorrespondOptions, Correspondence, Validity, ValidityTest, correspond_vertices};
+use wavg::apps::{
+    CorrespondOptions, Correspondence, Distortion, Validity, ValidityTest, correspond_vertices,
+};
 use wavg::{Anchor, Solver, Surface};
 
 use crate::CliError;
-use crate::apps_common::{embed, surface_and_anchors};
+use crate::apps_common::{PairArgs, embed, surface_and_anchors};
 use crate::common::one_line;
 use crate::textio::{self, write_numbers};
 
@@ -27,24 +29,8 @@ pub enum Test {
 /// Arguments shared by the commands that map one surface onto another.
 #[derive(clap::Args)]
 pub struct MapArgs {
-    /// Source mesh (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub source: String,
-    /// Target mesh.
-    #[arg(long)]
-    pub target: String,
-    /// Anchors on the source (`v VERTEX` or `f FACE B0 B1 B2` per line).
-    #[arg(long)]
-    pub source_anchors: PathBuf,
-    /// Anchors on the target, paired line by line with the source's (same count).
-    #[arg(long)]
-    pub target_anchors: PathBuf,
-    /// A .wavg embedding of the source (default: precompute one in memory).
-    #[arg(long)]
-    pub source_embedding: Option<PathBuf>,
-    /// A .wavg embedding of the target (default: precompute one in memory).
-    #[arg(long)]
-    pub target_embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub pair: PairArgs,
     /// Use the paper's inverse weights only (default: verified weights, the paper's where
     /// they round-trip, else the smallest offset penalty that does).
     #[arg(long)]
@@ -59,9 +45,6 @@ pub struct MapArgs {
     /// symmetrised stretch.
     #[arg(long, default_value_t = 4.0)]
     pub max_stretch: f64,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
 }
 
 /// Arguments.
@@ -122,14 +105,14 @@ pub struct Computed {
 /// both surfaces and maps every source vertex.
 pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
     let t0 = Instant::now();
-    let (mut source, sa) = surface_and_anchors(&a.source, &a.source_anchors)?;
-    let (mut target, ta) = surface_and_anchors(&a.target, &a.target_anchors)?;
+    let (mut source, sa) = surface_and_anchors(&a.pair.source, &a.pair.source_anchors)?;
+    let (mut target, ta) = surface_and_anchors(&a.pair.target, &a.pair.target_anchors)?;
     if sa.len() != ta.len() {
         return Err(CliError::input(format!(
             "{} has {} anchors and {} has {}; they are paired line by line and must agree",
-            a.source_anchors.display(),
+            a.pair.source_anchors.display(),
             sa.len(),
-            a.target_anchors.display(),
+            a.pair.target_anchors.display(),
             ta.len()
         )));
     }
@@ -141,8 +124,8 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
             "--max-stretch must be a finite number above 1",
         ));
     }
-    embed(&mut source, a.source_embedding.as_deref())?;
-    embed(&mut target, a.target_embedding.as_deref())?;
+    embed(&mut source, a.pair.source_embedding.as_deref())?;
+    embed(&mut target, a.pair.target_embedding.as_deref())?;
     let solver = |s: &Surface, l: Vec<Anchor>| -> Result<Solver, CliError> {
         s.solver(l).map_err(|e| CliError::input(one_line(&e)))
     };
@@ -159,7 +142,7 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
     };
     let t = Instant::now();
     let cpu0 = crate::common::cpu_seconds(false);
-    let map = textio::with_threads(a.threads, || correspond_vertices(&ss, &ts, &opts))?
+    let map = textio::with_threads(a.pair.threads, || correspond_vertices(&ss, &ts, &opts))?
         .map_err(|e| CliError::input(one_line(&e)))?;
     Ok(Computed {
         source,
@@ -228,6 +211,29 @@ fn ground_truth(c: &Computed) -> Result<serde_json::Value, CliError> {
     Ok(serde_json::json!({"valid": stats(valid), "answered": stats(answered)}))
 }
 
+/// The `--json` object: the map's [`Distortion`] with the CLI's counts and timings
+/// (printed through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    source: &'a str,
+    target: &'a str,
+    anchors: usize,
+    source_vertices: usize,
+    valid: usize,
+    valid_fraction: f64,
+    validity: String,
+    verified: bool,
+    reasons: serde_json::Value,
+    #[serde(flatten)]
+    distortion: &'a Distortion,
+    seconds: f64,
+    setup_seconds: f64,
+    vertices_per_s: f64,
+    cpu_seconds: Option<f64>,
+    vertices_per_cpu_s: Option<f64>,
+    ground_truth: Option<serde_json::Value>,
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let c = compute(&args.map)?;
@@ -241,28 +247,25 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let d = &c.map.distortion;
     let per_s = n as f64 / c.seconds.max(1e-12);
     if args.json {
-        let j = serde_json::json!({
-            "source": args.map.source,
-            "target": args.map.target,
-            "anchors": anchors_of(&args.map)?,
-            "source_vertices": n,
-            "valid": c.map.valid(),
-            "valid_fraction": c.map.valid_fraction(),
-            "validity": format!("{:?}", args.map.validity).to_lowercase(),
-            "verified": !args.map.paper_weights,
-            "reasons": reason_counts(&c.map),
-            "flipped_faces": d.flipped_faces,
-            "flipped_area_fraction": d.flipped_area_fraction,
-            "measured_faces": d.measured_faces,
-            "stretch": d.stretch,
-            "stretch_best95": d.stretch_best95,
-            "seconds": c.seconds,
-            "setup_seconds": c.setup_seconds,
-            "vertices_per_s": per_s,
-            "cpu_seconds": c.cpu_seconds,
-            "vertices_per_cpu_s": c.cpu_seconds.map(|s| n as f64 / s.max(1e-12)),
-            "ground_truth": truth,
-        });
+        let j = serde_json::to_value(JsonReport {
+            source: &args.map.pair.source,
+            target: &args.map.pair.target,
+            anchors: anchors_of(&args.map)?,
+            source_vertices: n,
+            valid: c.map.valid(),
+            valid_fraction: c.map.valid_fraction(),
+            validity: format!("{:?}", args.map.validity).to_lowercase(),
+            verified: !args.map.paper_weights,
+            reasons: reason_counts(&c.map),
+            distortion: d,
+            seconds: c.seconds,
+            setup_seconds: c.setup_seconds,
+            vertices_per_s: per_s,
+            cpu_seconds: c.cpu_seconds,
+            vertices_per_cpu_s: c.cpu_seconds.map(|s| n as f64 / s.max(1e-12)),
+            ground_truth: truth,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else if args.output != Path::new("-") {
         println!(
@@ -280,7 +283,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
 /// Anchor count (the source's; the pairing was checked).
 fn anchors_of(a: &MapArgs) -> Result<usize, CliError> {
-    Ok(textio::read_points(&a.source_anchors)?.len())
+    Ok(textio::read_points(&a.pair.source_anchors)?.len())
 }
 
 /// Writes one line per source vertex: its image or `none REASON`.

@@ -52,7 +52,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let t = Instant::now();
     let mesh = c.source.mesh();
     let mapped = harmonic_fill(mesh, &c.map.valid_positions())
-        .map_err(|e| CliError::failure(format!("{}: {}", args.map.source, one_line(&e))))?;
+        .map_err(|e| CliError::failure(format!("{}: {}", args.map.pair.source, one_line(&e))))?;
     let frames = morph_frames(&mesh.positions, &mapped, args.frames);
     let seconds = c.seconds + t.elapsed().as_secs_f64();
     std::fs::create_dir_all(&args.output)
@@ -74,8 +74,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     if args.json {
         let j = serde_json::json!({
-            "source": args.map.source,
-            "target": args.map.target,
+            "source": args.map.pair.source,
+            "target": args.map.pair.target,
             "output": args.output,
             "frames": args.frames,
             "valid_fraction": c.map.valid_fraction(),

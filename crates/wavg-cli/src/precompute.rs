@@ -15,7 +15,6 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
-use serde_json::json;
 use wavg::embed::{self, PrecomputeOptions, Progress, Stage};
 use wavg_mesh::{MeshError, ValidMesh, repair};
 
@@ -103,33 +102,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
     let s = &report.stages;
     if args.json {
-        let v = json!({
-            "mesh": args.mesh,
-            "output": args.output,
-            "seconds": report.seconds,
-            "stages": {
-                "decimate": s.decimate,
-                "geodesics": s.geodesics,
-                "mds": s.mds,
-                "lsmesh": s.lsmesh,
-                "quality": s.quality,
-            },
-            "load_seconds": load_seconds,
-            "save_seconds": save_seconds,
-            "landmarks": report.landmarks,
-            "geodesic_mesh_vertices": report.geodesic_mesh_vertices,
-            "dim": report.dim,
-            "stress": report.stress,
-            "initial_stress": report.initial_stress,
-            "mds_iterations": report.mds_iterations,
-            "mds_converged": report.mds_converged,
-            "geodesic_rel_err_p50": finite_or_null(report.geodesic_rel_err_p50),
-            "geodesic_rel_err_p90": finite_or_null(report.geodesic_rel_err_p90),
-            "quality_pairs": report.quality_pairs,
-            "vertices": report.vertices,
-            "faces": report.faces,
-            "removed_by_largest_component": removed.map(|(v, f)| json!({"vertices": v, "faces": f})),
-        });
+        let v = serde_json::to_value(JsonReport {
+            mesh: &args.mesh,
+            output: &args.output,
+            report: &report,
+            load_seconds,
+            save_seconds,
+            removed_by_largest_component: removed
+                .map(|(vertices, faces)| Removed { vertices, faces }),
+        })
+        .map_err(CliError::failure)?;
         println!("{v}");
     } else {
         println!(
@@ -183,12 +165,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
     Ok(())
 }
 
-fn finite_or_null(x: f64) -> serde_json::Value {
-    if x.is_finite() {
-        json!(x)
-    } else {
-        serde_json::Value::Null
-    }
+/// The `--json` object: the library's report with the files, the I/O times and the
+/// repair (printed through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    mesh: &'a str,
+    output: &'a std::path::Path,
+    #[serde(flatten)]
+    report: &'a embed::Report,
+    load_seconds: f64,
+    save_seconds: f64,
+    removed_by_largest_component: Option<Removed>,
+}
+
+/// What `--largest-component` removed.
+#[derive(serde::Serialize)]
+struct Removed {
+    vertices: usize,
+    faces: usize,
 }
 
 /// Validates with a message naming the problems and the repair options.

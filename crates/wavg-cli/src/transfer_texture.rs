@@ -6,10 +6,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use wavg::apps::{Image, TransferOptions, check_uv, transfer_texture};
+use wavg::apps::{Image, TextureTransfer, TransferOptions, check_uv, transfer_texture};
 
 use crate::CliError;
-use crate::apps_common::solver_for;
+use crate::apps_common::{PairArgs, solver_for};
 use crate::common::{load_mesh, one_line};
 use crate::render::{parse_size, write_png};
 use crate::textio::read_points;
@@ -42,33 +42,17 @@ a texel between four of them whose source UVs lie close together (one chart, no 
 between) takes their bilinear interpolation; every other covered texel is solved exactly.
 --stride 1 solves every texel.")]
 pub struct Args {
-    /// Source mesh (with UVs).
-    #[arg(long)]
-    pub source: String,
+    #[command(flatten)]
+    pub pair: PairArgs,
     /// Source texture (PNG).
     #[arg(long)]
     pub source_texture: PathBuf,
-    /// Target mesh (with UVs).
-    #[arg(long)]
-    pub target: String,
-    /// Source anchors, one per line.
-    #[arg(long)]
-    pub source_anchors: PathBuf,
-    /// Target anchors, one per line, corresponding to the source's.
-    #[arg(long)]
-    pub target_anchors: PathBuf,
     /// Output size W or WxH (default: the source texture's).
     #[arg(long)]
     pub size: Option<String>,
     /// Output PNG (RGBA).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
-    /// .wavg embedding of the source.
-    #[arg(long)]
-    pub source_embedding: Option<PathBuf>,
-    /// .wavg embedding of the target.
-    #[arg(long)]
-    pub target_embedding: Option<PathBuf>,
     /// Use the paper's inverse only (faster; weights need not lead back to the point).
     #[arg(long)]
     pub paper: bool,
@@ -76,35 +60,49 @@ pub struct Args {
     /// inside a chart (1: solve every texel).
     #[arg(long, default_value_t = 4)]
     pub stride: u32,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
     /// Print one JSON object on standard output.
     #[arg(long)]
     pub json: bool,
 }
 
+/// The `--json` object: the library's [`TextureTransfer`] counts with the atlas, the
+/// settings and the timings (printed through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    #[serde(flatten)]
+    transfer: &'a TextureTransfer,
+    valid_fraction: f64,
+    seconds: f64,
+    texels_per_s: f64,
+    width: u32,
+    height: u32,
+    atlas_texels: u64,
+    precompute_s: f64,
+    verified: bool,
+    stride: u32,
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    crate::textio::with_threads(args.threads, || run_inner(args))?
+    crate::textio::with_threads(args.pair.threads, || run_inner(args))?
 }
 
 fn run_inner(args: Args) -> Result<(), CliError> {
     // Cheap checks first: anchors, UVs, texture.
     let (sa, ta) = (
-        read_points(&args.source_anchors)?,
-        read_points(&args.target_anchors)?,
+        read_points(&args.pair.source_anchors)?,
+        read_points(&args.pair.target_anchors)?,
     );
     if sa.len() != ta.len() {
         return Err(CliError::input(format!(
             "{} has {} anchors and {} has {}: they must correspond one to one",
-            args.source_anchors.display(),
+            args.pair.source_anchors.display(),
             sa.len(),
-            args.target_anchors.display(),
+            args.pair.target_anchors.display(),
             ta.len()
         )));
     }
-    for (mesh, what) in [(&args.source, "source"), (&args.target, "target")] {
+    for (mesh, what) in [(&args.pair.source, "source"), (&args.pair.target, "target")] {
         let m = load_mesh(mesh)?;
         check_uv(&m, what).map_err(|e| CliError::input(format!("{mesh}: {e}")))?;
     }
@@ -120,14 +118,14 @@ fn run_inner(args: Args) -> Result<(), CliError> {
     let visible = std::io::stderr().is_terminal() && !args.json;
     let t0 = Instant::now();
     let source = solver_for(
-        &args.source,
-        args.source_embedding.as_deref(),
-        &args.source_anchors,
+        &args.pair.source,
+        args.pair.source_embedding.as_deref(),
+        &args.pair.source_anchors,
     )?;
     let target = solver_for(
-        &args.target,
-        args.target_embedding.as_deref(),
-        &args.target_anchors,
+        &args.pair.target,
+        args.pair.target_embedding.as_deref(),
+        &args.pair.target_anchors,
     )?;
     let precompute_s = t0.elapsed().as_secs_f64();
     let opts = TransferOptions {
@@ -166,22 +164,19 @@ fn run_inner(args: Args) -> Result<(), CliError> {
     };
     let rate = out.covered as f64 / seconds.max(1e-12);
     if args.json {
-        let j = serde_json::json!({
-            "texels": out.covered,
-            "valid_fraction": valid_fraction,
-            "seconds": seconds,
-            "texels_per_s": rate,
-            "width": width,
-            "height": height,
-            "atlas_texels": width as u64 * height as u64,
-            "valid_texels": out.valid,
-            "not_reached": out.not_reached,
-            "dilated_texels": out.dilated,
-            "precompute_s": precompute_s,
-            "verified": !args.paper,
-            "stride": args.stride,
-            "interpolated_texels": out.interpolated,
-        });
+        let j = serde_json::to_value(JsonReport {
+            transfer: &out,
+            valid_fraction,
+            seconds,
+            texels_per_s: rate,
+            width,
+            height,
+            atlas_texels: width as u64 * height as u64,
+            precompute_s,
+            verified: !args.paper,
+            stride: args.stride,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else {
         println!(

@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{json_object, wavg, wavg_ok};
+use common::{json_object, sphere_anchors, wavg, wavg_ok};
 
 fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()
@@ -16,14 +16,6 @@ fn has_keys(keys: &[String], want: &[&str]) {
     for k in want {
         assert!(keys.iter().any(|x| x == k), "missing {k} in {keys:?}");
     }
-}
-
-/// Every 85th vertex of the level-4 icosphere (2562 vertices): 31 anchors.
-fn sphere_anchors(dir: &Path) -> std::path::PathBuf {
-    let p = dir.join("a.txt");
-    let text: String = (0..2562).step_by(85).map(|v| format!("v {v}\n")).collect();
-    std::fs::write(&p, text).unwrap();
-    p
 }
 
 #[test]

@@ -40,7 +40,7 @@ pub use pipeline::{PrecomputeOptions, Report, StageSeconds, precompute};
 pub use embedding::{Embedding, EmbeddingParams};
 
 // Geodesic distances.
-pub use geodesic::{FastMarching, Workspace, distances_from, landmark_distances};
+pub use geodesic::{FastMarching, GeodesicOptions, Workspace, distances_from, landmark_distances};
 
 // Progress, cancellation and errors.
 pub use error::{EmbedError, NoProgress, Progress, Stage};
@@ -53,10 +53,6 @@ pub use error::{EmbedError, NoProgress, Progress, Stage};
 #[doc(hidden)]
 pub mod internal {
     pub use crate::decimate::decimate_with_snapshots;
-    pub use crate::geodesic::{
-        landmark_distances_coarse, landmark_distances_two_level, landmark_distances_with,
-        landmark_rows,
-    };
     pub use crate::lsmesh::{bilaplacian, least_squares_mesh};
     pub use crate::mds::{MdsResult, classical_mds, metric_mds, relative_stress, smacof};
     pub use crate::near_field::NEAR_FIELD_EDGES;

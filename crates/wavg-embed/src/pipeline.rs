@@ -7,10 +7,7 @@ use wavg_mesh::ValidMesh;
 use crate::decimate::{DecimateOptions, decimate_with_snapshots, select_landmarks};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
-use crate::geodesic::{
-    FastMarching, landmark_distances_decimated, landmark_distances_two_level,
-    landmark_distances_with,
-};
+use crate::geodesic::{FastMarching, GeodesicOptions, landmark_distances};
 use crate::lsmesh::LsMeshSolver;
 use crate::mds::{MdsOptions, metric_mds};
 use crate::quality::{QualityOptions, QualityPairs};
@@ -36,7 +33,7 @@ pub struct PrecomputeOptions {
     pub geodesic_vertices: usize,
     /// With an intermediate mesh, replace the distances of close landmark pairs by
     /// full-mesh values from short radius-limited runs
-    /// ([`crate::geodesic::landmark_distances_two_level`]): close pairs are where the
+    /// ([`GeodesicOptions::refine_near_pairs`]): close pairs are where the
     /// intermediate mesh is least accurate; distant pairs are unchanged.
     pub refine_near_pairs: bool,
     /// MDS settings (`mds.dim` is the embedding dimension, 8 in wavg).
@@ -64,6 +61,7 @@ impl Default for PrecomputeOptions {
 
 /// Wall-clock seconds per stage.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct StageSeconds {
     /// Landmark selection.
     pub decimate: f64,
@@ -77,8 +75,10 @@ pub struct StageSeconds {
     pub quality: f64,
 }
 
-/// What [`precompute`] measured.
+/// What [`precompute`] measured. With the `serde` feature it serialises to the keys of
+/// `wavg precompute --json` (a NaN error, when not measured, becomes `null` in JSON).
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Report {
     /// Total wall-clock seconds.
     pub seconds: f64,
@@ -217,14 +217,12 @@ pub fn precompute(
     let (q, solver) = rayon::join(
         || -> Result<_, EmbedError> {
             let t = Instant::now();
-            let q = match &coarse {
+            let mut geo = GeodesicOptions::new().fast_marching(fine);
+            if let Some(c) = &coarse {
                 // All pairs on the intermediate mesh, close pairs corrected on the full mesh.
-                Some(c) if opts.refine_near_pairs => {
-                    landmark_distances_two_level(fine, c, &landmarks, progress)?
-                }
-                Some(c) => landmark_distances_decimated(c, &landmarks, progress)?,
-                None => landmark_distances_with(fine, &landmarks, progress)?,
-            };
+                geo = geo.coarse_mesh(c).refine_near_pairs(opts.refine_near_pairs);
+            }
+            let q = landmark_distances(mesh, &landmarks, &geo, progress)?;
             Ok((q, secs(t)))
         },
         || {
@@ -393,7 +391,8 @@ mod tests {
         let (emb, r) = precompute(&mesh, &o, &NoProgress).unwrap();
         // Recompute the landmark MDS independently and compare distances at landmarks.
         let fm = FastMarching::new(&mesh);
-        let q = landmark_distances_with(&fm, &emb.landmarks, &NoProgress).unwrap();
+        let geo = GeodesicOptions::new().fast_marching(&fm);
+        let q = landmark_distances(&mesh, &emb.landmarks, &geo, &NoProgress).unwrap();
         let stress = crate::mds::relative_stress(
             &q,
             60,

@@ -18,7 +18,7 @@ pub(crate) struct Failure {
 
 impl Failure {
     /// An invalid-argument failure.
-    pub fn arg(message: impl Into<String>) -> Self {
+    pub(crate) fn arg(message: impl Into<String>) -> Self {
         Self {
             status: wavg_status::WAVG_STATUS_INVALID_ARGUMENT,
             message: message.into(),

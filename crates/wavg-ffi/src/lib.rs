@@ -6,6 +6,7 @@
 //! Handles are opaque and owned by the caller from creation to their `_free` call. No Rust
 //! type crosses the boundary.
 #![allow(non_camel_case_types)]
+#![deny(unreachable_pub)]
 
 mod apps;
 mod boundary;

@@ -7,7 +7,7 @@ use wavg::apps::{
 };
 
 use crate::boundary::{Failure, guard, handle, product, slice, slice_mut};
-use crate::solver::{optional, wavg_solver};
+use crate::solver::{optional, wavg_solver, write_image};
 use crate::types::{wavg_point, wavg_status};
 
 /// The status of an answered point that fails the validity test.
@@ -40,14 +40,20 @@ fn finish(
     first.map_or(Ok(()), Err)
 }
 
-fn point_out(r: &wavg::ForwardResult) -> (wavg_point, [f64; 3]) {
-    (
-        wavg_point {
-            face: r.point.face,
-            bary: r.point.bary,
-        },
-        [r.position.x, r.position.y, r.position.z],
-    )
+/// The query points of a call (`n` of them, at least one).
+///
+/// # Safety
+/// `points` must be NULL or hold `n` elements.
+unsafe fn queries(points: *const wavg_point, n: usize) -> Result<Vec<SurfacePoint>, Failure> {
+    if n == 0 {
+        return Err(Failure::arg("n is 0"));
+    }
+    // SAFETY: per this function's contract.
+    let pts = unsafe { slice(points, n, "points")? };
+    Ok(pts
+        .iter()
+        .map(|p| SurfacePoint::new(p.face, p.bary))
+        .collect())
 }
 
 fn solve_failure(e: &wavg::solve::SolveError) -> (wavg_status, String) {
@@ -86,9 +92,8 @@ pub unsafe extern "C" fn wavg_correspond(
     out_statuses: *mut wavg_status,
 ) -> wavg_status {
     guard(|| {
-        if n == 0 {
-            return Err(Failure::arg("n is 0"));
-        }
+        // SAFETY: per this function's contract.
+        let query = unsafe { queries(points, n)? };
         if !max_negative.is_finite() {
             return Err(Failure::arg("max_negative must be finite"));
         }
@@ -102,30 +107,18 @@ pub unsafe extern "C" fn wavg_correspond(
             )));
         }
         // SAFETY: per this function's contract.
-        let (pts, out, xyz, statuses) = unsafe {
+        let (out, xyz, statuses) = unsafe {
             (
-                slice(points, n, "points")?,
                 slice_mut(out, n, "out")?,
                 optional(out_xyz, product(n, 3, "n")?),
                 optional(out_statuses, n),
             )
         };
-        let query: Vec<SurfacePoint> = pts
-            .iter()
-            .map(|p| SurfacePoint::new(p.face, p.bary))
-            .collect();
         let mapped = map_points(s.inner(), t.inner(), &query, verified)
             .map_err(|e| Failure::from(wavg::Error::from(e)))?;
         let mut xyz = xyz;
         let each = mapped.iter().enumerate().map(|(i, m)| {
-            let (p, x) = match &m.target {
-                Ok(r) => point_out(r),
-                Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
-            };
-            out[i] = p;
-            if let Some(xyz) = xyz.as_deref_mut() {
-                xyz[3 * i..3 * i + 3].copy_from_slice(&x);
-            }
+            write_image(out, xyz.as_deref_mut(), i, &m.target);
             match &m.target {
                 Err(e) => Err(solve_failure(e)),
                 Ok(_) if !m.round_trip => Err((
@@ -199,14 +192,7 @@ pub unsafe extern "C" fn wavg_correspond_vertices(
         };
         let mut each = Vec::with_capacity(n);
         for (i, (m, v)) in c.mapped.iter().zip(&c.validity).enumerate() {
-            let (p, x) = match &m.target {
-                Ok(r) => point_out(r),
-                Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
-            };
-            out[i] = p;
-            if let Some(xyz) = xyz.as_deref_mut() {
-                xyz[3 * i..3 * i + 3].copy_from_slice(&x);
-            }
+            write_image(out, xyz.as_deref_mut(), i, &m.target);
             each.push(match v {
                 Validity::Valid => Ok(()),
                 Validity::Unanswered(e) => Err(solve_failure(e)),
@@ -242,24 +228,14 @@ pub unsafe extern "C" fn wavg_decal_uv(
     out_statuses: *mut wavg_status,
 ) -> wavg_status {
     guard(|| {
-        if n == 0 {
-            return Err(Failure::arg("n is 0"));
-        }
+        // SAFETY: per this function's contract.
+        let query = unsafe { queries(points, n)? };
         // SAFETY: per this function's contract.
         let s = unsafe { handle(solver, "solver")? };
         let k = s.inner().n_anchors();
         // SAFETY: per this function's contract.
-        let (uv, pts) = unsafe {
-            (
-                slice(anchor_uv, product(k, 2, "anchors")?, "anchor_uv")?,
-                slice(points, n, "points")?,
-            )
-        };
+        let uv = unsafe { slice(anchor_uv, product(k, 2, "anchors")?, "anchor_uv")? };
         let uv: Vec<[f64; 2]> = uv.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-        let query: Vec<SurfacePoint> = pts
-            .iter()
-            .map(|p| SurfacePoint::new(p.face, p.bary))
-            .collect();
         // Checks the coordinates and max_negative before any output is touched.
         let d = decal_uv(s.inner(), &uv, &query, max_negative)
             .map_err(|e| Failure::from(wavg::Error::from(e)))?;

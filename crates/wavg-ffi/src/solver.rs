@@ -220,6 +220,30 @@ pub unsafe extern "C" fn wavg_forward(
     })
 }
 
+/// Writes the image of point `i` to `out[i]` and, when given, its position to
+/// `xyz[3*i..3*i+3]`; `face = UINT32_MAX` and NaN where there is no image.
+pub(crate) fn write_image(
+    out: &mut [wavg_point],
+    xyz: Option<&mut [f64]>,
+    i: usize,
+    image: &Result<wavg::ForwardResult, wavg::solve::SolveError>,
+) {
+    let (p, x) = match image {
+        Ok(r) => (
+            wavg_point {
+                face: r.point.face,
+                bary: r.point.bary,
+            },
+            [r.position.x, r.position.y, r.position.z],
+        ),
+        Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
+    };
+    out[i] = p;
+    if let Some(xyz) = xyz {
+        xyz[3 * i..3 * i + 3].copy_from_slice(&x);
+    }
+}
+
 /// Writes forward answers: points (`wavg_point::NONE` and NaN positions where there is
 /// none), positions and statuses; the first failure becomes the call's outcome.
 pub(crate) fn write_points(
@@ -233,20 +257,7 @@ pub(crate) fn write_points(
         first: None,
     };
     for (i, r) in results.iter().enumerate() {
-        let (p, x) = match r {
-            Ok(r) => (
-                wavg_point {
-                    face: r.point.face,
-                    bary: r.point.bary,
-                },
-                [r.position.x, r.position.y, r.position.z],
-            ),
-            Err(_) => (wavg_point::NONE, [f64::NAN; 3]),
-        };
-        points[i] = p;
-        if let Some(xyz) = xyz.as_deref_mut() {
-            xyz[3 * i..3 * i + 3].copy_from_slice(&x);
-        }
+        write_image(points, xyz.as_deref_mut(), i, r);
         st.set(i, r.as_ref().map(|_| ()));
     }
     st.finish()

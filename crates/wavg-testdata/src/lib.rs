@@ -1,6 +1,7 @@
 //! Test support, not published: locating the shared test-mesh folder (`$WAVG_DATA_DIR`, default `../shared/data` beside
 //! the repository) for tests and benchmarks. The meshes are never copied into the repository.
 
+#![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
 
 use std::path::PathBuf;

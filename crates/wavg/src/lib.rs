@@ -28,6 +28,7 @@
 //! The workspace crates stay reachable as modules ([`mesh`], [`embed`], [`project`],
 //! [`solve`]) for what the front door does not cover.
 
+#![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
 
 mod decimate;

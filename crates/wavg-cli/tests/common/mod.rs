@@ -30,3 +30,12 @@ pub fn json_object(out: &Output) -> (serde_json::Map<String, serde_json::Value>,
     keys.sort();
     (o, keys)
 }
+
+/// Writes the anchors file `a.txt` in `dir`: every 85th vertex of the level-4 icosphere
+/// (`builtin:icosphere`, 2562 vertices), 31 anchors.
+pub fn sphere_anchors(dir: &std::path::Path) -> std::path::PathBuf {
+    let p = dir.join("a.txt");
+    let text: String = (0..2562).step_by(85).map(|v| format!("v {v}\n")).collect();
+    std::fs::write(&p, text).unwrap();
+    p
+}

@@ -26,30 +26,151 @@ pub fn distances_from(mesh: &ValidMesh, sources: &[u32]) -> Vec<f64> {
     ws.dist
 }
 
+/// Where [`landmark_distances`] runs fast marching.
+#[derive(Clone, Copy, Debug, Default)]
+enum Resolution<'a> {
+    /// Every run on the full mesh.
+    #[default]
+    Full,
+    /// On a decimation of the mesh down to this many vertices, landmarks locked.
+    Decimate(usize),
+    /// On this decimation of the mesh (it must contain every landmark).
+    Coarse(&'a Decimated),
+}
+
+/// How [`landmark_distances`] computes the landmark matrix: on the full mesh (the default)
+/// or on a coarser mesh, optionally correcting close pairs on the full mesh, and with an
+/// optional prebuilt [`FastMarching`] of the full mesh to reuse.
+///
+/// ```
+/// use wavg_embed::{GeodesicOptions, NoProgress, landmark_distances};
+/// use wavg_mesh::{ValidMesh, procedural};
+/// let mesh = ValidMesh::new(procedural::icosphere(4)).unwrap();
+/// let lm = [0, 700, 1500, 2300];
+/// let full = landmark_distances(&mesh, &lm, &GeodesicOptions::new(), &NoProgress).unwrap();
+/// let opts = GeodesicOptions::new().coarse_vertices(800);
+/// let coarse = landmark_distances(&mesh, &lm, &opts, &NoProgress).unwrap();
+/// assert!((coarse[1] - full[1]).abs() < 0.05 * full[1]);
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct GeodesicOptions<'a> {
+    resolution: Resolution<'a>,
+    fine: Option<&'a FastMarching>,
+    refine_near_pairs: bool,
+}
+
+impl Default for GeodesicOptions<'_> {
+    fn default() -> Self {
+        GeodesicOptions {
+            resolution: Resolution::Full,
+            fine: None,
+            refine_near_pairs: true,
+        }
+    }
+}
+
+impl<'a> GeodesicOptions<'a> {
+    /// Every pair on the full mesh, with a [`FastMarching`] built for the call.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Reuses `fm`, a [`FastMarching`] of the same mesh, for the full-mesh runs (its
+    /// near-field radius applies).
+    pub fn fast_marching(mut self, fm: &'a FastMarching) -> Self {
+        self.fine = Some(fm);
+        self
+    }
+
+    /// Computes every pair on a decimation of the mesh down to `vertices` vertices (the
+    /// landmarks locked, so they all survive), to save time on large meshes. With
+    /// `vertices >=` the vertex count this is the full-mesh computation.
+    pub fn coarse_vertices(mut self, vertices: usize) -> Self {
+        self.resolution = Resolution::Decimate(vertices);
+        self
+    }
+
+    /// Computes every pair on `coarse`, a decimation of the mesh containing every landmark
+    /// (for example a snapshot of the landmark decimation,
+    /// [`decimate_with_snapshots`](crate::internal::decimate_with_snapshots)).
+    pub fn coarse_mesh(mut self, coarse: &'a Decimated) -> Self {
+        self.resolution = Resolution::Coarse(coarse);
+        self
+    }
+
+    /// Whether pairs computed on a coarse mesh that lie closer than a few coarse edge
+    /// lengths are recomputed on the full mesh with short radius-limited runs (default
+    /// `true`): the coarse mesh's few large triangles between close landmarks are least
+    /// accurate there, and MDS weights close pairs most. The fine runs cost little, each
+    /// covering only a small disc. No effect on the full mesh.
+    pub fn refine_near_pairs(mut self, refine: bool) -> Self {
+        self.refine_near_pairs = refine;
+        self
+    }
+}
+
 /// Geodesic distances between all pairs of `landmarks`, symmetrised: the `n x n` matrix
 /// `Q = (D + D^T) / 2` row-major (`n = landmarks.len()`), where row `i` of `D` is one fast
-/// marching run from landmark `i`. Runs go in parallel (rayon), each stopping once all
-/// landmarks are frozen; progress is reported as [`Stage::Geodesics`] and cancellation is
-/// checked between runs.
+/// marching run from landmark `i` (see [`FastMarching::landmark_rows`]). Runs go in
+/// parallel (rayon), each stopping once all landmarks are frozen; progress is reported as
+/// [`Stage::Geodesics`] and cancellation is checked between runs. `opts` chooses the mesh
+/// the runs go on.
 ///
-/// Errors: a landmark id out of range or repeated, or a pair of landmarks in different
-/// components (infinite distance).
+/// Errors: a landmark id out of range or repeated, a pair of landmarks in different
+/// components (infinite distance), a landmark missing from the coarse mesh, a prebuilt
+/// [`FastMarching`] of another mesh, or cancellation.
 pub fn landmark_distances(
     mesh: &ValidMesh,
     landmarks: &[u32],
+    opts: &GeodesicOptions<'_>,
     progress: &dyn Progress,
 ) -> Result<Vec<f64>, EmbedError> {
-    let fm = FastMarching::new(mesh);
-    landmark_distances_with(&fm, landmarks, progress)
+    if let Some(fm) = opts.fine
+        && fm.n != mesh.n_vertices()
+    {
+        return Err(EmbedError::InvalidArgument(format!(
+            "the fast marching has {} vertices, the mesh {}",
+            fm.n,
+            mesh.n_vertices()
+        )));
+    }
+    let built = std::cell::OnceCell::new();
+    let fine = || {
+        opts.fine
+            .unwrap_or_else(|| built.get_or_init(|| FastMarching::new(mesh)))
+    };
+    let decimated;
+    let coarse = match opts.resolution {
+        Resolution::Full => return full_matrix(fine(), landmarks, progress),
+        Resolution::Decimate(target) if target >= mesh.n_vertices() => {
+            return full_matrix(fine(), landmarks, progress);
+        }
+        Resolution::Decimate(target) => {
+            let d = DecimateOptions {
+                target: target.max(landmarks.len()),
+                locked: landmarks.to_vec(),
+                ..DecimateOptions::default()
+            };
+            decimated = decimate(mesh, &d, &CancelOnly(progress))?;
+            &decimated
+        }
+        Resolution::Coarse(c) => c,
+    };
+    let mut q = landmark_distances_decimated(coarse, landmarks, progress)?;
+    if opts.refine_near_pairs {
+        let radius = NEAR_PAIR_RADIUS_EDGES * wavg_mesh::geometry::mean_edge_length(&coarse.mesh);
+        refine_near_pairs(fine(), landmarks, radius, &mut q, progress)?;
+    }
+    Ok(q)
 }
 
-/// [`landmark_distances`] with a prebuilt [`FastMarching`] (of the same mesh).
-pub fn landmark_distances_with(
+/// The symmetrised landmark matrix from full-mesh runs of `fm`.
+fn full_matrix(
     fm: &FastMarching,
     landmarks: &[u32],
     progress: &dyn Progress,
 ) -> Result<Vec<f64>, EmbedError> {
-    let rows = landmark_rows(fm, landmarks, progress)?;
+    let rows = fm.landmark_rows(landmarks, progress)?;
     let n = landmarks.len();
     let mut q = vec![0.0; n * n];
     for i in 0..n {
@@ -69,112 +190,72 @@ pub fn landmark_distances_with(
     Ok(q)
 }
 
-/// The raw rows behind [`landmark_distances_with`]: row `i` holds the fast-marching
-/// distances from `landmarks[i]` to every landmark, not symmetrised (`rows[i][j]` and
-/// `rows[j][i]` differ by the method's error). Runs in parallel, each stopping once every
-/// landmark is reached; progress is reported as [`Stage::Geodesics`].
-///
-/// Errors: a landmark id out of range or repeated, or cancellation.
-///
-/// ```
-/// use wavg_embed::NoProgress;
-/// use wavg_embed::{FastMarching, internal::landmark_rows};
-/// use wavg_mesh::{ValidMesh, procedural};
-/// let mesh = ValidMesh::new(procedural::icosphere(3)).unwrap();
-/// let rows = landmark_rows(&FastMarching::new(&mesh), &[0, 5, 100], &NoProgress).unwrap();
-/// assert_eq!(rows[1][1], 0.0);
-/// assert!((rows[0][2] - rows[2][0]).abs() < 0.02 * rows[0][2]);
-/// ```
-pub fn landmark_rows(
-    fm: &FastMarching,
-    landmarks: &[u32],
-    progress: &dyn Progress,
-) -> Result<Vec<Vec<f64>>, EmbedError> {
-    let n = landmarks.len();
-    let mut is_target = vec![false; fm.n];
-    for &l in landmarks {
-        let slot = is_target.get_mut(l as usize).ok_or_else(|| {
-            EmbedError::InvalidArgument(format!(
-                "landmark {l} out of range (mesh has {} vertices)",
-                fm.n
-            ))
-        })?;
-        if std::mem::replace(slot, true) {
-            return Err(EmbedError::InvalidArgument(format!(
-                "landmark {l} appears twice"
-            )));
+impl FastMarching {
+    /// The raw rows behind [`landmark_distances`]: row `i` holds the fast-marching
+    /// distances from `landmarks[i]` to every landmark, not symmetrised (`rows[i][j]` and
+    /// `rows[j][i]` differ by the method's error). Runs in parallel, each stopping once
+    /// every landmark is reached; progress is reported as [`Stage::Geodesics`].
+    ///
+    /// Errors: a landmark id out of range or repeated, or cancellation.
+    ///
+    /// ```
+    /// use wavg_embed::{FastMarching, NoProgress};
+    /// use wavg_mesh::{ValidMesh, procedural};
+    /// let mesh = ValidMesh::new(procedural::icosphere(3)).unwrap();
+    /// let rows = FastMarching::new(&mesh).landmark_rows(&[0, 5, 100], &NoProgress).unwrap();
+    /// assert_eq!(rows[1][1], 0.0);
+    /// assert!((rows[0][2] - rows[2][0]).abs() < 0.02 * rows[0][2]);
+    /// ```
+    pub fn landmark_rows(
+        &self,
+        landmarks: &[u32],
+        progress: &dyn Progress,
+    ) -> Result<Vec<Vec<f64>>, EmbedError> {
+        let fm = self;
+        let n = landmarks.len();
+        let mut is_target = vec![false; fm.n];
+        for &l in landmarks {
+            let slot = is_target.get_mut(l as usize).ok_or_else(|| {
+                EmbedError::InvalidArgument(format!(
+                    "landmark {l} out of range (mesh has {} vertices)",
+                    fm.n
+                ))
+            })?;
+            if std::mem::replace(slot, true) {
+                return Err(EmbedError::InvalidArgument(format!(
+                    "landmark {l} appears twice"
+                )));
+            }
         }
+        check_cancel(progress)?;
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let rows: Vec<Vec<f64>> = (0..n)
+            .into_par_iter()
+            .map_init(
+                || fm.workspace(),
+                |ws, i| {
+                    check_cancel(progress)?;
+                    let d = fm.run_until_targets(ws, &landmarks[i..i + 1], &is_target, n);
+                    let row: Vec<f64> = landmarks.iter().map(|&l| d[l as usize]).collect();
+                    let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    progress.report(Stage::Geodesics, k as f64 / n as f64);
+                    Ok(row)
+                },
+            )
+            .collect::<Result<_, EmbedError>>()?;
+        Ok(rows)
     }
-    check_cancel(progress)?;
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    let rows: Vec<Vec<f64>> = (0..n)
-        .into_par_iter()
-        .map_init(
-            || fm.workspace(),
-            |ws, i| {
-                check_cancel(progress)?;
-                let d = fm.run_until_targets(ws, &landmarks[i..i + 1], &is_target, n);
-                let row: Vec<f64> = landmarks.iter().map(|&l| d[l as usize]).collect();
-                let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress.report(Stage::Geodesics, k as f64 / n as f64);
-                Ok(row)
-            },
-        )
-        .collect::<Result<_, EmbedError>>()?;
-    Ok(rows)
 }
 
 /// Landmark pairs closer than this many mean edge lengths of the coarse mesh get their
-/// distance from the fine mesh in [`landmark_distances_two_level`].
+/// distance from the fine mesh (see [`GeodesicOptions::refine_near_pairs`]).
 pub(crate) const NEAR_PAIR_RADIUS_EDGES: f64 = 8.0;
-
-/// [`landmark_distances`] computed on a coarser mesh, to save time on large meshes: the
-/// mesh is first decimated (with the landmarks locked, so they all survive) down to
-/// `intermediate_vertices`, and the distances come from
-/// [`landmark_distances_two_level`]. With `intermediate_vertices >=` the vertex count this
-/// is exactly [`landmark_distances`].
-pub fn landmark_distances_coarse(
-    mesh: &ValidMesh,
-    landmarks: &[u32],
-    intermediate_vertices: usize,
-    progress: &dyn Progress,
-) -> Result<Vec<f64>, EmbedError> {
-    if intermediate_vertices >= mesh.n_vertices() {
-        return landmark_distances(mesh, landmarks, progress);
-    }
-    let opts = DecimateOptions {
-        target: intermediate_vertices.max(landmarks.len()),
-        locked: landmarks.to_vec(),
-        ..DecimateOptions::default()
-    };
-    let coarse = decimate(mesh, &opts, &CancelOnly(progress))?;
-    landmark_distances_two_level(&FastMarching::new(mesh), &coarse, landmarks, progress)
-}
-
-/// Landmark distances from two resolutions: every pair from fast marching on `coarse` (a
-/// decimation of the fine mesh containing all landmarks, for example a snapshot of the
-/// landmark decimation, [`crate::decimate::decimate_with_snapshots`]), then pairs closer
-/// than `NEAR_PAIR_RADIUS_EDGES` (8) coarse edge lengths replaced by fine-mesh values from
-/// short radius-limited runs on `fine` (the coarse mesh's few large triangles between
-/// close landmarks give errors of 20-80% there, and MDS weights close pairs most). The
-/// fine runs cost little: each covers only a small disc.
-pub fn landmark_distances_two_level(
-    fine: &FastMarching,
-    coarse: &Decimated,
-    landmarks: &[u32],
-    progress: &dyn Progress,
-) -> Result<Vec<f64>, EmbedError> {
-    let mut q = landmark_distances_decimated(coarse, landmarks, progress)?;
-    let radius = NEAR_PAIR_RADIUS_EDGES * wavg_mesh::geometry::mean_edge_length(&coarse.mesh);
-    refine_near_pairs(fine, landmarks, radius, &mut q, progress)?;
-    Ok(q)
-}
 
 /// Overwrites the entries of the symmetric `n x n` matrix `q` for landmark pairs within
 /// `radius` of each other on `fine` with fine-mesh fast-marching distances (averaged over
 /// both directions when both runs reach the other landmark). Returns the number of pairs
 /// replaced.
-pub(crate) fn refine_near_pairs(
+fn refine_near_pairs(
     fine: &FastMarching,
     landmarks: &[u32],
     radius: f64,
@@ -228,10 +309,9 @@ pub(crate) fn refine_near_pairs(
     Ok(acc.len())
 }
 
-/// [`landmark_distances`] on an already decimated mesh only (no fine-mesh correction of
-/// close pairs, see [`landmark_distances_two_level`]); `landmarks` are original vertex ids
-/// and must all be vertices of `coarse`.
-pub(crate) fn landmark_distances_decimated(
+/// The landmark matrix on an already decimated mesh only (no fine-mesh correction of
+/// close pairs); `landmarks` are original vertex ids and must all be vertices of `coarse`.
+fn landmark_distances_decimated(
     coarse: &Decimated,
     landmarks: &[u32],
     progress: &dyn Progress,
@@ -248,7 +328,7 @@ pub(crate) fn landmark_distances_decimated(
         .collect::<Result<Vec<u32>, _>>()?;
     let mesh = ValidMesh::new(coarse.mesh.clone())
         .map_err(|e| EmbedError::Numerical(format!("the decimated mesh is not valid: {e}")))?;
-    landmark_distances(&mesh, &ids, progress)
+    full_matrix(&FastMarching::new(&mesh), &ids, progress)
 }
 
 /// Forwards cancellation but not progress (for a sub-step reported as part of another stage).

@@ -32,10 +32,10 @@
 //! One run costs time linear in the vertex count (times a logarithm for the heap), and
 //! the precomputation needs one run per landmark. For large meshes, compute the landmark
 //! distances on an intermediate decimation of about [`DEFAULT_GEODESIC_VERTICES`]
-//! vertices that contains every landmark: either [`landmark_distances_coarse`]
-//! (decimates again with the landmarks locked), or, cheaper, a snapshot of the landmark
-//! decimation itself ([`crate::decimate::decimate_with_snapshots`]) passed to
-//! [`landmark_distances_two_level`]. Both use the coarse mesh for every pair and then
+//! vertices that contains every landmark: either decimate again with the landmarks locked
+//! ([`GeodesicOptions::coarse_vertices`]), or, cheaper, pass a snapshot of the landmark
+//! decimation itself ([`crate::decimate::decimate_with_snapshots`],
+//! [`GeodesicOptions::coarse_mesh`]). Both use the coarse mesh for every pair and then
 //! recompute the pairs closer than
 //! [`NEAR_PAIR_RADIUS_EDGES`](landmarks::NEAR_PAIR_RADIUS_EDGES) coarse edges on the fine
 //! mesh with radius-limited runs ([`FastMarching::run_within`]), because on the coarse
@@ -46,13 +46,9 @@
 //! run starts with exact polyhedral distances within [`crate::near_field::NEAR_FIELD_EDGES`]
 //! mean edge lengths of the source (windows of Chen & Han with pseudo-sources at saddle
 //! vertices and Xin & Wang's pruning, [`crate::near_field`]; the radius is a parameter,
-//! [`FastMarching::with_near_field_edges`]). With straight lines only, on a 40k icosphere
-//! this lowered the mean error from 0.40-0.52% to 0.21-0.26% and the maximum from 3.9-4.5%
-//! to 0.7-0.9%. On pig, camelhead and fertility (1000 landmarks) the largest asymmetry
-//! `|d(i,j) - d(j,i)| / mean` went from 8.7-16% (plain) to 5.3-7.3% (straight lines) and
-//! 2.7-6.4% (with pseudo-sources), and the pairs above 2% from 0.25-0.87% to 0.01-0.06% and
-//! 0.003-0.018%, for 1.1-1.5x the time of a plain run; at 16 edge lengths (3-5x the
-//! time) every pair is within 2% (1.4-1.9% at most).
+//! [`FastMarching::with_near_field_edges`]). It makes close pairs nearly exact and the
+//! landmark matrix far more symmetric for a little more time per run; the figures are in
+//! `BENCHMARKS.md`.
 //!
 //! All geometry is precomputed once per mesh in [`FastMarching`] (a flat list of
 //! update entries per freezing vertex, single precision), so one run only touches the
@@ -77,11 +73,7 @@ use unfold::*;
 
 pub(crate) use fast_marching::{DEFAULT_GEODESIC_VERTICES, MAX_UNFOLD_STEPS};
 pub use fast_marching::{FastMarching, Workspace};
-pub(crate) use landmarks::landmark_distances_decimated;
-pub use landmarks::{
-    distances_from, landmark_distances, landmark_distances_coarse, landmark_distances_two_level,
-    landmark_distances_with, landmark_rows,
-};
+pub use landmarks::{GeodesicOptions, distances_from, landmark_distances};
 
 #[cfg(test)]
 mod tests {
@@ -320,7 +312,8 @@ mod tests {
         let d = distances_from(&mesh, &[0]);
         assert!(d[..off as usize].iter().all(|x| x.is_finite()));
         assert!(d[off as usize..].iter().all(|x| *x == f64::INFINITY));
-        let e = landmark_distances(&mesh, &[0, off + 3], &NoProgress).unwrap_err();
+        let e = landmark_distances(&mesh, &[0, off + 3], &GeodesicOptions::new(), &NoProgress)
+            .unwrap_err();
         assert!(matches!(e, EmbedError::InvalidArgument(_)), "{e}");
     }
 
@@ -406,7 +399,7 @@ mod tests {
             worst_far * 100.0
         );
         assert!(worst_far < bound && mean < 0.005, "{worst_far} {mean}");
-        let q = landmark_distances(&mesh, &lm, &NoProgress).unwrap();
+        let q = landmark_distances(&mesh, &lm, &GeodesicOptions::new(), &NoProgress).unwrap();
         for i in 0..n {
             assert_eq!(q[i * n + i], 0.0);
             for j in 0..n {
@@ -422,7 +415,7 @@ mod tests {
     /// Asymmetry `|d_ij - d_ji| / mean` of the full landmark matrix: mean, max, and the
     /// share of pairs above 2%.
     fn matrix_asymmetry(fm: &FastMarching, lm: &[u32]) -> (f64, f64, f64) {
-        let rows = landmark_rows(fm, lm, &NoProgress).unwrap();
+        let rows = fm.landmark_rows(lm, &NoProgress).unwrap();
         let a: Vec<f64> = rows
             .iter()
             .enumerate()
@@ -489,15 +482,15 @@ mod tests {
         let mesh = valid(procedural::icosphere(2));
         let n = mesh.n_vertices() as u32;
         assert!(matches!(
-            landmark_distances(&mesh, &[0, n], &NoProgress),
+            landmark_distances(&mesh, &[0, n], &GeodesicOptions::new(), &NoProgress),
             Err(EmbedError::InvalidArgument(_))
         ));
         assert!(matches!(
-            landmark_distances(&mesh, &[4, 4], &NoProgress),
+            landmark_distances(&mesh, &[4, 4], &GeodesicOptions::new(), &NoProgress),
             Err(EmbedError::InvalidArgument(_))
         ));
         assert!(
-            landmark_distances(&mesh, &[], &NoProgress)
+            landmark_distances(&mesh, &[], &GeodesicOptions::new(), &NoProgress)
                 .unwrap()
                 .is_empty()
         );
@@ -509,7 +502,7 @@ mod tests {
             }
         }
         assert!(matches!(
-            landmark_distances(&mesh, &[0, 1, 2], &Stop),
+            landmark_distances(&mesh, &[0, 1, 2], &GeodesicOptions::new(), &Stop),
             Err(EmbedError::Cancelled)
         ));
         // Progress reaches 1.
@@ -522,7 +515,7 @@ mod tests {
             }
         }
         let p = Last(std::sync::Mutex::new(0.0));
-        landmark_distances(&mesh, &[0, 10, 20, 30], &p).unwrap();
+        landmark_distances(&mesh, &[0, 10, 20, 30], &GeodesicOptions::new(), &p).unwrap();
         assert_eq!(*p.0.lock().unwrap(), 1.0);
     }
 
@@ -532,11 +525,23 @@ mod tests {
         let n_v = mesh.n_vertices() as u32;
         let lm: Vec<u32> = (0..60).map(|i| i * (n_v / 60) + 3).collect();
         let n = lm.len();
-        let full = landmark_distances(&mesh, &lm, &NoProgress).unwrap();
+        let full = landmark_distances(&mesh, &lm, &GeodesicOptions::new(), &NoProgress).unwrap();
         // Not coarser than the mesh: identical.
-        let same = landmark_distances_coarse(&mesh, &lm, n_v as usize, &NoProgress).unwrap();
+        let same = landmark_distances(
+            &mesh,
+            &lm,
+            &GeodesicOptions::new().coarse_vertices(n_v as usize),
+            &NoProgress,
+        )
+        .unwrap();
         assert_eq!(same, full);
-        let coarse = landmark_distances_coarse(&mesh, &lm, 2000, &NoProgress).unwrap();
+        let coarse = landmark_distances(
+            &mesh,
+            &lm,
+            &GeodesicOptions::new().coarse_vertices(2000),
+            &NoProgress,
+        )
+        .unwrap();
         let (mut e_full, mut e_coarse, mut diff) = (0.0, 0.0, 0.0);
         for i in 0..n {
             for j in 0..n {
@@ -577,7 +582,8 @@ mod tests {
             ..Default::default()
         };
         let (fin, snaps) = decimate_with_snapshots(&mesh, &opts, &[800], &NoProgress).unwrap();
-        let full = landmark_distances(&mesh, &fin.landmarks, &NoProgress).unwrap();
+        let full = landmark_distances(&mesh, &fin.landmarks, &GeodesicOptions::new(), &NoProgress)
+            .unwrap();
         let fm = FastMarching::new(&mesh);
         let stats = |q: &[f64]| {
             let (mut sum, mut max) = (0.0, 0.0f64);
@@ -590,10 +596,24 @@ mod tests {
             }
             (sum / (40.0 * 39.0), max)
         };
-        let coarse_only =
-            landmark_distances_decimated(&snaps[0], &fin.landmarks, &NoProgress).unwrap();
-        let two =
-            landmark_distances_two_level(&fm, &snaps[0], &fin.landmarks, &NoProgress).unwrap();
+        let coarse_only = landmark_distances(
+            &mesh,
+            &fin.landmarks,
+            &GeodesicOptions::new()
+                .coarse_mesh(&snaps[0])
+                .refine_near_pairs(false),
+            &NoProgress,
+        )
+        .unwrap();
+        let two = landmark_distances(
+            &mesh,
+            &fin.landmarks,
+            &GeodesicOptions::new()
+                .fast_marching(&fm)
+                .coarse_mesh(&snaps[0]),
+            &NoProgress,
+        )
+        .unwrap();
         let (m1, x1) = stats(&coarse_only);
         let (m2, x2) = stats(&two);
         eprintln!(
@@ -612,7 +632,12 @@ mod tests {
             .find(|&v| snaps[0].coarse_index(v).is_none())
             .unwrap();
         assert!(matches!(
-            landmark_distances_decimated(&snaps[0], &[fin.landmarks[0], missing], &NoProgress),
+            landmark_distances(
+                &mesh,
+                &[fin.landmarks[0], missing],
+                &GeodesicOptions::new().coarse_mesh(&snaps[0]),
+                &NoProgress
+            ),
             Err(EmbedError::InvalidArgument(_))
         ));
     }

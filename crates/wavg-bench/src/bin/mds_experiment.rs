@@ -27,7 +27,8 @@ fn main() {
         (lm, q)
     } else {
         let lm = wavg_embed::select_landmarks(&mesh, &Default::default(), &NoProgress).unwrap();
-        let q = wavg_embed::landmark_distances(&mesh, &lm, &NoProgress).unwrap();
+        let q =
+            wavg_embed::landmark_distances(&mesh, &lm, &Default::default(), &NoProgress).unwrap();
         let mut b = (lm.len() as u64).to_le_bytes().to_vec();
         lm.iter().for_each(|l| b.extend(l.to_le_bytes()));
         q.iter().for_each(|x| b.extend(x.to_le_bytes()));

@@ -1,10 +1,8 @@
 //! Runs the whole precomputation on meshes and prints the per-stage table (markdown).
 //!
-//! `cargo run --release -p wavg-embed --example precompute_table -- [MESH...]
+//! `cargo run --release -p wavg-bench --bin precompute_table -- [MESH...]
 //! [--no-refine] [--geodesic-vertices N]`
 //! (default: pig, armadillo, horse, igea from the shared data folder).
-
-use std::path::PathBuf;
 
 use wavg_embed::{NoProgress, PrecomputeOptions, precompute};
 use wavg_mesh::ValidMesh;
@@ -20,16 +18,12 @@ fn main() {
         opts.geodesic_vertices = args[i + 1].parse().expect("--geodesic-vertices N");
         args.drain(i..i + 2);
     }
-    let paths: Vec<PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_testdata::require_data_dir("precompute_table") else {
-            return;
-        };
-        ["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"]
-            .iter()
-            .map(|m| dir.join("meshes").join(m))
-            .collect()
-    } else {
-        args.iter().map(PathBuf::from).collect()
+    let Some(paths) = wavg_bench::mesh_paths(
+        &args,
+        &["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"],
+        "precompute_table",
+    ) else {
+        return;
     };
     println!(
         "| mesh | vertices | geodesic mesh | seconds | decimate | geodesics | mds | lsmesh | quality | stress | p50 | p90 |"

@@ -1,7 +1,7 @@
 //! Relative embedding-vs-geodesic error on *near* vertex pairs (geodesic distance below a
 //! fraction of the bounding-box diagonal), for comparing embeddings of one mesh.
 //!
-//! `cargo run --release -p wavg-embed --example near_quality -- MESH FRACTION A.wavg [B.wavg ...]`
+//! `cargo run --release -p wavg-bench --bin near_quality -- MESH FRACTION A.wavg [B.wavg ...]`
 use std::path::Path;
 use wavg_embed::FastMarching;
 use wavg_embed::internal::percentile;

@@ -1,6 +1,6 @@
 //! Times landmark selection (decimation) and the landmark geodesics on real meshes.
 //!
-//! `cargo run --release -p wavg-embed --example landmark_timing -- [MESH...] [--landmarks N]
+//! `cargo run --release -p wavg-bench --bin landmark_timing -- [MESH...] [--landmarks N]
 //! [--coarse N,M,...] [--snapshot] [--decimate-only] [--runs-only]` (default meshes: pig, armadillo,
 //! horse, igea from the shared data folder).
 //!
@@ -18,11 +18,8 @@
 use std::time::Instant;
 
 use wavg_embed::NoProgress;
-use wavg_embed::internal::{
-    decimate_with_snapshots, landmark_distances_coarse, landmark_distances_two_level,
-    landmark_distances_with,
-};
-use wavg_embed::{DecimateOptions, FastMarching};
+use wavg_embed::internal::decimate_with_snapshots;
+use wavg_embed::{DecimateOptions, FastMarching, GeodesicOptions, landmark_distances};
 use wavg_mesh::ValidMesh;
 
 fn main() {
@@ -46,16 +43,12 @@ fn main() {
     args.retain(|a| a != "--runs-only");
     let decimate_only = args.iter().any(|a| a == "--decimate-only");
     args.retain(|a| a != "--decimate-only");
-    let paths: Vec<std::path::PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_testdata::require_data_dir("landmark_timing") else {
-            return;
-        };
-        ["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"]
-            .iter()
-            .map(|m| dir.join("meshes").join(m))
-            .collect()
-    } else {
-        args.iter().map(Into::into).collect()
+    let Some(paths) = wavg_bench::mesh_paths(
+        &args,
+        &["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"],
+        "landmark_timing",
+    ) else {
+        return;
     };
     println!(
         "| mesh | vertices | decimate (s) | fm build (s) | one run (ms) | {n_landmarks} runs, {} threads (s) | asymmetry % |",
@@ -128,7 +121,8 @@ fn main() {
         }
         let t_run = t.elapsed().as_secs_f64() / reps as f64;
         let (t, c) = (Instant::now(), cpu_seconds());
-        let q = landmark_distances_with(&fm, &landmarks, &NoProgress).expect("distances");
+        let geo = GeodesicOptions::new().fast_marching(&fm);
+        let q = landmark_distances(&mesh, &landmarks, &geo, &NoProgress).expect("distances");
         let t_all = t.elapsed().as_secs_f64();
         let c_all = cpu_seconds() - c;
         // Asymmetry |d_ij - d_ji| / q_ij of the raw rows of 30 landmarks against all others.
@@ -180,13 +174,17 @@ fn main() {
                 let (td, cd) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
                 label = format!("snapshot {m} (decimate+snapshot {td:.2} s, cpu {cd:.2}; then)");
                 let (t, c) = (Instant::now(), cpu_seconds());
-                let q = landmark_distances_two_level(&fm, &snaps[0], &landmarks, &NoProgress)
-                    .expect("two-level");
+                let geo = GeodesicOptions::new()
+                    .fast_marching(&fm)
+                    .coarse_mesh(&snaps[0]);
+                let q =
+                    landmark_distances(&mesh, &landmarks, &geo, &NoProgress).expect("two-level");
                 let (tc, cc) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
                 label = format!("{label} geodesics {tc:.2} s (cpu {cc:.2})");
                 q
             } else {
-                landmark_distances_coarse(&mesh, &landmarks, m, &NoProgress).expect("coarse")
+                let geo = GeodesicOptions::new().coarse_vertices(m);
+                landmark_distances(&mesh, &landmarks, &geo, &NoProgress).expect("coarse")
             };
             let (tc, cc) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
             let mut rel: Vec<f64> = (0..n * n)

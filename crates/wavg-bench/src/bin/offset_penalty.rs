@@ -3,7 +3,7 @@
 //! (`d_ref` = the 4th smallest `d_i`), or the hard constraint `ybar = yhat` (lambda = inf),
 //! to see what round-trip rate, locality and negativity cost.
 //!
-//! `cargo run --release -p wavg-solve --example offset_penalty -- MESH EMB.wavg|- ANCHORS QUERIES`
+//! `cargo run --release -p wavg-bench --bin offset_penalty -- MESH EMB.wavg|- ANCHORS QUERIES`
 
 use std::sync::Arc;
 

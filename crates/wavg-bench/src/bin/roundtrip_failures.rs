@@ -5,7 +5,7 @@
 //! compares the fast, exhaustive and the paper's plain search (walk + unbounded
 //! breadth-first search, first valid triangle wins), and counts folds of the embedding.
 //!
-//! `cargo run --release -p wavg-solve --example roundtrip_failures -- MESH EMB
+//! `cargo run --release -p wavg-bench --bin roundtrip_failures -- MESH EMB
 //!  [ANCHORS [QUERIES [GAMMA]]]` where EMB is a `.wavg` file, `-` (3-D positions) or
 //! `mds:MAX_ITERATIONS:TOLERANCE` (precompute with these SMACOF settings).
 

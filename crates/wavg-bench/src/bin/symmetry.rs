@@ -1,7 +1,7 @@
 //! Asymmetry of the full landmark distance matrix (fast marching from every landmark) and
 //! the time of those runs: the measure behind the fast-marching symmetry test.
 //!
-//! `cargo run --release -p wavg-embed --example symmetry -- [--landmarks N]
+//! `cargo run --release -p wavg-bench --bin symmetry -- [--landmarks N]
 //! [--near-field EDGES] [MESH...]`
 //! (default meshes: pig, camelhead, fertility from the shared data folder). `WORST=1` lists
 //! the most asymmetric pairs with both distances in mean edge lengths.
@@ -9,7 +9,7 @@
 use std::time::Instant;
 
 use wavg_embed::NoProgress;
-use wavg_embed::{DecimateOptions, FastMarching, internal::landmark_rows, select_landmarks};
+use wavg_embed::{DecimateOptions, FastMarching, select_landmarks};
 use wavg_mesh::ValidMesh;
 
 fn main() {
@@ -24,16 +24,12 @@ fn main() {
         near_field = args[i + 1].parse().expect("--near-field EDGES");
         args.drain(i..i + 2);
     }
-    let paths: Vec<std::path::PathBuf> = if args.is_empty() {
-        let Some(dir) = wavg_testdata::require_data_dir("symmetry") else {
-            return;
-        };
-        ["pig.off", "camelhead.off", "fertility.off"]
-            .iter()
-            .map(|m| dir.join("meshes").join(m))
-            .collect()
-    } else {
-        args.iter().map(Into::into).collect()
+    let Some(paths) = wavg_bench::mesh_paths(
+        &args,
+        &["pig.off", "camelhead.off", "fertility.off"],
+        "symmetry",
+    ) else {
+        return;
     };
     println!("| mesh | landmarks | runs (s) | mean % | max % | pairs above 2% |");
     println!("|---|---:|---:|---:|---:|---:|");
@@ -46,7 +42,7 @@ fn main() {
         let lm = select_landmarks(&mesh, &opts, &NoProgress).expect("landmarks");
         let fm = FastMarching::new(&mesh).with_near_field_edges(near_field);
         let t = Instant::now();
-        let rows = landmark_rows(&fm, &lm, &NoProgress).expect("landmark rows");
+        let rows = fm.landmark_rows(&lm, &NoProgress).expect("landmark rows");
         let secs = t.elapsed().as_secs_f64();
         let h = wavg_mesh::geometry::mean_edge_length(&mesh);
         let mut all = asymmetries(&rows);

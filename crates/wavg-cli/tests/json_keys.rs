@@ -1,0 +1,270 @@
+//! The exact key sets of the `--json` reports (nested objects included), on small
+//! generated meshes: the reports are serialised from library types, and these keys are a
+//! contract that must not change when those types do.
+
+mod common;
+
+use std::path::Path;
+
+use common::{json_object, sphere_anchors, wavg_ok};
+use serde_json::Value;
+
+fn s(p: &Path) -> String {
+    p.to_str().unwrap().to_string()
+}
+
+/// Every key of `v`, nested ones as `parent.child`, sorted.
+fn key_paths(v: &Value) -> Vec<String> {
+    fn walk(prefix: &str, v: &Value, out: &mut Vec<String>) {
+        if let Value::Object(o) = v {
+            for (k, x) in o {
+                let path = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                out.push(path.clone());
+                walk(&path, x, out);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk("", v, &mut out);
+    out.sort();
+    out
+}
+
+fn assert_keys(args: &[&str], want: &[&str]) {
+    let (o, _) = json_object(&wavg_ok(args));
+    let mut want: Vec<String> = want.iter().map(|k| k.to_string()).collect();
+    want.sort();
+    assert_eq!(key_paths(&Value::Object(o)), want, "wavg {}", args[0]);
+}
+
+#[test]
+fn precompute_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = s(&dir.path().join("t.wavg"));
+    let keys = [
+        "mesh",
+        "output",
+        "seconds",
+        "stages",
+        "stages.decimate",
+        "stages.geodesics",
+        "stages.mds",
+        "stages.lsmesh",
+        "stages.quality",
+        "load_seconds",
+        "save_seconds",
+        "landmarks",
+        "geodesic_mesh_vertices",
+        "dim",
+        "stress",
+        "initial_stress",
+        "mds_iterations",
+        "mds_converged",
+        "geodesic_rel_err_p50",
+        "geodesic_rel_err_p90",
+        "quality_pairs",
+        "vertices",
+        "faces",
+        "removed_by_largest_component",
+    ];
+    let base = [
+        "precompute",
+        "builtin:torus",
+        "-o",
+        &out,
+        "--landmarks",
+        "60",
+        "--json",
+    ];
+    assert_keys(&base, &keys);
+    let mut with_removed = keys.to_vec();
+    with_removed.extend([
+        "removed_by_largest_component.vertices",
+        "removed_by_largest_component.faces",
+    ]);
+    assert_keys(
+        &[&base[..], &["--largest-component"]].concat(),
+        &with_removed,
+    );
+}
+
+#[test]
+fn correspond_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = s(&sphere_anchors(dir.path()));
+    let out = s(&dir.path().join("map.txt"));
+    let m = "builtin:icosphere";
+    let args = [
+        "correspond",
+        "--source",
+        m,
+        "--target",
+        m,
+        "--source-anchors",
+        &a,
+        "--target-anchors",
+        &a,
+        "-o",
+        &out,
+        "--json",
+    ];
+    let keys = [
+        "source",
+        "target",
+        "anchors",
+        "source_vertices",
+        "valid",
+        "valid_fraction",
+        "validity",
+        "verified",
+        "reasons",
+        "flipped_faces",
+        "flipped_area_fraction",
+        "measured_faces",
+        "stretch",
+        "stretch_best95",
+        "seconds",
+        "setup_seconds",
+        "vertices_per_s",
+        "cpu_seconds",
+        "vertices_per_cpu_s",
+        "ground_truth",
+    ];
+    let (o, _) = json_object(&wavg_ok(&args));
+    let mut want: Vec<String> = keys.iter().map(|k| k.to_string()).collect();
+    // `reasons` counts by reason: its keys depend on the map, not on the format.
+    want.extend(
+        o["reasons"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(|k| format!("reasons.{k}")),
+    );
+    want.sort();
+    assert_eq!(key_paths(&Value::Object(o)), want);
+    let (o, _) = json_object(&wavg_ok(&[&args[..], &["--ground-truth"]].concat()));
+    let truth = key_paths(&o["ground_truth"]);
+    let stats = ["count", "max", "mean", "p95"];
+    let mut want: Vec<String> = ["answered", "valid"]
+        .iter()
+        .flat_map(|g| {
+            std::iter::once(g.to_string()).chain(stats.iter().map(move |k| format!("{g}.{k}")))
+        })
+        .collect();
+    want.sort();
+    assert_eq!(truth, want);
+}
+
+#[test]
+fn decal_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.txt");
+    std::fs::write(&a, "v 0\nv 1\nv 2\nv 3\n").unwrap();
+    let uv = dir.path().join("uv.txt");
+    std::fs::write(&uv, "0 0\n1 0\n0 1\n1 1\n").unwrap();
+    let out = s(&dir.path().join("d.obj"));
+    let args = [
+        "decal",
+        "--mesh",
+        "builtin:icosphere",
+        "--anchors",
+        &s(&a),
+        "--uv",
+        &s(&uv),
+        "-o",
+        &out,
+        "--json",
+    ];
+    let keys = [
+        "mesh",
+        "anchors",
+        "vertices",
+        "valid_fraction",
+        "stretch",
+        "stretch_best95",
+        "flipped_faces",
+        "flipped_area_fraction",
+        "seconds",
+        "marked",
+    ];
+    assert_keys(&args, &keys);
+}
+
+/// A flat 12 x 12 grid in the unit square with its own (x, y) as texture coordinates.
+fn textured_grid(path: &Path) {
+    let n = 12;
+    let mut obj = String::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            obj += &format!("v {x} {y} 0\nvt {x} {y}\n");
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let v = |a: usize, b: usize| (j + b) * (n + 1) + i + a + 1;
+            let (p, q, r, s) = (v(0, 0), v(1, 0), v(1, 1), v(0, 1));
+            obj += &format!("f {p}/{p} {q}/{q} {r}/{r}\nf {p}/{p} {r}/{r} {s}/{s}\n");
+        }
+    }
+    std::fs::write(path, obj).unwrap();
+}
+
+#[test]
+fn transfer_texture_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let grid = dir.path().join("grid.obj");
+    textured_grid(&grid);
+    let texture = s(&dir.path().join("texture.png"));
+    wavg_ok(&[
+        "render",
+        "builtin:icosphere",
+        "-o",
+        &texture,
+        "--size",
+        "32",
+    ]);
+    let a = dir.path().join("a.txt");
+    std::fs::write(&a, "v 0\nv 12\nv 84\nv 156\nv 168\n").unwrap();
+    let (grid, a) = (s(&grid), s(&a));
+    let out = s(&dir.path().join("out.png"));
+    let args = [
+        "transfer-texture",
+        "--source",
+        &grid,
+        "--source-texture",
+        &texture,
+        "--target",
+        &grid,
+        "--source-anchors",
+        &a,
+        "--target-anchors",
+        &a,
+        "-o",
+        &out,
+        "--size",
+        "16",
+        "--json",
+    ];
+    let keys = [
+        "texels",
+        "valid_fraction",
+        "seconds",
+        "texels_per_s",
+        "width",
+        "height",
+        "atlas_texels",
+        "valid_texels",
+        "not_reached",
+        "dilated_texels",
+        "precompute_s",
+        "verified",
+        "stride",
+        "interpolated_texels",
+    ];
+    assert_keys(&args, &keys);
+}
