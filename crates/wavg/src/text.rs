@@ -294,7 +294,20 @@ pub fn write_lines<T: Sync>(
     items: &[T],
     format: impl Fn(&T, &mut Vec<u8>) + Sync,
 ) -> io::Result<()> {
-    let buffers: Vec<Vec<u8>> = items
+    for b in &format_lines(items, format) {
+        w.write_all(b)?;
+    }
+    Ok(())
+}
+
+/// Formats one line per item in parallel (each call of `format` appends one line's text
+/// without its line break): the lines in input order, in consecutive blocks of several
+/// lines each, ready to be written by another thread.
+pub fn format_lines<T: Sync>(
+    items: &[T],
+    format: impl Fn(&T, &mut Vec<u8>) + Sync,
+) -> Vec<Vec<u8>> {
+    items
         .par_chunks(LINES_PER_TASK)
         .map(|group| {
             let mut buf = Vec::new();
@@ -304,11 +317,7 @@ pub fn write_lines<T: Sync>(
             }
             buf
         })
-        .collect();
-    for b in &buffers {
-        w.write_all(b)?;
-    }
-    Ok(())
+        .collect()
 }
 
 #[cfg(test)]
