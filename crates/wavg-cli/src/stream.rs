@@ -10,6 +10,7 @@ use std::fs::File;
 use std::io::{BufReader, Write};
 use std::path::Path;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 use wavg::npy::{NpyReader, NpyWriter};
@@ -19,7 +20,14 @@ use crate::CliError;
 use crate::textio::{located, write_atomic};
 
 /// Rows read, checked, computed and written per round.
-const CHUNK_ROWS: usize = 1 << 14;
+const CHUNK_ROWS: usize = 1 << 16;
+
+/// Written text buffers kept for reuse.
+const SPARE_BUFFERS: usize = 64;
+
+/// Text buffers that were written, cleared for reuse: formatting into them saves
+/// allocating and faulting in fresh memory for every chunk.
+type Spare = Arc<Mutex<Vec<Vec<u8>>>>;
 
 /// Bytes of input read ahead.
 const READ_BUFFER: usize = 1 << 22;
@@ -51,24 +59,46 @@ enum Block {
     Npy { cols: usize, values: Vec<f64> },
 }
 
+impl Block {
+    /// No answers yet: `.npy` rows of `npy_cols` values, or text.
+    fn empty(npy_cols: Option<usize>) -> Self {
+        match npy_cols {
+            Some(cols) => Block::Npy {
+                cols,
+                values: Vec::new(),
+            },
+            None => Block::Text(Vec::new()),
+        }
+    }
+
+    /// Hands the written text buffers back for reuse.
+    fn recycle(self, spare: &Spare) {
+        if let Block::Text(lines) = self {
+            let mut spare = spare.lock().unwrap_or_else(|e| e.into_inner());
+            for mut b in lines {
+                if spare.len() < SPARE_BUFFERS {
+                    b.clear();
+                    spare.push(b);
+                }
+            }
+        }
+    }
+}
+
 /// Where a command puts the answers to a chunk: text lines, or `.npy` rows of a fixed
 /// width.
 pub struct Sink {
     npy_cols: Option<usize>,
     block: Block,
+    spare: Spare,
 }
 
 impl Sink {
-    fn new(npy_cols: Option<usize>) -> Self {
+    fn new(npy_cols: Option<usize>, spare: Spare) -> Self {
         Self {
             npy_cols,
-            block: match npy_cols {
-                Some(cols) => Block::Npy {
-                    cols,
-                    values: Vec::new(),
-                },
-                None => Block::Text(Vec::new()),
-            },
+            spare,
+            block: Block::empty(npy_cols),
         }
     }
 
@@ -82,7 +112,13 @@ impl Sink {
         row: impl Fn(&T, &mut [f64]) + Sync,
     ) -> std::io::Result<()> {
         match &mut self.block {
-            Block::Text(lines) => lines.extend(wavg::text::format_lines(items, text)),
+            Block::Text(lines) => {
+                let buffer = || {
+                    let mut spare = self.spare.lock().unwrap_or_else(|e| e.into_inner());
+                    spare.pop().unwrap_or_default()
+                };
+                lines.extend(wavg::text::format_lines_in(items, text, buffer));
+            }
             Block::Npy { cols, values } => {
                 let cols = *cols;
                 let start = values.len();
@@ -99,7 +135,7 @@ impl Sink {
     }
 
     fn take(&mut self) -> Block {
-        std::mem::replace(&mut self.block, Sink::new(self.npy_cols).block)
+        std::mem::replace(&mut self.block, Block::empty(self.npy_cols))
     }
 }
 
@@ -207,10 +243,11 @@ fn compute_all<T: Send>(
     input: &Path,
     format: &Format<T>,
     npy_cols: Option<usize>,
+    spare: Spare,
     check: impl Fn(&[(usize, T)]) -> Result<(), CliError>,
     mut each: impl FnMut(Vec<(usize, T)>, &mut Sink) -> Result<(), CliError>,
 ) -> Result<Computed, CliError> {
-    let mut sink = Sink::new(npy_cols);
+    let mut sink = Sink::new(npy_cols, spare);
     for raw in rx {
         let rows = parse(raw?, input, format)?;
         check(&rows)?;
@@ -276,6 +313,7 @@ pub fn stream_queries<T: Send>(
         .num_threads(threads)
         .build()
         .map_err(|e| CliError::failure(format!("cannot start {threads} threads: {e}")))?;
+    let spare = Spare::default();
     let mut failure = None;
     let written = write_atomic(output, |w: &mut dyn Write| {
         let mut dest = if npy_out {
@@ -284,12 +322,16 @@ pub fn stream_queries<T: Send>(
             Dest::Text(w)
         };
         let (raw_tx, raw_rx) = sync_channel(1);
-        let (block_tx, block_rx) = sync_channel(1);
+        // A rendezvous: a chunk's answers wait until the writer takes them.
+        let (block_tx, block_rx) = sync_channel(0);
         let (computed, written) = std::thread::scope(|s| {
             s.spawn(|| read_all(source, input, raw_tx));
             let compute = s.spawn(|| {
                 let cols = npy_out.then_some(npy_cols);
-                pool.install(|| compute_all(raw_rx, block_tx, input, &format, cols, check, each))
+                let spare = Arc::clone(&spare);
+                pool.install(|| {
+                    compute_all(raw_rx, block_tx, input, &format, cols, spare, check, each)
+                })
             });
             let mut written = Ok(());
             for block in &block_rx {
@@ -297,6 +339,7 @@ pub fn stream_queries<T: Send>(
                 if written.is_err() {
                     break;
                 }
+                block.recycle(&spare);
             }
             drop(block_rx);
             let computed = compute

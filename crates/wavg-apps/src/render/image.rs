@@ -20,6 +20,12 @@ pub struct Image {
 /// Largest accepted side of an image (decoded or created), to bound memory.
 pub const MAX_SIDE: u32 = 16384;
 
+/// Largest PNG accepted for decoding, in bytes of decoded pixels at the file's own colour
+/// type and bit depth (1 GiB: a 16384x16384 RGBA image of 8 bits per channel). Larger
+/// declared sizes are refused from the header, before any pixel memory is allocated; the
+/// decoder's own buffers are held to the same bound.
+pub const MAX_DECODED_BYTES: usize = 1 << 30;
+
 impl Image {
     /// A `width` x `height` image filled with `fill`; both sides must be 1 to [`MAX_SIDE`].
     pub fn new(width: u32, height: u32, fill: [u8; 4]) -> Result<Self, AppError> {
@@ -72,10 +78,15 @@ impl Image {
         out
     }
 
-    /// Decodes a PNG of any colour type and bit depth into RGBA8.
+    /// Decodes a PNG of any colour type and bit depth into RGBA8. Sides over
+    /// [`MAX_SIDE`] and decoded sizes over [`MAX_DECODED_BYTES`] are refused before the
+    /// pixels are allocated.
     pub fn decode_png(reader: impl BufRead + Seek) -> Result<Self, AppError> {
         let err = |e: &dyn std::fmt::Display| AppError::Image(format!("PNG: {e}"));
-        let mut dec = png::Decoder::new(reader);
+        let limits = png::Limits {
+            bytes: MAX_DECODED_BYTES,
+        };
+        let mut dec = png::Decoder::new_with_limits(reader, limits);
         dec.set_transformations(png::Transformations::normalize_to_color8());
         let mut r = dec.read_info().map_err(|e| err(&e))?;
         let (w, h) = (r.info().width, r.info().height);
@@ -86,7 +97,15 @@ impl Image {
         }
         let size = r
             .output_buffer_size()
-            .ok_or_else(|| err(&"image too large"))?;
+            .filter(|&s| s <= MAX_DECODED_BYTES)
+            .ok_or_else(|| {
+                AppError::Image(format!(
+                    "PNG of {w}x{h} pixels ({:?}, {} bits): more than {} MiB decoded",
+                    r.info().color_type,
+                    r.info().bit_depth as u8,
+                    MAX_DECODED_BYTES >> 20
+                ))
+            })?;
         let mut buf = vec![0; size];
         let info = r.next_frame(&mut buf).map_err(|e| err(&e))?;
         let data = &buf[..info.buffer_size()];
@@ -186,6 +205,47 @@ mod tests {
         img.encode_png(&mut bytes).unwrap();
         let back = Image::decode_png(std::io::Cursor::new(bytes)).unwrap();
         assert_eq!(back, img);
+    }
+
+    /// A PNG that declares `w` x `h` pixels of `color` at 8 or 16 bits but holds one
+    /// short data chunk.
+    fn declared_png(w: u32, h: u32, color: png::ColorType, depth: png::BitDepth) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        let mut enc = png::Encoder::new(&mut bytes, w, h);
+        enc.set_color(color);
+        enc.set_depth(depth);
+        let mut wr = enc.write_header().unwrap();
+        wr.write_chunk(png::chunk::IDAT, &[0x78, 0x9c, 0x03, 0x00])
+            .unwrap();
+        drop(wr);
+        bytes
+    }
+
+    #[test]
+    fn decoded_size_is_bounded_from_the_header() {
+        use png::{BitDepth, ColorType};
+        // 16384 x 16384 RGBA of 16 bits: 2 GiB decoded, refused before allocating.
+        let big = declared_png(MAX_SIDE, MAX_SIDE, ColorType::Rgba, BitDepth::Sixteen);
+        let e = Image::decode_png(std::io::Cursor::new(big)).unwrap_err();
+        assert!(
+            matches!(&e, AppError::Image(m) if m.contains("MiB decoded")),
+            "{e}"
+        );
+        // Too wide a side is refused whatever the size.
+        let wide = declared_png(MAX_SIDE + 1, 1, ColorType::Grayscale, BitDepth::Eight);
+        let e = Image::decode_png(std::io::Cursor::new(wide)).unwrap_err();
+        assert!(
+            matches!(&e, AppError::Image(m) if m.contains("at most")),
+            "{e}"
+        );
+        // 8192 x 8192 RGBA of 8 bits (256 MiB) passes the checks and fails only on its
+        // missing pixel data.
+        let large = declared_png(8192, 8192, ColorType::Rgba, BitDepth::Eight);
+        let e = Image::decode_png(std::io::Cursor::new(large)).unwrap_err();
+        let AppError::Image(m) = &e else {
+            panic!("{e}")
+        };
+        assert!(!m.contains("MiB decoded") && !m.contains("limits"), "{m}");
     }
 
     #[test]
