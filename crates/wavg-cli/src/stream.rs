@@ -3,8 +3,9 @@
 //!
 //! Three stages overlap: a reader thread reads chunk k+1 while a compute thread parses,
 //! checks, solves and formats chunk k (each step parallel over the command's threads) and
-//! the calling thread writes chunk k-1. The stages meet in channels of one chunk, so at
-//! most a few chunks are in memory at once.
+//! the calling thread writes the answers formatted so far, a block at a time. The stages
+//! hand work over without queues, so memory holds about two chunks of input and two
+//! blocks of output.
 
 use std::fs::File;
 use std::io::{BufReader, Write};
@@ -23,7 +24,7 @@ use crate::textio::{located, write_atomic};
 const CHUNK_ROWS: usize = 1 << 16;
 
 /// Written text buffers kept for reuse.
-const SPARE_BUFFERS: usize = 64;
+const SPARE_BUFFERS: usize = 16;
 
 /// Text buffers that were written, cleared for reuse: formatting into them saves
 /// allocating and faulting in fresh memory for every chunk.
@@ -51,26 +52,19 @@ pub fn is_npy(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
 }
 
-/// The answers to one chunk, formatted, on their way to the writer.
+/// Answers formatted together and sent to the writer as one block: small enough that
+/// the blocks in flight stay small, large enough to spread over every thread.
+const BLOCK_ROWS: usize = 1 << 13;
+
+/// Formatted answers on their way to the writer.
 enum Block {
-    /// Text lines, in consecutive blocks.
+    /// Text lines, in consecutive buffers.
     Text(Vec<Vec<u8>>),
-    /// `.npy` rows of `cols` values, row after row.
-    Npy { cols: usize, values: Vec<f64> },
+    /// `.npy` rows, row after row.
+    Npy(Vec<f64>),
 }
 
 impl Block {
-    /// No answers yet: `.npy` rows of `npy_cols` values, or text.
-    fn empty(npy_cols: Option<usize>) -> Self {
-        match npy_cols {
-            Some(cols) => Block::Npy {
-                cols,
-                values: Vec::new(),
-            },
-            None => Block::Text(Vec::new()),
-        }
-    }
-
     /// Hands the written text buffers back for reuse.
     fn recycle(self, spare: &Spare) {
         if let Block::Text(lines) = self {
@@ -85,57 +79,49 @@ impl Block {
     }
 }
 
-/// Where a command puts the answers to a chunk: text lines, or `.npy` rows of a fixed
-/// width.
+/// Where a command puts its answers: text lines, or `.npy` rows of a fixed width. They
+/// are formatted in parallel and handed to the writer a block at a time.
 pub struct Sink {
     npy_cols: Option<usize>,
-    block: Block,
     spare: Spare,
+    tx: SyncSender<Block>,
 }
 
 impl Sink {
-    fn new(npy_cols: Option<usize>, spare: Spare) -> Self {
-        Self {
-            npy_cols,
-            spare,
-            block: Block::empty(npy_cols),
-        }
-    }
-
     /// Formats one answer per item, in parallel: `text` appends a line's text (without its
     /// line break), `row` fills a `.npy` row of the width the sink was opened with
-    /// (values it leaves alone are NaN).
+    /// (values it leaves alone are NaN). Fails when the writer has stopped.
     pub fn write<T: Sync>(
         &mut self,
         items: &[T],
         text: impl Fn(&T, &mut Vec<u8>) + Sync,
         row: impl Fn(&T, &mut [f64]) + Sync,
     ) -> std::io::Result<()> {
-        match &mut self.block {
-            Block::Text(lines) => {
-                let buffer = || {
-                    let mut spare = self.spare.lock().unwrap_or_else(|e| e.into_inner());
-                    spare.pop().unwrap_or_default()
-                };
-                lines.extend(wavg::text::format_lines_in(items, text, buffer));
-            }
-            Block::Npy { cols, values } => {
-                let cols = *cols;
-                let start = values.len();
-                values.resize(start + items.len() * cols, f64::NAN);
-                if cols > 0 {
-                    values[start..]
-                        .par_chunks_mut(cols)
-                        .zip(items)
-                        .for_each(|(r, item)| row(item, r));
+        for piece in items.chunks(BLOCK_ROWS) {
+            let block = match self.npy_cols {
+                None => {
+                    let buffer = || {
+                        let mut spare = self.spare.lock().unwrap_or_else(|e| e.into_inner());
+                        spare.pop().unwrap_or_default()
+                    };
+                    Block::Text(wavg::text::format_lines_in(piece, &text, buffer))
                 }
-            }
+                Some(cols) => {
+                    let mut values = vec![f64::NAN; piece.len() * cols];
+                    if cols > 0 {
+                        values
+                            .par_chunks_mut(cols)
+                            .zip(piece)
+                            .for_each(|(r, item)| row(item, r));
+                    }
+                    Block::Npy(values)
+                }
+            };
+            self.tx
+                .send(block)
+                .map_err(|_| std::io::Error::other("the writer stopped"))?;
         }
         Ok(())
-    }
-
-    fn take(&mut self) -> Block {
-        std::mem::replace(&mut self.block, Block::empty(self.npy_cols))
     }
 }
 
@@ -229,34 +215,21 @@ fn read_all(mut source: Source, input: &Path, tx: SyncSender<Result<Raw, CliErro
     }
 }
 
-/// Whether the compute stage ran to the end or found the writer gone.
-enum Computed {
-    Done,
-    WriterGone,
-}
-
-/// Parses, checks and computes every chunk from `rx`, sending the formatted answers
-/// down `tx`.
+/// Parses, checks and computes every chunk from `rx`; `each` puts the answers in `sink`.
 fn compute_all<T: Send>(
     rx: Receiver<Result<Raw, CliError>>,
-    tx: SyncSender<Block>,
+    mut sink: Sink,
     input: &Path,
     format: &Format<T>,
-    npy_cols: Option<usize>,
-    spare: Spare,
     check: impl Fn(&[(usize, T)]) -> Result<(), CliError>,
     mut each: impl FnMut(Vec<(usize, T)>, &mut Sink) -> Result<(), CliError>,
-) -> Result<Computed, CliError> {
-    let mut sink = Sink::new(npy_cols, spare);
+) -> Result<(), CliError> {
     for raw in rx {
         let rows = parse(raw?, input, format)?;
         check(&rows)?;
         each(rows, &mut sink)?;
-        if tx.send(sink.take()).is_err() {
-            return Ok(Computed::WriterGone);
-        }
     }
-    Ok(Computed::Done)
+    Ok(())
 }
 
 /// The output file as the writer sees it.
@@ -269,7 +242,7 @@ impl Dest<'_> {
     fn write(&mut self, block: &Block) -> std::io::Result<()> {
         match (self, block) {
             (Dest::Text(w), Block::Text(lines)) => lines.iter().try_for_each(|b| w.write_all(b)),
-            (Dest::Npy(w), Block::Npy { values, .. }) => w.write_rows(values),
+            (Dest::Npy(w), Block::Npy(values)) => w.write_rows(values),
             _ => Err(std::io::Error::other("answers of the wrong format")),
         }
     }
@@ -321,17 +294,19 @@ pub fn stream_queries<T: Send>(
         } else {
             Dest::Text(w)
         };
-        let (raw_tx, raw_rx) = sync_channel(1);
-        // A rendezvous: a chunk's answers wait until the writer takes them.
+        // Rendezvous channels: each stage holds one piece of work while it waits for the
+        // next to take it.
+        let (raw_tx, raw_rx) = sync_channel(0);
         let (block_tx, block_rx) = sync_channel(0);
         let (computed, written) = std::thread::scope(|s| {
             s.spawn(|| read_all(source, input, raw_tx));
             let compute = s.spawn(|| {
-                let cols = npy_out.then_some(npy_cols);
-                let spare = Arc::clone(&spare);
-                pool.install(|| {
-                    compute_all(raw_rx, block_tx, input, &format, cols, spare, check, each)
-                })
+                let sink = Sink {
+                    npy_cols: npy_out.then_some(npy_cols),
+                    spare: Arc::clone(&spare),
+                    tx: block_tx,
+                };
+                pool.install(|| compute_all(raw_rx, sink, input, &format, check, each))
             });
             let mut written = Ok(());
             for block in &block_rx {
@@ -348,13 +323,9 @@ pub fn stream_queries<T: Send>(
             (computed, written)
         });
         written?;
-        match computed {
-            Ok(Computed::Done) => {}
-            Ok(Computed::WriterGone) => return Err(std::io::Error::other("writer stopped")),
-            Err(e) => {
-                failure = Some(e);
-                return Err(std::io::Error::other("stopped"));
-            }
+        if let Err(e) = computed {
+            failure = Some(e);
+            return Err(std::io::Error::other("stopped"));
         }
         match dest {
             Dest::Npy(w) => w.finish().map(|_| ()),
