@@ -1,4 +1,4 @@
-//! `cargo xtask fuzz [--seconds N]`: builds the coverage-guided fuzz targets in `fuzz/`
+//! `cargo xtask fuzz [--seconds N] [--target NAME]`: builds the coverage-guided fuzz targets in `fuzz/`
 //! (cargo-fuzz, libFuzzer, no sanitizer, so the stable toolchain suffices), seeds their
 //! corpora from meshes the project generates, and runs each target for N seconds.
 
@@ -15,12 +15,12 @@ pub const TARGETS: &[&str] = &[
     "png_texture",
 ];
 
-/// Runs every target for `seconds` each; `Err` names the first failure.
-pub fn run(root: &Path, seconds: u64) -> Result<(), String> {
+/// Runs every target (or only `only`) for `seconds` each; `Err` names the first failure.
+pub fn run(root: &Path, seconds: u64, only: Option<&str>) -> Result<(), String> {
     ensure_cargo_fuzz()?;
     let fuzz_dir = root.join("fuzz");
     seed_corpora(root, &fuzz_dir)?;
-    for target in TARGETS {
+    for target in TARGETS.iter().filter(|t| only.is_none_or(|o| o == **t)) {
         eprintln!("==> fuzz {target} for {seconds} s");
         let corpus = fuzz_dir.join("corpus").join(target);
         std::fs::create_dir_all(&corpus).map_err(|e| format!("{}: {e}", corpus.display()))?;
