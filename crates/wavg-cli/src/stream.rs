@@ -1,11 +1,12 @@
 //! Streaming query files through `wavg forward` / `wavg inverse`: text or NumPy `.npy`
 //! in, text or `.npy` out, a bounded chunk of rows at a time, with atomic outputs.
 //!
-//! Three stages overlap: a reader thread reads chunk k+1 while a compute thread parses,
-//! checks, solves and formats chunk k (each step parallel over the command's threads) and
-//! the calling thread writes the answers formatted so far, a block at a time. The stages
-//! hand work over without queues, so memory holds about two chunks of input and two
-//! blocks of output.
+//! Three stages overlap: a reader thread reads and parses the rows of chunk k+1 while a
+//! compute thread checks, solves and formats chunk k (parsing, solving and formatting are
+//! parallel over the command's threads) and the calling thread writes the answers
+//! formatted so far, a block at a time. The stages hand work over without queues, so
+//! memory holds about two chunks of parsed input, two parts of raw input and two blocks
+//! of output.
 
 use std::fs::File;
 use std::io::{BufReader, Write};
@@ -22,6 +23,10 @@ use crate::textio::{located, write_atomic};
 
 /// Rows read, checked, computed and written per round.
 const CHUNK_ROWS: usize = 1 << 16;
+
+/// Rows read and parsed at a time (a quarter of a chunk, to keep the input in flight
+/// small).
+const READ_ROWS: usize = CHUNK_ROWS / 4;
 
 /// Written text buffers kept for reuse.
 const SPARE_BUFFERS: usize = 16;
@@ -153,7 +158,7 @@ impl Source {
                 .map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
             Source::Npy(r, 0)
         } else {
-            Source::Text(LineChunks::new(reader, CHUNK_ROWS))
+            Source::Text(LineChunks::new(reader, READ_ROWS))
         })
     }
 
@@ -165,7 +170,7 @@ impl Source {
             Source::Npy(reader, done) => {
                 let mut values = Vec::new();
                 let n = reader
-                    .read_rows(&mut values, CHUNK_ROWS)
+                    .read_rows(&mut values, READ_ROWS)
                     .map_err(|e| io(&e))?;
                 let first = *done + 1;
                 *done += n;
@@ -202,11 +207,20 @@ fn parse<T: Send>(raw: Raw, input: &Path, format: &Format<T>) -> Result<Vec<(usi
     }
 }
 
-/// Sends every chunk of `source` (or the first error) down `tx`, until the end or until
-/// the receiver is gone.
-fn read_all(mut source: Source, input: &Path, tx: SyncSender<Result<Raw, CliError>>) {
+/// Reads and parses every part of `source` (text in parallel on `pool`), sending the
+/// rows (or the first error) down `tx`, until the end or until the receiver is gone.
+fn read_all<T: Send>(
+    mut source: Source,
+    input: &Path,
+    format: &Format<T>,
+    pool: &rayon::ThreadPool,
+    tx: SyncSender<Result<Vec<(usize, T)>, CliError>>,
+) {
     loop {
-        let next = source.next_raw(input);
+        let next = source.next_raw(input).and_then(|raw| {
+            raw.map(|r| pool.install(|| parse(r, input, format)))
+                .transpose()
+        });
         let stop = !matches!(next, Ok(Some(_)));
         let Some(item) = next.transpose() else { return };
         if tx.send(item).is_err() || stop {
@@ -215,19 +229,28 @@ fn read_all(mut source: Source, input: &Path, tx: SyncSender<Result<Raw, CliErro
     }
 }
 
-/// Parses, checks and computes every chunk from `rx`; `each` puts the answers in `sink`.
+/// Checks the rows from `rx` and computes them a chunk at a time on `pool`; `each` puts
+/// the answers in `sink`. Waiting for rows happens outside the pool, so the reader's
+/// parsing always finds the pool's threads free, whatever their number.
 fn compute_all<T: Send>(
-    rx: Receiver<Result<Raw, CliError>>,
+    rx: Receiver<Result<Vec<(usize, T)>, CliError>>,
     mut sink: Sink,
-    input: &Path,
-    format: &Format<T>,
-    check: impl Fn(&[(usize, T)]) -> Result<(), CliError>,
-    mut each: impl FnMut(Vec<(usize, T)>, &mut Sink) -> Result<(), CliError>,
+    pool: &rayon::ThreadPool,
+    check: impl Fn(&[(usize, T)]) -> Result<(), CliError> + Sync,
+    mut each: impl FnMut(Vec<(usize, T)>, &mut Sink) -> Result<(), CliError> + Send,
 ) -> Result<(), CliError> {
-    for raw in rx {
-        let rows = parse(raw?, input, format)?;
-        check(&rows)?;
-        each(rows, &mut sink)?;
+    let mut chunk = Vec::new();
+    for part in rx {
+        let part = part?;
+        let mut part = pool.install(|| check(&part).map(|()| part))?;
+        chunk.append(&mut part);
+        if chunk.len() >= CHUNK_ROWS {
+            let rows = std::mem::take(&mut chunk);
+            pool.install(|| each(rows, &mut sink))?;
+        }
+    }
+    if !chunk.is_empty() {
+        pool.install(|| each(chunk, &mut sink))?;
     }
     Ok(())
 }
@@ -261,7 +284,7 @@ pub fn stream_queries<T: Send>(
     output: &Path,
     format: Format<T>,
     npy_cols: usize,
-    check: impl Fn(&[(usize, T)]) -> Result<(), CliError> + Send,
+    check: impl Fn(&[(usize, T)]) -> Result<(), CliError> + Send + Sync,
     each: impl FnMut(Vec<(usize, T)>, &mut Sink) -> Result<(), CliError> + Send,
 ) -> Result<(), CliError> {
     let npy_out = is_npy(output);
@@ -299,14 +322,14 @@ pub fn stream_queries<T: Send>(
         let (raw_tx, raw_rx) = sync_channel(0);
         let (block_tx, block_rx) = sync_channel(0);
         let (computed, written) = std::thread::scope(|s| {
-            s.spawn(|| read_all(source, input, raw_tx));
+            s.spawn(|| read_all(source, input, &format, &pool, raw_tx));
             let compute = s.spawn(|| {
                 let sink = Sink {
                     npy_cols: npy_out.then_some(npy_cols),
                     spare: Arc::clone(&spare),
                     tx: block_tx,
                 };
-                pool.install(|| compute_all(raw_rx, sink, input, &format, check, each))
+                compute_all(raw_rx, sink, &pool, check, each)
             });
             let mut written = Ok(());
             for block in &block_rx {
