@@ -1,4 +1,4 @@
-//! `cargo xtask fuzz [--seconds N]`: builds the coverage-guided fuzz targets in `fuzz/`
+//! `cargo xtask fuzz [--seconds N] [--target NAME]`: builds the coverage-guided fuzz targets in `fuzz/`
 //! (cargo-fuzz, libFuzzer, no sanitizer, so the stable toolchain suffices), seeds their
 //! corpora from meshes the project generates, and runs each target for N seconds.
 
@@ -15,12 +15,21 @@ pub const TARGETS: &[&str] = &[
     "png_texture",
 ];
 
-/// Runs every target for `seconds` each; `Err` names the first failure.
-pub fn run(root: &Path, seconds: u64) -> Result<(), String> {
+/// Longest input libFuzzer makes for `target` (its own default otherwise, which is the
+/// largest seed's length). Mesh seeds run to hundreds of kilobytes, and a valid mesh is
+/// analysed, validated and written and read back in three formats, so long inputs cost
+/// milliseconds each; every branch of the readers (headers, counts, lists, binary
+/// layouts) is reachable within a few kilobytes.
+fn max_len(target: &str) -> Option<usize> {
+    (target == "mesh_read").then_some(4096)
+}
+
+/// Runs every target (or only `only`) for `seconds` each; `Err` names the first failure.
+pub fn run(root: &Path, seconds: u64, only: Option<&str>) -> Result<(), String> {
     ensure_cargo_fuzz()?;
     let fuzz_dir = root.join("fuzz");
     seed_corpora(root, &fuzz_dir)?;
-    for target in TARGETS {
+    for target in TARGETS.iter().filter(|t| only.is_none_or(|o| o == **t)) {
         eprintln!("==> fuzz {target} for {seconds} s");
         let corpus = fuzz_dir.join("corpus").join(target);
         std::fs::create_dir_all(&corpus).map_err(|e| format!("{}: {e}", corpus.display()))?;
@@ -34,6 +43,7 @@ pub fn run(root: &Path, seconds: u64) -> Result<(), String> {
                 "-timeout=20",
                 "-print_final_stats=1",
             ])
+            .args(max_len(target).map(|n| format!("-max_len={n}")))
             .current_dir(&fuzz_dir)
             .status()
             .map_err(|e| format!("could not start cargo fuzz: {e}"))?;
@@ -104,6 +114,20 @@ fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
         }
     };
     let mut sources: Vec<PathBuf> = Vec::new();
+    // A tetrahedron in every format: seeds well within the mesh target's input length.
+    let tet = tmp.join("tet-src.obj");
+    let tet_text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    std::fs::write(&tet, tet_text).map_err(|e| format!("{}: {e}", tet.display()))?;
+    for ext in ["obj", "off", "ply"] {
+        let p = tmp.join(format!("tet.{ext}"));
+        run(&[
+            "repair",
+            tet.to_str().unwrap_or_default(),
+            "-o",
+            p.to_str().unwrap_or_default(),
+        ])?;
+        sources.push(p);
+    }
     for (name, builtin) in [("sphere", "builtin:sphere-small"), ("grid", "builtin:grid")] {
         for ext in ["obj", "off", "ply"] {
             let p = tmp.join(format!("{name}.{ext}"));

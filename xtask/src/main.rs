@@ -16,8 +16,10 @@ fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("test") => run_all(&workspace_root()),
-        Some("fuzz") => match fuzz_seconds(&args[1..]) {
-            Some(seconds) => report(fuzz::run(&workspace_root(), seconds)),
+        Some("fuzz") => match fuzz_args(&args[1..]) {
+            Some((seconds, target)) => {
+                report(fuzz::run(&workspace_root(), seconds, target.as_deref()))
+            }
             None => usage(),
         },
         Some("lines") => report(lines::run(&workspace_root())),
@@ -52,12 +54,12 @@ fn bench(root: &Path, args: &[String]) -> Result<(), String> {
 
 fn usage() -> ExitCode {
     eprintln!(
-        "usage: cargo xtask test | cargo xtask fuzz [--seconds N] | cargo xtask bench NAME [ARGS] | cargo xtask lines\n\n  \
+        "usage: cargo xtask test | cargo xtask fuzz [--seconds N] [--target NAME] | cargo xtask bench NAME [ARGS] | cargo xtask lines\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the examples \
          (and quickstart.rs as a crate outside the workspace), the C/C++ build (CMake: \
          libwavg, C tests, examples, OpenMesh harness) and ctest, a {SMOKE_SECONDS} s smoke \
          run of every fuzz target\n  \
-         fuzz   every fuzz target for N seconds (default 60) each\n  \
+         fuzz   every fuzz target (or only NAME) for N seconds (default 60) each\n  \
          bench  the timing script or experiment NAME (crates/wavg-bench/src/bin/NAME.rs) with ARGS\n  \
          lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])",
         MAX = lines::MAX_LINES
@@ -68,12 +70,19 @@ fn usage() -> ExitCode {
 /// Seconds each fuzz target runs within `cargo xtask test`.
 const SMOKE_SECONDS: u64 = 15;
 
-fn fuzz_seconds(args: &[String]) -> Option<u64> {
-    match args {
-        [] => Some(60),
-        [flag, n] if flag == "--seconds" => n.parse().ok(),
-        _ => None,
+/// `[--seconds N] [--target NAME]` in any order: seconds (default 60) and target.
+fn fuzz_args(args: &[String]) -> Option<(u64, Option<String>)> {
+    let (mut seconds, mut target) = (60, None);
+    let mut it = args.iter();
+    while let Some(flag) = it.next() {
+        let value = it.next()?;
+        match flag.as_str() {
+            "--seconds" => seconds = value.parse().ok()?,
+            "--target" if fuzz::TARGETS.contains(&value.as_str()) => target = Some(value.clone()),
+            _ => return None,
+        }
     }
+    Some((seconds, target))
 }
 
 fn report(result: Result<(), String>) -> ExitCode {
@@ -151,7 +160,7 @@ fn run_all(root: &Path) -> ExitCode {
             return ExitCode::FAILURE;
         }
     }
-    if let Err(msg) = fuzz::run(root, SMOKE_SECONDS) {
+    if let Err(msg) = fuzz::run(root, SMOKE_SECONDS, None) {
         eprintln!("==> fuzz smoke FAILED: {msg}");
         return ExitCode::FAILURE;
     }

@@ -1,10 +1,20 @@
 //! Streaming query files through `wavg forward` / `wavg inverse`: text or NumPy `.npy`
 //! in, text or `.npy` out, a bounded chunk of rows at a time, with atomic outputs.
+//!
+//! Three stages overlap: a reader thread reads and parses the rows of chunk k+1 while a
+//! compute thread checks, solves and formats chunk k (parsing, solving and formatting are
+//! parallel over the command's threads) and the calling thread writes the answers
+//! formatted so far, a block at a time. The stages hand work over without queues, so
+//! memory holds about two chunks of parsed input, two parts of raw input and two blocks
+//! of output.
 
 use std::fs::File;
 use std::io::{BufReader, Write};
 use std::path::Path;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::sync::{Arc, Mutex};
 
+use rayon::prelude::*;
 use wavg::npy::{NpyReader, NpyWriter};
 use wavg::text::{LineChunks, LineError};
 
@@ -13,6 +23,20 @@ use crate::textio::{located, write_atomic};
 
 /// Rows read, checked, computed and written per round.
 const CHUNK_ROWS: usize = 1 << 16;
+
+/// Rows read and parsed at a time (a quarter of a chunk, to keep the input in flight
+/// small).
+const READ_ROWS: usize = CHUNK_ROWS / 4;
+
+/// Written text buffers kept for reuse.
+const SPARE_BUFFERS: usize = 16;
+
+/// Text buffers that were written, cleared for reuse: formatting into them saves
+/// allocating and faulting in fresh memory for every chunk.
+type Spare = Arc<Mutex<Vec<Vec<u8>>>>;
+
+/// Bytes of input read ahead.
+const READ_BUFFER: usize = 1 << 22;
 
 /// A text chunk parser: the chunk's text and first line number to numbered rows.
 pub type ParseChunk<T> = fn(&str, usize) -> Result<Vec<(usize, T)>, LineError>;
@@ -33,36 +57,89 @@ pub fn is_npy(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
 }
 
-/// Where a command writes its answers.
-pub enum Sink<'a> {
-    /// One text line per answer.
-    Text(&'a mut dyn Write),
-    /// One `.npy` row per answer.
-    Npy(NpyWriter<&'a mut dyn Write>),
+/// Answers formatted together and sent to the writer as one block: small enough that
+/// the blocks in flight stay small, large enough to spread over every thread.
+const BLOCK_ROWS: usize = 1 << 13;
+
+/// Formatted answers on their way to the writer.
+enum Block {
+    /// Text lines, in consecutive buffers.
+    Text(Vec<Vec<u8>>),
+    /// `.npy` rows, row after row.
+    Npy(Vec<f64>),
 }
 
-impl Sink<'_> {
-    /// Writes one answer per item: `text` appends a line's text (without its line break),
-    /// `row` fills a `.npy` row of the width the sink was opened with.
+impl Block {
+    /// Hands the written text buffers back for reuse.
+    fn recycle(self, spare: &Spare) {
+        if let Block::Text(lines) = self {
+            let mut spare = spare.lock().unwrap_or_else(|e| e.into_inner());
+            for mut b in lines {
+                if spare.len() < SPARE_BUFFERS {
+                    b.clear();
+                    spare.push(b);
+                }
+            }
+        }
+    }
+}
+
+/// Where a command puts its answers: text lines, or `.npy` rows of a fixed width. They
+/// are formatted in parallel and handed to the writer a block at a time.
+pub struct Sink {
+    npy_cols: Option<usize>,
+    spare: Spare,
+    tx: SyncSender<Block>,
+}
+
+impl Sink {
+    /// Formats one answer per item, in parallel: `text` appends a line's text (without its
+    /// line break), `row` fills a `.npy` row of the width the sink was opened with
+    /// (values it leaves alone are NaN). Fails when the writer has stopped.
     pub fn write<T: Sync>(
         &mut self,
         items: &[T],
         text: impl Fn(&T, &mut Vec<u8>) + Sync,
-        row: impl Fn(&T, &mut [f64]),
+        row: impl Fn(&T, &mut [f64]) + Sync,
     ) -> std::io::Result<()> {
-        match self {
-            Sink::Text(w) => wavg::text::write_lines(*w, items, text),
-            Sink::Npy(w) => {
-                let mut buf = vec![0.0; w.cols()];
-                for item in items {
-                    buf.fill(f64::NAN);
-                    row(item, &mut buf);
-                    w.write_row(&buf)?;
+        for piece in items.chunks(BLOCK_ROWS) {
+            let block = match self.npy_cols {
+                None => {
+                    let buffer = || {
+                        let mut spare = self.spare.lock().unwrap_or_else(|e| e.into_inner());
+                        spare.pop().unwrap_or_default()
+                    };
+                    Block::Text(wavg::text::format_lines_in(piece, &text, buffer))
                 }
-                Ok(())
-            }
+                Some(cols) => {
+                    let mut values = vec![f64::NAN; piece.len() * cols];
+                    if cols > 0 {
+                        values
+                            .par_chunks_mut(cols)
+                            .zip(piece)
+                            .for_each(|(r, item)| row(item, r));
+                    }
+                    Block::Npy(values)
+                }
+            };
+            self.tx
+                .send(block)
+                .map_err(|_| std::io::Error::other("the writer stopped"))?;
         }
+        Ok(())
     }
+}
+
+/// A chunk of input as read, before parsing.
+enum Raw {
+    /// Whole text lines.
+    Text(wavg::text::Chunk),
+    /// `.npy` rows of `cols` values; the first is row `first` (1-based).
+    Npy {
+        first: usize,
+        cols: usize,
+        values: Vec<f64>,
+    },
 }
 
 /// The rows of a query file, text or `.npy`, a chunk at a time.
@@ -75,97 +152,207 @@ impl Source {
     fn open(input: &Path) -> Result<Self, CliError> {
         let file =
             File::open(input).map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
-        let reader = BufReader::with_capacity(1 << 20, file);
+        let reader = BufReader::with_capacity(READ_BUFFER, file);
         Ok(if is_npy(input) {
             let r = NpyReader::new(reader)
                 .map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
             Source::Npy(r, 0)
         } else {
-            Source::Text(LineChunks::new(reader, CHUNK_ROWS))
+            Source::Text(LineChunks::new(reader, READ_ROWS))
         })
     }
 
-    /// The next chunk of numbered rows, or `None` at the end.
-    fn next<T>(
-        &mut self,
-        input: &Path,
-        format: &Format<T>,
-    ) -> Result<Option<Vec<(usize, T)>>, CliError> {
+    /// The next chunk as read, or `None` at the end.
+    fn next_raw(&mut self, input: &Path) -> Result<Option<Raw>, CliError> {
         let io = |e: &dyn std::fmt::Display| CliError::input(format!("{}: {e}", input.display()));
-        let bad = |e: LineError| located(input, e.line, &e.message);
         match self {
-            Source::Text(chunks) => {
-                let Some(chunk) = chunks.next_chunk().map_err(|e| io(&e))? else {
-                    return Ok(None);
-                };
-                (format.text)(&chunk.text, chunk.first_line)
-                    .map(Some)
-                    .map_err(bad)
-            }
+            Source::Text(chunks) => Ok(chunks.next_chunk().map_err(|e| io(&e))?.map(Raw::Text)),
             Source::Npy(reader, done) => {
-                let mut rows = Vec::new();
-                let mut buf = vec![0.0; reader.cols()];
-                while rows.len() < CHUNK_ROWS && reader.read_row(&mut buf).map_err(|e| io(&e))? {
-                    *done += 1;
-                    rows.push((*done, (format.npy)(*done, &buf).map_err(bad)?));
-                }
-                Ok((!rows.is_empty()).then_some(rows))
+                let mut values = Vec::new();
+                let n = reader
+                    .read_rows(&mut values, READ_ROWS)
+                    .map_err(|e| io(&e))?;
+                let first = *done + 1;
+                *done += n;
+                Ok((n > 0).then_some(Raw::Npy {
+                    first,
+                    cols: reader.cols(),
+                    values,
+                }))
             }
+        }
+    }
+}
+
+/// Parses a chunk into numbered rows (text in parallel).
+fn parse<T: Send>(raw: Raw, input: &Path, format: &Format<T>) -> Result<Vec<(usize, T)>, CliError> {
+    let bad = |e: LineError| located(input, e.line, &e.message);
+    match raw {
+        Raw::Text(chunk) => (format.text)(&chunk.text, chunk.first_line).map_err(bad),
+        Raw::Npy {
+            first,
+            cols,
+            values,
+        } => {
+            let rows = if cols == 0 {
+                Vec::new()
+            } else {
+                values.chunks_exact(cols).collect()
+            };
+            rows.into_iter()
+                .enumerate()
+                .map(|(i, row)| Ok((first + i, (format.npy)(first + i, row).map_err(bad)?)))
+                .collect()
+        }
+    }
+}
+
+/// Reads and parses every part of `source` (text in parallel on `pool`), sending the
+/// rows (or the first error) down `tx`, until the end or until the receiver is gone.
+fn read_all<T: Send>(
+    mut source: Source,
+    input: &Path,
+    format: &Format<T>,
+    pool: &rayon::ThreadPool,
+    tx: SyncSender<Result<Vec<(usize, T)>, CliError>>,
+) {
+    loop {
+        let next = source.next_raw(input).and_then(|raw| {
+            raw.map(|r| pool.install(|| parse(r, input, format)))
+                .transpose()
+        });
+        let stop = !matches!(next, Ok(Some(_)));
+        let Some(item) = next.transpose() else { return };
+        if tx.send(item).is_err() || stop {
+            return;
+        }
+    }
+}
+
+/// Checks the rows from `rx` and computes them a chunk at a time on `pool`; `each` puts
+/// the answers in `sink`. Waiting for rows happens outside the pool, so the reader's
+/// parsing always finds the pool's threads free, whatever their number.
+fn compute_all<T: Send>(
+    rx: Receiver<Result<Vec<(usize, T)>, CliError>>,
+    mut sink: Sink,
+    pool: &rayon::ThreadPool,
+    check: impl Fn(&[(usize, T)]) -> Result<(), CliError> + Sync,
+    mut each: impl FnMut(Vec<(usize, T)>, &mut Sink) -> Result<(), CliError> + Send,
+) -> Result<(), CliError> {
+    let mut chunk = Vec::new();
+    for part in rx {
+        let part = part?;
+        let mut part = pool.install(|| check(&part).map(|()| part))?;
+        chunk.append(&mut part);
+        if chunk.len() >= CHUNK_ROWS {
+            let rows = std::mem::take(&mut chunk);
+            pool.install(|| each(rows, &mut sink))?;
+        }
+    }
+    if !chunk.is_empty() {
+        pool.install(|| each(chunk, &mut sink))?;
+    }
+    Ok(())
+}
+
+/// The output file as the writer sees it.
+enum Dest<'a> {
+    Text(&'a mut dyn Write),
+    Npy(NpyWriter<&'a mut dyn Write>),
+}
+
+impl Dest<'_> {
+    fn write(&mut self, block: &Block) -> std::io::Result<()> {
+        match (self, block) {
+            (Dest::Text(w), Block::Text(lines)) => lines.iter().try_for_each(|b| w.write_all(b)),
+            (Dest::Npy(w), Block::Npy(values)) => w.write_rows(values),
+            _ => Err(std::io::Error::other("answers of the wrong format")),
         }
     }
 }
 
 /// Streams the query file `input` through bounded memory: each chunk of rows is parsed
 /// (text in parallel), checked by `check` (errors name their line, or row for `.npy`), and
-/// handed to `each`, which writes its answers to the sink: text, or with an `output`
-/// ending in `.npy` rows of `npy_cols` values. The output goes to a temporary file renamed
-/// on success, so a bad row anywhere leaves nothing; for stdout (`-`), and to count the
-/// rows of a `.npy` output from a text input, a first pass parses and checks the whole
-/// file before anything is written.
+/// handed to `each`, which puts its answers in the sink: text, or with an `output`
+/// ending in `.npy` rows of `npy_cols` values. Reading, computing and writing overlap
+/// (see the module documentation). The output goes to a temporary file renamed on
+/// success, so a bad row anywhere leaves nothing; for stdout (`-`), and to count the rows
+/// of a `.npy` output from a text input, a first pass parses and checks the whole file
+/// before anything is written.
 pub fn stream_queries<T: Send>(
     input: &Path,
     output: &Path,
     format: Format<T>,
     npy_cols: usize,
-    check: impl Fn(&[(usize, T)]) -> Result<(), CliError>,
-    mut each: impl FnMut(Vec<(usize, T)>, &mut Sink) -> Result<(), CliError>,
+    check: impl Fn(&[(usize, T)]) -> Result<(), CliError> + Send + Sync,
+    each: impl FnMut(Vec<(usize, T)>, &mut Sink) -> Result<(), CliError> + Send,
 ) -> Result<(), CliError> {
     let npy_out = is_npy(output);
     let mut rows = None;
     if output == Path::new("-") || (npy_out && !is_npy(input)) {
         let mut source = Source::open(input)?;
         let mut n = 0;
-        while let Some(chunk) = source.next(input, &format)? {
+        while let Some(raw) = source.next_raw(input)? {
+            let chunk = parse(raw, input, &format)?;
             check(&chunk)?;
             n += chunk.len();
         }
         rows = Some(n);
     }
-    let mut source = Source::open(input)?;
+    let source = Source::open(input)?;
     if let (Source::Npy(r, _), None) = (&source, rows) {
         rows = Some(r.rows());
     }
+    // The compute stage gets a pool of its own, as large as the one this runs in.
+    let threads = rayon::current_num_threads();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| CliError::failure(format!("cannot start {threads} threads: {e}")))?;
+    let spare = Spare::default();
     let mut failure = None;
     let written = write_atomic(output, |w: &mut dyn Write| {
-        let mut sink = if npy_out {
-            Sink::Npy(NpyWriter::new(w, rows.unwrap_or(0), npy_cols)?)
+        let mut dest = if npy_out {
+            Dest::Npy(NpyWriter::new(w, rows.unwrap_or(0), npy_cols)?)
         } else {
-            Sink::Text(w)
+            Dest::Text(w)
         };
-        let mut round = || -> Result<(), CliError> {
-            while let Some(chunk) = source.next(input, &format)? {
-                check(&chunk)?;
-                each(chunk, &mut sink)?;
+        // Rendezvous channels: each stage holds one piece of work while it waits for the
+        // next to take it.
+        let (raw_tx, raw_rx) = sync_channel(0);
+        let (block_tx, block_rx) = sync_channel(0);
+        let (computed, written) = std::thread::scope(|s| {
+            s.spawn(|| read_all(source, input, &format, &pool, raw_tx));
+            let compute = s.spawn(|| {
+                let sink = Sink {
+                    npy_cols: npy_out.then_some(npy_cols),
+                    spare: Arc::clone(&spare),
+                    tx: block_tx,
+                };
+                compute_all(raw_rx, sink, &pool, check, each)
+            });
+            let mut written = Ok(());
+            for block in &block_rx {
+                written = dest.write(&block);
+                if written.is_err() {
+                    break;
+                }
+                block.recycle(&spare);
             }
-            Ok(())
-        };
-        round().map_err(|e| {
+            drop(block_rx);
+            let computed = compute
+                .join()
+                .unwrap_or_else(|p| std::panic::resume_unwind(p));
+            (computed, written)
+        });
+        written?;
+        if let Err(e) = computed {
             failure = Some(e);
-            std::io::Error::other("stopped")
-        })?;
-        match sink {
-            Sink::Npy(w) => w.finish().map(|_| ()),
-            Sink::Text(_) => Ok(()),
+            return Err(std::io::Error::other("stopped"));
+        }
+        match dest {
+            Dest::Npy(w) => w.finish().map(|_| ()),
+            Dest::Text(_) => Ok(()),
         }
     });
     match failure {

@@ -237,6 +237,21 @@ impl<R: Read> NpyReader<R> {
     }
 }
 
+impl<R: Read> NpyReader<R> {
+    /// Appends up to `max_rows` further rows to `out` (row after row); returns how many
+    /// were read, 0 after the last row.
+    pub fn read_rows(&mut self, out: &mut Vec<f64>, max_rows: usize) -> Result<usize, NpyError> {
+        let cols = self.header.cols;
+        let mut row = vec![0.0; cols];
+        let mut n = 0;
+        while n < max_rows && self.read_row(&mut row)? {
+            out.extend_from_slice(&row);
+            n += 1;
+        }
+        Ok(n)
+    }
+}
+
 /// Reads a whole array (C or Fortran order) as `(rows, cols, row-major values)`.
 pub fn read_matrix(inner: impl Read) -> Result<(usize, usize, Vec<f64>), NpyError> {
     let mut inner = inner;
@@ -335,6 +350,29 @@ impl<W: Write> NpyWriter<W> {
         Ok(())
     }
 
+    /// Writes whole rows at once: `values` holds consecutive rows of `cols` values.
+    pub fn write_rows(&mut self, values: &[f64]) -> std::io::Result<()> {
+        let cols = self.cols.max(1);
+        let rows = values.len() / cols;
+        if values.len() % cols != 0 || rows > self.rows - self.written {
+            return Err(std::io::Error::other(format!(
+                "npy rows {}.. of {} values for a {} x {} array",
+                self.written,
+                values.len(),
+                self.rows,
+                self.cols
+            )));
+        }
+        let mut bytes = Vec::with_capacity(8 * values.len().min(1 << 16));
+        for part in values.chunks(1 << 16) {
+            bytes.clear();
+            bytes.extend(part.iter().flat_map(|v| v.to_le_bytes()));
+            self.inner.write_all(&bytes)?;
+        }
+        self.written += rows;
+        Ok(())
+    }
+
     /// Checks that every row was written and returns the writer.
     pub fn finish(mut self) -> std::io::Result<W> {
         if self.written != self.rows {
@@ -373,6 +411,29 @@ mod tests {
     }
 
     /// Bytes NumPy 1.26 writes for `np.save(f, np.array([[1.5, -2.0], [3.0, 4.25]]))`.
+    #[test]
+    fn rows_in_blocks_match_rows_one_by_one() {
+        let (rows, cols) = (700, 93);
+        let data: Vec<f64> = (0..rows * cols).map(|i| (i as f64).sin() * 1e-3).collect();
+        let mut w = NpyWriter::new(Vec::new(), rows, cols).unwrap();
+        w.write_rows(&data[..300 * cols]).unwrap();
+        w.write_rows(&data[300 * cols..]).unwrap();
+        assert!(
+            w.write_rows(&data[..cols]).is_err(),
+            "more rows than declared"
+        );
+        let blocks = w.finish().unwrap();
+        assert_eq!(blocks, write(rows, cols, &data));
+        let mut w = NpyWriter::new(Vec::new(), 2, 3).unwrap();
+        assert!(w.write_rows(&[1.0; 4]).is_err(), "not whole rows");
+        let mut r = NpyReader::new(&blocks[..]).unwrap();
+        let mut back = Vec::new();
+        assert_eq!(r.read_rows(&mut back, 512).unwrap(), 512);
+        assert_eq!(r.read_rows(&mut back, 512).unwrap(), rows - 512);
+        assert_eq!(r.read_rows(&mut back, 512).unwrap(), 0);
+        assert_eq!(back, data);
+    }
+
     #[test]
     fn reads_numpy_output() {
         let mut bytes = b"\x93NUMPY\x01\x00\x76\x00".to_vec();

@@ -222,10 +222,24 @@ pub fn push_number(out: &mut Vec<u8>, x: f64) {
     }
     let mut buf = zmij::Buffer::new();
     let s = buf.format_finite(x);
-    // zmij writes the same layout as `{:?}` between 1e-4 and 1e16 (tested); outside that
-    // range `{:?}` uses exponent notation of its own style.
-    if x == 0.0 || (1e-4..1e16).contains(&x.abs()) {
+    // zmij writes the same layout as `{:?}` between 1e-4 and 1e16, and below 1e-5 where
+    // both write a negative exponent (tested); elsewhere `{:?}` uses exponent notation of
+    // its own style.
+    let a = x.abs();
+    if x == 0.0 || (1e-4..1e16).contains(&a) || (a < 1e-5 && s.contains("e-")) {
         out.extend_from_slice(s.as_bytes());
+    } else if let Some(digits) = s.trim_start_matches('-').strip_prefix("0.0000") {
+        // Between 1e-5 and 1e-4 zmij writes `0.0000DDD`; `{:?}` writes `D.DDe-5`.
+        let digits = digits.trim_end_matches('0').as_bytes();
+        if x < 0.0 {
+            out.push(b'-');
+        }
+        out.push(digits[0]);
+        if digits.len() > 1 {
+            out.push(b'.');
+            out.extend_from_slice(&digits[1..]);
+        }
+        out.extend_from_slice(b"e-5");
     } else {
         push_exponent_form(out, s);
     }
@@ -294,21 +308,41 @@ pub fn write_lines<T: Sync>(
     items: &[T],
     format: impl Fn(&T, &mut Vec<u8>) + Sync,
 ) -> io::Result<()> {
-    let buffers: Vec<Vec<u8>> = items
+    for b in &format_lines(items, format) {
+        w.write_all(b)?;
+    }
+    Ok(())
+}
+
+/// Formats one line per item in parallel (each call of `format` appends one line's text
+/// without its line break): the lines in input order, in consecutive blocks of several
+/// lines each, ready to be written by another thread.
+pub fn format_lines<T: Sync>(
+    items: &[T],
+    format: impl Fn(&T, &mut Vec<u8>) + Sync,
+) -> Vec<Vec<u8>> {
+    format_lines_in(items, format, Vec::new)
+}
+
+/// [`format_lines`] into buffers handed out by `buffer` (for example buffers already
+/// written and recycled, which saves allocating and faulting in fresh memory); what they
+/// hold is kept in front of the lines.
+pub fn format_lines_in<T: Sync>(
+    items: &[T],
+    format: impl Fn(&T, &mut Vec<u8>) + Sync,
+    buffer: impl Fn() -> Vec<u8> + Sync,
+) -> Vec<Vec<u8>> {
+    items
         .par_chunks(LINES_PER_TASK)
         .map(|group| {
-            let mut buf = Vec::new();
+            let mut buf = buffer();
             for item in group {
                 format(item, &mut buf);
                 buf.push(b'\n');
             }
             buf
         })
-        .collect();
-    for b in &buffers {
-        w.write_all(b)?;
-    }
-    Ok(())
+        .collect()
 }
 
 #[cfg(test)]
@@ -425,6 +459,15 @@ mod tests {
             123456.789,
             1e21,
             1e22,
+            1e-5,
+            -1e-5,
+            3.163712034781162e-5,
+            -1.1063214808739927e-5,
+            1.5e-5,
+            f64::from_bits(1e-5f64.to_bits() - 1),
+            f64::from_bits(1e-5f64.to_bits() + 1),
+            -8.839876561713762e-7,
+            f64::MIN_POSITIVE,
         ] {
             let mut out = Vec::new();
             push_number(&mut out, x);
@@ -432,7 +475,30 @@ mod tests {
         }
     }
 
+    /// The layout before the fast paths of [`push_number`]: zmij's text as is between
+    /// 1e-4 and 1e16, rewritten by [`push_exponent_form`] elsewhere.
+    fn general_form(x: f64) -> Vec<u8> {
+        let mut buf = zmij::Buffer::new();
+        let s = buf.format_finite(x);
+        let mut out = Vec::new();
+        if x == 0.0 || (1e-4..1e16).contains(&x.abs()) {
+            out.extend_from_slice(s.as_bytes());
+        } else {
+            push_exponent_form(&mut out, s);
+        }
+        out
+    }
+
     proptest! {
+        #[test]
+        fn fast_paths_write_the_general_form(m in 1.0f64..10.0, e in -330i32..-3, neg: bool) {
+            let x = if neg { -m } else { m } * 10f64.powi(e);
+            prop_assume!(x.is_finite());
+            let mut out = Vec::new();
+            push_number(&mut out, x);
+            prop_assert_eq!(out, general_form(x));
+        }
+
         #[test]
         fn numbers_read_back_as_short_as_debug(bits in any::<u64>(), scale in -30i32..30) {
             let x = f64::from_bits(bits);

@@ -20,6 +20,12 @@ pub struct Image {
 /// Largest accepted side of an image (decoded or created), to bound memory.
 pub const MAX_SIDE: u32 = 16384;
 
+/// Largest PNG accepted for decoding, in bytes of pixels decoded to 8 bits per channel
+/// (1 GiB: a [`MAX_SIDE`] x [`MAX_SIDE`] RGBA image). Larger declared sizes are refused
+/// from the header, before any pixel memory is allocated; the decoder's own buffers
+/// (rows, metadata chunks) are held to the same bound.
+pub const MAX_DECODED_BYTES: usize = 1 << 30;
+
 impl Image {
     /// A `width` x `height` image filled with `fill`; both sides must be 1 to [`MAX_SIDE`].
     pub fn new(width: u32, height: u32, fill: [u8; 4]) -> Result<Self, AppError> {
@@ -72,10 +78,15 @@ impl Image {
         out
     }
 
-    /// Decodes a PNG of any colour type and bit depth into RGBA8.
+    /// Decodes a PNG of any colour type and bit depth into RGBA8. Sides over
+    /// [`MAX_SIDE`] and decoded sizes over [`MAX_DECODED_BYTES`] are refused before the
+    /// pixels are allocated.
     pub fn decode_png(reader: impl BufRead + Seek) -> Result<Self, AppError> {
         let err = |e: &dyn std::fmt::Display| AppError::Image(format!("PNG: {e}"));
-        let mut dec = png::Decoder::new(reader);
+        let limits = png::Limits {
+            bytes: MAX_DECODED_BYTES,
+        };
+        let mut dec = png::Decoder::new_with_limits(reader, limits);
         dec.set_transformations(png::Transformations::normalize_to_color8());
         let mut r = dec.read_info().map_err(|e| err(&e))?;
         let (w, h) = (r.info().width, r.info().height);
@@ -86,7 +97,15 @@ impl Image {
         }
         let size = r
             .output_buffer_size()
-            .ok_or_else(|| err(&"image too large"))?;
+            .filter(|&s| s <= MAX_DECODED_BYTES)
+            .ok_or_else(|| {
+                AppError::Image(format!(
+                    "PNG of {w}x{h} pixels ({:?}, {} bits): more than {} MiB decoded",
+                    r.info().color_type,
+                    r.info().bit_depth as u8,
+                    MAX_DECODED_BYTES >> 20
+                ))
+            })?;
         let mut buf = vec![0; size];
         let info = r.next_frame(&mut buf).map_err(|e| err(&e))?;
         let data = &buf[..info.buffer_size()];
@@ -186,6 +205,48 @@ mod tests {
         img.encode_png(&mut bytes).unwrap();
         let back = Image::decode_png(std::io::Cursor::new(bytes)).unwrap();
         assert_eq!(back, img);
+    }
+
+    /// A PNG that declares `w` x `h` pixels of `color` at 8 or 16 bits but holds one byte
+    /// of pixel data.
+    fn declared_png(w: u32, h: u32, color: png::ColorType, depth: png::BitDepth) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        let mut enc = png::Encoder::new(&mut bytes, w, h);
+        enc.set_color(color);
+        enc.set_depth(depth);
+        let mut wr = enc.write_header().unwrap();
+        // A complete zlib stream of one stored zero byte: far fewer pixels than declared.
+        let zlib = [
+            0x78, 0x01, 0x01, 0x01, 0x00, 0xfe, 0xff, 0x00, 0x00, 0x01, 0x00, 0x01,
+        ];
+        wr.write_chunk(png::chunk::IDAT, &zlib).unwrap();
+        drop(wr);
+        bytes
+    }
+
+    #[test]
+    fn decoded_size_is_bounded_from_the_header() {
+        use png::{BitDepth, ColorType};
+        // Sides over the limit are refused from the header, before any pixel memory.
+        for (w, h) in [
+            (MAX_SIDE + 1, 1),
+            (1, MAX_SIDE + 1),
+            (u32::MAX >> 1, MAX_SIDE),
+        ] {
+            let wide = declared_png(w, h, ColorType::Rgba, BitDepth::Sixteen);
+            let e = Image::decode_png(std::io::Cursor::new(wide)).unwrap_err();
+            // The decoder's own bound may refuse a row of 2^31 pixels first.
+            let refused = |m: &str| m.contains("at most") || m.contains("limits are exceeded");
+            assert!(matches!(&e, AppError::Image(m) if refused(m)), "{e}");
+        }
+        // 8192 x 8192 RGBA of 8 bits (256 MiB) passes the checks and fails only on its
+        // missing pixel data.
+        let large = declared_png(8192, 8192, ColorType::Rgba, BitDepth::Eight);
+        let e = Image::decode_png(std::io::Cursor::new(large)).unwrap_err();
+        let AppError::Image(m) = &e else {
+            panic!("{e}")
+        };
+        assert!(!m.contains("MiB decoded") && !m.contains("limits"), "{m}");
     }
 
     #[test]

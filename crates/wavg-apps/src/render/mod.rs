@@ -16,7 +16,7 @@ use wavg_mesh::TriMesh;
 
 pub use camera::{Camera, FOV_DEGREES, View};
 pub use colormap::viridis;
-pub use image::{Image, MAX_SIDE};
+pub use image::{Image, MAX_DECODED_BYTES, MAX_SIDE};
 
 use crate::AppError;
 use raster::VisBuffer;
