@@ -45,7 +45,7 @@ pub struct PrecomputeOptions {
     /// Vertex pairs for the quality check; 0 skips it (errors are then NaN).
     pub quality_pairs: usize,
     /// Fast-marching runs the quality pairs are spread over. On meshes of more than
-    /// 8 000 000 / `quality_sources` vertices, fewer runs (at least 4) carry
+    /// 16 000 000 / `quality_sources` vertices, fewer runs (at least 8) carry
     /// the same number of pairs, so the check costs at most about that many vertex visits;
     /// the pairs' distances are still exact full-mesh geodesics.
     pub quality_sources: usize,
@@ -60,7 +60,7 @@ pub struct PrecomputeOptions {
 }
 
 /// Vertex visits (sources x vertices) above which the quality check uses fewer sources.
-pub(crate) const QUALITY_SOURCE_VERTICES: usize = 8_000_000;
+pub(crate) const QUALITY_SOURCE_VERTICES: usize = 16_000_000;
 
 impl Default for PrecomputeOptions {
     fn default() -> Self {
@@ -224,7 +224,7 @@ pub fn precompute(
             let fm = FastMarching::new(mesh);
             let sources = opts
                 .quality_sources
-                .min((QUALITY_SOURCE_VERTICES / n).max(4))
+                .min((QUALITY_SOURCE_VERTICES / n).max(8))
                 .clamp(1, opts.quality_pairs);
             let qo = QualityOptions {
                 pairs: opts.quality_pairs,
