@@ -50,7 +50,7 @@ impl Default for CgOptions {
 /// levels for large meshes.
 pub(crate) enum LsMeshExtension {
     /// One sparse Cholesky factorisation of the full system.
-    Direct(LsMeshSolver),
+    Direct(Box<LsMeshSolver>),
     /// Coarse factorisation plus conjugate gradients on the full system.
     TwoLevel(Box<TwoLevelLsMesh>),
 }

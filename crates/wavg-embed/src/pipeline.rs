@@ -268,7 +268,9 @@ pub fn precompute(
                     CgOptions::default(),
                     progress,
                 )?)),
-                None => LsMeshExtension::Direct(LsMeshSolver::new(mesh, &landmarks, progress)?),
+                None => LsMeshExtension::Direct(Box::new(LsMeshSolver::new(
+                    mesh, &landmarks, progress,
+                )?)),
             };
             Ok((solver, secs(t)))
         },
