@@ -44,10 +44,10 @@ pub struct PrecomputeOptions {
     pub mds: MdsOptions,
     /// Vertex pairs for the quality check; 0 skips it (errors are then NaN).
     pub quality_pairs: usize,
-    /// Fast-marching runs the quality pairs are spread over. On meshes of more than
-    /// 16 000 000 / `quality_sources` vertices, fewer runs (at least 8) carry
-    /// the same number of pairs, so the check costs at most about that many vertex visits;
-    /// the pairs' distances are still exact full-mesh geodesics.
+    /// Fast-marching runs the quality pairs are spread over, at most
+    /// `max(8, 16 000 000 / vertices)`: on large meshes fewer runs carry the same number of
+    /// pairs, which bounds the check's cost while the pairs' distances stay exact full-mesh
+    /// geodesics (the default 16 is used in full up to 1M vertices).
     pub quality_sources: usize,
     /// Meshes with more vertices than this solve the least-squares mesh in two levels
     /// (a direct solve on the landmark decimation's state with
