@@ -24,6 +24,7 @@ mod error;
 pub mod file;
 mod geodesic;
 mod lsmesh;
+mod lsmesh_two_level;
 mod mds;
 mod near_field;
 mod ordering;

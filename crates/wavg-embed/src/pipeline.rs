@@ -9,6 +9,7 @@ use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
 use crate::geodesic::{FastMarching, GeodesicOptions, landmark_distances};
 use crate::lsmesh::LsMeshSolver;
+use crate::lsmesh_two_level::{CgOptions, LsMeshExtension, TwoLevelLsMesh};
 use crate::mds::{MdsOptions, metric_mds};
 use crate::quality::{QualityOptions, QualityPairs};
 use crate::{Embedding, EmbeddingParams};
@@ -40,9 +41,23 @@ pub struct PrecomputeOptions {
     pub mds: MdsOptions,
     /// Vertex pairs for the quality check; 0 skips it (errors are then NaN).
     pub quality_pairs: usize,
-    /// Fast-marching runs the quality pairs are spread over.
+    /// Fast-marching runs the quality pairs are spread over, at most
+    /// `max(8, 16 000 000 / vertices)`: on large meshes fewer runs carry the same number of
+    /// pairs, which bounds the check's cost while the pairs' distances stay exact full-mesh
+    /// geodesics (the default 16 is used in full up to 1M vertices).
     pub quality_sources: usize,
+    /// Meshes with more vertices than this solve the least-squares mesh in two levels
+    /// (a direct solve on the landmark decimation's state with
+    /// `lsmesh_coarse_vertices` vertices, then conjugate gradients on the full system
+    /// started from it) instead of one sparse Cholesky factorisation, whose time and
+    /// memory grow faster than the mesh. Default 300 000.
+    pub lsmesh_direct_max: usize,
+    /// Vertices of the coarse level of the two-level least-squares mesh (default 150 000).
+    pub lsmesh_coarse_vertices: usize,
 }
+
+/// Vertex visits (sources x vertices) above which the quality check uses fewer sources.
+pub(crate) const QUALITY_SOURCE_VERTICES: usize = 16_000_000;
 
 impl Default for PrecomputeOptions {
     fn default() -> Self {
@@ -55,6 +70,8 @@ impl Default for PrecomputeOptions {
             mds: MdsOptions::default(),
             quality_pairs: 1024,
             quality_sources: 16,
+            lsmesh_direct_max: 300_000,
+            lsmesh_coarse_vertices: 150_000,
         }
     }
 }
@@ -165,6 +182,9 @@ pub fn precompute(
     let secs = |t: Instant| t.elapsed().as_secs_f64();
     let use_coarse =
         opts.landmarks < n && opts.geodesic_vertices > opts.landmarks && opts.geodesic_vertices < n;
+    let two_level = n > opts.lsmesh_direct_max
+        && opts.lsmesh_coarse_vertices > opts.landmarks
+        && opts.lsmesh_coarse_vertices < n;
 
     // 1. Landmarks (and, for large meshes, an intermediate mesh for the geodesics), while
     //    the quality check's fast marching on the full mesh runs alongside (it does not
@@ -172,22 +192,29 @@ pub fn precompute(
     let (landmark_result, quality_result) = rayon::join(
         || -> Result<_, EmbedError> {
             let t = Instant::now();
-            let (landmarks, coarse) = if opts.landmarks >= n {
-                ((0..n as u32).collect::<Vec<u32>>(), None)
+            let (landmarks, coarse, ls_coarse) = if opts.landmarks >= n {
+                ((0..n as u32).collect::<Vec<u32>>(), None, None)
             } else {
                 let d = DecimateOptions {
                     target: opts.landmarks,
                     ..opts.decimate.clone()
                 };
-                if use_coarse {
-                    let (fin, mut snaps) =
-                        decimate_with_snapshots(mesh, &d, &[opts.geodesic_vertices], progress)?;
-                    (fin.landmarks, snaps.pop())
+                if use_coarse || two_level {
+                    let sizes: Vec<usize> = [
+                        (use_coarse, opts.geodesic_vertices),
+                        (two_level, opts.lsmesh_coarse_vertices),
+                    ]
+                    .iter()
+                    .filter_map(|&(on, s)| on.then_some(s))
+                    .collect();
+                    let (fin, mut snaps) = decimate_with_snapshots(mesh, &d, &sizes, progress)?;
+                    let ls = if two_level { snaps.pop() } else { None };
+                    (fin.landmarks, snaps.pop(), ls)
                 } else {
-                    (select_landmarks(mesh, &d, progress)?, None)
+                    (select_landmarks(mesh, &d, progress)?, None, None)
                 }
             };
-            Ok((landmarks, coarse, secs(t)))
+            Ok((landmarks, coarse, ls_coarse, secs(t)))
         },
         || -> Result<_, EmbedError> {
             let t = Instant::now();
@@ -195,16 +222,20 @@ pub fn precompute(
                 return Ok((None, None, 0.0));
             }
             let fm = FastMarching::new(mesh);
+            let sources = opts
+                .quality_sources
+                .min((QUALITY_SOURCE_VERTICES / n).max(8))
+                .clamp(1, opts.quality_pairs);
             let qo = QualityOptions {
                 pairs: opts.quality_pairs,
-                sources: opts.quality_sources.clamp(1, opts.quality_pairs),
+                sources,
                 seed: opts.seed,
             };
             let pairs = QualityPairs::compute(mesh, &fm, &qo, progress)?;
             Ok((Some(fm), Some(pairs), secs(t)))
         },
     );
-    let (landmarks, coarse, t_decimate) = landmark_result?;
+    let (landmarks, coarse, ls_coarse, t_decimate) = landmark_result?;
     let (mut fm, quality_pairs, t_quality) = quality_result?;
     stages.decimate = t_decimate;
     stages.quality = t_quality;
@@ -227,7 +258,19 @@ pub fn precompute(
         },
         || {
             let t = Instant::now();
-            LsMeshSolver::new(mesh, &landmarks, progress).map(|s| (s, secs(t)))
+            let solver = match &ls_coarse {
+                Some(c) => LsMeshExtension::TwoLevel(Box::new(TwoLevelLsMesh::new(
+                    mesh,
+                    c,
+                    &landmarks,
+                    CgOptions::default(),
+                    progress,
+                )?)),
+                None => LsMeshExtension::Direct(Box::new(LsMeshSolver::new(
+                    mesh, &landmarks, progress,
+                )?)),
+            };
+            Ok((solver, secs(t)))
         },
     );
     let (q, t_geodesics) = q?;
@@ -235,6 +278,7 @@ pub fn precompute(
     drop(fm);
     let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
     drop(coarse);
+    drop(ls_coarse);
     stages.geodesics = t_geodesics;
     check_cancel(progress)?;
 
@@ -247,7 +291,7 @@ pub fn precompute(
 
     // 4. Least-squares mesh: the landmarks' MDS positions extended to every vertex.
     let t = Instant::now();
-    let coords = solver.solve(&mds.points, dim)?;
+    let coords = solver.solve(&mds.points, dim, progress)?;
     drop(solver);
     progress.report(Stage::LsMesh, 1.0);
     stages.lsmesh = t_factor + secs(t);

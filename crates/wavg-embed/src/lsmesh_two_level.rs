@@ -1,0 +1,549 @@
+//! Least-squares mesh of large meshes in two levels.
+//!
+//! A direct Cholesky factorisation of the bi-Laplacian system grows faster than the mesh
+//! (time and memory), so above a size threshold the system is solved on a coarser mesh
+//! whose vertices are a subset of the original ones (a state of the landmark decimation,
+//! so it contains every landmark), and the coarse solution, prolongated to every vertex,
+//! starts a Jacobi-preconditioned conjugate-gradient solve of the full system
+//! `A_FF v_F = -A_FS v_S` (the same system as [`crate::lsmesh`]). The coarse solve carries
+//! the low frequencies, which conjugate gradients would need very many iterations for; a
+//! few iterations remove the high-frequency error of the prolongation. What remains is the
+//! coarse mesh's discretisation error at low frequencies, small against the embedding's own
+//! error (the landmark distances' MDS fit), so by default the iterations stop early
+//! ([`CgOptions::default`]) rather than converge.
+//!
+//! `A = L M⁻¹ L` is applied as two products with the cotangent stiffness `L` and never
+//! assembled, so the memory is a few vectors per vertex on top of the coarse factor.
+
+use faer::sparse::SparseColMat;
+use rayon::prelude::*;
+use wavg_mesh::{ValidMesh, geometry};
+
+use crate::decimate::Decimated;
+use crate::error::{EmbedError, Progress, Stage, check_cancel};
+use crate::file::MAX_DIM;
+use crate::lsmesh::LsMeshSolver;
+
+type Row = [f64; MAX_DIM];
+
+/// Settings of the conjugate-gradient refinement. The default (40 iterations at most) smooths
+/// the prolongated coarse solution; a tight tolerance with many iterations converges to the
+/// direct solution, slowly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CgOptions {
+    /// Stop when every column's residual norm is at most this times its right-hand side's.
+    pub tolerance: f64,
+    /// Stop after this many iterations in any case (the iterate is returned).
+    pub max_iterations: usize,
+}
+
+impl Default for CgOptions {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-6,
+            max_iterations: 40,
+        }
+    }
+}
+
+/// A least-squares-mesh system ready for landmark values: factored directly, or in two
+/// levels for large meshes.
+pub(crate) enum LsMeshExtension {
+    /// One sparse Cholesky factorisation of the full system.
+    Direct(Box<LsMeshSolver>),
+    /// Coarse factorisation plus conjugate gradients on the full system.
+    TwoLevel(Box<TwoLevelLsMesh>),
+}
+
+impl LsMeshExtension {
+    /// The extension of `values` (one per landmark) to every vertex; see
+    /// [`LsMeshSolver::solve`].
+    pub(crate) fn solve(
+        &self,
+        values: &[Row],
+        dim: usize,
+        progress: &dyn Progress,
+    ) -> Result<Vec<Row>, EmbedError> {
+        match self {
+            Self::Direct(s) => s.solve(values, dim),
+            Self::TwoLevel(s) => s.solve(values, dim, progress),
+        }
+    }
+}
+
+/// The least-squares mesh of a large mesh: a factored coarse system plus the operator of
+/// the full one.
+pub(crate) struct TwoLevelLsMesh {
+    landmarks: Vec<u32>,
+    fixed: Vec<bool>,
+    /// Original ids of the coarse vertices, in coarse order.
+    coarse_ids: Vec<u32>,
+    coarse: LsMeshSolver,
+    /// Cotangent stiffness of the full mesh (symmetric, both triangles stored).
+    stiffness: SparseColMat<usize, f64>,
+    inv_mass: Vec<f64>,
+    /// Inverse diagonal of `A` (Jacobi preconditioner); 0 at fixed vertices.
+    inv_diag: Vec<f64>,
+    cg: CgOptions,
+}
+
+impl TwoLevelLsMesh {
+    /// Factors the system on `coarse` (a decimation state of `mesh` containing every
+    /// landmark) and sets up the full-mesh operator.
+    pub(crate) fn new(
+        mesh: &ValidMesh,
+        coarse: &Decimated,
+        landmarks: &[u32],
+        cg: CgOptions,
+        progress: &dyn Progress,
+    ) -> Result<Self, EmbedError> {
+        let n = mesh.n_vertices();
+        let mut fixed = vec![false; n];
+        let mut coarse_landmarks = Vec::with_capacity(landmarks.len());
+        for &s in landmarks {
+            let slot = fixed.get_mut(s as usize).ok_or_else(|| {
+                EmbedError::InvalidArgument(format!("landmark {s} out of range ({n} vertices)"))
+            })?;
+            if std::mem::replace(slot, true) {
+                return Err(EmbedError::InvalidArgument(format!(
+                    "landmark {s} appears twice"
+                )));
+            }
+            coarse_landmarks.push(coarse.coarse_index(s).ok_or_else(|| {
+                EmbedError::InvalidArgument(format!("landmark {s} is not a coarse vertex"))
+            })?);
+        }
+        if coarse.landmarks.iter().any(|&v| v as usize >= n) {
+            return Err(EmbedError::InvalidArgument(
+                "the coarse mesh is not a decimation of this mesh".into(),
+            ));
+        }
+        let coarse_mesh = ValidMesh::new(coarse.mesh.clone())
+            .map_err(|e| EmbedError::InvalidArgument(format!("coarse mesh: {e}")))?;
+        let coarse_solver = LsMeshSolver::new(&coarse_mesh, &coarse_landmarks, progress)?;
+        check_cancel(progress)?;
+
+        let stiffness = geometry::cotan_stiffness(mesh)
+            .map_err(|e| EmbedError::InvalidArgument(e.to_string()))?;
+        let mass = geometry::lumped_mass(mesh);
+        if let Some(v) = mass.iter().position(|&m| !(m > 0.0 && m.is_finite())) {
+            return Err(EmbedError::InvalidArgument(format!(
+                "vertex {v} has zero or invalid area; the least-squares mesh needs a mesh \
+                 without isolated vertices or degenerate faces"
+            )));
+        }
+        let inv_mass: Vec<f64> = mass.iter().map(|m| 1.0 / m).collect();
+        // diag(L M⁻¹ L)_j = sum_k L_kj² / m_k.
+        let (sym, vals) = stiffness.parts();
+        let inv_diag: Vec<f64> = (0..n)
+            .into_par_iter()
+            .map(|j| {
+                if fixed[j] {
+                    return 0.0;
+                }
+                let d: f64 = sym
+                    .col_range(j)
+                    .map(|k| vals[k] * vals[k] * inv_mass[sym.row_idx()[k]])
+                    .sum();
+                if d > 0.0 { 1.0 / d } else { 0.0 }
+            })
+            .collect();
+        Ok(Self {
+            landmarks: landmarks.to_vec(),
+            fixed,
+            coarse_ids: coarse.landmarks.clone(),
+            coarse: coarse_solver,
+            stiffness,
+            inv_mass,
+            inv_diag,
+            cg,
+        })
+    }
+
+    /// One point per vertex, equal to `values[k]` at vertex `landmarks[k]` and (to the
+    /// conjugate-gradient tolerance) minimising the bi-Laplacian energy elsewhere. Only the
+    /// first `dim` entries of each value are used; the rest of the output is zero.
+    pub(crate) fn solve(
+        &self,
+        values: &[Row],
+        dim: usize,
+        progress: &dyn Progress,
+    ) -> Result<Vec<Row>, EmbedError> {
+        let coarse = self.coarse.solve(values, dim)?;
+        check_cancel(progress)?;
+        let mut x = self.prolongate(&coarse);
+        for (&s, v) in self.landmarks.iter().zip(values) {
+            x[s as usize] = *v;
+            x[s as usize][dim..].fill(0.0);
+        }
+        self.conjugate_gradients(&mut x, dim, progress)?;
+        if x.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(EmbedError::Numerical(
+                "least-squares mesh produced non-finite coordinates".into(),
+            ));
+        }
+        Ok(x)
+    }
+
+    /// Coarse values at the coarse vertices; every other vertex gets the mean of its
+    /// neighbours one breadth-first layer closer to the coarse vertices, then a few
+    /// Gauss-Seidel sweeps of neighbour averaging smooth the result.
+    fn prolongate(&self, coarse: &[Row]) -> Vec<Row> {
+        const SWEEPS: usize = 4;
+        let n = self.fixed.len();
+        let (sym, _) = self.stiffness.parts();
+        let neighbours = |v: usize| {
+            sym.row_idx()[sym.col_range(v)]
+                .iter()
+                .copied()
+                .filter(move |&u| u != v)
+        };
+        let mut x = vec![[0.0; MAX_DIM]; n];
+        let mut known = vec![false; n];
+        let mut is_coarse = vec![false; n];
+        for (&v, c) in self.coarse_ids.iter().zip(coarse) {
+            x[v as usize] = *c;
+            known[v as usize] = true;
+            is_coarse[v as usize] = true;
+        }
+        let mut frontier: Vec<usize> = self.coarse_ids.iter().map(|&v| v as usize).collect();
+        let mut queued = known.clone();
+        while !frontier.is_empty() {
+            let mut next = Vec::new();
+            for &v in &frontier {
+                for u in neighbours(v) {
+                    if !queued[u] {
+                        queued[u] = true;
+                        next.push(u);
+                    }
+                }
+            }
+            for &u in &next {
+                let (mut sum, mut count) = ([0.0; MAX_DIM], 0.0);
+                for w in neighbours(u).filter(|&w| known[w]) {
+                    for c in 0..MAX_DIM {
+                        sum[c] += x[w][c];
+                    }
+                    count += 1.0;
+                }
+                x[u] = sum.map(|s| s / count);
+            }
+            for &u in &next {
+                known[u] = true;
+            }
+            frontier = next;
+        }
+        for _ in 0..SWEEPS {
+            for v in (0..n).filter(|&v| !is_coarse[v]) {
+                let (mut sum, mut count) = ([0.0; MAX_DIM], 0.0);
+                for w in neighbours(v) {
+                    for c in 0..MAX_DIM {
+                        sum[c] += x[w][c];
+                    }
+                    count += 1.0;
+                }
+                if count > 0.0 {
+                    x[v] = sum.map(|s| s / count);
+                }
+            }
+        }
+        x
+    }
+
+    /// `y = L x` (rows in parallel; `L` symmetric, so its columns are its rows).
+    fn stiffness_times(&self, x: &[Row], y: &mut [Row]) {
+        let (sym, vals) = self.stiffness.parts();
+        y.par_iter_mut().enumerate().for_each(|(j, yj)| {
+            let mut acc = [0.0; MAX_DIM];
+            for k in sym.col_range(j) {
+                let (a, xi) = (vals[k], &x[sym.row_idx()[k]]);
+                for c in 0..MAX_DIM {
+                    acc[c] += a * xi[c];
+                }
+            }
+            *yj = acc;
+        });
+    }
+
+    /// `y = A x` with `A = L M⁻¹ L`, using `t` as scratch; rows of fixed vertices of `y`
+    /// are zeroed (the free rows of the system).
+    fn apply(&self, x: &[Row], t: &mut [Row], y: &mut [Row]) {
+        self.stiffness_times(x, t);
+        t.par_iter_mut()
+            .zip(&self.inv_mass)
+            .for_each(|(ti, &w)| *ti = ti.map(|c| c * w));
+        self.stiffness_times(t, y);
+        y.par_iter_mut()
+            .zip(&self.fixed)
+            .filter(|(_, f)| **f)
+            .for_each(|(yi, _)| *yi = [0.0; MAX_DIM]);
+    }
+
+    /// Per-column dot products of two blocks.
+    fn dots(a: &[Row], b: &[Row]) -> Row {
+        a.par_chunks(8192)
+            .zip(b.par_chunks(8192))
+            .map(|(a, b)| {
+                let mut s = [0.0; MAX_DIM];
+                for (u, v) in a.iter().zip(b) {
+                    for c in 0..MAX_DIM {
+                        s[c] += u[c] * v[c];
+                    }
+                }
+                s
+            })
+            .reduce(
+                || [0.0; MAX_DIM],
+                |mut s, t| {
+                    for c in 0..MAX_DIM {
+                        s[c] += t[c];
+                    }
+                    s
+                },
+            )
+    }
+
+    /// Jacobi-preconditioned conjugate gradients on the free rows, all columns at once
+    /// (each with its own step lengths), from the iterate `x` (whose fixed rows hold the
+    /// landmark values and stay unchanged).
+    fn conjugate_gradients(
+        &self,
+        x: &mut [Row],
+        dim: usize,
+        progress: &dyn Progress,
+    ) -> Result<(), EmbedError> {
+        let n = x.len();
+        let mut t = vec![[0.0; MAX_DIM]; n];
+        // Right-hand side norms: b = -(A x_S) on the free rows.
+        let mut r = vec![[0.0; MAX_DIM]; n];
+        {
+            let mut xs = vec![[0.0; MAX_DIM]; n];
+            for &s in &self.landmarks {
+                xs[s as usize] = x[s as usize];
+            }
+            self.apply(&xs, &mut t, &mut r);
+        }
+        let b2 = Self::dots(&r, &r);
+        // r = b - A_FF x_F = -(A x) on the free rows.
+        self.apply(x, &mut t, &mut r);
+        r.par_iter_mut().for_each(|ri| *ri = ri.map(|c| -c));
+        let precondition = |r: &[Row], z: &mut [Row]| {
+            z.par_iter_mut()
+                .zip(r.par_iter().zip(&self.inv_diag))
+                .for_each(|(zi, (ri, &d))| *zi = ri.map(|c| c * d));
+        };
+        let mut z = vec![[0.0; MAX_DIM]; n];
+        precondition(&r, &mut z);
+        let mut p = z.clone();
+        let mut rz = Self::dots(&r, &z);
+        let mut q = vec![[0.0; MAX_DIM]; n];
+        let tol2 = self.cg.tolerance * self.cg.tolerance;
+        let mut active: Vec<bool> = (0..MAX_DIM).map(|c| c < dim && b2[c] > 0.0).collect();
+        for it in 0..self.cg.max_iterations {
+            let r2 = Self::dots(&r, &r);
+            for c in 0..MAX_DIM {
+                active[c] &= r2[c] > tol2 * b2[c];
+            }
+            if !active.iter().any(|&a| a) {
+                break;
+            }
+            if it % 16 == 0 {
+                check_cancel(progress)?;
+                progress.report(
+                    Stage::LsMesh,
+                    0.9 + 0.1 * it as f64 / self.cg.max_iterations as f64,
+                );
+            }
+            self.apply(&p, &mut t, &mut q);
+            let pq = Self::dots(&p, &q);
+            let alpha: Row = std::array::from_fn(|c| {
+                if active[c] && pq[c] > 0.0 {
+                    rz[c] / pq[c]
+                } else {
+                    0.0
+                }
+            });
+            x.par_iter_mut()
+                .zip(r.par_iter_mut())
+                .zip(p.par_iter().zip(&q))
+                .for_each(|((xi, ri), (pi, qi))| {
+                    for c in 0..MAX_DIM {
+                        xi[c] += alpha[c] * pi[c];
+                        ri[c] -= alpha[c] * qi[c];
+                    }
+                });
+            precondition(&r, &mut z);
+            let rz_new = Self::dots(&r, &z);
+            let beta: Row = std::array::from_fn(|c| {
+                if active[c] && rz[c] > 0.0 {
+                    rz_new[c] / rz[c]
+                } else {
+                    0.0
+                }
+            });
+            rz = rz_new;
+            p.par_iter_mut().zip(&z).for_each(|(pi, zi)| {
+                for c in 0..MAX_DIM {
+                    pi[c] = zi[c] + beta[c] * pi[c];
+                }
+            });
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::NoProgress;
+    use crate::decimate::{DecimateOptions, decimate_with_snapshots};
+    use rand::{Rng, SeedableRng};
+    use wavg_mesh::procedural;
+
+    /// Direct and two-level solutions of the same problem, and the scale of the values.
+    fn both(mesh: &ValidMesh, landmarks: usize, coarse: usize, cg: CgOptions) -> f64 {
+        let opts = DecimateOptions {
+            target: landmarks,
+            ..Default::default()
+        };
+        let (fin, mut snaps) =
+            decimate_with_snapshots(mesh, &opts, &[coarse], &NoProgress).unwrap();
+        let snap = snaps.pop().unwrap();
+        let lm = fin.landmarks;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let values: Vec<Row> = lm
+            .iter()
+            .map(|_| std::array::from_fn(|_| rng.random_range(-1.0..1.0)))
+            .collect();
+        let direct = LsMeshSolver::new(mesh, &lm, &NoProgress)
+            .unwrap()
+            .solve(&values, MAX_DIM)
+            .unwrap();
+        let two = TwoLevelLsMesh::new(mesh, &snap, &lm, cg, &NoProgress)
+            .unwrap()
+            .solve(&values, MAX_DIM, &NoProgress)
+            .unwrap();
+        for (&s, v) in lm.iter().zip(&values) {
+            assert_eq!(two[s as usize], *v, "landmark {s} moved");
+        }
+        let scale = direct
+            .iter()
+            .flat_map(|p| p.iter())
+            .fold(0.0f64, |m, c| m.max(c.abs()));
+        direct
+            .iter()
+            .zip(&two)
+            .flat_map(|(a, b)| a.iter().zip(b).map(|(a, b)| (a - b).abs()))
+            .fold(0.0f64, f64::max)
+            / scale
+    }
+
+    /// Enough iterations to converge on the small test meshes.
+    const CONVERGE: CgOptions = CgOptions {
+        tolerance: 1e-11,
+        max_iterations: 20_000,
+    };
+
+    #[test]
+    fn converges_to_the_direct_solve() {
+        let mesh = ValidMesh::new(procedural::with_noise(
+            procedural::torus(160, 80, 1.0, 0.35),
+            0.002,
+            3,
+        ))
+        .unwrap();
+        let err = both(&mesh, 100, 2000, CONVERGE);
+        let default = both(&mesh, 100, 2000, CgOptions::default());
+        eprintln!(
+            "two-level vs direct, max difference / max value: converged {err:.2e}, \
+             default {default:.2e}"
+        );
+        assert!(err < 1e-7, "{err}");
+    }
+
+    #[test]
+    fn the_iterations_do_the_work() {
+        // Without iterations the prolongated coarse solution is only an approximation; the
+        // conjugate gradients must close the gap (so the comparison above can fail).
+        let mesh = ValidMesh::new(procedural::grid(90, 60, 3.0, 2.0)).unwrap();
+        let none = CgOptions {
+            max_iterations: 0,
+            ..Default::default()
+        };
+        let coarse_only = both(&mesh, 60, 800, none);
+        let default = both(&mesh, 60, 800, CgOptions::default());
+        let refined = both(&mesh, 60, 800, CONVERGE);
+        eprintln!("coarse only {coarse_only:.2e}, default {default:.2e}, converged {refined:.2e}");
+        assert!(coarse_only > 1e-3, "{coarse_only}");
+        assert!(
+            default < 0.5 * coarse_only && refined < 1e-7,
+            "{default} {refined}"
+        );
+    }
+
+    #[test]
+    fn precompute_through_two_levels_keeps_quality() {
+        // The pipeline forced onto the two-level path against its direct solve.
+        let mesh = ValidMesh::new(procedural::with_noise(
+            procedural::torus(200, 100, 1.0, 0.35),
+            0.002,
+            5,
+        ))
+        .unwrap();
+        let direct = crate::PrecomputeOptions {
+            landmarks: 200,
+            ..Default::default()
+        };
+        let two = crate::PrecomputeOptions {
+            lsmesh_direct_max: 0,
+            lsmesh_coarse_vertices: 4000,
+            ..direct.clone()
+        };
+        let (a, ra) = crate::precompute(&mesh, &direct, &NoProgress).unwrap();
+        let (b, rb) = crate::precompute(&mesh, &two, &NoProgress).unwrap();
+        assert_eq!(a.landmarks, b.landmarks);
+        let scale = a
+            .coords
+            .iter()
+            .flat_map(|p| p.iter())
+            .fold(0.0f64, |m, c| m.max(c.abs()));
+        let diff = a
+            .coords
+            .iter()
+            .zip(&b.coords)
+            .flat_map(|(p, q)| p.iter().zip(q).map(|(x, y)| (x - y).abs()))
+            .fold(0.0f64, f64::max)
+            / scale;
+        eprintln!(
+            "direct vs two-level: max coordinate difference / scale {diff:.2e}; p50 {:.4} / \
+             {:.4}, p90 {:.4} / {:.4}",
+            ra.geodesic_rel_err_p50,
+            rb.geodesic_rel_err_p50,
+            ra.geodesic_rel_err_p90,
+            rb.geodesic_rel_err_p90
+        );
+        assert!(diff > 0.0 && diff < 1e-2, "{diff}");
+        assert!((ra.geodesic_rel_err_p50 - rb.geodesic_rel_err_p50).abs() < 0.002);
+        assert!((ra.geodesic_rel_err_p90 - rb.geodesic_rel_err_p90).abs() < 0.004);
+    }
+
+    #[test]
+    fn landmarks_outside_the_coarse_mesh_are_errors() {
+        let mesh = ValidMesh::new(procedural::torus(30, 15, 1.0, 0.4)).unwrap();
+        let opts = DecimateOptions {
+            target: 40,
+            ..Default::default()
+        };
+        let (_, mut snaps) = decimate_with_snapshots(&mesh, &opts, &[200], &NoProgress).unwrap();
+        let snap = snaps.pop().unwrap();
+        let outside = (0..mesh.n_vertices() as u32)
+            .find(|&v| snap.coarse_index(v).is_none())
+            .unwrap();
+        let run = |lm: &[u32]| {
+            TwoLevelLsMesh::new(&mesh, &snap, lm, CgOptions::default(), &NoProgress).is_err()
+        };
+        assert!(run(&[snap.landmarks[0], outside]));
+        assert!(run(&[snap.landmarks[0], snap.landmarks[0]]));
+        assert!(run(&[snap.landmarks[0], u32::MAX]));
+    }
+}
