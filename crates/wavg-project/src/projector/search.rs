@@ -120,7 +120,7 @@ impl Projector {
         }
         let mut level = 0..seen.n;
         let mut best: Option<Best> = None;
-        for ring in 0.. {
+        loop {
             for &(_, f) in &order[..level.len()] {
                 if first_hit {
                     // Newton's exits lead on to the face beyond (a short walk over faces
@@ -194,7 +194,6 @@ impl Projector {
                     .sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             }
         }
-        best
     }
 
     /// The search after the walk: the local search from `v` (candidates `cands`), then
