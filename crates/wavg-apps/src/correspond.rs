@@ -214,7 +214,39 @@ pub struct Correspondence {
     pub distortion: Distortion,
 }
 
+/// Vertices per [`Validity::reason`]; with the `serde` feature, keyed by those reasons.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
+pub struct ReasonCounts {
+    /// Kept.
+    pub valid: usize,
+    /// No image: the inverse or the forward problem failed.
+    pub unanswered: usize,
+    /// The weights do not return to the source point.
+    pub no_round_trip: usize,
+    /// A weight is below the limit (paper test).
+    pub negative_weight: usize,
+    /// Most triangles around the vertex are flipped or over-stretched (local test).
+    pub inconsistent: usize,
+}
+
 impl Correspondence {
+    /// Vertices per reason.
+    pub fn reason_counts(&self) -> ReasonCounts {
+        let mut c = ReasonCounts::default();
+        for v in &self.validity {
+            *match v {
+                Validity::Valid => &mut c.valid,
+                Validity::Unanswered(_) => &mut c.unanswered,
+                Validity::NoRoundTrip => &mut c.no_round_trip,
+                Validity::NegativeWeight(_) => &mut c.negative_weight,
+                Validity::Inconsistent => &mut c.inconsistent,
+            } += 1;
+        }
+        c
+    }
+
     /// Valid vertices.
     pub fn valid(&self) -> usize {
         self.validity
