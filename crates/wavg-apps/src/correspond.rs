@@ -441,6 +441,26 @@ mod tests {
                 ..Default::default()
             };
             let c = correspond_vertices(&s, &s, &opts).unwrap();
+            let r = c.reason_counts();
+            let count = |name| c.validity.iter().filter(|v| v.reason() == name).count();
+            let reasons = [
+                "valid",
+                "unanswered",
+                "no-round-trip",
+                "negative-weight",
+                "inconsistent",
+            ];
+            assert_eq!(
+                [
+                    r.valid,
+                    r.unanswered,
+                    r.no_round_trip,
+                    r.negative_weight,
+                    r.inconsistent
+                ],
+                reasons.map(count)
+            );
+            assert_eq!(r.valid, c.valid());
             // The paper's test also rejects correct images with negative weights.
             let want = if test == ValidityTest::Local {
                 0.99
