@@ -214,7 +214,39 @@ pub struct Correspondence {
     pub distortion: Distortion,
 }
 
+/// Vertices per [`Validity::reason`]; with the `serde` feature, keyed by those reasons.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
+pub struct ReasonCounts {
+    /// Kept.
+    pub valid: usize,
+    /// No image: the inverse or the forward problem failed.
+    pub unanswered: usize,
+    /// The weights do not return to the source point.
+    pub no_round_trip: usize,
+    /// A weight is below the limit (paper test).
+    pub negative_weight: usize,
+    /// Most triangles around the vertex are flipped or over-stretched (local test).
+    pub inconsistent: usize,
+}
+
 impl Correspondence {
+    /// Vertices per reason.
+    pub fn reason_counts(&self) -> ReasonCounts {
+        let mut c = ReasonCounts::default();
+        for v in &self.validity {
+            *match v {
+                Validity::Valid => &mut c.valid,
+                Validity::Unanswered(_) => &mut c.unanswered,
+                Validity::NoRoundTrip => &mut c.no_round_trip,
+                Validity::NegativeWeight(_) => &mut c.negative_weight,
+                Validity::Inconsistent => &mut c.inconsistent,
+            } += 1;
+        }
+        c
+    }
+
     /// Valid vertices.
     pub fn valid(&self) -> usize {
         self.validity
@@ -409,6 +441,26 @@ mod tests {
                 ..Default::default()
             };
             let c = correspond_vertices(&s, &s, &opts).unwrap();
+            let r = c.reason_counts();
+            let count = |name| c.validity.iter().filter(|v| v.reason() == name).count();
+            let reasons = [
+                "valid",
+                "unanswered",
+                "no-round-trip",
+                "negative-weight",
+                "inconsistent",
+            ];
+            assert_eq!(
+                [
+                    r.valid,
+                    r.unanswered,
+                    r.no_round_trip,
+                    r.negative_weight,
+                    r.inconsistent
+                ],
+                reasons.map(count)
+            );
+            assert_eq!(r.valid, c.valid());
             // The paper's test also rejects correct images with negative weights.
             let want = if test == ValidityTest::Local {
                 0.99

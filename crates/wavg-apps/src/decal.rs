@@ -94,6 +94,42 @@ pub struct Decal {
     pub distortion: Distortion,
 }
 
+/// What a decal over every vertex came to; with the `serde` feature, the `wavg decal
+/// --json` keys (the [`Distortion`] totals without `measured_faces`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct DecalReport {
+    /// Vertices.
+    pub vertices: usize,
+    /// Unmarked vertices over all vertices (0 for an empty mesh).
+    pub valid_fraction: f64,
+    /// [`Distortion::stretch`].
+    pub stretch: f64,
+    /// [`Distortion::stretch_best95`].
+    pub stretch_best95: f64,
+    /// [`Distortion::flipped_faces`].
+    pub flipped_faces: usize,
+    /// [`Distortion::flipped_area_fraction`].
+    pub flipped_area_fraction: f64,
+}
+
+impl Decal {
+    /// The decal's [`DecalReport`].
+    pub fn report(&self) -> DecalReport {
+        let n = self.uv.marked.len();
+        let unmarked = self.uv.marked.iter().filter(|m| !**m).count();
+        let d = &self.distortion;
+        DecalReport {
+            vertices: n,
+            valid_fraction: unmarked as f64 / n.max(1) as f64,
+            stretch: d.stretch,
+            stretch_best95: d.stretch_best95,
+            flipped_faces: d.flipped_faces,
+            flipped_area_fraction: d.flipped_area_fraction,
+        }
+    }
+}
+
 /// [`decal_uv`] at every vertex of the solver's mesh, with the map's [`Distortion`].
 pub fn decal_vertices(
     solver: &Solver,

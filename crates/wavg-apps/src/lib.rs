@@ -14,25 +14,25 @@ mod spline;
 
 pub use basis::{SplineKind, spline_weights};
 pub use remesh::{
-    BaseMesh, DEFAULT_MAX_BASE_DISTANCE, MAX_LEVELS, MAX_POLYGON, RemeshError, RemeshResult,
-    Remesher, polygons_to_obj,
+    BaseMesh, DEFAULT_MAX_BASE_DISTANCE, MAX_LEVELS, MAX_POLYGON, RemeshError, RemeshReport,
+    RemeshResult, Remesher, polygons_to_obj,
 };
-pub use spline::{Curve, evaluate_spline};
+pub use spline::{Curve, CurveReport, evaluate_spline};
 
 mod correspond;
 mod metrics;
 
 pub use correspond::{
-    CorrespondOptions, Correspondence, Mapped, ROUND_TRIP_TOLERANCE, Validity, ValidityTest,
-    correspond_vertices, map_points, vertex_points,
+    CorrespondOptions, Correspondence, Mapped, ROUND_TRIP_TOLERANCE, ReasonCounts, Validity,
+    ValidityTest, correspond_vertices, map_points, vertex_points,
 };
 pub use metrics::{Distortion, distortion};
 
 mod decal;
 mod morph;
 
-pub use decal::{Decal, DecalUv, decal_uv, decal_vertices};
-pub use morph::{harmonic_fill, morph_frames};
+pub use decal::{Decal, DecalReport, DecalUv, decal_uv, decal_vertices};
+pub use morph::{MorphReport, harmonic_fill, morph_frames};
 mod error;
 mod render;
 mod transfer;

@@ -102,6 +102,16 @@ pub fn harmonic_fill(
     Ok(out)
 }
 
+/// What a morph came to; with the `serde` feature, the `wavg morph --json` keys.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct MorphReport {
+    /// Frames written.
+    pub frames: usize,
+    /// Vertices mapped directly (the rest filled by [`harmonic_fill`]) over all vertices.
+    pub valid_fraction: f64,
+}
+
 /// `frames` positions blending linearly from `from` (frame 0) to `to` (the last frame);
 /// one frame is `from`.
 pub fn morph_frames(

@@ -15,7 +15,28 @@ pub struct Curve {
     pub closed: bool,
 }
 
+/// What a sampled curve came to; with the `serde` feature, the `wavg spline --json` keys.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct CurveReport {
+    /// Samples asked for.
+    pub samples: usize,
+    /// Of these, the ones on the surface ([`Curve::ok_samples`]).
+    pub ok_samples: usize,
+    /// [`Curve::length`].
+    pub length: f64,
+}
+
 impl Curve {
+    /// The curve's [`CurveReport`].
+    pub fn report(&self) -> CurveReport {
+        CurveReport {
+            samples: self.samples.len(),
+            ok_samples: self.ok_samples(),
+            length: self.length(),
+        }
+    }
+
     /// Samples that lie on the surface.
     pub fn ok_samples(&self) -> usize {
         self.samples.iter().filter(|r| r.is_ok()).count()

@@ -315,8 +315,14 @@ impl Solve<'_> {
         for chunk in points.chunks(self.opts.batch.max(1)) {
             if self.opts.verified {
                 let tol = self.opts.tolerance;
-                self.target
-                    .inverse_verified_batch_into(chunk, tol, &mut weights, &mut trips);
+                // `Par::Rayon` always starts.
+                let _ = self.target.inverse_verified_batch_into(
+                    chunk,
+                    tol,
+                    &mut weights,
+                    &mut trips,
+                    Par::Rayon,
+                );
                 self.not_reached += trips
                     .iter()
                     .filter(|t| matches!(t, Ok(RoundTrip::NotReached)))

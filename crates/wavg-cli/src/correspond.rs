@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use wavg::apps::{
-    CorrespondOptions, Correspondence, Distortion, Validity, ValidityTest, correspond_vertices,
+    CorrespondOptions, Correspondence, Distortion, ReasonCounts, Validity, ValidityTest,
+    correspond_vertices,
 };
 use wavg::{Anchor, Solver, Surface};
 
@@ -156,22 +157,6 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
     })
 }
 
-/// Counts per validity reason, as a JSON object.
-pub fn reason_counts(map: &Correspondence) -> serde_json::Value {
-    let mut o = serde_json::Map::new();
-    for r in [
-        "valid",
-        "unanswered",
-        "no-round-trip",
-        "negative-weight",
-        "inconsistent",
-    ] {
-        let n = map.validity.iter().filter(|v| v.reason() == r).count();
-        o.insert(r.to_string(), n.into());
-    }
-    o.into()
-}
-
 /// Mean, 95th percentile and maximum of the errors (0 when empty).
 fn stats(mut e: Vec<f64>) -> serde_json::Value {
     e.sort_by(f64::total_cmp);
@@ -223,7 +208,7 @@ struct JsonReport<'a> {
     valid_fraction: f64,
     validity: String,
     verified: bool,
-    reasons: serde_json::Value,
+    reasons: ReasonCounts,
     #[serde(flatten)]
     distortion: &'a Distortion,
     seconds: f64,
@@ -256,7 +241,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             valid_fraction: c.map.valid_fraction(),
             validity: format!("{:?}", args.map.validity).to_lowercase(),
             verified: !args.map.paper_weights,
-            reasons: reason_counts(&c.map),
+            reasons: c.map.reason_counts(),
             distortion: d,
             seconds: c.seconds,
             setup_seconds: c.setup_seconds,

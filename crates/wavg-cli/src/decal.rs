@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use wavg::apps::decal_vertices;
+use wavg::apps::{DecalReport, decal_vertices};
 
 use crate::CliError;
 use crate::apps_common::{embed, surface_and_anchors};
@@ -48,6 +48,18 @@ pub struct Args {
     /// Print one JSON object on standard output.
     #[arg(long)]
     pub json: bool,
+}
+
+/// The `--json` object: the [`DecalReport`] with the inputs, the timing and the marked
+/// vertices (printed through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    mesh: &'a str,
+    anchors: usize,
+    #[serde(flatten)]
+    decal: DecalReport,
+    seconds: f64,
+    marked: Vec<usize>,
 }
 
 /// Runs the command.
@@ -110,30 +122,25 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let marked: Vec<usize> = (0..mesh.n_vertices())
         .filter(|&v| decal.uv.marked[v])
         .collect();
-    let n = mesh.n_vertices();
-    let valid_fraction = (n - marked.len()) as f64 / n.max(1) as f64;
-    let d = &decal.distortion;
+    let report = decal.report();
     if args.json {
-        let j = serde_json::json!({
-            "mesh": args.mesh,
-            "anchors": uv.len(),
-            "vertices": n,
-            "valid_fraction": valid_fraction,
-            "stretch": d.stretch,
-            "stretch_best95": d.stretch_best95,
-            "flipped_faces": d.flipped_faces,
-            "flipped_area_fraction": d.flipped_area_fraction,
-            "seconds": seconds,
-            "marked": marked,
-        });
+        let j = serde_json::to_value(JsonReport {
+            mesh: &args.mesh,
+            anchors: uv.len(),
+            decal: report,
+            seconds,
+            marked,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else if args.output != std::path::Path::new("-") {
+        let n = report.vertices;
         println!(
             "{} of {n} vertices unmarked ({:.1}%), stretch {:.4}, {} flipped faces -> {}",
             n - marked.len(),
-            100.0 * valid_fraction,
-            d.stretch,
-            d.flipped_faces,
+            100.0 * report.valid_fraction,
+            report.stretch,
+            report.flipped_faces,
             args.output.display()
         );
     }

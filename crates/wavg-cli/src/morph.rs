@@ -3,14 +3,14 @@
 //! blending linearly from the source to the mapped shape.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use wavg::apps::{harmonic_fill, morph_frames};
+use wavg::apps::{MorphReport, ReasonCounts, harmonic_fill, morph_frames};
 
 use crate::CliError;
 use crate::common::one_line;
-use crate::correspond::{MapArgs, compute, reason_counts};
+use crate::correspond::{MapArgs, compute};
 use crate::textio::{self, write_numbers};
 
 /// Arguments.
@@ -35,6 +35,20 @@ pub struct Args {
     /// Print one JSON object on standard output.
     #[arg(long)]
     pub json: bool,
+}
+
+/// The `--json` object: the [`MorphReport`] with the map's reasons, the inputs and the
+/// timings (printed through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    source: &'a str,
+    target: &'a str,
+    output: &'a Path,
+    #[serde(flatten)]
+    morph: MorphReport,
+    reasons: ReasonCounts,
+    seconds: f64,
+    setup_seconds: f64,
 }
 
 /// Runs the command.
@@ -73,16 +87,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
         })?;
     }
     if args.json {
-        let j = serde_json::json!({
-            "source": args.map.pair.source,
-            "target": args.map.pair.target,
-            "output": args.output,
-            "frames": args.frames,
-            "valid_fraction": c.map.valid_fraction(),
-            "reasons": reason_counts(&c.map),
-            "seconds": seconds,
-            "setup_seconds": c.setup_seconds,
-        });
+        let j = serde_json::to_value(JsonReport {
+            source: &args.map.pair.source,
+            target: &args.map.pair.target,
+            output: &args.output,
+            morph: MorphReport {
+                frames: args.frames,
+                valid_fraction: c.map.valid_fraction(),
+            },
+            reasons: c.map.reason_counts(),
+            seconds,
+            setup_seconds: c.setup_seconds,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else {
         println!(

@@ -3,12 +3,12 @@
 //! base vertex is dragged.
 
 use std::io::{IsTerminal, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use wavg::apps::{BaseMesh, Remesher, polygons_to_obj};
+use wavg::apps::{BaseMesh, RemeshReport, Remesher, polygons_to_obj};
 use wavg::{NoProgress, PrecomputeOptions, Surface, Vector3};
 
 use crate::CliError;
@@ -115,33 +115,24 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
     let drag = drag_frames(&mut r, &base, &args)?;
     let warm = drag.median;
     // The file is the first (undragged) result.
-    let max_offsurface = r.max_offsurface(&out.positions);
     let obj = polygons_to_obj(&out.positions, &out.faces);
     textio::write_atomic(&args.output, |w: &mut dyn Write| {
         w.write_all(obj.as_bytes())
     })?;
     if args.json {
-        let j = serde_json::json!({
-            "mesh": args.mesh,
-            "base": args.base,
-            "base_vertices": base.positions.len(),
-            "base_faces": base.faces.len(),
-            "vertices": out.positions.len(),
-            "faces": out.faces.len(),
-            "levels": out.levels,
-            "smooth_steps": out.smooth_steps,
-            "seconds": seconds,
-            "warm_seconds": warm,
-            "warm_seconds_max": drag.max,
-            "warm_cpu_seconds": drag.cpu,
-            "frames": args.frames,
-            "max_offsurface": max_offsurface,
-            "roughness": out.roughness(),
-            "problems": out.problems,
-            "fallbacks": out.fallbacks,
-            "threads": rayon::current_num_threads(),
-            "precompute_seconds": precompute_seconds,
-        });
+        let j = serde_json::to_value(JsonReport {
+            mesh: &args.mesh,
+            base: &args.base,
+            remesh: r.report(&out),
+            seconds,
+            warm_seconds: warm,
+            warm_seconds_max: drag.max,
+            warm_cpu_seconds: drag.cpu,
+            frames: args.frames,
+            threads: rayon::current_num_threads(),
+            precompute_seconds,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else if args.output != std::path::Path::new("-") {
         println!(
@@ -159,6 +150,23 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// The `--json` object: the [`RemeshReport`] with the inputs and the timings (printed
+/// through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    mesh: &'a str,
+    base: &'a Path,
+    #[serde(flatten)]
+    remesh: RemeshReport,
+    seconds: f64,
+    warm_seconds: Option<f64>,
+    warm_seconds_max: Option<f64>,
+    warm_cpu_seconds: Option<f64>,
+    frames: usize,
+    threads: usize,
+    precompute_seconds: Option<f64>,
 }
 
 /// Drags base vertex `--drag` over `--frames` frames (a small circle of radius 2% of the

@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use wavg::apps::{SplineKind, evaluate_spline};
+use wavg::apps::{CurveReport, SplineKind, evaluate_spline};
 
 use crate::CliError;
 use crate::common::one_line;
@@ -55,6 +55,21 @@ pub struct Args {
     pub json: bool,
 }
 
+/// The `--json` object: the curve's [`CurveReport`] with the command's settings and
+/// timings (printed through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    mesh: &'a str,
+    controls: usize,
+    degree: usize,
+    closed: bool,
+    bezier: bool,
+    #[serde(flatten)]
+    curve: CurveReport,
+    seconds: f64,
+    us_per_sample: f64,
+}
+
 /// Samples evaluated in sequence, warm-started, per parallel chunk.
 const CHUNK: usize = 256;
 
@@ -96,18 +111,21 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let ok = curve.ok_samples();
     let us = seconds / args.samples as f64 * 1e6;
     if args.json {
-        let j = serde_json::json!({
-            "mesh": args.mesh,
-            "controls": solver.n_anchors(),
-            "degree": if args.bezier { solver.n_anchors() - 1 } else { args.degree },
-            "closed": args.closed,
-            "bezier": args.bezier,
-            "samples": args.samples,
-            "ok_samples": ok,
-            "seconds": seconds,
-            "us_per_sample": us,
-            "length": curve.length(),
-        });
+        let j = serde_json::to_value(JsonReport {
+            mesh: &args.mesh,
+            controls: solver.n_anchors(),
+            degree: if args.bezier {
+                solver.n_anchors() - 1
+            } else {
+                args.degree
+            },
+            closed: args.closed,
+            bezier: args.bezier,
+            curve: curve.report(),
+            seconds,
+            us_per_sample: us,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else if args.output != std::path::Path::new("-") {
         println!(

@@ -268,3 +268,138 @@ fn transfer_texture_json_keys() {
     ];
     assert_keys(&args, &keys);
 }
+
+#[test]
+fn spline_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let control = dir.path().join("c.txt");
+    std::fs::write(&control, "v 0\nv 500\nv 1000\nv 1500\nv 2000\n").unwrap();
+    let out = s(&dir.path().join("curve.txt"));
+    let keys = [
+        "mesh",
+        "controls",
+        "degree",
+        "closed",
+        "bezier",
+        "samples",
+        "ok_samples",
+        "seconds",
+        "us_per_sample",
+        "length",
+    ];
+    let args = [
+        "spline",
+        "--mesh",
+        "builtin:icosphere",
+        "--control",
+        &s(&control),
+        "--samples",
+        "50",
+        "-o",
+        &out,
+        "--json",
+    ];
+    assert_keys(&args, &keys);
+    assert_keys(&[&args[..], &["--bezier"]].concat(), &keys);
+}
+
+#[test]
+fn remesh_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("tetra.obj");
+    // A tetrahedron inscribed in the unit sphere.
+    std::fs::write(
+        &base,
+        "v 0.5773502691896258 0.5773502691896258 0.5773502691896258\n\
+         v 0.5773502691896258 -0.5773502691896258 -0.5773502691896258\n\
+         v -0.5773502691896258 0.5773502691896258 -0.5773502691896258\n\
+         v -0.5773502691896258 -0.5773502691896258 0.5773502691896258\n\
+         f 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n",
+    )
+    .unwrap();
+    let out = s(&dir.path().join("fine.obj"));
+    let keys = [
+        "mesh",
+        "base",
+        "base_vertices",
+        "base_faces",
+        "vertices",
+        "faces",
+        "levels",
+        "smooth_steps",
+        "seconds",
+        "warm_seconds",
+        "warm_seconds_max",
+        "warm_cpu_seconds",
+        "frames",
+        "max_offsurface",
+        "roughness",
+        "problems",
+        "fallbacks",
+        "threads",
+        "precompute_seconds",
+    ];
+    let args = [
+        "remesh",
+        "--mesh",
+        "builtin:icosphere",
+        "--base",
+        &s(&base),
+        "--levels",
+        "1",
+        "--frames",
+        "2",
+        "-o",
+        &out,
+        "--json",
+    ];
+    assert_keys(&args, &keys);
+}
+
+#[test]
+fn morph_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = s(&sphere_anchors(dir.path()));
+    let out = s(&dir.path().join("frames"));
+    let m = "builtin:icosphere";
+    let args = [
+        "morph",
+        "--source",
+        m,
+        "--target",
+        m,
+        "--source-anchors",
+        &a,
+        "--target-anchors",
+        &a,
+        "--frames",
+        "2",
+        "-o",
+        &out,
+        "--json",
+    ];
+    let (o, _) = json_object(&wavg_ok(&args));
+    let mut want: Vec<String> = [
+        "source",
+        "target",
+        "output",
+        "frames",
+        "valid_fraction",
+        "reasons",
+        "seconds",
+        "setup_seconds",
+    ]
+    .iter()
+    .map(|k| k.to_string())
+    .collect();
+    // `reasons` counts by reason: its keys depend on the map, not on the format.
+    want.extend(
+        o["reasons"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(|k| format!("reasons.{k}")),
+    );
+    want.sort();
+    assert_eq!(key_paths(&Value::Object(o)), want);
+}

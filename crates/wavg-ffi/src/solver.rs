@@ -327,7 +327,9 @@ fn verified_rows(
         Some(b) => (&mut b.0, &mut b.1),
         None => (&mut owned.0, &mut owned.1),
     };
-    solver.inverse_verified_batch_into(&points, wavg::solve::DEFAULT_TOLERANCE, batch, trips);
+    let tol = wavg::solve::DEFAULT_TOLERANCE;
+    // `Par::Rayon` always starts.
+    let _ = solver.inverse_verified_batch_into(&points, tol, batch, trips, wavg::solve::Par::Rayon);
     let n = solver.n_anchors();
     out.par_chunks_exact_mut(n)
         .enumerate()

@@ -283,7 +283,14 @@ fn verified_round_trip(
     let mut weights = BatchWeights::default();
     let mut trips = Vec::new();
     let (t, ()) = best_of(repeat, || {
-        solver.inverse_verified_batch_into(points, ROUND_TRIP_TOLERANCE, &mut weights, &mut trips)
+        // `Par::Rayon` always starts.
+        let _ = solver.inverse_verified_batch_into(
+            points,
+            ROUND_TRIP_TOLERANCE,
+            &mut weights,
+            &mut trips,
+            wavg_project::Par::Rayon,
+        );
     });
     let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
     let fwd = solver.forward_batch(&rows, opts);

@@ -15,7 +15,9 @@
 
 use wavg_mesh::SurfacePoint;
 
-use crate::batch::BatchWeights;
+use wavg_project::Par;
+
+use crate::batch::{BatchWeights, ForwardScratch};
 use crate::error::SolveError;
 use crate::kernel::AnchorCoords;
 use crate::points::check_point;
@@ -24,6 +26,11 @@ use crate::{DIM, Mat2x8, Vec8};
 
 /// The penalties tried, in order, after the paper's weights.
 pub const PENALTY_LADDER: [f64; 4] = [10.0, 100.0, 1_000.0, 10_000.0];
+
+/// Points one parallel task checks for their round trip.
+const CHECK_CHUNK: usize = 256;
+/// Points one parallel task gives penalized weights.
+const PENALTY_CHUNK: usize = 16;
 
 /// Default round-trip tolerance, in mean edge lengths of the mesh (the Table 1 bench's).
 pub const DEFAULT_TOLERANCE: f64 = 1e-3;
@@ -235,8 +242,8 @@ impl Solver {
         })
     }
 
-    /// [`Solver::inverse_verified`] for many points in parallel (results in input order,
-    /// equal to the one-by-one ones for any thread count); see
+    /// [`Solver::inverse_verified`] for many points in parallel on the current rayon pool
+    /// (results in input order, equal to the one-by-one ones for any thread count); see
     /// [`Solver::inverse_verified_batch_into`].
     pub fn inverse_verified_batch(
         &self,
@@ -245,7 +252,14 @@ impl Solver {
     ) -> Vec<Result<Verified, SolveError>> {
         let mut weights = BatchWeights::default();
         let mut trips = Vec::new();
-        self.inverse_verified_batch_into(points, tolerance, &mut weights, &mut trips);
+        // `Par::Rayon` always starts.
+        let _ = self.inverse_verified_batch_into(
+            points,
+            tolerance,
+            &mut weights,
+            &mut trips,
+            Par::Rayon,
+        );
         weights
             .iter()
             .zip(trips)
@@ -258,24 +272,27 @@ impl Solver {
             .collect()
     }
 
-    /// [`Solver::inverse_verified_batch`] into existing buffers (repeated batches then
-    /// neither allocate nor page-fault): row `i` of `weights` and `round_trips[i]` belong
+    /// [`Solver::inverse_verified_batch`] into existing buffers, with explicit parallelism
+    /// (the results do not depend on it): row `i` of `weights` and `round_trips[i]` belong
     /// to `points[i]` (both carry the error when it failed). In stages, each a batch: the
     /// paper's weights for all points ([`Solver::inverse_batch_into`]) and their forward
-    /// problems ([`Solver::forward_batch`], which orders them for cache locality); then,
-    /// for the points still not returned, one rung of the penalty ladder at a time.
+    /// problems ([`Solver::forward_batch_into`], which orders them for cache locality);
+    /// then, for the points still not returned, one rung of the penalty ladder at a time.
+    /// Fails only when `par`'s threads cannot start.
     ///
     /// ```
     /// use std::sync::Arc;
     /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
     /// use wavg_solve::{DEFAULT_TOLERANCE, RoundTrip};
-    /// use wavg_solve::{Anchor, BatchWeights, EmbeddedMesh, Projector, Solver};
+    /// use wavg_solve::{Anchor, BatchWeights, EmbeddedMesh, Par, Projector, Solver};
     /// let mesh = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
     /// let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
     /// let solver = Solver::new(proj, (0..12).map(Anchor::Vertex)).unwrap();
     /// let points = [SurfacePoint::new(100, [0.2, 0.3, 0.5]), SurfacePoint::new(9999, [1.0, 0.0, 0.0])];
     /// let (mut w, mut trips) = (BatchWeights::default(), Vec::new());
-    /// solver.inverse_verified_batch_into(&points, DEFAULT_TOLERANCE, &mut w, &mut trips);
+    /// solver
+    ///     .inverse_verified_batch_into(&points, DEFAULT_TOLERANCE, &mut w, &mut trips, Par::Seq)
+    ///     .unwrap();
     /// assert_eq!(trips[0], Ok(RoundTrip::Paper));
     /// assert!(w.get(1).is_err() && trips[1].is_err()); // no face 9999
     /// ```
@@ -285,10 +302,9 @@ impl Solver {
         tolerance: f64,
         weights: &mut BatchWeights,
         round_trips: &mut Vec<Result<RoundTrip, SolveError>>,
-    ) {
-        use rayon::prelude::*;
-        // `Par::Rayon` always starts.
-        let _ = self.inverse_batch_into(points, weights, wavg_project::Par::Rayon);
+        par: Par,
+    ) -> Result<(), SolveError> {
+        self.inverse_batch_into(points, weights, par)?;
         round_trips.clear();
         if !(tolerance.is_finite() && tolerance > 0.0) {
             let e = SolveError::InvalidParameter(format!(
@@ -298,7 +314,7 @@ impl Solver {
                 weights.set(i, Err(e.clone()));
             }
             round_trips.resize(points.len(), Err(e));
-            return;
+            return Ok(());
         }
         let mesh = self.mesh();
         let tol = tolerance * self.mean_edge_length();
@@ -307,34 +323,33 @@ impl Solver {
                 check_point(mesh, p).is_ok_and(|c| (f.position - c.position(mesh)).norm() <= tol)
             })
         };
+        let opts = ForwardOptions::default();
+        let (mut scratch, mut fwd) = (ForwardScratch::default(), Vec::new());
         let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
-        let fwd = self.forward_batch(&rows, &ForwardOptions::default());
+        self.forward_batch_into(&rows, &opts, &mut scratch, &mut fwd, par)?;
         let paper = &*weights;
-        (0..points.len())
-            .into_par_iter()
-            .map(|i| match paper.get(i) {
+        par.map_range(points.len(), CHECK_CHUNK, round_trips, |i| {
+            match paper.get(i) {
                 Err(e) => Err(e.clone()),
                 Ok(_) if returns(&points[i], &fwd[i]) => Ok(RoundTrip::Paper),
                 Ok(_) => Ok(RoundTrip::NotReached),
-            })
-            .collect_into_vec(round_trips);
+            }
+        })?;
         let mut pending: Vec<usize> = (0..points.len())
             .filter(|&i| round_trips[i] == Ok(RoundTrip::NotReached))
             .collect();
+        let mut tried = Vec::new();
         for lambda in PENALTY_LADDER {
             if pending.is_empty() {
                 break;
             }
-            let tried: Vec<Result<Vec<f64>, SolveError>> = pending
-                .par_iter()
-                .map(|&i| {
-                    let p = check_point(mesh, &points[i])?;
-                    let (psi, yhat) = self.tangent_plane(&p);
-                    penalized_weights(&psi, &yhat, self.anchors().coords(), self.gamma(), lambda)
-                })
-                .collect();
+            par.map_range(pending.len(), PENALTY_CHUNK, &mut tried, |k| {
+                let p = check_point(mesh, &points[pending[k]])?;
+                let (psi, yhat) = self.tangent_plane(&p);
+                penalized_weights(&psi, &yhat, self.anchors().coords(), self.gamma(), lambda)
+            })?;
             let rows: Vec<&[f64]> = tried.iter().map(|r| r.as_deref().unwrap_or(&[])).collect();
-            let fwd = self.forward_batch(&rows, &ForwardOptions::default());
+            self.forward_batch_into(&rows, &opts, &mut scratch, &mut fwd, par)?;
             let mut still = Vec::new();
             for ((&i, w), f) in pending.iter().zip(&tried).zip(&fwd) {
                 match w {
@@ -351,5 +366,6 @@ impl Solver {
             }
             pending = still;
         }
+        Ok(())
     }
 }

@@ -8,7 +8,8 @@ use wavg_solve::DEFAULT_TOLERANCE;
 use wavg_solve::internal::penalized_weights;
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
 use wavg_solve::{
-    Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, Mat2x8, Projector, RoundTrip, Solver, Vec8,
+    Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, Mat2x8, Par, Projector, RoundTrip, Solver,
+    Vec8,
 };
 use wavg_solve::{AnchorCoords, InverseScratch, inverse_weights};
 
@@ -127,6 +128,41 @@ fn verified_weights_round_trip_on_a_thin_torus() {
     eprintln!("thin torus: paper {paper:.3}, verified {back:.3}, penalised {penalised:.3}");
 }
 
+/// The explicit layer gives the same weights and round trips for every parallelism, with
+/// points that need the penalty ladder and points that fail, buffers reused between calls.
+#[test]
+fn verified_batch_does_not_depend_on_par() {
+    let s = solver_on(procedural::torus(64, 16, 1.0, 0.12), 12);
+    let mut pts = uniform_surface_points(s.mesh(), 300, 9).unwrap();
+    pts[5] = SurfacePoint::new(u32::MAX, [1.0, 0.0, 0.0]);
+    let batch = s.inverse_verified_batch(&pts, DEFAULT_TOLERANCE);
+    let penalised = batch
+        .iter()
+        .filter(|v| matches!(v, Ok(v) if matches!(v.round_trip, RoundTrip::Penalized(_))))
+        .count();
+    assert!(penalised > 0, "no point needs the penalty");
+    let (mut w, mut trips) = (BatchWeights::default(), Vec::new());
+    let two = Par::Threads(std::num::NonZeroUsize::new(2).unwrap());
+    let three = Par::Threads(std::num::NonZeroUsize::new(3).unwrap());
+    for par in [Par::Seq, two, three, Par::Rayon, Par::Seq] {
+        s.inverse_verified_batch_into(&pts, DEFAULT_TOLERANCE, &mut w, &mut trips, par)
+            .unwrap();
+        assert_eq!((w.len(), trips.len()), (pts.len(), pts.len()), "{par:?}");
+        for (i, v) in batch.iter().enumerate() {
+            match v {
+                Ok(v) => {
+                    assert_eq!(w.get(i).unwrap(), &v.weights[..], "{par:?}, point {i}");
+                    assert_eq!(trips[i], Ok(v.round_trip), "{par:?}, point {i}");
+                }
+                Err(e) => {
+                    assert_eq!(w.get(i), Err(e), "{par:?}, point {i}");
+                    assert_eq!(trips[i].as_ref(), Err(e), "{par:?}, point {i}");
+                }
+            }
+        }
+    }
+}
+
 /// Pig, 27 anchors (the paper's Table 1 setting): with the 3-D positions as embedding and
 /// with the real geodesic embedding (the precomputation pipeline).
 #[test]
@@ -199,7 +235,8 @@ fn verified_batch_errors_and_reuse() {
     assert!(batch[7].is_err() && batch[9].is_err());
     let (mut w, mut trips) = (BatchWeights::default(), Vec::new());
     for _ in 0..2 {
-        s.inverse_verified_batch_into(&pts, DEFAULT_TOLERANCE, &mut w, &mut trips);
+        s.inverse_verified_batch_into(&pts, DEFAULT_TOLERANCE, &mut w, &mut trips, Par::Rayon)
+            .unwrap();
         for (i, v) in batch.iter().enumerate() {
             match v {
                 Ok(v) => {
@@ -210,7 +247,8 @@ fn verified_batch_errors_and_reuse() {
             }
         }
     }
-    s.inverse_verified_batch_into(&pts, 0.0, &mut w, &mut trips);
+    s.inverse_verified_batch_into(&pts, 0.0, &mut w, &mut trips, Par::Seq)
+        .unwrap();
     assert!(trips.iter().all(|t| t.is_err()) && w.iter().all(|r| r.is_err()));
     assert_eq!(trips.len(), pts.len());
 }

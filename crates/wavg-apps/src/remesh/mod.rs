@@ -65,6 +65,32 @@ pub struct RemeshResult {
     pub fallbacks: usize,
 }
 
+/// What one remeshing came to; with the `serde` feature, the `wavg remesh --json` keys.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct RemeshReport {
+    /// Base vertices.
+    pub base_vertices: usize,
+    /// Base polygons.
+    pub base_faces: usize,
+    /// Output vertices.
+    pub vertices: usize,
+    /// Output polygons.
+    pub faces: usize,
+    /// [`RemeshResult::levels`].
+    pub levels: usize,
+    /// [`RemeshResult::smooth_steps`].
+    pub smooth_steps: usize,
+    /// [`Remesher::max_offsurface`] of the output vertices.
+    pub max_offsurface: f64,
+    /// [`RemeshResult::roughness`].
+    pub roughness: f64,
+    /// [`RemeshResult::problems`].
+    pub problems: usize,
+    /// [`RemeshResult::fallbacks`].
+    pub fallbacks: usize,
+}
+
 impl RemeshResult {
     /// Roughness of the mesh: the mean length of the umbrella vector (a vertex's offset
     /// from the 3-D centroid of its edge neighbours) over the vertices with neighbours,
@@ -218,6 +244,22 @@ impl Remesher {
     /// The base polygons.
     pub fn base_faces(&self) -> &[Vec<u32>] {
         &self.faces
+    }
+
+    /// The [`RemeshReport`] of `out`, a result of this remesher.
+    pub fn report(&self, out: &RemeshResult) -> RemeshReport {
+        RemeshReport {
+            base_vertices: self.base_points.len(),
+            base_faces: self.faces.len(),
+            vertices: out.positions.len(),
+            faces: out.faces.len(),
+            levels: out.levels,
+            smooth_steps: out.smooth_steps,
+            max_offsurface: self.max_offsurface(&out.positions),
+            roughness: out.roughness(),
+            problems: out.problems,
+            fallbacks: out.fallbacks,
+        }
     }
 
     /// Moves base vertex `i` to `p` (validated); the next [`Remesher::remesh`] starts

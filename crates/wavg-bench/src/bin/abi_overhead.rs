@@ -227,7 +227,17 @@ fn main() {
     );
     report(
         "inverse_verified",
-        &mut || solver.inverse_verified_batch_into(&points, tol, &mut rust_batch, &mut rust_trips),
+        &mut || {
+            let par = wavg::solve::Par::Rayon;
+            // `Par::Rayon` always starts.
+            let _ = solver.inverse_verified_batch_into(
+                &points,
+                tol,
+                &mut rust_batch,
+                &mut rust_trips,
+                par,
+            );
+        },
         // SAFETY: as above.
         &mut || unsafe {
             inverse(
