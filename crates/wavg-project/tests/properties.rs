@@ -184,8 +184,11 @@ proptest! {
                 // and Newton on that face alone finds the same point.
                 let bary = x.point.bary;
                 prop_assert!(bary.iter().all(|&t| t >= 0.0) && (bary.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+                // A root up to BARY_EPS outside the triangle is clamped onto its edge, which
+                // leaves a residual of that order.
                 let r = fx.proj.psi(&x.point) * (y - fx.emb.point(&x.point));
-                prop_assert!(r.norm() <= 1e-6 * (x.distance + fx.mean_edge), "{}: residual {}", fx.name, r.norm());
+                let tol = if bary.contains(&0.0) { wavg_project::BARY_EPS } else { 1e-6 };
+                prop_assert!(r.norm() <= tol * (x.distance + fx.mean_edge), "{}: residual {} at {:?}", fx.name, r.norm(), x.point);
                 let again = fx.proj.project_onto_face_with_distance(&y, x.point.face);
                 prop_assert!(again.is_some_and(|(_, d)| (d - x.distance).abs() <= 1e-9 * (d + fx.mean_edge)));
                 prop_assert!(x.distance >= bf.distance - 1e-9 * (bf.distance + fx.mean_edge));
