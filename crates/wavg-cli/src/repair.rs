@@ -16,10 +16,14 @@ use crate::common::{load_mesh, one_line};
 #[command(
     long_about = "Repair a mesh so that wavg can use it, and write the result.\n\n\
     By default: weld vertices with identical positions, drop degenerate faces (repeated \
-    index, zero area, out-of-range index, NaN/inf corner), drop duplicate faces and drop \
-    unreferenced vertices. Components are kept unless --largest-component is given.\n\n\
+    index, zero area, out-of-range index, NaN/inf corner), drop duplicate faces, make the \
+    mesh manifold (a vertex or edge shared by separate sheets of surface is split into one \
+    copy per sheet: new vertices are appended after the input's, which keep their \
+    indices), flip faces to one orientation per component, and drop unreferenced \
+    vertices. Components are kept unless --largest-component is given.\n\n\
     --map FILE writes one line per output vertex: the 0-based index of the input vertex it \
-    came from (after welding, the lowest such index).\n\n\
+    came from (after welding, the lowest such index; for a copy made by splitting, the \
+    vertex it copies).\n\n\
     Exit status: 0 when the output is a valid mesh, 1 when problems remain (the output is \
     still written, and the remaining problems are listed), 2 for unreadable input."
 )]
@@ -38,6 +42,12 @@ pub struct Args {
     /// Keep only the largest connected component (by face count).
     #[arg(long)]
     pub largest_component: bool,
+    /// Do not split non-manifold vertices and edges.
+    #[arg(long)]
+    pub keep_nonmanifold: bool,
+    /// Do not flip faces to a consistent orientation.
+    #[arg(long)]
+    pub keep_orientation: bool,
     /// Write the new-to-original vertex map here (one index per line).
     #[arg(long)]
     pub map: Option<PathBuf>,
@@ -58,6 +68,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let options = RepairOptions {
         weld: (!args.no_weld).then_some(args.weld),
         keep_largest_component: args.largest_component,
+        make_manifold: !args.keep_nonmanifold,
+        orient: !args.keep_orientation,
         ..RepairOptions::default()
     };
     let r = repair_all(&mesh, &options);
@@ -84,6 +96,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "vertices": r.mesh.n_vertices(),
             "faces": r.mesh.n_faces(),
             "removed_vertices": r.removed_vertices(),
+            "added_vertices": r.added_vertices(),
             "removed_faces": r.removed_faces(mesh.n_faces()),
             "components": after.stats.components,
             "valid": after.report.is_valid(),

@@ -108,12 +108,41 @@ fn invalid_but_parseable_file_exits_zero_and_lists_problems() {
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("valid:                no"), "{text}");
+    // The fin comes apart into three sheets.
+    assert!(text.contains("`wavg repair` fixes every problem"), "{text}");
+    assert_eq!(j["repair"]["fixes_all"], true);
+    assert_eq!(j["repair"]["removed_vertices"], 1);
+    // A problem no repair fixes: a Moebius strip has no consistent orientation.
+    let mut positions = Vec::new();
+    let n = 12;
+    for i in 0..n {
+        let t = std::f64::consts::TAU * i as f64 / n as f64;
+        for s in [-0.3, 0.3] {
+            let (r, h) = (1.0 + s * (t / 2.0).cos(), s * (t / 2.0).sin());
+            positions.push(nalgebra::Vector3::new(r * t.cos(), r * t.sin(), h));
+        }
+    }
+    let triangles = (0..n as u32)
+        .flat_map(|i| {
+            let (a, b) = (2 * i, 2 * i + 1);
+            let (c, d) = if i + 1 == n as u32 {
+                (1, 0)
+            } else {
+                (a + 2, a + 3)
+            };
+            [[a, c, b], [b, c, d]]
+        })
+        .collect();
+    let mpath = dir.path().join("moebius.obj");
+    io::save(&mpath, &wavg_mesh::TriMesh::new(positions, triangles)).unwrap();
+    let j = info_json(&mpath);
+    assert_eq!(j["repair"]["fixes_all"], false);
+    let out = wavg(&["info", mpath.to_str().unwrap()]);
+    let text = String::from_utf8(out.stdout).unwrap();
     assert!(
-        text.contains("`wavg repair` leaves: 1 non-manifold edges"),
+        text.contains("`wavg repair` leaves: 1 edges with inconsistent orientation"),
         "{text}"
     );
-    assert_eq!(j["repair"]["fixes_all"], false);
-    assert_eq!(j["repair"]["removed_vertices"], 1);
     // A problem the repairs do fix: an unreferenced vertex on a valid torus.
     let mut torus = procedural::torus(8, 5, 1.0, 0.3);
     torus.positions.push(torus.positions[0] * 5.0);

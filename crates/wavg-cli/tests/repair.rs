@@ -61,8 +61,7 @@ fn repairs_unwelded_mesh_and_writes_vertex_map() {
 #[test]
 fn remaining_problems_exit_1_and_components_need_opt_in() {
     let dir = tempfile::tempdir().unwrap();
-    // Two disjoint spheres: valid per component, but two components are fine for info;
-    // a pinched vertex (two cones sharing an apex) is not repairable.
+    // Two disjoint spheres: --largest-component keeps one.
     let a = procedural::icosphere(1);
     let mut two = a.clone();
     let n = a.n_vertices() as u32;
@@ -85,7 +84,9 @@ fn remaining_problems_exit_1_and_components_need_opt_in() {
     ]);
     assert_eq!(io::load(&output).unwrap().n_vertices(), a.n_vertices());
 
-    // A fin (three faces on one edge) cannot be repaired: output written, exit 1.
+    // A fin (three faces on one edge) comes apart into three sheets; the map names the
+    // input vertex of every copy. With --keep-nonmanifold it stays broken: output
+    // written, exit 1.
     let fin = wavg_mesh::TriMesh::new(
         vec![
             nalgebra::Vector3::new(0.0, 0.0, 0.0),
@@ -99,11 +100,42 @@ fn remaining_problems_exit_1_and_components_need_opt_in() {
     let input = dir.path().join("fin.obj");
     io::save(&input, &fin).unwrap();
     let output = dir.path().join("fin-out.obj");
+    let map = dir.path().join("fin-map.txt");
+    let out = wavg_ok(&[
+        "repair",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+        "--map",
+        map.to_str().unwrap(),
+        "--json",
+    ]);
+    let j: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        (j["valid"].as_bool(), j["components"].as_u64()),
+        (Some(true), Some(3))
+    );
+    assert_eq!(
+        (j["added_vertices"].as_u64(), j["removed_faces"].as_u64()),
+        (Some(4), Some(0))
+    );
+    let fixed = ValidMesh::new(io::load(&output).unwrap()).expect("split fin is valid");
+    let lines: Vec<u32> = std::fs::read_to_string(&map)
+        .unwrap()
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect();
+    assert_eq!(lines.len(), 9);
+    assert_eq!(&lines[..5], &[0, 1, 2, 3, 4]);
+    for (new, &old) in lines.iter().enumerate() {
+        assert_eq!(fixed.positions[new], fin.positions[old as usize]);
+    }
     let out = wavg(&[
         "repair",
         input.to_str().unwrap(),
         "-o",
         output.to_str().unwrap(),
+        "--keep-nonmanifold",
     ]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stdout).contains("non-manifold edges"));

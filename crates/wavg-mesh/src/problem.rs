@@ -153,6 +153,11 @@ impl ProblemKind {
             | Self::NonFiniteCoordinate => Some("drop degenerate faces"),
             Self::DuplicateFace => Some("drop duplicate faces"),
             Self::UnreferencedVertex => Some("drop unreferenced vertices"),
+            Self::NonManifoldEdge | Self::NonManifoldVertex => {
+                Some("split non-manifold vertices and edges")
+            }
+            // A non-orientable surface (a Moebius strip) has no consistent orientation.
+            Self::InconsistentOrientation => Some("orient faces (orientable surfaces only)"),
             _ => None,
         }
     }

@@ -53,19 +53,19 @@ const fn report(
 
 #[rustfmt::skip]
 const TABLE: &[(&str, Expect)] = &[
-    ("beetle.obj", report(1148, 2053, 23, Some(-3), &[(NonManifoldEdge, Some(47)), (NonManifoldVertex, None)], false)),
-    ("camel-reference.obj.gz", report(21887, 43814, 2, Some(3), &[(DuplicateFace, Some(14)), (NonManifoldEdge, Some(26)), (NonManifoldVertex, None)], false)),
-    ("cow.obj", report(2903, 5804, 0, Some(1), &[(NonManifoldVertex, Some(1))], false)),
+    ("beetle.obj", report(1148, 2053, 23, Some(-3), &[(NonManifoldEdge, Some(47)), (NonManifoldVertex, None)], true)),
+    ("camel-reference.obj.gz", report(21887, 43814, 2, Some(3), &[(DuplicateFace, Some(14)), (NonManifoldEdge, Some(26)), (NonManifoldVertex, None)], true)),
+    ("cow.obj", report(2903, 5804, 0, Some(1), &[(NonManifoldVertex, Some(1))], true)),
     // 108 zero-area faces; welding its 2100 duplicate positions joins the 151 components.
     ("dragon_vrip.off.gz", report(437645, 871414, 407, Some(-197), &[(ZeroAreaFace, Some(108))], true)),
-    ("dragon_vrip_res4.off", report(5205, 11102, 0, Some(509), &[(DuplicateFace, Some(502)), (NonManifoldEdge, Some(803)), (NonManifoldVertex, None), (UnreferencedVertex, Some(2))], false)),
+    ("dragon_vrip_res4.off", report(5205, 11102, 0, Some(509), &[(DuplicateFace, Some(502)), (NonManifoldEdge, Some(803)), (NonManifoldVertex, None), (UnreferencedVertex, Some(2))], true)),
     ("ogre.obj.gz", report(62194, 124008, 12, Some(72), &[(ZeroAreaFace, Some(4)), (NonManifoldVertex, Some(3))], true)),
     ("stanford-bunny.obj.gz", report(35947, 69451, 5, None, &[(UnreferencedVertex, Some(1113))], true)),
-    ("suzanne.obj", report(507, 32 + 468 * 2, 4, Some(3), &[(DuplicateFace, Some(1)), (NonManifoldEdge, Some(1)), (NonManifoldVertex, None)], false)),
-    ("teapot.obj", report(3644, 6320, 10, Some(-34), &[(NonManifoldVertex, Some(38))], false)),
+    ("suzanne.obj", report(507, 32 + 468 * 2, 4, Some(3), &[(DuplicateFace, Some(1)), (NonManifoldEdge, Some(1)), (NonManifoldVertex, None)], true)),
+    ("teapot.obj", report(3644, 6320, 10, Some(-34), &[(NonManifoldVertex, Some(38))], true)),
     // Face lines lack the vertex count and are 1-based: strict OFF rejects the first one.
     ("tosca_cat0_malformed.off", Parse(3403)),
-    ("trimesh_joined_tetrahedra.obj", report(5, 8, 0, Some(4), &[(DuplicateFace, Some(1)), (NonManifoldEdge, Some(3)), (NonManifoldVertex, None)], false)),
+    ("trimesh_joined_tetrahedra.obj", report(5, 8, 0, Some(4), &[(DuplicateFace, Some(1)), (NonManifoldEdge, Some(3)), (NonManifoldVertex, None)], true)),
     ("trimesh_nancolor.obj", Valid { v: 8, tris: 12, loops: 0, components: 1, genus: 0 }),
     ("trimesh_negative_indices.obj", Valid { v: 8, tris: 12, loops: 0, components: 1, genus: 0 }),
     // The 2-index face is skipped (fan triangulation of a 2-gon is empty).
@@ -75,16 +75,16 @@ const TABLE: &[(&str, Expect)] = &[
     ("synthetic/duplicate_vertices_soup.obj", Valid { v: 24, tris: 12, loops: 6, components: 6, genus: 0 }),
     ("synthetic/empty.obj", report(0, 0, 0, Some(0), &[(Empty, Some(1))], false)),
     ("synthetic/empty.off", report(0, 0, 0, Some(0), &[(Empty, Some(1))], false)),
-    ("synthetic/flipped_face.obj", report(4, 4, 0, Some(2), &[(InconsistentOrientation, Some(3))], false)),
+    ("synthetic/flipped_face.obj", report(4, 4, 0, Some(2), &[(InconsistentOrientation, Some(3))], true)),
     ("synthetic/index_out_of_range.obj", report(4, 2, 1, None, &[(IndexOutOfRange, Some(1)), (UnreferencedVertex, Some(1))], true)),
     ("synthetic/inf_vertex.off", report(4, 4, 0, Some(2), &[(NonFiniteCoordinate, Some(1))], true)),
     ("synthetic/isolated_vertices.off", report(6, 4, 0, Some(2), &[(UnreferencedVertex, Some(2))], true)),
     ("synthetic/mixed_polygons.obj", Valid { v: 10, tris: 5 * 2 + 2 * 3, loops: 0, components: 1, genus: 0 }),
     ("synthetic/moebius.obj", report(48, 48, 1, Some(0), &[(InconsistentOrientation, Some(1))], false)),
     ("synthetic/nan_vertex.obj", report(4, 4, 0, Some(2), &[(NonFiniteCoordinate, Some(1))], true)),
-    ("synthetic/nonmanifold_edge_fin.obj", report(5, 3, 1, Some(1), &[(NonManifoldEdge, Some(1)), (NonManifoldVertex, None)], false)),
-    ("synthetic/nonmanifold_vertex_bowtie.obj", report(5, 2, 1, Some(1), &[(NonManifoldVertex, Some(1))], false)),
-    ("synthetic/nonmanifold_vertex_two_cones.obj", report(9, 12, 0, Some(3), &[(NonManifoldVertex, Some(1))], false)),
+    ("synthetic/nonmanifold_edge_fin.obj", report(5, 3, 1, Some(1), &[(NonManifoldEdge, Some(1)), (NonManifoldVertex, None)], true)),
+    ("synthetic/nonmanifold_vertex_bowtie.obj", report(5, 2, 1, Some(1), &[(NonManifoldVertex, Some(1))], true)),
+    ("synthetic/nonmanifold_vertex_two_cones.obj", report(9, 12, 0, Some(3), &[(NonManifoldVertex, Some(1))], true)),
     ("synthetic/sliver_faces.obj", report(5, 6, 0, Some(2), &[(ZeroAreaFace, Some(1))], true)),
     // The header promises 4 vertices and 4 faces; the face line is read as a 4th vertex.
     ("synthetic/truncated.off", Parse(7)),
@@ -180,7 +180,12 @@ fn every_bad_file_is_diagnosed_and_repairable_ones_are_repaired() {
                 assert!(ValidMesh::new(mesh.clone()).is_err(), "{name}");
                 let r = repair::repair_all(&mesh, &RepairOptions::default());
                 let valid = ValidMesh::new(r.mesh);
-                assert_eq!(valid.is_ok(), *repairable, "{name}: after repair {valid:?}");
+                assert_eq!(
+                    valid.is_ok(),
+                    *repairable,
+                    "{name}: after repair {:?}",
+                    valid.err()
+                );
             }
         }
     }

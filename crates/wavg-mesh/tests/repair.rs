@@ -5,15 +5,18 @@ use proptest::prelude::*;
 use wavg_mesh::{NONE, ProblemKind, TexCoords, TriMesh, ValidMesh, analyze, procedural};
 use wavg_mesh::{RepairOptions, Repaired, repair};
 
-/// Every face of the result is the mapped original face, every position is the original's,
-/// and the two vertex maps are consistent.
+/// Every position is the original's, the two vertex maps are consistent, and every face
+/// is the mapped original face (up to a flip, which swaps its last two corners and their
+/// texture coordinates).
 fn check_maps(orig: &TriMesh, r: &Repaired) {
     assert_eq!(r.vertex_map.len(), r.mesh.n_vertices());
     assert_eq!(r.face_map.len(), r.mesh.n_faces());
     assert_eq!(r.original_to_new.len(), orig.n_vertices());
     for (new, &o) in r.vertex_map.iter().enumerate() {
         assert_eq!(r.mesh.positions[new], orig.positions[o as usize]);
-        assert_eq!(r.original_to_new[o as usize], new as u32);
+        // A copy made by splitting names its original, which keeps one new index.
+        let kept = r.original_to_new[o as usize];
+        assert_eq!(r.vertex_map[kept as usize], o);
     }
     for (o, &new) in r.original_to_new.iter().enumerate() {
         if new != NONE {
@@ -23,16 +26,20 @@ fn check_maps(orig: &TriMesh, r: &Repaired) {
         }
     }
     for (f, &of) in r.face_map.iter().enumerate() {
-        let ot = orig.triangles[of as usize];
-        let nt = r.mesh.triangles[f];
-        for c in 0..3 {
-            assert_eq!(
-                r.original_to_new[ot[c] as usize], nt[c],
-                "face {f} corner {c}"
-            );
-        }
+        let ot = orig.triangles[of as usize].map(|v| r.original_to_new[v as usize]);
+        let nt = r.mesh.triangles[f].map(|v| r.original_to_new[r.vertex_map[v as usize] as usize]);
+        let flipped = [nt[0], nt[2], nt[1]];
+        assert!(nt == ot || flipped == ot, "face {f}: {nt:?} vs {ot:?}");
         if let (Some(ou), Some(nu)) = (&orig.uv, &r.mesh.uv) {
-            assert_eq!(nu.faces[f], ou.faces[of as usize]);
+            let (n, o) = (nu.faces[f], ou.faces[of as usize]);
+            assert!(
+                if nt == ot {
+                    n == o
+                } else {
+                    [n[0], n[2], n[1]] == o
+                },
+                "uv of face {f}"
+            );
         }
     }
 }
@@ -270,11 +277,193 @@ fn remedies_named_by_problem_kinds_are_real() {
     m.positions.push(mid);
     m.triangles.push([0, 11, n]);
     cases.push((m, ProblemKind::ZeroAreaFace));
+    let mut m = base.clone();
+    m.triangles[3].swap(0, 1);
+    cases.push((m, ProblemKind::InconsistentOrientation));
+    // Two spheres glued at one vertex, and along one edge.
+    let (mut pinch, mut fin) = (base.clone(), base.clone());
+    for (m, shared) in [(&mut pinch, 1), (&mut fin, 2)] {
+        let t0 = base.triangles[0];
+        let shift = Vector3::new(3.0, 0.0, 0.0);
+        let new: Vec<u32> = (0..n).map(|v| n + v).collect();
+        m.positions.extend(base.positions.iter().map(|p| p + shift));
+        // Move the copy so that its first `shared` corners of face 0 coincide.
+        for &v in &t0[..shared] {
+            m.positions[(n + v) as usize] = base.positions[v as usize];
+        }
+        let glue = |v: u32| {
+            if t0[..shared].contains(&v) {
+                v
+            } else {
+                new[v as usize]
+            }
+        };
+        m.triangles
+            .extend(base.triangles.iter().map(|t| t.map(glue)));
+    }
+    cases.push((pinch, ProblemKind::NonManifoldVertex));
+    cases.push((fin, ProblemKind::NonManifoldEdge));
     for (m, kind) in cases {
         let a = analyze(&m);
         assert!(a.report.count(kind) > 0, "{kind:?}: {}", a.report);
         assert!(kind.remedy().is_some(), "{kind:?}");
         let r = repair::repair_all(&m, &RepairOptions::default());
         assert!(ValidMesh::new(r.mesh).is_ok(), "{}", a.report);
+    }
+}
+
+/// A fin (three triangles on one edge), a bowtie (two triangles on one vertex) and two
+/// tetrahedra sharing an edge come apart into valid sheets; original indices still name
+/// the same positions, and the texture coordinates follow their faces.
+#[test]
+fn non_manifold_vertices_and_edges_are_split() {
+    let p = |x: f64, y: f64, z: f64| Vector3::new(x, y, z);
+    let fin = TriMesh::new(
+        vec![
+            p(0., 0., 0.),
+            p(1., 0., 0.),
+            p(0., 1., 0.),
+            p(0., -1., 0.),
+            p(0., 0., 1.),
+        ],
+        vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
+    );
+    let bowtie = TriMesh::new(
+        vec![
+            p(0., 0., 0.),
+            p(1., 0., 0.),
+            p(1., 1., 0.),
+            p(-1., 0., 0.),
+            p(-1., -1., 0.),
+        ],
+        vec![[0, 1, 2], [0, 3, 4]],
+    );
+    let tet = |o: u32| {
+        [
+            [o, o + 1, o + 2],
+            [o, o + 3, o + 1],
+            [o + 1, o + 3, o + 2],
+            [o + 2, o + 3, o],
+        ]
+    };
+    let mut tets = TriMesh::new(
+        vec![p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.), p(0., 0., 1.)],
+        tet(0).to_vec(),
+    );
+    // A second tetrahedron on the first one's edge (0, 1).
+    tets.positions.extend([p(0., -1., 0.), p(0., 0., -1.)]);
+    tets.triangles
+        .extend([[1, 0, 4], [0, 5, 4], [4, 5, 1], [1, 5, 0]]);
+    for (name, mut m, sheets) in [("fin", fin, 3), ("bowtie", bowtie, 2), ("tets", tets, 2)] {
+        m.uv = Some(TexCoords {
+            coords: vec![nalgebra::Vector2::zeros(); 3 * m.n_faces()],
+            faces: (0..m.n_faces() as u32)
+                .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+                .collect(),
+        });
+        assert!(ValidMesh::new(m.clone()).is_err(), "{name}");
+        let r = repair::make_manifold(&m);
+        check_maps(&m, &r);
+        assert_eq!(r.mesh.n_faces(), m.n_faces(), "{name}: no face lost");
+        assert_eq!(r.removed_vertices(), 0, "{name}");
+        let v = ValidMesh::new(r.mesh.clone()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(v.topology().n_components(), sheets, "{name}");
+        assert_eq!(
+            r.added_vertices(),
+            r.mesh.n_vertices() - m.n_vertices(),
+            "{name}"
+        );
+        assert_eq!(r.mesh.uv, m.uv, "{name}: texture coordinates unchanged");
+    }
+}
+
+/// Flipped faces are turned back (with their texture coordinates) and the first face of
+/// each component keeps its orientation; a Moebius strip cannot be oriented and stays
+/// invalid without panicking.
+#[test]
+fn faces_are_oriented_consistently() {
+    let base = procedural::icosphere(2);
+    let mut m = base.clone();
+    for f in (1..m.n_faces()).step_by(3) {
+        m.triangles[f].swap(1, 2);
+    }
+    m.uv = Some(TexCoords {
+        coords: vec![nalgebra::Vector2::zeros(); 3 * m.n_faces()],
+        faces: (0..m.n_faces() as u32)
+            .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+            .collect(),
+    });
+    assert!(ValidMesh::new(m.clone()).is_err());
+    let r = repair::orient_faces(&m);
+    check_maps(&m, &r);
+    assert_eq!(r.mesh.triangles, base.triangles);
+    assert!(ValidMesh::new(r.mesh).is_ok());
+
+    let moebius = moebius_strip(24);
+    let r = repair::repair_all(&moebius, &RepairOptions::default());
+    check_maps(&moebius, &r);
+    let a = analyze(&r.mesh);
+    assert!(a.report.count(ProblemKind::InconsistentOrientation) > 0);
+}
+
+/// A Moebius strip of `n` quads (two triangles each), one half twist.
+fn moebius_strip(n: u32) -> TriMesh {
+    let mut positions = Vec::new();
+    for i in 0..n {
+        let t = std::f64::consts::TAU * i as f64 / n as f64;
+        for s in [-0.3, 0.3] {
+            let (r, h) = (1.0 + s * (t / 2.0).cos(), s * (t / 2.0).sin());
+            positions.push(Vector3::new(r * t.cos(), r * t.sin(), h));
+        }
+    }
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        let (a, b) = (2 * i, 2 * i + 1);
+        // The last quad closes onto the first with its sides swapped.
+        let (c, d) = if i + 1 == n {
+            (1, 0)
+        } else {
+            (2 * i + 2, 2 * i + 3)
+        };
+        triangles.push([a, c, b]);
+        triangles.push([b, c, d]);
+    }
+    TriMesh::new(positions, triangles)
+}
+
+fn scrambled(level: u32, seed: u64, flips: usize, glue: bool) -> TriMesh {
+    let mut m = procedural::with_noise(procedural::icosphere(level), 0.1, seed);
+    let nf = m.n_faces();
+    for k in 0..flips {
+        m.triangles[(k * 7919 + seed as usize) % nf].swap(0, 2);
+    }
+    if glue {
+        // A second sphere sharing one vertex with the first.
+        let n = m.n_vertices() as u32;
+        let first = m.triangles[0][0];
+        let shift = Vector3::new(5.0, 0.0, 0.0);
+        let copy: Vec<_> = m.positions.iter().map(|p| p + shift).collect();
+        m.positions.extend(copy);
+        let more: Vec<[u32; 3]> = (m.triangles.iter())
+            .map(|t| t.map(|v| if v == first { first } else { v + n }))
+            .collect();
+        m.triangles.extend(more);
+    }
+    m
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    /// Random flips and a pinched second sphere: the default repairs give a valid mesh
+    /// with every face kept, and every original index still names its position.
+    #[test]
+    fn repair_all_orients_and_splits(level in 0u32..3, seed in 0u64..1000, flips in 0usize..40, glue: bool) {
+        let m = scrambled(level, seed, flips, glue);
+        let r = repair::repair_all(&m, &RepairOptions::default());
+        check_maps(&m, &r);
+        prop_assert_eq!(r.mesh.n_faces(), m.n_faces());
+        let v = ValidMesh::new(r.mesh.clone());
+        prop_assert!(v.is_ok(), "{:?}", v.err());
+        prop_assert_eq!(v.unwrap().topology().n_components(), 1 + glue as usize);
     }
 }

@@ -27,7 +27,10 @@ use crate::analyze::is_degenerate;
 use crate::mesh::{NONE, TriMesh};
 use crate::topology::face_components;
 
+mod manifold;
 pub(crate) mod types;
+
+pub use manifold::{make_manifold, orient_faces, split_nonmanifold_vertices};
 
 use types::{RepairOptions, Repaired};
 
@@ -273,6 +276,14 @@ pub fn repair_all(mesh: &TriMesh, options: &RepairOptions) -> Repaired {
     }
     if options.drop_duplicate_faces {
         let next = drop_duplicate_faces(&r.mesh);
+        r = r.then(next);
+    }
+    if options.make_manifold {
+        let next = make_manifold(&r.mesh);
+        r = r.then(next);
+    }
+    if options.orient {
+        let next = orient_faces(&r.mesh);
         r = r.then(next);
     }
     if options.keep_largest_component {

@@ -27,7 +27,20 @@ impl Repaired {
 
     /// Number of original vertices that were merged into others or dropped.
     pub fn removed_vertices(&self) -> usize {
-        self.original_to_new.len() - self.vertex_map.len()
+        self.original_to_new.len() - self.kept_vertices()
+    }
+
+    /// Number of new vertices that are copies of a kept vertex (made by splitting a
+    /// non-manifold vertex).
+    pub fn added_vertices(&self) -> usize {
+        self.vertex_map.len() - self.kept_vertices()
+    }
+
+    /// Original vertices that survive as themselves (not dropped, not merged away).
+    fn kept_vertices(&self) -> usize {
+        (self.original_to_new.iter().enumerate())
+            .filter(|&(v, &n)| self.vertex_map.get(n as usize) == Some(&(v as u32)))
+            .count()
     }
 
     /// Number of original faces that were dropped.
@@ -79,8 +92,9 @@ impl Repaired {
     }
 }
 
-/// Which repairs [`repair_all`](super::repair_all) applies, in this order: weld, drop degenerate faces, drop
-/// duplicate faces, keep the largest component, drop unreferenced vertices.
+/// Which repairs [`repair_all`](super::repair_all) applies, in this order: weld, drop
+/// degenerate faces, drop duplicate faces, make manifold, orient, keep the largest
+/// component, drop unreferenced vertices.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RepairOptions {
     /// Weld vertices closer than this distance (`Some(0.0)`: identical positions only).
@@ -89,6 +103,12 @@ pub struct RepairOptions {
     pub drop_degenerate_faces: bool,
     /// Drop faces repeating an earlier face's vertices.
     pub drop_duplicate_faces: bool,
+    /// Split vertices and edges shared by separate sheets of surface
+    /// ([`make_manifold`](super::make_manifold)).
+    pub make_manifold: bool,
+    /// Flip faces to a consistent orientation per component
+    /// ([`orient_faces`](super::orient_faces)).
+    pub orient: bool,
     /// Keep only the largest connected component.
     pub keep_largest_component: bool,
     /// Drop vertices no face uses.
@@ -97,12 +117,14 @@ pub struct RepairOptions {
 
 impl Default for RepairOptions {
     /// Everything that cannot lose surface: exact weld, drop degenerate and duplicate
-    /// faces and unreferenced vertices; components are kept.
+    /// faces, make manifold, orient, drop unreferenced vertices; components are kept.
     fn default() -> Self {
         Self {
             weld: Some(0.0),
             drop_degenerate_faces: true,
             drop_duplicate_faces: true,
+            make_manifold: true,
+            orient: true,
             keep_largest_component: false,
             drop_unreferenced_vertices: true,
         }
