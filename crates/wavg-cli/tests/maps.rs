@@ -192,6 +192,79 @@ fn a_pose_pair_maps_close_to_its_ground_truth() {
     assert!(err < 0.01, "mean error {err} of the diagonal");
 }
 
+/// Two different shapes (horse and camel, 107 paired markers), where the camel must be
+/// repaired first (non-manifold, several components): the markers are carried through
+/// the repair's vertex map, and most of the horse maps onto the camel without folding.
+#[test]
+fn different_shapes_map_through_markers_after_repair() {
+    let test = "different_shapes_map_through_markers_after_repair";
+    let (Some(horse), Some(camel), Some(cons)) = (
+        wavg_testdata::require_data_file(
+            test,
+            "correspondence/sumner_horse/horse-reference.obj.gz",
+        ),
+        wavg_testdata::require_data_file(test, "bad/camel-reference.obj.gz"),
+        wavg_testdata::require_data_file(test, "correspondence/horse_camel_markers.cons"),
+    ) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (fixed, map) = (dir.path().join("camel.obj"), dir.path().join("camel.map"));
+    wavg_ok(&[
+        "repair",
+        &s(&camel),
+        "-o",
+        &s(&fixed),
+        "--largest-component",
+        "--map",
+        &s(&map),
+    ]);
+    // Original camel id -> repaired id (the first copy of a split vertex).
+    let mut new_id = std::collections::HashMap::new();
+    for (new, line) in std::fs::read_to_string(&map).unwrap().lines().enumerate() {
+        new_id.entry(line.parse::<u32>().unwrap()).or_insert(new);
+    }
+    let text = std::fs::read_to_string(&cons).unwrap();
+    let mut lines = text.lines();
+    let count: usize = lines.next().unwrap().trim().parse().unwrap();
+    let (mut ha, mut ca) = (String::new(), String::new());
+    for l in lines.filter(|l| !l.trim().is_empty()) {
+        let ids: Vec<u32> = l
+            .split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|t| !t.is_empty())
+            .map(|t| t.parse().unwrap())
+            .collect();
+        ha.push_str(&format!("v {}\n", ids[0]));
+        ca.push_str(&format!("v {}\n", new_id[&ids[1]]));
+    }
+    assert_eq!(ha.lines().count(), count);
+    let (hp, cp) = (dir.path().join("h.txt"), dir.path().join("c.txt"));
+    std::fs::write(&hp, ha).unwrap();
+    std::fs::write(&cp, ca).unwrap();
+    let out = dir.path().join("map.txt");
+    let r = wavg_ok(&[
+        "correspond",
+        "--source",
+        &s(&horse),
+        "--target",
+        &s(&fixed),
+        "--source-anchors",
+        &s(&hp),
+        "--target-anchors",
+        &s(&cp),
+        "-o",
+        &s(&out),
+        "--json",
+    ]);
+    let (o, _) = json_object(&r);
+    let frac = o["valid_fraction"].as_f64().unwrap();
+    let stretch = o["stretch_best95"].as_f64().unwrap();
+    let flipped = o["flipped_area_fraction"].as_f64().unwrap();
+    assert!(frac > 0.8, "valid fraction {frac}");
+    assert!(stretch < 1.5, "stretch of the best 95% {stretch}");
+    assert!(flipped < 0.05, "flipped area {flipped}");
+}
+
 #[test]
 fn bad_input_writes_nothing() {
     let dir = tempfile::tempdir().unwrap();
