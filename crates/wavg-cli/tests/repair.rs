@@ -5,8 +5,28 @@ mod common;
 
 use common::{wavg, wavg_ok};
 
+use std::path::Path;
+
 use serde_json::Value;
 use wavg_mesh::{ValidMesh, io, procedural};
+
+/// `wavg repair IN -o OUT --map MAP --json`, which must succeed; its JSON.
+fn repair_with_map(input: &Path, output: &Path, map: &Path) -> Value {
+    let args = [
+        "repair",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+    ];
+    let out = wavg_ok(&[&args[..], &["--map", map.to_str().unwrap(), "--json"]].concat());
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// The vertex map file: one input vertex per output vertex.
+fn read_map(map: &Path) -> Vec<u32> {
+    let text = std::fs::read_to_string(map).unwrap();
+    text.lines().map(|l| l.parse().unwrap()).collect()
+}
 
 #[test]
 fn repairs_unwelded_mesh_and_writes_vertex_map() {
@@ -26,26 +46,13 @@ fn repairs_unwelded_mesh_and_writes_vertex_map() {
     io::save(&input, &soup).unwrap();
     let output = dir.path().join("fixed.off");
     let map = dir.path().join("map.txt");
-    let out = wavg_ok(&[
-        "repair",
-        input.to_str().unwrap(),
-        "-o",
-        output.to_str().unwrap(),
-        "--map",
-        map.to_str().unwrap(),
-        "--json",
-    ]);
-    let j: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let j = repair_with_map(&input, &output, &map);
     assert_eq!(j["valid"], true);
     assert_eq!(j["vertices"], torus.n_vertices());
     assert_eq!(j["faces"], torus.n_faces());
     let fixed = ValidMesh::new(io::load(&output).unwrap()).expect("repaired mesh is valid");
     assert_eq!(fixed.topology().genus(), 1);
-    let lines: Vec<u32> = std::fs::read_to_string(&map)
-        .unwrap()
-        .lines()
-        .map(|l| l.parse().unwrap())
-        .collect();
+    let lines = read_map(&map);
     assert_eq!(lines.len(), fixed.n_vertices());
     for (new, &old) in lines.iter().enumerate() {
         assert_eq!(fixed.positions[new], soup.positions[old as usize]);
@@ -101,16 +108,7 @@ fn remaining_problems_exit_1_and_components_need_opt_in() {
     io::save(&input, &fin).unwrap();
     let output = dir.path().join("fin-out.obj");
     let map = dir.path().join("fin-map.txt");
-    let out = wavg_ok(&[
-        "repair",
-        input.to_str().unwrap(),
-        "-o",
-        output.to_str().unwrap(),
-        "--map",
-        map.to_str().unwrap(),
-        "--json",
-    ]);
-    let j: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let j = repair_with_map(&input, &output, &map);
     assert_eq!(
         (j["valid"].as_bool(), j["components"].as_u64()),
         (Some(true), Some(3))
@@ -120,11 +118,7 @@ fn remaining_problems_exit_1_and_components_need_opt_in() {
         (Some(4), Some(0))
     );
     let fixed = ValidMesh::new(io::load(&output).unwrap()).expect("split fin is valid");
-    let lines: Vec<u32> = std::fs::read_to_string(&map)
-        .unwrap()
-        .lines()
-        .map(|l| l.parse().unwrap())
-        .collect();
+    let lines = read_map(&map);
     assert_eq!(lines.len(), 9);
     assert_eq!(&lines[..5], &[0, 1, 2, 3, 4]);
     for (new, &old) in lines.iter().enumerate() {

@@ -82,16 +82,13 @@ pub fn split_nonmanifold_vertices(mesh: &TriMesh) -> Repaired {
             }
         }
     }
-    Repaired {
-        mesh: TriMesh {
-            positions,
-            triangles,
-            uv: mesh.uv.clone(),
-        },
-        vertex_map,
-        original_to_new: (0..nv as u32).collect(),
-        face_map: (0..nf as u32).collect(),
-    }
+    let uv = mesh.uv.clone();
+    let mesh = TriMesh {
+        positions,
+        triangles,
+        uv,
+    };
+    Repaired::faces_kept(mesh, vertex_map, (0..nv as u32).collect())
 }
 
 /// Drops, on every edge with more than two faces, all faces but the first two (in face
@@ -183,10 +180,5 @@ pub fn orient_faces(mesh: &TriMesh) -> Repaired {
         }
     }
     let nv = mesh.n_vertices() as u32;
-    Repaired {
-        mesh: out,
-        vertex_map: (0..nv).collect(),
-        original_to_new: (0..nv).collect(),
-        face_map: (0..nf as u32).collect(),
-    }
+    Repaired::faces_kept(out, (0..nv).collect(), (0..nv).collect())
 }

@@ -77,16 +77,13 @@ fn remap_vertices(mesh: &TriMesh, original_to_new: Vec<u32>, vertex_map: Vec<u32
         .iter()
         .map(|t| [map(t[0]), map(t[1]), map(t[2])])
         .collect();
-    Repaired {
-        mesh: TriMesh {
-            positions,
-            triangles,
-            uv: mesh.uv.clone(),
-        },
-        vertex_map,
-        original_to_new,
-        face_map: (0..mesh.n_faces() as u32).collect(),
-    }
+    let uv = mesh.uv.clone();
+    let mesh = TriMesh {
+        positions,
+        triangles,
+        uv,
+    };
+    Repaired::faces_kept(mesh, vertex_map, original_to_new)
 }
 
 /// Merges vertices whose positions are within `tolerance` (Euclidean; `0.0` merges only

@@ -48,6 +48,21 @@ impl Repaired {
         original_faces - self.face_map.len()
     }
 
+    /// A repair that keeps every face, in order.
+    pub(super) fn faces_kept(
+        mesh: TriMesh,
+        vertex_map: Vec<VertexId>,
+        original_to_new: Vec<VertexId>,
+    ) -> Self {
+        let face_map = (0..mesh.n_faces() as u32).collect();
+        Self {
+            mesh,
+            vertex_map,
+            original_to_new,
+            face_map,
+        }
+    }
+
     /// The identity repair of `mesh`.
     pub(super) fn identity(mesh: &TriMesh) -> Self {
         let nv = mesh.n_vertices() as u32;
