@@ -71,7 +71,7 @@ vertices_per_cpu_s (CPU time of the map, all threads), counts per reason and, wi
 --ground-truth, the error of the images against vertex i of the target as fractions of the
 target's bounding-box diagonal.
 
-Timings: `seconds` is the wall time of the map alone, from the first inverse problem to the
+Timings: `seconds` is the wall time of the map alone, from starting its worker threads to the
 last validity decision; `vertices_per_s` is source_vertices / seconds. Neither includes
 setup_seconds: reading the meshes, anchors and embeddings (or precomputing them), building
 the projectors and resolving the anchors. Writing MAP.txt and --ground-truth come after and
