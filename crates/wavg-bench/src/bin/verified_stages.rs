@@ -1,8 +1,9 @@
 //! Where the verified inverse's time goes: the paper's inverse batch, the forward batch that
 //! checks it, and each rung of the penalty ladder (points tried, forward paths), composed
 //! from the public batches one stage at a time, on the Table-1 protocol's anchors and
-//! points; then the library's verified batch on the same points. Wall and process CPU
-//! time (CPU time is what a loaded machine distorts least).
+//! points; then the library's verified batch on the same points. Wall and CPU time of all
+//! threads (from `/proc/self/task/*/schedstat`; CPU time is what a loaded machine distorts
+//! least).
 //!
 //! `cargo run --release -p wavg-bench --bin verified_stages -- MESH EMB.wavg ANCHORS QUERIES [THREADS]`
 
@@ -42,18 +43,15 @@ fn main() {
     let tol = 1e-3 * solver.mean_edge_length();
     let opts = ForwardOptions::default();
     let us = |t: Instant| t.elapsed().as_secs_f64() / n * 1e6;
+    // On-CPU nanoseconds of every thread of the process (the scheduler's accounting).
     let cpu = || {
-        let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-        let f: Vec<f64> = s
-            .rsplit(')')
-            .next()
-            .unwrap_or("")
-            .split_whitespace()
-            .filter_map(|x| x.parse().ok())
-            .collect();
-        f.get(10)
-            .zip(f.get(11))
-            .map_or(f64::NAN, |(u, s)| (u + s) / 100.0)
+        let tasks = std::fs::read_dir("/proc/self/task").into_iter().flatten();
+        tasks
+            .flatten()
+            .filter_map(|t| std::fs::read_to_string(t.path().join("schedstat")).ok())
+            .filter_map(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+            .sum::<f64>()
+            / 1e9
     };
     let cpu_us = |c0: f64| (cpu() - c0) / n * 1e6;
     for rep in 0..3 {
