@@ -164,9 +164,9 @@ impl System {
         let mut q = self.q0.clone();
         if let Some(s_chol) = &s_chol {
             // Woodbury: subtract D^-2 V^T S^-1 V z from z = D^-2 x, for the three columns.
-            let u = s_chol.solve(&self.t);
+            let ut = s_chol.solve(&self.t).transpose();
             for ((qi, vi), &di) in q.iter_mut().zip(&self.v).zip(&self.dinv2) {
-                *qi -= (u.transpose() * vi) * di;
+                *qi -= (ut * vi) * di;
             }
         }
         let gm: nalgebra::Matrix3<f64> = self
