@@ -16,10 +16,12 @@
 //! trip. A single wrongly mapped vertex spoils all its triangles but only a minority of
 //! each neighbour's, so the rejection does not spread to correct neighbours.
 
+use std::time::Instant;
+
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use wavg_mesh::{SurfacePoint, ValidMesh};
-use wavg_solve::{ForwardOptions, ForwardResult, RoundTrip, SolveError, Solver};
+use wavg_solve::{BatchWeights, ForwardOptions, ForwardResult, Par, RoundTrip, SolveError, Solver};
 
 use crate::metrics::{Distortion, distortion};
 
@@ -128,6 +130,15 @@ pub fn map_points(
     points: &[SurfacePoint],
     verified: bool,
 ) -> Result<Vec<Mapped>, SolveError> {
+    check_paired(source, target)?;
+    let (weights, trips) = source_weights(source, points, verified);
+    let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
+    let images = target.forward_batch(&rows, &ForwardOptions::default());
+    Ok(mapped(&weights, images, trips))
+}
+
+/// The anchors of `source` and `target` are paired one to one.
+fn check_paired(source: &Solver, target: &Solver) -> Result<(), SolveError> {
     if source.n_anchors() != target.n_anchors() {
         return Err(SolveError::InvalidParameter(format!(
             "the source has {} anchors and the target {}; they must be paired one to one",
@@ -135,29 +146,43 @@ pub fn map_points(
             target.n_anchors()
         )));
     }
-    let (weights, trips): (Vec<Result<Vec<f64>, SolveError>>, Vec<bool>) = if verified {
-        source
-            .inverse_verified_batch(points, ROUND_TRIP_TOLERANCE)
-            .into_iter()
-            .map(|r| match r {
-                Ok(v) => (Ok(v.weights), v.round_trip != RoundTrip::NotReached),
-                Err(e) => (Err(e), false),
-            })
-            .unzip()
-    } else {
-        let (batch, trips) = paper_round_trip(source, points);
-        let weights = batch
-            .iter()
-            .map(|r| r.map(<[f64]>::to_vec).map_err(Clone::clone))
-            .collect();
-        (weights, trips)
-    };
-    let rows: Vec<&[f64]> = weights
+    Ok(())
+}
+
+/// Each point's weights on the source and whether they return to it: the verified
+/// inverse's (round trip checked, penalised where needed) or the paper's, with their
+/// round trip checked the same way.
+fn source_weights(
+    source: &Solver,
+    points: &[SurfacePoint],
+    verified: bool,
+) -> (BatchWeights, Vec<bool>) {
+    if !verified {
+        return paper_round_trip(source, points);
+    }
+    let (mut weights, mut trips) = (BatchWeights::default(), Vec::new());
+    // `Par::Rayon` always starts.
+    let _ = source.inverse_verified_batch_into(
+        points,
+        ROUND_TRIP_TOLERANCE,
+        &mut weights,
+        &mut trips,
+        Par::Rayon,
+    );
+    let trips = trips
         .iter()
-        .map(|r| r.as_deref().unwrap_or(&[]))
+        .map(|t| t.as_ref().is_ok_and(|t| *t != RoundTrip::NotReached))
         .collect();
-    let images = target.forward_batch(&rows, &ForwardOptions::default());
-    Ok(weights
+    (weights, trips)
+}
+
+/// The images with their weights' round trips and smallest weights.
+fn mapped(
+    weights: &BatchWeights,
+    images: Vec<Result<ForwardResult, SolveError>>,
+    trips: Vec<bool>,
+) -> Vec<Mapped> {
+    weights
         .iter()
         .zip(images)
         .zip(trips)
@@ -173,7 +198,7 @@ pub fn map_points(
                 min_weight: f64::NAN,
             },
         })
-        .collect())
+        .collect()
 }
 
 /// The paper's inverse weights of `points` and whether each returns to its point
@@ -212,6 +237,23 @@ pub struct Correspondence {
     /// Distortion of the map restricted to valid vertices (faces with three valid
     /// corners); flips are judged against the target's normals where the corners land.
     pub distortion: Distortion,
+    /// Wall time of each stage of [`correspond_vertices`].
+    pub timings: CorrespondTimings,
+}
+
+/// Wall time of each stage of a correspondence, in seconds; with the `serde` feature,
+/// keyed by the field names.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct CorrespondTimings {
+    /// The weights of every source vertex: the inverse problem on the source with its
+    /// round-trip check (forward problems on the source, and the penalty ladder for the
+    /// verified inverse).
+    pub weights_seconds: f64,
+    /// The forward problems on the target.
+    pub forward_seconds: f64,
+    /// The validity test and the distortion of the map.
+    pub validity_seconds: f64,
 }
 
 /// Vertices per [`Validity::reason`]; with the `serde` feature, keyed by those reasons.
@@ -286,9 +328,18 @@ pub fn correspond_vertices(
             opts.max_negative, opts.max_stretch
         )));
     }
+    check_paired(source, target)?;
+    let t = Instant::now();
     let mesh = source.mesh();
     let points = vertex_points(mesh);
-    let mapped = map_points(source, target, &points, opts.verified)?;
+    let (weights, trips) = source_weights(source, &points, opts.verified);
+    let weights_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
+    let images = target.forward_batch(&rows, &ForwardOptions::default());
+    let forward_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let mapped = mapped(&weights, images, trips);
     let mut validity: Vec<Validity> = mapped
         .iter()
         .map(|m| match &m.target {
@@ -326,6 +377,11 @@ pub fn correspond_vertices(
         mapped,
         validity,
         distortion,
+        timings: CorrespondTimings {
+            weights_seconds,
+            forward_seconds,
+            validity_seconds: t.elapsed().as_secs_f64(),
+        },
     })
 }
 

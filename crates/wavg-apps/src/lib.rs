@@ -23,8 +23,8 @@ mod correspond;
 mod metrics;
 
 pub use correspond::{
-    CorrespondOptions, Correspondence, Mapped, ROUND_TRIP_TOLERANCE, ReasonCounts, Validity,
-    ValidityTest, correspond_vertices, map_points, vertex_points,
+    CorrespondOptions, CorrespondTimings, Correspondence, Mapped, ROUND_TRIP_TOLERANCE,
+    ReasonCounts, Validity, ValidityTest, correspond_vertices, map_points, vertex_points,
 };
 pub use metrics::{Distortion, distortion};
 

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use wavg::apps::{
-    CorrespondOptions, Correspondence, Distortion, ReasonCounts, Validity, ValidityTest,
-    correspond_vertices,
+    CorrespondOptions, CorrespondTimings, Correspondence, Distortion, ReasonCounts, Validity,
+    ValidityTest, correspond_vertices,
 };
 use wavg::{Anchor, Solver, Surface};
 
@@ -66,10 +66,18 @@ weights are not. `paper` is the paper's test: the weights round-trip and none is
 Output: one line per source vertex, `FACE B0 B1 B2 X Y Z` on the target, or `none REASON`
 (unanswered, no-round-trip, negative-weight, inconsistent). --json prints one object:
 source_vertices, valid_fraction, flipped_faces, flipped_area_fraction, stretch (symmetrised
-L2 stretch over the valid part), stretch_best95, seconds, vertices_per_s (precomputation
-excluded), plus cpu_seconds and vertices_per_cpu_s (CPU time of the map, all threads), counts
-per reason and, with --ground-truth, the error of the images against
-vertex i of the target as fractions of the target's bounding-box diagonal.")]
+L2 stretch over the valid part), stretch_best95, seconds, vertices_per_s, plus cpu_seconds and
+vertices_per_cpu_s (CPU time of the map, all threads), counts per reason and, with
+--ground-truth, the error of the images against vertex i of the target as fractions of the
+target's bounding-box diagonal.
+
+Timings: `seconds` is the wall time of the map alone, from starting its worker threads to the
+last validity decision; `vertices_per_s` is source_vertices / seconds. Neither includes
+setup_seconds: reading the meshes, anchors and embeddings (or precomputing them), building
+the projectors and resolving the anchors. Writing MAP.txt and --ground-truth come after and
+are not timed. The map splits into weights_seconds (inverse problems on the source with their
+round-trip checks and, for verified weights, the penalty ladder), forward_seconds (forward
+problems on the target) and validity_seconds (validity test and distortion).")]
 pub struct Args {
     #[command(flatten)]
     pub map: MapArgs,
@@ -211,6 +219,8 @@ struct JsonReport<'a> {
     reasons: ReasonCounts,
     #[serde(flatten)]
     distortion: &'a Distortion,
+    #[serde(flatten)]
+    timings: CorrespondTimings,
     seconds: f64,
     setup_seconds: f64,
     vertices_per_s: f64,
@@ -243,6 +253,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             verified: !args.map.paper_weights,
             reasons: c.map.reason_counts(),
             distortion: d,
+            timings: c.map.timings,
             seconds: c.seconds,
             setup_seconds: c.setup_seconds,
             vertices_per_s: per_s,

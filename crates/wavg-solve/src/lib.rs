@@ -37,6 +37,7 @@ mod anchors;
 mod batch;
 mod error;
 mod kernel;
+mod penalty;
 mod points;
 pub mod roundtrip;
 pub mod sampling;
@@ -78,5 +79,5 @@ pub use error::SolveError;
 /// release.
 #[doc(hidden)]
 pub mod internal {
-    pub use crate::verified::penalized_weights;
+    pub use crate::penalty::penalized_weights;
 }

@@ -19,18 +19,17 @@ use wavg_project::Par;
 
 use crate::batch::{BatchWeights, ForwardScratch};
 use crate::error::SolveError;
-use crate::kernel::AnchorCoords;
+use crate::penalty::PenaltySystem;
 use crate::points::check_point;
 use crate::solver::{ForwardOptions, ForwardResult, Solver};
-use crate::{DIM, Mat2x8, Vec8};
 
 /// The penalties tried, in order, after the paper's weights.
 pub const PENALTY_LADDER: [f64; 4] = [10.0, 100.0, 1_000.0, 10_000.0];
 
 /// Points one parallel task checks for their round trip.
 const CHECK_CHUNK: usize = 256;
-/// Points one parallel task gives penalized weights.
-const PENALTY_CHUNK: usize = 16;
+/// Points one parallel task takes up the penalty ladder.
+const PENALTY_CHUNK: usize = 4;
 
 /// Default round-trip tolerance, in mean edge lengths of the mesh (the Table 1 bench's).
 pub const DEFAULT_TOLERANCE: f64 = 1e-3;
@@ -54,132 +53,6 @@ pub struct Verified {
     pub weights: Vec<f64>,
     /// How they were found.
     pub round_trip: RoundTrip,
-}
-
-/// Weights minimising `sum (D_ii w_i)^2 + lambda d_ref |ybar - yhat|^2` under the paper's
-/// constraints (`Psi (ybar - yhat) = 0`, `sum w = 1`); `lambda = 0` gives the paper's.
-///
-/// The penalty has rank at most 8, so the normal equations are solved with the Woodbury
-/// identity in `O(n)` (an 8x8 and a 3x3 system), not as an `n x n` system. That 8x8
-/// system grows ill-conditioned as `lambda` does: results are accurate up to `lambda`
-/// around 1e6 (the ladder stops at 1e4).
-///
-/// ```
-/// use wavg_solve::AnchorCoords;
-/// use wavg_solve::internal::penalized_weights;
-/// use wavg_solve::{Mat2x8, Vec8};
-/// let mut psi = Mat2x8::zeros();
-/// psi[(0, 0)] = 1.0;
-/// psi[(1, 1)] = 1.0;
-/// // Four anchors: three in the tangent plane, one above it.
-/// let pts = [[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [0.0, 3.0, 0.0], [1.0, 1.0, 2.0]];
-/// let ys = pts.map(|p| Vec8::from_fn(|k, _| p.get(k).copied().unwrap_or(0.0)));
-/// let yhat = Vec8::from_fn(|k, _| if k < 2 { 1.0 } else { 0.0 });
-/// let anchors = AnchorCoords::from_points(&ys);
-/// let w = penalized_weights(&psi, &yhat, &anchors, 10.0, 1e6).unwrap();
-/// let ybar: Vec8 = ys.iter().zip(&w).map(|(y, w)| y * *w).sum();
-/// assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
-/// assert!((ybar - yhat).norm() < 1e-3); // the penalty pulls the average onto the point
-/// ```
-pub fn penalized_weights(
-    psi: &Mat2x8,
-    yhat: &Vec8,
-    anchors: &AnchorCoords,
-    gamma: f64,
-    lambda: f64,
-) -> Result<Vec<f64>, SolveError> {
-    let n = anchors.len();
-    if n == 0 {
-        return Err(SolveError::NoAnchors);
-    }
-    if !(gamma.is_finite() && gamma > 0.0 && lambda.is_finite() && lambda >= 0.0) {
-        return Err(SolveError::InvalidParameter(format!(
-            "gamma must be finite and positive and lambda finite and non-negative, got \
-             {gamma} and {lambda}"
-        )));
-    }
-    let g = psi * psi.transpose();
-    let gi = g
-        .try_inverse()
-        .filter(|m| m.iter().all(|x| x.is_finite()))
-        .ok_or(SolveError::DegenerateTangentPlane)?;
-    let v: Vec<Vec8> = (0..n).map(|i| anchors.get(i) - yhat).collect();
-    let a: Vec<nalgebra::Vector2<f64>> = v.iter().map(|v| psi * v).collect();
-    let d: Vec<f64> = v
-        .iter()
-        .zip(&a)
-        .map(|(v, a)| {
-            let vv = v.norm_squared();
-            let vt = (a.transpose() * gi * a)[0].clamp(0.0, vv);
-            vt + gamma * (vv - vt)
-        })
-        .collect();
-    if d.iter().any(|x| !x.is_finite()) {
-        return Err(SolveError::InvalidParameter(
-            "non-finite anchor or point coordinates".into(),
-        ));
-    }
-    let mut sorted = d.clone();
-    let k = 3.min(n - 1);
-    sorted.select_nth_unstable_by(k, f64::total_cmp);
-    if sorted[..=k].iter().any(|&x| x <= 0.0) {
-        // The point is an anchor: the one-hot weight is exact (and has no offset).
-        let i = d.iter().position(|&x| x <= 0.0).unwrap_or(0);
-        return Ok((0..n).map(|j| if j == i { 1.0 } else { 0.0 }).collect());
-    }
-    // Scale-free: D / d_ref, and the penalty scaled the same way.
-    let d_ref = sorted[k];
-    let dinv2: Vec<f64> = d.iter().map(|x| (d_ref / x).powi(2)).collect();
-    let mu = lambda / d_ref;
-    // M = D^2 + mu V^T V; M^-1 x = z - D^-2 V^T S^-1 V z with z = D^-2 x and
-    // S = I / mu + V D^-2 V^T (8x8).
-    // S is symmetric positive definite for mu > 0: its upper triangle by rank-one updates
-    // (a tenth of the flops of full outer products), then a Cholesky factor.
-    let s_chol = (mu > 0.0)
-        .then(|| {
-            let mut s = nalgebra::SMatrix::<f64, DIM, DIM>::identity() / mu;
-            for (vi, &di) in v.iter().zip(&dinv2) {
-                for c in 0..DIM {
-                    let x = vi[c] * di;
-                    for r in 0..=c {
-                        s[(r, c)] += vi[r] * x;
-                    }
-                }
-            }
-            s.fill_lower_triangle_with_upper_triangle();
-            s.cholesky()
-        })
-        .flatten();
-    // The constraint rows C = [a_0; a_1; 1] (3 x n) and Q = M^-1 C^T, row by row.
-    use nalgebra::Vector3;
-    let c: Vec<Vector3<f64>> = a.iter().map(|a| Vector3::new(a[0], a[1], 1.0)).collect();
-    let mut q: Vec<Vector3<f64>> = c.iter().zip(&dinv2).map(|(ci, &di)| ci * di).collect();
-    if let Some(s_chol) = &s_chol {
-        // Woodbury: subtract D^-2 V^T S^-1 V z from z = D^-2 x, for the three columns.
-        let mut t = nalgebra::SMatrix::<f64, DIM, 3>::zeros();
-        for (vi, qi) in v.iter().zip(&q) {
-            t += vi * qi.transpose();
-        }
-        let u = s_chol.solve(&t);
-        for ((qi, vi), &di) in q.iter_mut().zip(&v).zip(&dinv2) {
-            *qi -= (u.transpose() * vi) * di;
-        }
-    }
-    let gm: nalgebra::Matrix3<f64> = c.iter().zip(&q).map(|(ci, qi)| ci * qi.transpose()).sum();
-    let z = gm
-        .lu()
-        .solve(&nalgebra::Vector3::new(0.0, 0.0, 1.0))
-        .filter(|z| z.iter().all(|x| x.is_finite()))
-        .ok_or(SolveError::DegenerateTangentPlane)?;
-    let mut w: Vec<f64> = q.iter().map(|qi| qi.dot(&z)).collect();
-    let sum: f64 = w.iter().sum();
-    if !(sum.is_finite() && sum.abs() > 1e-12) {
-        return Err(SolveError::DegenerateTangentPlane);
-    }
-    for x in &mut w {
-        *x /= sum;
-    }
-    Ok(w)
 }
 
 impl Solver {
@@ -216,30 +89,46 @@ impl Solver {
         let paper = self.inverse(point)?;
         let target = p.position(self.mesh());
         let tol = tolerance * self.mean_edge_length();
-        let returns = |w: &[f64]| {
-            self.forward(w, &ForwardOptions::default())
-                .is_ok_and(|r| (r.position - target).norm() <= tol)
-        };
-        if returns(&paper) {
+        let opts = ForwardOptions::default();
+        if self
+            .forward(&paper, &opts)
+            .is_ok_and(|r| (r.position - target).norm() <= tol)
+        {
             return Ok(Verified {
                 weights: paper,
                 round_trip: RoundTrip::Paper,
             });
         }
-        let (psi, yhat) = self.tangent_plane(&p);
+        Ok(match self.ladder(&p, tol)? {
+            Some((weights, lambda)) => Verified {
+                weights,
+                round_trip: RoundTrip::Penalized(lambda),
+            },
+            None => Verified {
+                weights: paper,
+                round_trip: RoundTrip::NotReached,
+            },
+        })
+    }
+
+    /// The first rung of [`PENALTY_LADDER`] whose weights return to the (checked) point
+    /// `p` within `tol`, with its `lambda`; `None` when none does. The lambda-independent
+    /// part of the problem is set up once for all rungs.
+    fn ladder(&self, p: &SurfacePoint, tol: f64) -> Result<Option<(Vec<f64>, f64)>, SolveError> {
+        let target = p.position(self.mesh());
+        let (psi, yhat) = self.tangent_plane(p);
+        let system = PenaltySystem::new(&psi, &yhat, self.anchors().coords(), self.gamma())?;
+        let opts = ForwardOptions::default();
         for lambda in PENALTY_LADDER {
-            let w = penalized_weights(&psi, &yhat, self.anchors().coords(), self.gamma(), lambda)?;
-            if returns(&w) {
-                return Ok(Verified {
-                    weights: w,
-                    round_trip: RoundTrip::Penalized(lambda),
-                });
+            let w = system.weights(lambda)?;
+            if self
+                .forward(&w, &opts)
+                .is_ok_and(|r| (r.position - target).norm() <= tol)
+            {
+                return Ok(Some((w, lambda)));
             }
         }
-        Ok(Verified {
-            weights: paper,
-            round_trip: RoundTrip::NotReached,
-        })
+        Ok(None)
     }
 
     /// [`Solver::inverse_verified`] for many points in parallel on the current rayon pool
@@ -277,7 +166,8 @@ impl Solver {
     /// to `points[i]` (both carry the error when it failed). In stages, each a batch: the
     /// paper's weights for all points ([`Solver::inverse_batch_into`]) and their forward
     /// problems ([`Solver::forward_batch_into`], which orders them for cache locality);
-    /// then, for the points still not returned, one rung of the penalty ladder at a time.
+    /// then the points still not returned, each up the penalty ladder on its own (the
+    /// lambda-independent part of its problem set up once).
     /// Fails only when `par`'s threads cannot start.
     ///
     /// ```
@@ -335,36 +225,26 @@ impl Solver {
                 Ok(_) => Ok(RoundTrip::NotReached),
             }
         })?;
-        let mut pending: Vec<usize> = (0..points.len())
+        // The rest climb the penalty ladder, each point on its own.
+        let pending: Vec<usize> = (0..points.len())
             .filter(|&i| round_trips[i] == Ok(RoundTrip::NotReached))
             .collect();
         let mut tried = Vec::new();
-        for lambda in PENALTY_LADDER {
-            if pending.is_empty() {
-                break;
-            }
-            par.map_range(pending.len(), PENALTY_CHUNK, &mut tried, |k| {
-                let p = check_point(mesh, &points[pending[k]])?;
-                let (psi, yhat) = self.tangent_plane(&p);
-                penalized_weights(&psi, &yhat, self.anchors().coords(), self.gamma(), lambda)
-            })?;
-            let rows: Vec<&[f64]> = tried.iter().map(|r| r.as_deref().unwrap_or(&[])).collect();
-            self.forward_batch_into(&rows, &opts, &mut scratch, &mut fwd, par)?;
-            let mut still = Vec::new();
-            for ((&i, w), f) in pending.iter().zip(&tried).zip(&fwd) {
-                match w {
-                    Err(e) => {
-                        weights.set(i, Err(e.clone()));
-                        round_trips[i] = Err(e.clone());
-                    }
-                    Ok(w) if returns(&points[i], f) => {
-                        weights.set(i, Ok(w));
-                        round_trips[i] = Ok(RoundTrip::Penalized(lambda));
-                    }
-                    Ok(_) => still.push(i),
+        par.map_range(pending.len(), PENALTY_CHUNK, &mut tried, |k| {
+            self.ladder(&check_point(mesh, &points[pending[k]])?, tol)
+        })?;
+        for (&i, t) in pending.iter().zip(tried) {
+            match t {
+                Err(e) => {
+                    weights.set(i, Err(e.clone()));
+                    round_trips[i] = Err(e);
                 }
+                Ok(Some((w, lambda))) => {
+                    weights.set(i, Ok(&w));
+                    round_trips[i] = Ok(RoundTrip::Penalized(lambda));
+                }
+                Ok(None) => {}
             }
-            pending = still;
         }
         Ok(())
     }

@@ -8,8 +8,8 @@ use wavg_solve::DEFAULT_TOLERANCE;
 use wavg_solve::internal::penalized_weights;
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
 use wavg_solve::{
-    Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, Mat2x8, Par, Projector, RoundTrip, Solver,
-    Vec8,
+    Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, Mat2x8, PENALTY_LADDER, Par, Projector,
+    RoundTrip, Solver, Vec8,
 };
 use wavg_solve::{AnchorCoords, InverseScratch, inverse_weights};
 
@@ -91,26 +91,41 @@ fn check_verified(s: &Solver, n: usize) -> (f64, f64, f64) {
         assert_eq!(v, s.inverse_verified(p, DEFAULT_TOLERANCE).unwrap());
         assert!((v.weights.iter().sum::<f64>() - 1.0).abs() < 1e-9);
         let returns = |w: &[f64]| {
-            let r = s.forward(w, &ForwardOptions::default()).unwrap();
-            (r.position - p.position(s.mesh())).norm() <= tol
+            s.forward(w, &ForwardOptions::default())
+                .is_ok_and(|r| (r.position - p.position(s.mesh())).norm() <= tol)
         };
         let paper = s.inverse(p).unwrap();
         paper_back += returns(&paper) as usize;
+        let psi = s.projector().psi(p);
+        let yhat = s.projector().embedded().point(p);
+        let coords = s.anchors().coords();
+        let rung = |l| penalized_weights(&psi, &yhat, coords, s.gamma(), l).unwrap();
         match v.round_trip {
             RoundTrip::Paper => {
                 assert_eq!(v.weights, paper);
                 assert!(returns(&v.weights));
                 back += 1;
             }
-            RoundTrip::Penalized(_) => {
+            RoundTrip::Penalized(lambda) => {
                 assert!(!returns(&paper));
                 assert!(returns(&v.weights));
+                // The first rung that returns, with the weights penalized_weights gives.
+                // (The psi here is computed apart from the solver's, so to rounding.)
+                for (a, b) in v.weights.iter().zip(rung(lambda)) {
+                    assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+                }
+                for l in PENALTY_LADDER.into_iter().take_while(|&l| l < lambda) {
+                    assert!(!returns(&rung(l)), "rung {l} below {lambda} returns");
+                }
                 back += 1;
                 penalised += 1;
             }
             RoundTrip::NotReached => {
                 assert_eq!(v.weights, paper);
                 assert!(!returns(&paper));
+                for l in PENALTY_LADDER {
+                    assert!(!returns(&rung(l)), "rung {l} returns");
+                }
             }
         }
     }
