@@ -38,7 +38,8 @@
 //! [`GeodesicOptions::coarse_mesh`]). Both use the coarse mesh for every pair and then
 //! recompute the pairs closer than
 //! [`NEAR_PAIR_RADIUS_EDGES`](landmarks::NEAR_PAIR_RADIUS_EDGES) coarse edges on the fine
-//! mesh with radius-limited runs ([`FastMarching::run_within`]), because on the coarse
+//! mesh (or on a finer decimation, [`GeodesicOptions::refine_on`]) with radius-limited runs
+//! ([`FastMarching::run_within`]), because on the coarse
 //! mesh alone those close pairs are the least accurate. The measured differences from
 //! full-resolution fast marching are in `BENCHMARKS.md`.
 //!
