@@ -12,7 +12,6 @@ pub(super) struct IndexedHeap {
     pub(super) items: Vec<(Key, u32)>,
     /// Position of each vertex in `items`, or `NONE`.
     pub(super) at: Vec<u32>,
-    pub(super) key: Vec<Key>,
 }
 
 impl IndexedHeap {
@@ -20,7 +19,6 @@ impl IndexedHeap {
         Self {
             items: Vec::with_capacity(n),
             at: vec![NONE; n],
-            key: vec![(0, 0, 0); n],
         }
     }
 
@@ -38,7 +36,6 @@ impl IndexedHeap {
     /// Inserts `v` or changes its key.
     pub(super) fn set(&mut self, v: u32, k: Key) {
         let vi = v as usize;
-        self.key[vi] = k;
         let i = self.at[vi];
         if i == NONE {
             self.items.push((k, v));

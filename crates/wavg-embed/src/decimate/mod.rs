@@ -637,8 +637,9 @@ mod tests {
             let mut want: Vec<_> = model.into_values().collect();
             want.sort();
             let mut got = Vec::new();
-            while let Some(v) = h.pop() {
-                got.push(h.key[v as usize]);
+            while let Some(&(k, v)) = h.items.first() {
+                prop_assert_eq!(h.pop(), Some(v));
+                got.push(k);
             }
             prop_assert_eq!(got, want);
         }
