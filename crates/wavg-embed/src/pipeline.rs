@@ -35,7 +35,10 @@ pub struct PrecomputeOptions {
     /// With an intermediate mesh, replace the distances of close landmark pairs by
     /// full-mesh values from short radius-limited runs
     /// ([`GeodesicOptions::refine_near_pairs`]): close pairs are where the
-    /// intermediate mesh is least accurate; distant pairs are unchanged.
+    /// intermediate mesh is least accurate; distant pairs are unchanged. When the
+    /// least-squares mesh is solved in two levels, these runs go on its coarse level's mesh
+    /// (`lsmesh_coarse_vertices` vertices, [`GeodesicOptions::refine_on`]) instead, so
+    /// that their cost stops growing with the mesh.
     pub refine_near_pairs: bool,
     /// MDS settings (`mds.dim` is the embedding dimension, 8 in wavg).
     pub mds: MdsOptions,
@@ -252,6 +255,9 @@ pub fn precompute(
             if let Some(c) = &coarse {
                 // All pairs on the intermediate mesh, close pairs corrected on the full mesh.
                 geo = geo.coarse_mesh(c).refine_near_pairs(opts.refine_near_pairs);
+                if let Some(mid) = &ls_coarse {
+                    geo = geo.refine_on(mid);
+                }
             }
             let q = landmark_distances(mesh, &landmarks, &geo, progress)?;
             Ok((q, secs(t)))

@@ -319,7 +319,8 @@ impl<'a> Decimator<'a> {
         self.outgoing(x, &mut hs);
         // Candidates by (priority, squared length, target); the first legal one wins.
         // Checking legality in that order gives the same answer as checking all, but
-        // usually stops at the first.
+        // usually stops at the first, so the smallest is selected each time instead of
+        // sorting them all.
         let mut cands = std::mem::take(&mut self.scratch_cands);
         cands.clear();
         for &h in &hs {
@@ -327,14 +328,17 @@ impl<'a> Decimator<'a> {
             let l = (self.pos[t as usize] - self.pos[xi]).norm_squared();
             cands.push((self.priority(h), l, t, h));
         }
-        cands.sort_unstable_by(|a, b| {
-            (a.0, a.1, a.2)
-                .partial_cmp(&(b.0, b.1, b.2))
-                .unwrap_or(std::cmp::Ordering::Equal)
-        });
         let mut best = None;
         let mut deg = None;
-        for &c in &cands {
+        while !cands.is_empty() {
+            let mut m = 0;
+            for (i, c) in cands.iter().enumerate().skip(1) {
+                let b = &cands[m];
+                if (c.0, c.1, c.2).partial_cmp(&(b.0, b.1, b.2)) == Some(std::cmp::Ordering::Less) {
+                    m = i;
+                }
+            }
+            let c = cands.swap_remove(m);
             let d = *deg.get_or_insert_with(|| self.mark_ring(&hs));
             if self.topo_legal_marked(c.3, d) && self.geometry_legal(c.3, &hs) {
                 best = Some(c);

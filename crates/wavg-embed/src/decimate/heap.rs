@@ -2,12 +2,16 @@
 
 use super::*;
 
-/// Binary min-heap of vertices with updatable keys (each vertex at most once).
+/// A heap key: (priority, squared edge length, vertex), compared lexicographically.
+pub(super) type Key = (u64, u64, u32);
+
+/// Binary min-heap of vertices with updatable keys (each vertex at most once). Each entry
+/// carries its key, so sifting compares contiguous memory instead of looking keys up by
+/// vertex.
 pub(super) struct IndexedHeap {
-    pub(super) items: Vec<u32>,
+    pub(super) items: Vec<(Key, u32)>,
     /// Position of each vertex in `items`, or `NONE`.
     pub(super) at: Vec<u32>,
-    pub(super) key: Vec<(u64, u64, u32)>,
 }
 
 impl IndexedHeap {
@@ -15,7 +19,6 @@ impl IndexedHeap {
         Self {
             items: Vec::with_capacity(n),
             at: vec![NONE; n],
-            key: vec![(0, 0, 0); n],
         }
     }
 
@@ -24,23 +27,23 @@ impl IndexedHeap {
     }
 
     pub(super) fn clear(&mut self) {
-        for &v in &self.items {
+        for &(_, v) in &self.items {
             self.at[v as usize] = NONE;
         }
         self.items.clear();
     }
 
     /// Inserts `v` or changes its key.
-    pub(super) fn set(&mut self, v: u32, k: (u64, u64, u32)) {
+    pub(super) fn set(&mut self, v: u32, k: Key) {
         let vi = v as usize;
-        self.key[vi] = k;
         let i = self.at[vi];
         if i == NONE {
-            self.items.push(v);
+            self.items.push((k, v));
             self.at[vi] = (self.items.len() - 1) as u32;
             self.up(self.items.len() - 1);
         } else {
             let i = i as usize;
+            self.items[i].0 = k;
             self.up(i);
             self.down(self.at[vi] as usize);
         }
@@ -56,27 +59,27 @@ impl IndexedHeap {
         self.at[v as usize] = NONE;
         if i < self.items.len() {
             self.items[i] = last;
-            self.at[last as usize] = i as u32;
+            self.at[last.1 as usize] = i as u32;
             self.up(i);
-            self.down(self.at[last as usize] as usize);
+            self.down(self.at[last.1 as usize] as usize);
         }
     }
 
     pub(super) fn pop(&mut self) -> Option<u32> {
-        let v = *self.items.first()?;
+        let v = self.items.first()?.1;
         self.remove(v);
         Some(v)
     }
 
     #[inline]
     pub(super) fn less(&self, a: usize, b: usize) -> bool {
-        self.key[self.items[a] as usize] < self.key[self.items[b] as usize]
+        self.items[a].0 < self.items[b].0
     }
 
     pub(super) fn swap(&mut self, a: usize, b: usize) {
         self.items.swap(a, b);
-        self.at[self.items[a] as usize] = a as u32;
-        self.at[self.items[b] as usize] = b as u32;
+        self.at[self.items[a].1 as usize] = a as u32;
+        self.at[self.items[b].1 as usize] = b as u32;
     }
 
     pub(super) fn up(&mut self, mut i: usize) {

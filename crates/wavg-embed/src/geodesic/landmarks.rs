@@ -57,6 +57,7 @@ pub struct GeodesicOptions<'a> {
     resolution: Resolution<'a>,
     fine: Option<&'a FastMarching>,
     refine_near_pairs: bool,
+    refine_on: Option<&'a Decimated>,
 }
 
 impl Default for GeodesicOptions<'_> {
@@ -65,6 +66,7 @@ impl Default for GeodesicOptions<'_> {
             resolution: Resolution::Full,
             fine: None,
             refine_near_pairs: true,
+            refine_on: None,
         }
     }
 }
@@ -105,6 +107,16 @@ impl<'a> GeodesicOptions<'a> {
     /// covering only a small disc. No effect on the full mesh.
     pub fn refine_near_pairs(mut self, refine: bool) -> Self {
         self.refine_near_pairs = refine;
+        self
+    }
+
+    /// Runs the close-pair correction ([`Self::refine_near_pairs`]) on `mesh`, a
+    /// decimation of the mesh that contains every landmark and is finer than the coarse
+    /// mesh, instead of the full mesh. Each correction run covers a disc of fixed radius,
+    /// so on the full mesh its cost grows with the vertex count; a decimation of a few
+    /// hundred thousand vertices resolves those discs almost as well.
+    pub fn refine_on(mut self, mesh: &'a Decimated) -> Self {
+        self.refine_on = Some(mesh);
         self
     }
 }
@@ -159,7 +171,19 @@ pub fn landmark_distances(
     let mut q = landmark_distances_decimated(coarse, landmarks, progress)?;
     if opts.refine_near_pairs {
         let radius = NEAR_PAIR_RADIUS_EDGES * wavg_mesh::geometry::mean_edge_length(&coarse.mesh);
-        refine_near_pairs(fine(), landmarks, radius, &mut q, progress)?;
+        match opts.refine_on {
+            None => {
+                refine_near_pairs(fine(), landmarks, radius, &mut q, progress)?;
+            }
+            Some(mid) => {
+                let ids = decimated_ids(mid, landmarks)?;
+                let mid_mesh = ValidMesh::new(mid.mesh.clone()).map_err(|e| {
+                    EmbedError::Numerical(format!("the decimated mesh is not valid: {e}"))
+                })?;
+                let fm = FastMarching::new(&mid_mesh);
+                refine_near_pairs(&fm, &ids, radius, &mut q, progress)?;
+            }
+        }
     }
     Ok(q)
 }
@@ -316,7 +340,16 @@ fn landmark_distances_decimated(
     landmarks: &[u32],
     progress: &dyn Progress,
 ) -> Result<Vec<f64>, EmbedError> {
-    let ids = landmarks
+    let ids = decimated_ids(coarse, landmarks)?;
+    let mesh = ValidMesh::new(coarse.mesh.clone())
+        .map_err(|e| EmbedError::Numerical(format!("the decimated mesh is not valid: {e}")))?;
+    full_matrix(&FastMarching::new(&mesh), &ids, progress)
+}
+
+/// The indices in `coarse` of the original vertices `landmarks` (an error if one is not
+/// a vertex of `coarse`).
+fn decimated_ids(coarse: &Decimated, landmarks: &[u32]) -> Result<Vec<u32>, EmbedError> {
+    landmarks
         .iter()
         .map(|&l| {
             coarse.coarse_index(l).ok_or_else(|| {
@@ -325,10 +358,7 @@ fn landmark_distances_decimated(
                 ))
             })
         })
-        .collect::<Result<Vec<u32>, _>>()?;
-    let mesh = ValidMesh::new(coarse.mesh.clone())
-        .map_err(|e| EmbedError::Numerical(format!("the decimated mesh is not valid: {e}")))?;
-    full_matrix(&FastMarching::new(&mesh), &ids, progress)
+        .collect()
 }
 
 /// Forwards cancellation but not progress (for a sub-step reported as part of another stage).

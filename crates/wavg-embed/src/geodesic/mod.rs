@@ -38,7 +38,8 @@
 //! [`GeodesicOptions::coarse_mesh`]). Both use the coarse mesh for every pair and then
 //! recompute the pairs closer than
 //! [`NEAR_PAIR_RADIUS_EDGES`](landmarks::NEAR_PAIR_RADIUS_EDGES) coarse edges on the fine
-//! mesh with radius-limited runs ([`FastMarching::run_within`]), because on the coarse
+//! mesh (or on a finer decimation, [`GeodesicOptions::refine_on`]) with radius-limited runs
+//! ([`FastMarching::run_within`]), because on the coarse
 //! mesh alone those close pairs are the least accurate. The measured differences from
 //! full-resolution fast marching are in `BENCHMARKS.md`.
 //!
@@ -581,7 +582,8 @@ mod tests {
             target: 40,
             ..Default::default()
         };
-        let (fin, snaps) = decimate_with_snapshots(&mesh, &opts, &[800], &NoProgress).unwrap();
+        let (fin, snaps) =
+            decimate_with_snapshots(&mesh, &opts, &[800, 1600], &NoProgress).unwrap();
         let full = landmark_distances(&mesh, &fin.landmarks, &GeodesicOptions::new(), &NoProgress)
             .unwrap();
         let fm = FastMarching::new(&mesh);
@@ -614,18 +616,35 @@ mod tests {
             &NoProgress,
         )
         .unwrap();
+        // Close pairs corrected on the finer snapshot instead of the full mesh.
+        let mid = landmark_distances(
+            &mesh,
+            &fin.landmarks,
+            &GeodesicOptions::new()
+                .coarse_mesh(&snaps[0])
+                .refine_on(&snaps[1]),
+            &NoProgress,
+        )
+        .unwrap();
         let (m1, x1) = stats(&coarse_only);
         let (m2, x2) = stats(&two);
+        let (m3, x3) = stats(&mid);
         eprintln!(
-            "torus 2400 v -> snapshot 800 v, 40 landmarks, rel. diff to full: coarse only mean {:.3}% max {:.2}%, two-level mean {:.3}% max {:.2}%",
+            "torus 2400 v -> snapshot 800 v, 40 landmarks, rel. diff to full: coarse only mean {:.3}% max {:.2}%, two-level mean {:.3}% max {:.2}%, near pairs on 1600 v mean {:.3}% max {:.2}%",
             100.0 * m1,
             100.0 * x1,
             100.0 * m2,
-            100.0 * x2
+            100.0 * x2,
+            100.0 * m3,
+            100.0 * x3
         );
         assert!(m1 < 0.03 && m2 <= m1 && x2 <= x1, "{m1} {m2} {x1} {x2}");
-        for k in 0..two.len() {
-            assert_eq!(two[k], two[(k % 40) * 40 + k / 40], "symmetric");
+        assert!(m3 < m1 && x3 < x1, "{m1} {m3} {x1} {x3}");
+        assert_ne!(mid, coarse_only, "some pairs were corrected");
+        for q in [&two, &mid] {
+            for k in 0..q.len() {
+                assert_eq!(q[k], q[(k % 40) * 40 + k / 40], "symmetric");
+            }
         }
         // A landmark that is not in the coarse mesh is refused.
         let missing = (0..mesh.n_vertices() as u32)
