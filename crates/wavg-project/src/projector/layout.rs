@@ -182,11 +182,13 @@ impl Projector {
                 }
             }),
         );
+        let cones = Cones::new(&bvh, &faces, &verts);
         Ok(Self {
             emb,
             verts,
             frame_kinds,
             faces,
+            cones,
             bvh,
             walk_origin,
             walk_inv_step,

@@ -234,7 +234,9 @@ impl Projector {
             (SearchGoal::Closest, Some(local)) => {
                 let mut improved = None;
                 let mut bound = local.d2;
-                self.bvh.search(y, &mut bound, |f, bound| {
+                let keep =
+                    |ni: usize, lo: &[f32; 8], hi: &[f32; 8]| !self.cones.excludes(ni, lo, hi, y);
+                self.bvh.search_pruned(y, &mut bound, keep, |f, bound| {
                     if tried.contains(f) {
                         return;
                     }
