@@ -211,6 +211,11 @@ impl Bvh {
         }
     }
 
+    /// The box of node `ni` (`lo`, `hi`): it holds every corner of the node's triangles.
+    pub(crate) fn node_box(&self, ni: usize) -> (&[f32; 8], &[f32; 8]) {
+        (&self.nodes[ni].lo, &self.nodes[ni].hi)
+    }
+
     fn visit_all(&self, ni: usize, visit: &mut impl FnMut(u32, &mut f64), best: &mut f64) {
         let node = &self.nodes[ni];
         if node.n > 0 {

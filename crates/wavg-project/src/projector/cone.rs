@@ -6,29 +6,33 @@
 //! `Psi(xi) = sum_e c_e(xi) B_e`, `B_e = X_e T_{i(e)}` (2x8) and convex weights `c_e`.
 //! Rotating the equations by any orthogonal 2x2 `Q` changes neither their roots nor
 //! `|F|`, so each triangle may be compared in its own gauge: each node stores a 2x8
-//! matrix `M`, and `eps`, `s` such that every triangle `f` under it has an orthogonal
-//! `Q_f` with `||Q_f B_e - M|| <= eps` for its six terms, and `||B_e||, ||T_i|| <= s`
-//! (Frobenius norms, which bound the operator norms); then `||Q_f Psi(xi) - M|| <= eps`
-//! on the triangle. For a query `y`, with `alpha` the distance from the origin to the 2-D
-//! box that interval arithmetic gives for `M (p - y)` over the node's box, and `beta` the
-//! largest distance from `y` to a point of that box, every point of every triangle under
-//! the node has `|F| = |Q_f F| >= |M (p - y)| - eps |p - y| >= alpha - eps beta`.
-//! Newton's method accepts only points of the triangle with
+//! matrix `M` and `eps`, `s` such that every triangle `f` under it has an orthogonal
+//! `Q_f` with `||Q_f B_e - M|| <= eps` for its six terms and `||B_e||, ||T_i|| <= s`
+//! (operator norms), so `||Q_f Psi(xi) - M|| <= eps` on the triangle; and a 2-D box `W`
+//! holding `M (v - c)` for every corner `v` under the node (`c` the centre of the node's
+//! box), so `M (p - c)` lies in `W` for every point `p` of its triangles. For a query
+//! `y`, with `alpha` the distance from the origin to the box `W + M (c - y)` and `beta`
+//! the largest distance from `y` to a point of the node's box, every point of every
+//! triangle under the node has `|F| = |Q_f F| >= |M (p - y)| - eps |p - y| >=
+//! alpha - eps beta`. Newton's method accepts only points of the triangle with
 //! `|F|_inf <= CLAMP_RESIDUAL fscale`, and the system's scale is at most `2 s beta` (its
 //! entries are `T_i (y - v_i)` and `B_e (v_k - v_i)`, corners in the box), so
 //! `alpha > (eps + 3 CLAMP_RESIDUAL s) beta` (`3 > 2 sqrt(2)`, the rest covers f64
-//! rounding) proves that no triangle under the node holds a projection.
+//! rounding) proves that no triangle under the node holds a projection. Stored bounds are
+//! rounded outwards.
 
 use super::*;
 use crate::ort::{self, M2};
 use crate::triangle::{CLAMP_RESIDUAL, TERM_VERTEX};
 
-/// One node's bound, 72 bytes.
+/// One node's bound, 88 bytes.
 #[derive(Clone, Copy, Debug, Default)]
 struct Cone {
     /// The reference plane `M`, row-major.
     m: [f32; 16],
-    /// `eps`: bounds `||B_e - M||` over the node's terms.
+    /// `W`: per row of `M (v - c)`, its least and greatest value.
+    w: [[f32; 2]; 2],
+    /// `eps`: bounds `||Q_f B_e - M||` over the node's terms.
     eps: f32,
     /// `s`: bounds `||B_e||` and `||T_i||` over the node's terms and corners.
     s: f32,
@@ -42,43 +46,68 @@ fn up32(x: f64) -> f32 {
     (x * (1.0 + 1e-6)) as f32
 }
 
-/// `||a - b||_F` of two 2x8 matrices, `a` stored as f32.
-fn dist_f(a: &[f32; 16], b: &[f64; 16]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(&x, &y)| (x as f64 - y) * (x as f64 - y))
-        .sum::<f64>()
-        .sqrt()
+/// An interval rounded outwards to f32.
+fn out32([l, u]: [f64; 2]) -> [f32; 2] {
+    let pad = 1e-6 * (l.abs() + u.abs()) + 1e-30;
+    [(l - pad) as f32, (u + pad) as f32]
+}
+
+/// Operator (spectral) norm of a 2x8 matrix: the root of the larger eigenvalue of `D D^T`.
+fn op_norm(d: &[f64; 16]) -> f64 {
+    let [a, b, _, e] = gram(d, d);
+    let h = 0.5 * (a - e);
+    (0.5 * (a + e) + (h * h + b * b).sqrt()).max(0.0).sqrt()
+}
+
+/// `||a - b||` (operator norm) of two 2x8 matrices, `a` stored as f32.
+fn dist_op(a: &[f32; 16], b: &[f64; 16]) -> f64 {
+    op_norm(&std::array::from_fn(|k| a[k] as f64 - b[k]))
+}
+
+/// Centre of a stored box (computed the same way at build and query time).
+#[inline(always)]
+fn centre(lo: &[f32; 8], hi: &[f32; 8]) -> [f64; 8] {
+    std::array::from_fn(|k| 0.5 * (lo[k] as f64 + hi[k] as f64))
+}
+
+/// Per row, the range of `d x` over the box `x - c` with `x` in `[lo, hi]`.
+fn box_range(d: &[f64; 16], lo: &[f32; 8], hi: &[f32; 8], c: &[f64; 8]) -> [[f64; 2]; 2] {
+    let mut iv = [[0.0f64; 2]; 2];
+    for (r, iv) in iv.iter_mut().enumerate() {
+        for k in 0..8 {
+            let (u, v) = (
+                d[r * 8 + k] * (lo[k] as f64 - c[k]),
+                d[r * 8 + k] * (hi[k] as f64 - c[k]),
+            );
+            iv[0] += u.min(v);
+            iv[1] += u.max(v);
+        }
+    }
+    iv
 }
 
 impl Cones {
-    /// Computes the bounds bottom-up: leaves from their triangles' terms, interior nodes
-    /// from their children (`M` the children's mean, `eps` by the triangle inequality).
+    /// Computes the bounds bottom-up: leaves from their triangles' terms and corners,
+    /// interior nodes from their children (`M` the mean of the children's in one gauge,
+    /// `eps` by the triangle inequality, `W` by interval arithmetic).
     pub(super) fn new(bvh: &Bvh, faces: &[Face], verts: &[VertexRec]) -> Self {
         let n = bvh.n_nodes();
         let mut cones: Vec<Cone> = (0..n)
             .into_par_iter()
             .with_min_len(1024)
             .map(|ni| match bvh.node(ni) {
-                Err(items) => leaf(items, faces, verts),
+                Err(items) => leaf(items, bvh.node_box(ni), faces, verts),
                 Ok(_) => Cone::default(),
             })
             .collect();
         for ni in (0..n).rev() {
             if let Ok((l, r)) = bvh.node(ni) {
                 debug_assert!(l > ni && r > ni);
-                let (a, b) = (&cones[l], &cones[r]);
-                let (ma, mb) = (a.m.map(|v| v as f64), b.m.map(|v| v as f64));
-                // The right child's gauge turned to the left's (the children's bounds hold
-                // for any rotation of their `M`).
-                let mb = rotate(&ort::ort(&gram(&ma, &mb)), &mb);
-                let m = std::array::from_fn(|k| (0.5 * (ma[k] + mb[k])) as f32);
-                let eps = (a.eps as f64 + dist_f(&m, &ma)).max(b.eps as f64 + dist_f(&m, &mb));
-                cones[ni] = Cone {
-                    m,
-                    eps: up32(eps),
-                    s: a.s.max(b.s),
-                };
+                cones[ni] = interior(
+                    [&cones[l], &cones[r]],
+                    [bvh.node_box(l), bvh.node_box(r)],
+                    bvh.node_box(ni),
+                );
             }
         }
         Self(cones)
@@ -94,19 +123,18 @@ impl Cones {
     #[inline]
     pub(super) fn excludes(&self, ni: usize, lo: &[f32; 8], hi: &[f32; 8], y: &Vec8) -> bool {
         let c = &self.0[ni];
-        let mut iv = [[0.0f64; 2]; 2];
+        let mid = centre(lo, hi);
+        let mut my = [0.0f64; 2];
         let mut beta2 = 0.0;
         for k in 0..8 {
             let (a, b) = (lo[k] as f64 - y[k], hi[k] as f64 - y[k]);
             beta2 += (a * a).max(b * b);
-            for (r, iv) in iv.iter_mut().enumerate() {
-                let m = c.m[r * 8 + k] as f64;
-                let (u, v) = (m * a, m * b);
-                iv[0] += u.min(v);
-                iv[1] += u.max(v);
-            }
+            let t = mid[k] - y[k];
+            my[0] += c.m[k] as f64 * t;
+            my[1] += c.m[8 + k] as f64 * t;
         }
-        let gap = |[l, u]: [f64; 2]| {
+        let gap = |w: [f32; 2], t: f64| {
+            let (l, u) = (w[0] as f64 + t, w[1] as f64 + t);
             if l > 0.0 {
                 l
             } else if u < 0.0 {
@@ -115,23 +143,85 @@ impl Cones {
                 0.0
             }
         };
-        let (g0, g1) = (gap(iv[0]), gap(iv[1]));
+        let (g0, g1) = (gap(c.w[0], my[0]), gap(c.w[1], my[1]));
         let alpha2 = g0 * g0 + g1 * g1;
         let k = (c.eps as f64 + 3.0 * CLAMP_RESIDUAL * c.s as f64) * (1.0 + 1e-9);
         alpha2 > k * k * beta2
     }
 }
 
-/// A leaf's bound: `M` the mean of its terms `B_e`.
-fn leaf(items: &[u32], faces: &[Face], verts: &[VertexRec]) -> Cone {
+/// A bound that never excludes.
+const NEVER: Cone = Cone {
+    m: [0.0; 16],
+    w: [[f32::NEG_INFINITY, f32::INFINITY]; 2],
+    eps: f32::INFINITY,
+    s: f32::INFINITY,
+};
+
+/// An interior node's bound from its children's (`boxes`: theirs, `own`: the node's).
+fn interior(
+    ch: [&Cone; 2],
+    boxes: [(&[f32; 8], &[f32; 8]); 2],
+    own: (&[f32; 8], &[f32; 8]),
+) -> Cone {
+    let ma = ch[0].m.map(|v| v as f64);
+    let mb = ch[1].m.map(|v| v as f64);
+    // The right child's gauge turned to the left's (a child's bounds hold for any rotation
+    // of its `M` and `W`).
+    let rot = [ort::I2, ort::ort(&gram(&ma, &mb))];
+    let turned = [ma, rotate(&rot[1], &mb)];
+    let m: [f32; 16] = std::array::from_fn(|k| (0.5 * (turned[0][k] + turned[1][k])) as f32);
+    let m64 = m.map(|v| v as f64);
+    let c = centre(own.0, own.1);
+    let mut eps: f64 = 0.0;
+    let mut w = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+    for i in 0..2 {
+        eps = eps.max(ch[i].eps as f64 + dist_op(&m, &turned[i]));
+        // For v under child i: M (v - c) = R W_i-point + R M_i (c_i - c) + (M - R M_i)(v - c).
+        let ci = centre(boxes[i].0, boxes[i].1);
+        let q = &rot[i];
+        let d: [f64; 16] = std::array::from_fn(|k| m64[k] - turned[i][k]);
+        let dr = box_range(&d, boxes[i].0, boxes[i].1, &c);
+        for r in 0..2 {
+            let mut lo = dr[r][0];
+            let mut hi = dr[r][1];
+            for (j, wj) in ch[i].w.iter().enumerate() {
+                let (u, v) = (q[2 * r + j] * wj[0] as f64, q[2 * r + j] * wj[1] as f64);
+                lo += u.min(v);
+                hi += u.max(v);
+            }
+            let shift: f64 = (0..8).map(|k| turned[i][r * 8 + k] * (ci[k] - c[k])).sum();
+            w[r][0] = w[r][0].min(lo + shift);
+            w[r][1] = w[r][1].max(hi + shift);
+        }
+    }
+    let cone = Cone {
+        m,
+        w: w.map(out32),
+        eps: up32(eps),
+        s: ch[0].s.max(ch[1].s),
+    };
+    if cone.w.iter().flatten().all(|v| v.is_finite()) && cone.eps.is_finite() {
+        cone
+    } else {
+        NEVER
+    }
+}
+
+/// A leaf's bound: `M` the mean of its terms `B_e`, each triangle in its own gauge.
+fn leaf(items: &[u32], bx: (&[f32; 8], &[f32; 8]), faces: &[Face], verts: &[VertexRec]) -> Cone {
+    if items.is_empty() || items.len() > LEAF_MAX {
+        // Not expected (leaves are small).
+        return NEVER;
+    }
     let mut terms = [[0.0f64; 16]; 6 * LEAF_MAX];
     let mut n = 0;
     let mut s: f64 = 0.0;
-    for &f in items.iter().take(LEAF_MAX) {
+    for &f in items {
         let face = &faces[f as usize];
         for v in face.v {
-            let t = &verts[v as usize].t;
-            s = s.max(t.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt());
+            let t = verts[v as usize].t.map(|x| x as f64);
+            s = s.max(op_norm(&t));
         }
         for e in 0..6 {
             let x = face.d.x[e].map(|v| v as f64);
@@ -142,39 +232,53 @@ fn leaf(items: &[u32], faces: &[Face], verts: &[VertexRec]) -> Cone {
                 b[col] = x[0] * t0 + x[1] * t1;
                 b[8 + col] = x[2] * t0 + x[3] * t1;
             }
-            s = s.max(b.iter().map(|v| v * v).sum::<f64>().sqrt());
+            s = s.max(op_norm(b));
             n += 1;
         }
     }
-    if items.len() > LEAF_MAX || n == 0 {
-        // Not expected (leaves are small); a bound that never excludes.
-        return Cone {
-            m: [0.0; 16],
-            eps: f32::INFINITY,
-            s: f32::INFINITY,
-        };
-    }
     // Each triangle's terms turned (as one) to the gauge of the first triangle's mean.
-    let nf = n / 6;
     let face_mean = |t: &[[f64; 16]]| -> [f64; 16] {
         std::array::from_fn(|k| t.iter().map(|b| b[k]).sum::<f64>() / t.len() as f64)
     };
     let reference = face_mean(&terms[..6]);
-    for f in 0..nf {
-        let t = &mut terms[6 * f..6 * f + 6];
+    for t in terms[..n].chunks_mut(6) {
         let q = ort::ort(&gram(&reference, &face_mean(t)));
         for b in t.iter_mut() {
             *b = rotate(&q, b);
         }
     }
     let m = face_mean(&terms[..n]).map(|v| v as f32);
-    let eps = terms[..n].iter().map(|b| dist_f(&m, b)).fold(0.0, f64::max);
-    Cone {
+    let eps = terms[..n]
+        .iter()
+        .map(|b| dist_op(&m, b))
+        .fold(0.0, f64::max);
+    let c = centre(bx.0, bx.1);
+    let mut w = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
+    for &f in items {
+        for v in faces[f as usize].v {
+            let x = &verts[v as usize].x;
+            for (r, w) in w.iter_mut().enumerate() {
+                let t: f64 = (0..8).map(|k| m[r * 8 + k] as f64 * (x[k] - c[k])).sum();
+                w[0] = w[0].min(t);
+                w[1] = w[1].max(t);
+            }
+        }
+    }
+    let cone = Cone {
         m,
+        w: w.map(out32),
         eps: up32(eps),
         s: up32(s),
+    };
+    if cone.w.iter().flatten().all(|v| v.is_finite()) && cone.eps.is_finite() {
+        cone
+    } else {
+        NEVER
     }
 }
+
+/// Triangles a leaf's bound is computed from directly.
+const LEAF_MAX: usize = 8;
 
 /// `a b^T` of two 2x8 matrices: `ort` of it turns `b` closest to `a`.
 fn gram(a: &[f64; 16], b: &[f64; 16]) -> M2 {
@@ -193,9 +297,6 @@ fn rotate(q: &M2, b: &[f64; 16]) -> [f64; 16] {
         }
     })
 }
-
-/// Triangles a leaf's bound is computed from directly.
-const LEAF_MAX: usize = 8;
 
 #[cfg(test)]
 mod tests {
