@@ -25,6 +25,24 @@ use super::*;
 use crate::ort::{self, M2};
 use crate::triangle::{CLAMP_RESIDUAL, TERM_VERTEX};
 
+/// Nodes a search pops before it starts testing them: most searches end within a few
+/// dozen nodes near the query, where the test rarely excludes anything; only the long
+/// ones (no projection near the query) repay it.
+pub(super) const CONE_AFTER: usize = 32;
+
+/// A search's node filter: after [`CONE_AFTER`] nodes, keeps only the nodes whose bound
+/// does not exclude `y`.
+pub(super) fn keep_filter<'a>(
+    cones: &'a Cones,
+    y: &'a Vec8,
+) -> impl Fn(usize, &[f32; 8], &[f32; 8]) -> bool + 'a {
+    let popped = std::cell::Cell::new(0usize);
+    move |ni, lo, hi| {
+        popped.set(popped.get() + 1);
+        popped.get() <= CONE_AFTER || !cones.excludes(ni, lo, hi, y)
+    }
+}
+
 /// One node's bound, 88 bytes.
 #[derive(Clone, Copy, Debug, Default)]
 struct Cone {
@@ -91,24 +109,9 @@ impl Cones {
     /// interior nodes from their children (`M` the mean of the children's in one gauge,
     /// `eps` by the triangle inequality, `W` by interval arithmetic).
     pub(super) fn new(bvh: &Bvh, faces: &[Face], verts: &[VertexRec]) -> Self {
-        let n = bvh.n_nodes();
-        let mut cones: Vec<Cone> = (0..n)
-            .into_par_iter()
-            .with_min_len(1024)
-            .map(|ni| match bvh.node(ni) {
-                Err(items) => leaf(items, bvh.node_box(ni), faces, verts),
-                Ok(_) => Cone::default(),
-            })
-            .collect();
-        for ni in (0..n).rev() {
-            if let Ok((l, r)) = bvh.node(ni) {
-                debug_assert!(l > ni && r > ni);
-                cones[ni] = interior(
-                    [&cones[l], &cones[r]],
-                    [bvh.node_box(l), bvh.node_box(r)],
-                    bvh.node_box(ni),
-                );
-            }
+        let mut cones = vec![Cone::default(); bvh.n_nodes()];
+        if !cones.is_empty() {
+            fill(bvh, &mut cones, 0, faces, verts);
         }
         Self(cones)
     }
@@ -119,7 +122,8 @@ impl Cones {
     }
 
     /// Whether no triangle under node `ni` (box `lo`, `hi`) can hold a projection of `y`
-    /// (see the module documentation).
+    /// (see the module documentation). A search that has popped fewer than
+    /// [`CONE_AFTER`] nodes does not ask (see there).
     #[inline]
     pub(super) fn excludes(&self, ni: usize, lo: &[f32; 8], hi: &[f32; 8], y: &Vec8) -> bool {
         let c = &self.0[ni];
@@ -148,6 +152,42 @@ impl Cones {
         let k = (c.eps as f64 + 3.0 * CLAMP_RESIDUAL * c.s as f64) * (1.0 + 1e-9);
         alpha2 > k * k * beta2
     }
+}
+
+/// Subtrees of at least this many nodes are computed in parallel.
+const PARALLEL: usize = 2048;
+
+/// Computes the bounds of the subtree rooted at node `base` into `out` (its nodes, in
+/// the hierarchy's depth-first order: the left subtree, then the right one).
+fn fill(bvh: &Bvh, out: &mut [Cone], base: usize, faces: &[Face], verts: &[VertexRec]) {
+    let (l, r) = match bvh.node(base) {
+        Err(items) => {
+            out[0] = leaf(items, bvh.node_box(base), faces, verts);
+            return;
+        }
+        Ok(children) => children,
+    };
+    if l != base + 1 || r <= l || r - base >= out.len() {
+        // Not the depth-first layout (not expected): a subtree bound that never excludes.
+        out.fill(NEVER);
+        return;
+    }
+    let (me, rest) = out.split_at_mut(1);
+    let (left, right) = rest.split_at_mut(r - l);
+    if me.len() + left.len() + right.len() >= PARALLEL {
+        rayon::join(
+            || fill(bvh, left, l, faces, verts),
+            || fill(bvh, right, r, faces, verts),
+        );
+    } else {
+        fill(bvh, left, l, faces, verts);
+        fill(bvh, right, r, faces, verts);
+    }
+    me[0] = interior(
+        [&left[0], &right[0]],
+        [bvh.node_box(l), bvh.node_box(r)],
+        bvh.node_box(base),
+    );
 }
 
 /// A bound that never excludes.

@@ -234,8 +234,7 @@ impl Projector {
             (SearchGoal::Closest, Some(local)) => {
                 let mut improved = None;
                 let mut bound = local.d2;
-                let keep =
-                    |ni: usize, lo: &[f32; 8], hi: &[f32; 8]| !self.cones.excludes(ni, lo, hi, y);
+                let keep = cone::keep_filter(&self.cones, y);
                 self.bvh.search_pruned(y, &mut bound, keep, |f, bound| {
                     if tried.contains(f) {
                         return;
