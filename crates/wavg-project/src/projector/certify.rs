@@ -54,7 +54,7 @@ impl Projector {
     pub(super) fn exhaustive(&self, y: &Vec8) -> Option<Best> {
         let mut bound = f64::INFINITY;
         let mut best: Option<Best> = None;
-        let keep = cone::keep_filter(&self.cones, y);
+        let keep = cone::keep_filter(self, y);
         self.bvh
             .search_best_first_pruned(y, &mut bound, keep, |f, bound| {
                 // `try_face_bounded` keeps answers below the bound: not farther than the best.

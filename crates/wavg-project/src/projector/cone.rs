@@ -31,15 +31,15 @@ use crate::triangle::{CLAMP_RESIDUAL, TERM_VERTEX};
 pub(super) const CONE_AFTER: usize = 32;
 
 /// A search's node filter: after [`CONE_AFTER`] nodes, keeps only the nodes whose bound
-/// does not exclude `y`.
+/// does not exclude `y` (the bounds are built then if they were not yet).
 pub(super) fn keep_filter<'a>(
-    cones: &'a Cones,
+    p: &'a Projector,
     y: &'a Vec8,
 ) -> impl Fn(usize, &[f32; 8], &[f32; 8]) -> bool + 'a {
     let popped = std::cell::Cell::new(0usize);
     move |ni, lo, hi| {
         popped.set(popped.get() + 1);
-        popped.get() <= CONE_AFTER || !cones.excludes(ni, lo, hi, y)
+        popped.get() <= CONE_AFTER || !p.cones().excludes(ni, lo, hi, y)
     }
 }
 
@@ -254,44 +254,44 @@ fn leaf(items: &[u32], bx: (&[f32; 8], &[f32; 8]), faces: &[Face], verts: &[Vert
         // Not expected (leaves are small).
         return NEVER;
     }
-    let mut terms = [[0.0f64; 16]; 6 * LEAF_MAX];
-    let mut n = 0;
+    // `||B_e|| <= ||X_e||_F ||T_i||_F`.
+    let frob = |v: &[f32]| v.iter().map(|&x| x as f64 * x as f64).sum::<f64>().sqrt();
     let mut s: f64 = 0.0;
-    for &f in items {
+    let mut means = [[0.0f64; 16]; LEAF_MAX];
+    for (&f, mean) in items.iter().zip(&mut means) {
         let face = &faces[f as usize];
-        for v in face.v {
-            let t = verts[v as usize].t.map(|x| x as f64);
-            s = s.max(op_norm(&t));
-        }
+        let (mut xs, mut ts): (f64, f64) = (0.0, 0.0);
         for e in 0..6 {
-            let x = face.d.x[e].map(|v| v as f64);
-            let t = &verts[face.v[TERM_VERTEX[e]] as usize].t;
-            let b = &mut terms[n];
-            for col in 0..8 {
-                let (t0, t1) = (t[col] as f64, t[8 + col] as f64);
-                b[col] = x[0] * t0 + x[1] * t1;
-                b[8 + col] = x[2] * t0 + x[3] * t1;
+            xs = xs.max(frob(&face.d.x[e]));
+            let b = term(face, e, verts);
+            for k in 0..16 {
+                mean[k] += b[k] / 6.0;
             }
-            s = s.max(op_norm(b));
-            n += 1;
         }
+        for v in face.v {
+            ts = ts.max(frob(&verts[v as usize].t));
+        }
+        s = s.max(xs * ts);
     }
+    let n = items.len();
     // Each triangle's terms turned (as one) to the gauge of the first triangle's mean.
-    let face_mean = |t: &[[f64; 16]]| -> [f64; 16] {
-        std::array::from_fn(|k| t.iter().map(|b| b[k]).sum::<f64>() / t.len() as f64)
-    };
-    let reference = face_mean(&terms[..6]);
-    for t in terms[..n].chunks_mut(6) {
-        let q = ort::ort(&gram(&reference, &face_mean(t)));
-        for b in t.iter_mut() {
-            *b = rotate(&q, b);
+    let mut gauges = [ort::I2; LEAF_MAX];
+    let mut total = [0.0f64; 16];
+    for (mean, q) in means[..n].iter().zip(&mut gauges) {
+        *q = ort::ort(&gram(&means[0], mean));
+        let t = rotate(q, mean);
+        for k in 0..16 {
+            total[k] += t[k] / n as f64;
         }
     }
-    let m = face_mean(&terms[..n]).map(|v| v as f32);
-    let eps = terms[..n]
-        .iter()
-        .map(|b| dist_op(&m, b))
-        .fold(0.0, f64::max);
+    let m = total.map(|v| v as f32);
+    let mut eps: f64 = 0.0;
+    for (&f, q) in items.iter().zip(&gauges) {
+        let face = &faces[f as usize];
+        for e in 0..6 {
+            eps = eps.max(dist_op(&m, &rotate(q, &term(face, e, verts))));
+        }
+    }
     let c = centre(bx.0, bx.1);
     let mut w = [[f64::INFINITY, f64::NEG_INFINITY]; 2];
     for &f in items {
@@ -315,6 +315,22 @@ fn leaf(items: &[u32], bx: (&[f32; 8], &[f32; 8]), faces: &[Face], verts: &[Vert
     } else {
         NEVER
     }
+}
+
+/// The term `B_e = X_e T_{i(e)}` of a face (2x8, row-major).
+#[inline]
+fn term(face: &Face, e: usize, verts: &[VertexRec]) -> [f64; 16] {
+    let x = face.d.x[e].map(|v| v as f64);
+    let t = &verts[face.v[TERM_VERTEX[e]] as usize].t;
+    std::array::from_fn(|k| {
+        let col = k % 8;
+        let (t0, t1) = (t[col] as f64, t[8 + col] as f64);
+        if k < 8 {
+            x[0] * t0 + x[1] * t1
+        } else {
+            x[2] * t0 + x[3] * t1
+        }
+    })
 }
 
 /// Triangles a leaf's bound is computed from directly.
@@ -439,7 +455,7 @@ mod tests {
                 }
                 for (ni, bx) in boxes(&p, &y).into_iter().enumerate() {
                     let (lo, hi) = bx.unwrap();
-                    let ex = p.cones.excludes(ni, &lo, &hi, &y);
+                    let ex = p.cones().excludes(ni, &lo, &hi, &y);
                     prop_assert!(!(ex && any_under(&p, ni, &ok)), "node {ni} excluded, offset {off}");
                     nodes_excluded += ex as usize;
                 }

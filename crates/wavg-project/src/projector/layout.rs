@@ -182,14 +182,13 @@ impl Projector {
                 }
             }),
         );
-        let cones = Cones::new(&bvh, &faces, &verts);
         Ok(Self {
             emb,
             verts,
             frame_kinds,
             faces,
-            cones,
             bvh,
+            cones: std::sync::OnceLock::new(),
             walk_origin,
             walk_inv_step,
             walk_coords,

@@ -80,7 +80,8 @@ pub struct Projector {
     frame_kinds: [usize; 4],
     faces: Vec<Face>,
     bvh: Bvh,
-    cones: Cones,
+    /// Built on first use: most workloads' searches end before they would ask.
+    cones: std::sync::OnceLock<Cones>,
     walk_origin: Vec8,
     walk_inv_step: f64,
     walk_coords: Vec<WalkPoint>,
@@ -115,9 +116,15 @@ impl Projector {
         std::mem::size_of_val(&self.verts[..])
             + std::mem::size_of_val(&self.faces[..])
             + self.bvh.bytes()
-            + self.cones.bytes()
+            + self.cones.get().map_or(0, Cones::bytes)
             + std::mem::size_of_val(&self.walk_coords[..])
             + std::mem::size_of_val(self.emb.coords())
+    }
+
+    /// The hierarchy's cone bounds, computed on first use.
+    fn cones(&self) -> &Cones {
+        self.cones
+            .get_or_init(|| Cones::new(&self.bvh, &self.faces, &self.verts))
     }
 
     fn face_frames(&self, f: FaceId) -> [&Frame32; 3] {

@@ -234,7 +234,7 @@ impl Projector {
             (SearchGoal::Closest, Some(local)) => {
                 let mut improved = None;
                 let mut bound = local.d2;
-                let keep = cone::keep_filter(&self.cones, y);
+                let keep = cone::keep_filter(self, y);
                 self.bvh.search_pruned(y, &mut bound, keep, |f, bound| {
                     if tried.contains(f) {
                         return;
