@@ -87,7 +87,19 @@ impl Bvh {
 
     /// Branch and bound: visits (in roughly nearest-first order) every face whose box is
     /// closer to `y` than `sqrt(*best)`; `visit(face, best)` may lower `*best`.
-    pub(crate) fn search(&self, y: &Vec8, best: &mut f64, mut visit: impl FnMut(u32, &mut f64)) {
+    pub(crate) fn search(&self, y: &Vec8, best: &mut f64, visit: impl FnMut(u32, &mut f64)) {
+        self.search_pruned(y, best, |_, _, _| true, visit);
+    }
+
+    /// [`Bvh::search`] that skips every subtree `keep(node, lo, hi)` rejects (`lo`, `hi`:
+    /// the node's box, which holds every corner of its triangles).
+    pub(crate) fn search_pruned(
+        &self,
+        y: &Vec8,
+        best: &mut f64,
+        keep: impl Fn(usize, &[f32; 8], &[f32; 8]) -> bool,
+        mut visit: impl FnMut(u32, &mut f64),
+    ) {
         if self.nodes.is_empty() {
             return;
         }
@@ -102,6 +114,9 @@ impl Bvh {
                 continue;
             }
             let node = &self.nodes[ni];
+            if !keep(ni, &node.lo, &node.hi) {
+                continue;
+            }
             if node.n > 0 {
                 for &f in &self.items[node.a as usize..(node.a + node.n) as usize] {
                     visit(f, best);
@@ -142,10 +157,12 @@ impl Bvh {
     /// distance of every point in the convex hull of its triangles' corners, so every face
     /// not visited is at least `sqrt(*best)` away. Visits fewer faces than
     /// [`Bvh::search`] when the first leaves reached depth first are far from the answer.
-    pub(crate) fn search_best_first(
+    /// Subtrees that `keep(node, lo, hi)` rejects are skipped (as in [`Bvh::search_pruned`]).
+    pub(crate) fn search_best_first_pruned(
         &self,
         y: &Vec8,
         best: &mut f64,
+        keep: impl Fn(usize, &[f32; 8], &[f32; 8]) -> bool,
         mut visit: impl FnMut(u32, &mut f64),
     ) {
         use std::cmp::Reverse;
@@ -161,6 +178,9 @@ impl Bvh {
                 break;
             }
             let node = &self.nodes[ni as usize];
+            if !keep(ni as usize, &node.lo, &node.hi) {
+                continue;
+            }
             if node.n > 0 {
                 for &f in &self.items[node.a as usize..(node.a + node.n) as usize] {
                     visit(f, best);
@@ -174,6 +194,26 @@ impl Bvh {
                 }
             }
         }
+    }
+
+    /// Number of nodes (indices `0..n`; a node's children have larger indices).
+    pub(crate) fn n_nodes(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Node `ni`: `Ok((left, right))` children of an interior node, `Err(faces)` of a leaf.
+    pub(crate) fn node(&self, ni: usize) -> Result<(usize, usize), &[u32]> {
+        let n = &self.nodes[ni];
+        if n.n > 0 {
+            Err(&self.items[n.a as usize..(n.a + n.n) as usize])
+        } else {
+            Ok((ni + 1, n.a as usize))
+        }
+    }
+
+    /// The box of node `ni` (`lo`, `hi`): it holds every corner of the node's triangles.
+    pub(crate) fn node_box(&self, ni: usize) -> (&[f32; 8], &[f32; 8]) {
+        (&self.nodes[ni].lo, &self.nodes[ni].hi)
     }
 
     fn visit_all(&self, ni: usize, visit: &mut impl FnMut(u32, &mut f64), best: &mut f64) {

@@ -15,6 +15,8 @@
 use crate::ort::{self, M2};
 use crate::{Mat2x8, Vec8};
 
+mod exclude;
+
 /// Corner whose frame term `e` multiplies.
 pub(crate) const TERM_VERTEX: [usize; 6] = [0, 1, 1, 2, 2, 0];
 
@@ -27,6 +29,13 @@ pub(crate) const MAX_NEWTON: usize = 16;
 /// Barycentric tolerance of a valid projection: a projection up to this far outside its
 /// triangle (in barycentric coordinates) is accepted and clamped onto the edge.
 pub const BARY_EPS: f64 = 1e-4;
+
+/// Largest residual `|F|_inf`, relative to the system's scale, at the iterate inside the
+/// triangle from which Newton's method accepts a root up to [`BARY_EPS`] outside it
+/// (clamped onto the edge). Every accepted projection therefore has a point of the closed
+/// triangle where `|F|_inf <= CLAMP_RESIDUAL * fscale`, which is what the exclusion tests
+/// ([`TriData::solve_unless_excluded`], the hierarchy's cone bounds) rule out.
+pub(crate) const CLAMP_RESIDUAL: f64 = 1e-2;
 
 /// `S` below which a point counts as a vertex and `Psi` takes its limit there.
 const S_MIN: f64 = 1e-12;
@@ -294,7 +303,15 @@ impl TriData {
         corners: [&Vec8; 3],
         y: &Vec8,
     ) -> Result<[f64; 3], Option<usize>> {
-        let sys = System::new(self, frames, corners, y);
+        System::new(self, frames, corners, y).newton()
+    }
+}
+
+impl System {
+    /// Newton's method on this system (see [`TriData::solve_or_exit`]).
+    #[inline(always)]
+    fn newton(&self) -> Result<[f64; 3], Option<usize>> {
+        let sys = self;
         let ftol = 1e-11 * sys.fscale;
         let mut xi = sys.initial_guess();
         let mut stuck = 0;
@@ -319,7 +336,10 @@ impl TriData {
                     (t, block) = (xi[k] / -d[k], Some(k));
                 }
             }
-            if t < 1.0 && d[0].abs().max(d[1].abs()).max(d[2].abs()) <= BARY_EPS {
+            if t < 1.0
+                && d[0].abs().max(d[1].abs()).max(d[2].abs()) <= BARY_EPS
+                && f[0].abs().max(f[1].abs()) <= CLAMP_RESIDUAL * sys.fscale
+            {
                 // The root is within BARY_EPS outside the triangle (on an edge, up to the
                 // rounding of the f32 data): a valid projection, clamped onto the triangle.
                 return renormalize([xi[0] + d[0], xi[1] + d[1], xi[2] + d[2]]).ok_or(None);

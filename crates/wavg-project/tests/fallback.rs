@@ -15,8 +15,9 @@ use wavg_mesh::{ValidMesh, io};
 use wavg_project::{ProjectionPath, Vec8};
 use wavg_testdata as data;
 
-/// Offsets off the surface, in mean edge lengths: on it, near, a few rings, far away.
-const OFFSETS: [f64; 5] = [0.0, 0.05, 0.5, 5.0, 50.0];
+/// Offsets off the surface, in mean edge lengths: on it, near, a few rings, far away, very
+/// far (where the exclusion tests prune most of the hierarchy).
+const OFFSETS: [f64; 6] = [0.0, 0.05, 0.5, 5.0, 50.0, 500.0];
 
 /// Compares the global search with the brute force on `queries` surface points per
 /// offset; returns how many answers differed only by a tie in distance (equal up to

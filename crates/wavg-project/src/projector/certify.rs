@@ -6,9 +6,17 @@ use super::*;
 
 impl Projector {
     /// `try_face` if the triangle's own box is closer than `sqrt(bound)` and the answer
-    /// is strictly closer than that.
+    /// is strictly closer than that (Newton's method skipped where the triangle provably
+    /// holds no projection: the same answer).
     #[inline]
     pub(super) fn try_face_bounded(&self, f: FaceId, y: &Vec8, bound: f64) -> Option<Best> {
+        self.try_face_bounded_with(f, y, bound, true)
+    }
+
+    /// [`Projector::try_face_bounded`], with the exclusion test or (`filter == false`,
+    /// for the brute force) without.
+    #[inline(always)]
+    fn try_face_bounded_with(&self, f: FaceId, y: &Vec8, bound: f64, filter: bool) -> Option<Best> {
         let [a, b, c] = self.corners(f);
         let lo = a.inf(&b).inf(&c);
         let hi = a.sup(&b).sup(&c);
@@ -26,7 +34,12 @@ impl Projector {
         if (a * w[0] + b * w[1] + c * w[2] - y).norm_squared() >= bound {
             return None;
         }
-        self.try_face(f, y).filter(|r| r.d2 < bound)
+        let r = if filter {
+            self.try_face_filtered(f, y)
+        } else {
+            self.try_face(f, y)
+        };
+        r.filter(|r| r.d2 < bound)
     }
 
     /// The closest valid Phong projection over all triangles, with the brute force's
@@ -36,21 +49,24 @@ impl Projector {
     /// triangle under it; nodes are opened nearest first and the search stops at the
     /// first box farther than the best valid projection so far. Boxes at exactly that
     /// distance are still opened (the bound is the next float up), as they may hold an
-    /// equally close face of lower index.
+    /// equally close face of lower index. Subtrees whose tangent-cone bound proves that
+    /// none of their triangles holds a projection are skipped.
     pub(super) fn exhaustive(&self, y: &Vec8) -> Option<Best> {
         let mut bound = f64::INFINITY;
         let mut best: Option<Best> = None;
-        self.bvh.search_best_first(y, &mut bound, |f, bound| {
-            // `try_face_bounded` keeps answers below the bound: not farther than the best.
-            if let Some(b) = self.try_face_bounded(f, y, *bound) {
-                let better = best.is_none_or(|x| b.d2 < x.d2 || (b.d2 == x.d2 && f < x.face));
-                if better {
-                    best = Some(b);
-                    // The next float up (d2 >= 0): keep boxes at exactly this distance.
-                    *bound = f64::from_bits(b.d2.to_bits() + 1);
+        let keep = cone::keep_filter(self, y);
+        self.bvh
+            .search_best_first_pruned(y, &mut bound, keep, |f, bound| {
+                // `try_face_bounded` keeps answers below the bound: not farther than the best.
+                if let Some(b) = self.try_face_bounded(f, y, *bound) {
+                    let better = best.is_none_or(|x| b.d2 < x.d2 || (b.d2 == x.d2 && f < x.face));
+                    if better {
+                        best = Some(b);
+                        // The next float up (d2 >= 0): keep boxes at exactly this distance.
+                        *bound = f64::from_bits(b.d2.to_bits() + 1);
+                    }
                 }
-            }
-        });
+            });
         best
     }
 
@@ -67,8 +83,9 @@ impl Projector {
     }
 
     /// The closest valid Phong projection by a literal scan over every triangle (skipping
-    /// only triangles whose bounding box is farther than the best so far). Slow; for tests
-    /// and for checking the other two paths.
+    /// only triangles whose bounding box or Euclidean distance is farther than the best so
+    /// far; Newton's method on every other one). Slow; for tests and for checking the
+    /// other two paths.
     pub fn project_brute_force(&self, y: &Vec8) -> Result<Projection, ProjectError> {
         if !y.iter().all(|v| v.is_finite()) {
             return Err(ProjectError::NonFiniteQuery);
@@ -76,7 +93,7 @@ impl Projector {
         let mut best: Option<Best> = None;
         for f in 0..self.faces.len() as u32 {
             let bound = best.map_or(f64::INFINITY, |b| b.d2);
-            if let Some(b) = self.try_face_bounded(f, y, bound) {
+            if let Some(b) = self.try_face_bounded_with(f, y, bound, false) {
                 best = Some(b);
             }
         }

@@ -188,6 +188,7 @@ impl Projector {
             frame_kinds,
             faces,
             bvh,
+            cones: std::sync::OnceLock::new(),
             walk_origin,
             walk_inv_step,
             walk_coords,

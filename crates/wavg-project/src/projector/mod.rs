@@ -22,9 +22,11 @@ use crate::euclid::closest_point_barycentric;
 use crate::frames::FrameKind;
 use crate::triangle::{Frame32, TriData, frame_to_f32, frame_to_f64};
 use crate::{EmbeddedMesh, Mat2x8, ProjectError, Vec8};
+use cone::Cones;
 
 mod batch;
 mod certify;
+mod cone;
 mod layout;
 mod nearest;
 mod order;
@@ -78,6 +80,8 @@ pub struct Projector {
     frame_kinds: [usize; 4],
     faces: Vec<Face>,
     bvh: Bvh,
+    /// Built on first use: most workloads' searches end before they would ask.
+    cones: std::sync::OnceLock<Cones>,
     walk_origin: Vec8,
     walk_inv_step: f64,
     walk_coords: Vec<WalkPoint>,
@@ -112,8 +116,15 @@ impl Projector {
         std::mem::size_of_val(&self.verts[..])
             + std::mem::size_of_val(&self.faces[..])
             + self.bvh.bytes()
+            + self.cones.get().map_or(0, Cones::bytes)
             + std::mem::size_of_val(&self.walk_coords[..])
             + std::mem::size_of_val(self.emb.coords())
+    }
+
+    /// The hierarchy's cone bounds, computed on first use.
+    fn cones(&self) -> &Cones {
+        self.cones
+            .get_or_init(|| Cones::new(&self.bvh, &self.faces, &self.verts))
     }
 
     fn face_frames(&self, f: FaceId) -> [&Frame32; 3] {
@@ -264,15 +275,30 @@ impl Projector {
     /// drove negative (see [`TriData::solve_or_exit`]).
     #[inline]
     fn try_face_or_exit(&self, f: FaceId, y: &Vec8) -> Result<Best, Option<usize>> {
+        self.solve_face(f, y, false)
+    }
+
+    /// [`Projector::try_face`], skipping Newton's method on a triangle that provably holds
+    /// no projection (the same answer, see [`TriData::solve_unless_excluded`]).
+    #[inline]
+    fn try_face_filtered(&self, f: FaceId, y: &Vec8) -> Option<Best> {
+        self.solve_face(f, y, true).ok()
+    }
+
+    #[inline(always)]
+    fn solve_face(&self, f: FaceId, y: &Vec8, filter: bool) -> Result<Best, Option<usize>> {
         let face = &self.faces[f as usize];
         let r = [
             &self.verts[face.v[0] as usize],
             &self.verts[face.v[1] as usize],
             &self.verts[face.v[2] as usize],
         ];
-        let xi =
-            face.d
-                .solve_or_exit([&r[0].t, &r[1].t, &r[2].t], [&r[0].x, &r[1].x, &r[2].x], y)?;
+        let (frames, corners) = ([&r[0].t, &r[1].t, &r[2].t], [&r[0].x, &r[1].x, &r[2].x]);
+        let xi = if filter {
+            face.d.solve_unless_excluded(frames, corners, y)?
+        } else {
+            face.d.solve_or_exit(frames, corners, y)?
+        };
         let (a, b, cc) = (&r[0].x.data.0[0], &r[1].x.data.0[0], &r[2].x.data.0[0]);
         let yy = &y.data.0[0];
         let mut d2 = 0.0;

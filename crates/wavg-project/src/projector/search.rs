@@ -234,7 +234,8 @@ impl Projector {
             (SearchGoal::Closest, Some(local)) => {
                 let mut improved = None;
                 let mut bound = local.d2;
-                self.bvh.search(y, &mut bound, |f, bound| {
+                let keep = cone::keep_filter(self, y);
+                self.bvh.search_pruned(y, &mut bound, keep, |f, bound| {
                     if tried.contains(f) {
                         return;
                     }
