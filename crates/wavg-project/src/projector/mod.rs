@@ -19,19 +19,20 @@ use wavg_mesh::{FaceId, NONE, SurfacePoint, VertexId};
 
 use crate::bvh::Bvh;
 use crate::euclid::closest_point_barycentric;
-use crate::frames::FrameKind;
 use crate::triangle::{Frame32, TriData, frame_to_f32, frame_to_f64};
 use crate::{EmbeddedMesh, Mat2x8, ProjectError, Vec8};
 
 mod batch;
 mod certify;
 mod layout;
+mod locate;
 mod nearest;
 mod order;
 mod search;
 mod walk;
 
 use layout::{Face, VertexRec, WalkPoint};
+use locate::StartGrid;
 
 pub use batch::ProjectScratch;
 pub use order::FaceOrder;
@@ -81,6 +82,7 @@ pub struct Projector {
     walk_origin: Vec8,
     walk_inv_step: f64,
     walk_coords: Vec<WalkPoint>,
+    starts: StartGrid,
 }
 
 #[derive(Clone, Copy)]
@@ -113,6 +115,7 @@ impl Projector {
             + std::mem::size_of_val(&self.faces[..])
             + self.bvh.bytes()
             + std::mem::size_of_val(&self.walk_coords[..])
+            + self.starts.bytes()
             + std::mem::size_of_val(self.emb.coords())
     }
 
