@@ -44,8 +44,8 @@ impl Solver {
     /// [`Solver::forward_batch`] into `out`, with explicit buffers and parallelism. The
     /// weight rows are read once, in input order, into their averages; the searches then
     /// run in the Morton order of the averages (nearby queries together, so they share
-    /// cached mesh data). Each still starts from its own highest-weight anchor (or warm
-    /// start), so the results equal [`Solver::forward`]'s for any `par`. Fails only when
+    /// cached mesh data). Each still starts where [`Solver::forward`] would (its
+    /// highest-weight anchor, a vertex near its average or its warm start), so the results equal [`Solver::forward`]'s for any `par`. Fails only when
     /// `par`'s threads cannot start.
     pub fn forward_batch_into<W: AsRef<[f64]> + Sync>(
         &self,

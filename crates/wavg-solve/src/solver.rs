@@ -67,6 +67,14 @@ pub enum Start {
         /// Its start vertex.
         vertex: VertexId,
     },
+    /// At a vertex near the average ([`Projector::start_near`]), closer to it than the
+    /// start vertex of the anchor with the highest weight.
+    Located {
+        /// The anchor with the highest weight.
+        anchor: usize,
+        /// The vertex.
+        vertex: VertexId,
+    },
     /// Nowhere: the exact mode searches every triangle.
     Exhaustive,
 }
@@ -305,11 +313,25 @@ impl Solver {
         prepared: &Prepared,
         opts: &ForwardOptions,
     ) -> Result<ForwardResult, SolveError> {
-        let Prepared { ybar, start, hint } = *prepared;
+        let Prepared {
+            ybar,
+            mut start,
+            hint,
+        } = *prepared;
         let mesh = self.mesh();
+        if let Start::HighestWeight { anchor, vertex } = start {
+            // Here rather than in `prepare`: batches search in spatial order, so the
+            // lookups of nearby queries share cached data.
+            let v = self.projector.start_near(&ybar, vertex);
+            if v != vertex {
+                start = Start::Located { anchor, vertex: v };
+            }
+        }
         let proj = match start {
             Start::Exhaustive => self.projector.project_exhaustive(&ybar),
-            Start::Warm(v) | Start::HighestWeight { vertex: v, .. } => match opts.mode {
+            Start::Warm(v)
+            | Start::HighestWeight { vertex: v, .. }
+            | Start::Located { vertex: v, .. } => match opts.mode {
                 SearchMode::Fast => {
                     self.projector
                         .project_with(&ybar, v, hint, SearchGoal::FirstHit)

@@ -95,34 +95,43 @@ pub(super) struct Face {
 }
 
 impl Projector {
-    /// Computes the vertex frames, the per-triangle data and the bounding volume hierarchy.
+    /// Computes the vertex frames, the per-triangle data, the bounding volume hierarchy,
+    /// the walk records and the start grid, each in parallel chunks written in place (the
+    /// result does not depend on the number of threads).
     pub fn new(emb: Arc<EmbeddedMesh>) -> Result<Self, ProjectError> {
         let mesh = emb.mesh();
         if mesh.n_faces() == 0 {
             return Err(ProjectError::EmptyMesh);
         }
         let coords = emb.coords();
+        let topo = mesh.topology();
         let chunk = 4096;
-        let (verts, kinds): (Vec<VertexRec>, Vec<FrameKind>) = (0..mesh.n_vertices())
-            .into_par_iter()
-            .with_min_len(chunk)
-            .map(|v| {
-                let (t, k) = crate::frames::vertex_frame(mesh, coords, v as u32);
-                let rec = VertexRec {
-                    x: coords[v],
-                    t: frame_to_f32(&t),
-                };
-                (rec, k)
+        let mut verts = crate::hugepage::filled(
+            mesh.n_vertices(),
+            VertexRec {
+                x: Vec8::zeros(),
+                t: [0.0; 16],
+            },
+        );
+        let frame_kinds = verts
+            .par_chunks_mut(chunk)
+            .enumerate()
+            .map(|(c, out)| {
+                let mut counts = [0usize; 4];
+                for (i, o) in out.iter_mut().enumerate() {
+                    let v = c * chunk + i;
+                    let (t, k) = crate::frames::vertex_frame(mesh, coords, v as u32);
+                    *o = VertexRec {
+                        x: coords[v],
+                        t: frame_to_f32(&t),
+                    };
+                    counts[k as usize] += 1;
+                }
+                counts
             })
-            .unzip();
-        let verts = crate::hugepage::collect(verts.len(), verts);
-        let mut frame_kinds = [0; 4];
-        for k in kinds {
-            frame_kinds[k as usize] += 1;
-        }
+            .reduce(|| [0; 4], |a, b| std::array::from_fn(|k| a[k] + b[k]));
         const BATCH: usize = 4;
-        let mut faces = crate::hugepage::vec_with_capacity(mesh.n_faces());
-        faces.resize(mesh.n_faces(), Face::default());
+        let mut faces = crate::hugepage::filled(mesh.n_faces(), Face::default());
         faces
             .par_chunks_mut(BATCH)
             .zip(mesh.triangles.par_chunks(BATCH))
@@ -144,10 +153,17 @@ impl Projector {
                 }
             });
         let bvh = Bvh::new(&mesh.triangles, coords);
-        let (lo, hi) = coords.iter().fold(
-            (Vec8::repeat(f64::INFINITY), Vec8::repeat(f64::NEG_INFINITY)),
-            |(l, h), c| (l.inf(c), h.sup(c)),
-        );
+        let (lo, hi) = coords
+            .par_iter()
+            .with_min_len(chunk)
+            .fold(
+                || (Vec8::repeat(f64::INFINITY), Vec8::repeat(f64::NEG_INFINITY)),
+                |(l, h), c| (l.inf(c), h.sup(c)),
+            )
+            .reduce(
+                || (Vec8::repeat(f64::INFINITY), Vec8::repeat(f64::NEG_INFINITY)),
+                |(l0, h0), (l1, h1)| (l0.inf(&l1), h0.sup(&h1)),
+            );
         let walk_origin = lo;
         let extent = (hi - lo).max();
         let walk_inv_step = if extent > 0.0 && extent.is_finite() {
@@ -155,33 +171,38 @@ impl Projector {
         } else {
             1.0
         };
-        let walk_coords = crate::hugepage::collect(
-            coords.len(),
-            coords.iter().enumerate().map(|(v, c)| {
-                let r = mesh.topology().ring(v as u32);
-                let rf = mesh.topology().ring_faces(v as u32);
-                let mut ring = [0u32; WALK_RING];
-                let mut faces = [0u32; WALK_RING];
-                let n = if r.len() <= WALK_RING {
-                    ring[..r.len()].copy_from_slice(r);
-                    faces[..rf.len()].copy_from_slice(rf);
-                    r.len() as u32
-                } else {
-                    u32::MAX
-                };
-                WalkPoint {
-                    c: std::array::from_fn(|k| {
-                        ((c[k] - walk_origin[k]) * walk_inv_step)
-                            .round()
-                            .clamp(0.0, 65535.0) as u16
-                    }),
-                    ring,
-                    faces,
-                    n,
-                    nf: rf.len() as u32,
-                }
-            }),
+        let mut walk_coords = crate::hugepage::vec_with_capacity(coords.len());
+        walk_coords.par_extend(
+            coords
+                .par_iter()
+                .enumerate()
+                .with_min_len(chunk)
+                .map(|(v, c)| {
+                    let r = topo.ring(v as u32);
+                    let rf = topo.ring_faces(v as u32);
+                    let mut ring = [0u32; WALK_RING];
+                    let mut faces = [0u32; WALK_RING];
+                    let n = if r.len() <= WALK_RING {
+                        ring[..r.len()].copy_from_slice(r);
+                        faces[..rf.len()].copy_from_slice(rf);
+                        r.len() as u32
+                    } else {
+                        u32::MAX
+                    };
+                    WalkPoint {
+                        c: std::array::from_fn(|k| {
+                            ((c[k] - walk_origin[k]) * walk_inv_step)
+                                .round()
+                                .clamp(0.0, 65535.0) as u16
+                        }),
+                        ring,
+                        faces,
+                        n,
+                        nf: rf.len() as u32,
+                    }
+                }),
         );
+        let starts = StartGrid::new(&walk_coords);
         Ok(Self {
             emb,
             verts,
@@ -192,6 +213,47 @@ impl Projector {
             walk_origin,
             walk_inv_step,
             walk_coords,
+            starts,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wavg_mesh::{ValidMesh, procedural};
+
+    /// The set-up runs in parallel chunks; its result is the same on any number of
+    /// threads (the hierarchy is large enough for its subtrees to be built in parallel).
+    #[test]
+    fn set_up_does_not_depend_on_the_thread_count() {
+        let m = Arc::new(ValidMesh::new(procedural::icosphere(5)).unwrap());
+        let emb = Arc::new(EmbeddedMesh::from_positions(m));
+        let build = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| Projector::new(emb.clone()).unwrap())
+        };
+        let one = build(1);
+        for threads in [2, 5] {
+            let p = build(threads);
+            assert_eq!(format!("{:?}", p.bvh), format!("{:?}", one.bvh));
+            assert_eq!(p.frame_kinds, one.frame_kinds);
+            for (a, b) in p.verts.iter().zip(&one.verts) {
+                assert_eq!((a.x, a.t), (b.x, b.t));
+            }
+            for (a, b) in p.faces.iter().zip(&one.faces) {
+                assert_eq!(format!("{a:?}"), format!("{b:?}"));
+            }
+            for (a, b) in p.walk_coords.iter().zip(&one.walk_coords) {
+                assert_eq!(
+                    (a.c, a.ring, a.faces, a.n, a.nf),
+                    (b.c, b.ring, b.faces, b.n, b.nf)
+                );
+            }
+            assert_eq!(p.starts.bytes(), one.starts.bytes());
+        }
     }
 }

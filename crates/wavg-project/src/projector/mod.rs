@@ -19,7 +19,6 @@ use wavg_mesh::{FaceId, NONE, SurfacePoint, VertexId};
 
 use crate::bvh::Bvh;
 use crate::euclid::closest_point_barycentric;
-use crate::frames::FrameKind;
 use crate::triangle::{Frame32, TriData, frame_to_f32, frame_to_f64};
 use crate::{EmbeddedMesh, Mat2x8, ProjectError, Vec8};
 use cone::Cones;
@@ -28,12 +27,14 @@ mod batch;
 mod certify;
 mod cone;
 mod layout;
+mod locate;
 mod nearest;
 mod order;
 mod search;
 mod walk;
 
 use layout::{Face, VertexRec, WalkPoint};
+use locate::StartGrid;
 
 pub use batch::ProjectScratch;
 pub use order::FaceOrder;
@@ -85,6 +86,7 @@ pub struct Projector {
     walk_origin: Vec8,
     walk_inv_step: f64,
     walk_coords: Vec<WalkPoint>,
+    starts: StartGrid,
 }
 
 #[derive(Clone, Copy)]
@@ -118,6 +120,7 @@ impl Projector {
             + self.bvh.bytes()
             + self.cones.get().map_or(0, Cones::bytes)
             + std::mem::size_of_val(&self.walk_coords[..])
+            + self.starts.bytes()
             + std::mem::size_of_val(self.emb.coords())
     }
 

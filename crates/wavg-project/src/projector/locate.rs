@@ -1,0 +1,265 @@
+//! Start vertices near any query: a coarse grid over the three widest of the walk's
+//! coordinates, each cell holding the vertex of the mesh nearest its centre (an empty cell,
+//! that of the nearest cell with one). A greedy walk over the vertex graph takes a number
+//! of steps that grows with the mesh's resolution (about the square root of its vertex
+//! count) times the distance to cover; a greedy walk over the grid's cells, each step
+//! comparing the neighbouring cells' vertices in all eight coordinates, covers most of the
+//! distance in steps of a cell.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use super::layout::WalkPoint;
+use super::*;
+
+/// Cells along the widest axis per square root of the vertex count: about as many
+/// vertices per occupied cell at every resolution, so walks from a cell's vertex take
+/// about the same number of steps.
+const CELLS_PER_SQRT_VERTEX: f64 = 1.0 / 8.0;
+/// At most this many cells along an axis (the grid stays a few megabytes).
+const MAX_CELLS: u32 = 128;
+/// The walk over the cells stops after this many steps (the walk over the vertices goes
+/// on from where it stopped).
+const MAX_CELL_STEPS: usize = 64;
+
+/// The grid: cell `(i, j, k)` over walk axes `axes` holds a vertex: the most central one
+/// inside it, or for an empty cell that of the nearest cell with one.
+#[derive(Clone, Debug)]
+pub(super) struct StartGrid {
+    axes: [usize; 3],
+    origin: [f32; 3],
+    /// Cells per walk unit.
+    inv_cell: f32,
+    dims: [u32; 3],
+    cells: Vec<u32>,
+}
+
+impl StartGrid {
+    /// The grid over the walk records (deterministic: each cell keeps its most central
+    /// vertex, ties to the lowest index, whatever the number of threads).
+    pub(super) fn new(walk: &[WalkPoint]) -> Self {
+        let (lo, hi) = walk
+            .par_iter()
+            .with_min_len(4096)
+            .fold(
+                || ([u16::MAX; 8], [0u16; 8]),
+                |(l, h), w| {
+                    (
+                        std::array::from_fn(|k| l[k].min(w.c[k])),
+                        std::array::from_fn(|k| h[k].max(w.c[k])),
+                    )
+                },
+            )
+            .reduce(
+                || ([u16::MAX; 8], [0u16; 8]),
+                |(l0, h0), (l1, h1)| {
+                    (
+                        std::array::from_fn(|k| l0[k].min(l1[k])),
+                        std::array::from_fn(|k| h0[k].max(h1[k])),
+                    )
+                },
+            );
+        // Extents in walk units (one more than the span: a cell is half-open).
+        let ext: [f32; 8] = std::array::from_fn(|k| hi[k].saturating_sub(lo[k]) as f32 + 1.0);
+        let mut order: [usize; 8] = std::array::from_fn(|k| k);
+        order.sort_by(|&a, &b| ext[b].total_cmp(&ext[a]).then(a.cmp(&b)));
+        let axes = [order[0], order[1], order[2]];
+        let n = ((walk.len() as f64).sqrt() * CELLS_PER_SQRT_VERTEX)
+            .ceil()
+            .clamp(1.0, MAX_CELLS as f64) as f32;
+        let inv_cell = n / ext[axes[0]];
+        let dims = axes.map(|a| ((ext[a] * inv_cell).ceil() as u32).clamp(1, MAX_CELLS));
+        let mut grid = Self {
+            axes,
+            origin: axes.map(|a| lo[a] as f32),
+            inv_cell,
+            dims,
+            cells: Vec::new(),
+        };
+        let n_cells = dims.iter().map(|&d| d as usize).product::<usize>();
+        // Key: squared distance to the cell's centre (non-negative f32: its bits sort like
+        // its value) above the vertex id, so the minimum is the most central, lowest id.
+        let best: Vec<AtomicU64> = (0..n_cells).map(|_| AtomicU64::new(u64::MAX)).collect();
+        walk.par_iter()
+            .enumerate()
+            .with_min_len(4096)
+            .for_each(|(v, w)| {
+                let (cell, d2) = grid.cell_of(&w.unpack());
+                let key = (u64::from(d2.to_bits()) << 32) | v as u64;
+                best[cell].fetch_min(key, Ordering::Relaxed);
+            });
+        grid.cells = best
+            .into_iter()
+            .map(|b| match b.into_inner() {
+                u64::MAX => NONE,
+                k => k as u32,
+            })
+            .collect();
+        grid.fill_empty_cells();
+        grid
+    }
+
+    /// Gives every empty cell the vertex of the nearest cell holding one (breadth-first
+    /// over face-adjacent cells from all occupied cells in index order: deterministic).
+    fn fill_empty_cells(&mut self) {
+        let mut queue: std::collections::VecDeque<usize> = (0..self.cells.len())
+            .filter(|&c| self.cells[c] != NONE)
+            .collect();
+        while let Some(c) = queue.pop_front() {
+            let v = self.cells[c];
+            for n in self.neighbours(c, false).into_iter().flatten() {
+                if self.cells[n] == NONE {
+                    self.cells[n] = v;
+                    queue.push_back(n);
+                }
+            }
+        }
+    }
+
+    /// The cells next to cell `c`: the 6 sharing a face, or with `all` the 26 sharing a
+    /// face, an edge or a corner (`None` past the grid's sides).
+    #[inline]
+    fn neighbours(&self, c: usize, all: bool) -> [Option<usize>; 26] {
+        let [d0, d1, d2] = self.dims.map(|d| d as usize);
+        let (i, j, k) = (c / (d1 * d2), c / d2 % d1, c % d2);
+        let mut out = [None; 26];
+        let mut m = 0;
+        for di in -1i64..=1 {
+            for dj in -1i64..=1 {
+                for dk in -1i64..=1 {
+                    let far = di.abs() + dj.abs() + dk.abs();
+                    if far == 0 || (!all && far > 1) {
+                        continue;
+                    }
+                    let (a, b, e) = (i as i64 + di, j as i64 + dj, k as i64 + dk);
+                    if (0..d0 as i64).contains(&a)
+                        && (0..d1 as i64).contains(&b)
+                        && (0..d2 as i64).contains(&e)
+                    {
+                        out[m] = Some((a as usize * d1 + b as usize) * d2 + e as usize);
+                    }
+                    m += 1;
+                }
+            }
+        }
+        out
+    }
+
+    /// The cell holding walk point `p` (clamped to the grid) and the squared distance
+    /// from `p` to its centre, in cells.
+    #[inline]
+    fn cell_of(&self, p: &[f32; 8]) -> (usize, f32) {
+        let mut idx = 0usize;
+        let mut d2 = 0.0f32;
+        for i in 0..3 {
+            let x = (p[self.axes[i]] - self.origin[i]) * self.inv_cell;
+            // `as` saturates (NaN to 0).
+            let c = (x.floor() as u32).min(self.dims[i] - 1);
+            let d = x - (c as f32 + 0.5);
+            d2 += d * d;
+            idx = idx * self.dims[i] as usize + c as usize;
+        }
+        (idx, d2)
+    }
+
+    /// Greedy walk over the cells from the one holding walk point `p`: moves to the
+    /// neighbouring cell whose vertex is closest to `p` (squared distance `dist2`) while
+    /// that improves; returns the last cell's vertex and its squared distance.
+    #[inline]
+    pub(super) fn walk(&self, p: &[f32; 8], dist2: impl Fn(VertexId) -> f32) -> (VertexId, f32) {
+        let mut c = self.cell_of(p).0;
+        let mut v = self.cells[c];
+        let mut d = dist2(v);
+        for _ in 0..MAX_CELL_STEPS {
+            let mut next = c;
+            for n in self.neighbours(c, true).into_iter().flatten() {
+                let u = self.cells[n];
+                let du = dist2(u);
+                if du < d {
+                    (next, v, d) = (n, u, du);
+                }
+            }
+            if next == c {
+                break;
+            }
+            c = next;
+        }
+        (v, d)
+    }
+
+    /// Heap bytes used.
+    pub(super) fn bytes(&self) -> usize {
+        std::mem::size_of_val(&self.cells[..])
+    }
+}
+
+impl Projector {
+    /// A vertex to start a search for `y` from: `start`, or the vertex of a coarse grid
+    /// over the surface nearest `y` when that one is closer to `y` (in the greedy walk's
+    /// compact coordinates). A walk from a far-off start takes a number of steps that
+    /// grows with the mesh's resolution; from this one it takes a few. The start only
+    /// changes the work of [`Projector::project`], never its answer. `start` itself when
+    /// `y` is not finite or `start` is out of range.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector};
+    /// let m = Arc::new(ValidMesh::new(procedural::icosphere(5)).unwrap());
+    /// let emb = Arc::new(EmbeddedMesh::from_positions(m));
+    /// let p = Projector::new(emb.clone()).unwrap();
+    /// let y = emb.point(&SurfacePoint::new(9000, [0.2, 0.3, 0.5]));
+    /// let s = p.start_near(&y, 0);
+    /// assert!((emb.coords()[s as usize] - y).norm() <= (emb.coords()[0] - y).norm());
+    /// assert_eq!(p.project(&y, s).unwrap().point.face, 9000);
+    /// ```
+    pub fn start_near(&self, y: &Vec8, start: VertexId) -> VertexId {
+        let Some(ws) = self.walk_coords.get(start as usize) else {
+            return start;
+        };
+        if !y.iter().all(|v| v.is_finite()) {
+            return start;
+        }
+        let yw = self.walk_point(y);
+        let (v, d) = self
+            .starts
+            .walk(&yw, |u| self.walk_coords[u as usize].dist2(&yw));
+        if d < ws.dist2(&yw) { v } else { start }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wavg_mesh::{ValidMesh, procedural};
+
+    /// Every cell holds a vertex; an occupied cell's vertex lies in it; the grid is the
+    /// same on one thread as on several.
+    #[test]
+    fn grid_cells_hold_their_own_vertices_whatever_the_threads() {
+        let m = Arc::new(ValidMesh::new(procedural::icosphere(5)).unwrap());
+        let emb = Arc::new(EmbeddedMesh::from_positions(m));
+        let p = Projector::new(emb.clone()).unwrap();
+        let g = &p.starts;
+        assert!(g.cells.len() > 100 && g.cells.iter().all(|&v| v != NONE));
+        let mut own = vec![false; g.cells.len()];
+        for (v, w) in p.walk_coords.iter().enumerate() {
+            own[g.cell_of(&w.unpack()).0] = true;
+            // A vertex's cell holds a vertex of that cell.
+            let u = g.cells[g.cell_of(&w.unpack()).0];
+            assert_eq!(
+                g.cell_of(&p.walk_coords[u as usize].unpack()).0,
+                g.cell_of(&w.unpack()).0,
+                "vertex {v}"
+            );
+        }
+        assert!(own.iter().any(|&o| !o), "some cells are empty (and filled)");
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let q = pool.install(|| StartGrid::new(&p.walk_coords));
+            assert_eq!(q.cells, g.cells);
+        }
+    }
+}
