@@ -117,16 +117,26 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
         }
         let r = repair_outcome(mesh);
         if r.remaining.is_empty() {
+            let added = if r.added_vertices > 0 {
+                format!(", splits off {} vertex copies", r.added_vertices)
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 o,
                 "repair:               `wavg repair` fixes every problem \
-                 (removes {} vertices, {} faces)",
+                 (removes {} vertices, {} faces{added})",
                 r.removed_vertices, r.removed_faces
             );
         } else {
+            let hint = if r.components > 1 {
+                " (try --largest-component)"
+            } else {
+                ""
+            };
             let _ = writeln!(
                 o,
-                "repair:               `wavg repair` leaves: {} (try --largest-component)",
+                "repair:               `wavg repair` leaves: {}{hint}",
                 r.remaining.join("; ")
             );
         }
@@ -138,7 +148,11 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
 /// face also makes non-manifold edges that disappear with it).
 struct RepairOutcome {
     removed_vertices: usize,
+    /// Copies made by splitting non-manifold vertices.
+    added_vertices: usize,
     removed_faces: usize,
+    /// Connected components after repair.
+    components: usize,
     /// Problem lines left after repair (empty: the repaired mesh is valid).
     remaining: Vec<String>,
 }
@@ -148,7 +162,9 @@ fn repair_outcome(mesh: &TriMesh) -> RepairOutcome {
     let after = analyze(&r.mesh);
     RepairOutcome {
         removed_vertices: r.removed_vertices(),
+        added_vertices: r.added_vertices(),
         removed_faces: r.removed_faces(mesh.n_faces()),
+        components: after.stats.components,
         remaining: after
             .report
             .summary()
@@ -187,6 +203,7 @@ pub fn to_json(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
         json!({
             "fixes_all": r.remaining.is_empty(),
             "removed_vertices": r.removed_vertices,
+            "added_vertices": r.added_vertices,
             "removed_faces": r.removed_faces,
             "remaining_problems": r.remaining,
         })

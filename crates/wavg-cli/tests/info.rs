@@ -112,6 +112,8 @@ fn invalid_but_parseable_file_exits_zero_and_lists_problems() {
     assert!(text.contains("`wavg repair` fixes every problem"), "{text}");
     assert_eq!(j["repair"]["fixes_all"], true);
     assert_eq!(j["repair"]["removed_vertices"], 1);
+    assert_eq!(j["repair"]["added_vertices"], 4);
+    assert!(text.contains("splits off 4 vertex copies"), "{text}");
     // A problem no repair fixes: a Moebius strip has no consistent orientation.
     let mut positions = Vec::new();
     let n = 12;
@@ -140,7 +142,7 @@ fn invalid_but_parseable_file_exits_zero_and_lists_problems() {
     let out = wavg(&["info", mpath.to_str().unwrap()]);
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(
-        text.contains("`wavg repair` leaves: 1 edges with inconsistent orientation"),
+        text.contains("`wavg repair` leaves: 1 edges with inconsistent orientation\n"),
         "{text}"
     );
     // A problem the repairs do fix: an unreferenced vertex on a valid torus.
