@@ -228,19 +228,8 @@ pub fn push_number(out: &mut Vec<u8>, x: f64) {
     let a = x.abs();
     if x == 0.0 || (1e-4..1e16).contains(&a) || (a < 1e-5 && s.contains("e-")) {
         out.extend_from_slice(s.as_bytes());
-    } else if let Some(digits) = s.trim_start_matches('-').strip_prefix("0.0000") {
-        // Between 1e-5 and 1e-4 zmij writes `0.0000DDD`; `{:?}` writes `D.DDe-5`.
-        let digits = digits.trim_end_matches('0').as_bytes();
-        if x < 0.0 {
-            out.push(b'-');
-        }
-        out.push(digits[0]);
-        if digits.len() > 1 {
-            out.push(b'.');
-            out.extend_from_slice(&digits[1..]);
-        }
-        out.extend_from_slice(b"e-5");
     } else {
+        // Between 1e-5 and 1e-4 zmij writes `0.0000DDD`, where `{:?}` writes `D.DDe-5`.
         push_exponent_form(out, s);
     }
 }
