@@ -4,9 +4,9 @@
 //!
 //! `Psi(xi) = sum_e c_e(xi) X_e T_{i(e)}` over six terms `e`: for each edge `k = (i, i+1)`
 //! the term `2k` is `c_first E_k R_k T_i` and the term `2k+1` is `c_second E_k T_{i+1}`
-//! (algorithm.md section 3). Each triangle stores the six 2x2 matrices `X_e` and, for the
-//! Newton solve, `G_e = X_e T_i (v_k - v_i)` for the two other corners `k`: with
-//! `h_i = T_i (y - v_i)` the tangent equations become
+//! (the paper's Section 3.2; `R_k = Ort(T_{i+1} T_i^T)`). Each triangle stores the six 2x2
+//! matrices `X_e` and, for the Newton solve, `G_e = X_e T_i (v_k - v_i)` for the two other
+//! corners `k`: with `h_i = T_i (y - v_i)` the tangent equations become
 //! `F(xi) = sum_e c_e(xi) (sum_k xi_k G_ek - X_e h_i) = Psi(xi) (p(xi) - y)`, a 2-D
 //! computation per Newton step. Everything is relative to the triangle's corners, so the
 //! results do not depend on where the mesh is or on its scale. Stored as f32; evaluated in
