@@ -148,3 +148,38 @@ fn fertility_matches_the_brute_force() {
 fn armadillo_matches_the_brute_force() {
     real("meshes/armadillo.obj.gz", 40);
 }
+
+/// A walk that ends where no face holds a projection (here on another component, beside
+/// the query) searches once more from the vertex nearest to the query and certifies what
+/// it finds there, instead of going to the global search.
+#[test]
+fn a_stranded_walk_searches_again_from_the_nearest_vertex() {
+    // Two flat sheets side by side in the plane z = 0: B on [0, 1]^2, A on [3, 4] x [0, 1].
+    let mut mesh = wavg_mesh::procedural::grid(4, 4, 1.0, 1.0);
+    let n = mesh.positions.len() as u32;
+    let tris = mesh.triangles.clone();
+    for p in mesh.positions.clone() {
+        mesh.positions
+            .push(nalgebra::Vector3::new(p.x + 3.0, p.y, p.z));
+    }
+    for t in tris {
+        mesh.triangles.push([t[0] + n, t[1] + n, t[2] + n]);
+    }
+    let fx = Fixture::new("side by side", mesh, Embedding::Padded);
+    let faces_b = fx.mesh().n_faces() as u32 / 2;
+    for k in 0..40 {
+        let u = |m: f64| (k as f64 * m).fract();
+        // A point of sheet A, and a start on sheet B.
+        let p = fx.point(0.5 + u(0.618) * 0.5, u(0.755), u(0.57));
+        assert!(p.face >= faces_b);
+        let y = fx.emb.point(&p);
+        let start = fx.vertex(u(0.377) * 0.5);
+        assert!(start < n);
+        let fast = fx.proj.project(&y, start).unwrap();
+        let brute = fx.proj.project_brute_force(&y).unwrap();
+        assert_eq!(fast.path, ProjectionPath::Certified, "{fast:?}");
+        assert!(fast.point.face >= faces_b, "{fast:?}");
+        assert!(fast.distance <= 1e-12, "{fast:?}");
+        assert!((fx.emb.point(&fast.point) - fx.emb.point(&brute.point)).norm() <= 1e-12);
+    }
+}

@@ -21,8 +21,10 @@ const HINT_MARGIN: f64 = 0.0;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SearchGoal {
     /// The closest valid projection: the local search tests the faces around the walk's
-    /// end, then rings of their neighbours until one holds a projection, then certifies its best answer against the bounding
-    /// volume hierarchy (or searches globally). Path [`ProjectionPath::Certified`] or
+    /// end, then rings of their neighbours until one holds a projection, then certifies
+    /// its best answer against the bounding volume hierarchy. When nothing is found within
+    /// [`LOCAL_BUDGET`] faces, the search runs again from the vertex nearest to the query,
+    /// then the global search answers. Path [`ProjectionPath::Certified`] or
     /// [`ProjectionPath::Fallback`].
     #[default]
     Closest,
@@ -228,28 +230,45 @@ impl Projector {
                 }
                 global(y)
             }
-            (SearchGoal::Closest, Some(b)) if self.is_zero(&b) => {
-                Ok(Self::finish(b, ProjectionPath::Certified))
-            }
-            (SearchGoal::Closest, Some(local)) => {
-                let mut improved = None;
-                let mut bound = local.d2;
-                let keep = cone::keep_filter(self, y);
-                self.bvh.search_pruned(y, &mut bound, keep, |f, bound| {
-                    if tried.contains(f) {
-                        return;
+            (SearchGoal::Closest, Some(b)) => Ok(self.certify(y, b, &tried)),
+            (SearchGoal::Closest, None) => {
+                // As for the first hit: once more from the nearest vertex before the
+                // global search (the walk can end on another sheet that lies close in R^8).
+                let u = self.nearest_vertex(y);
+                if u != v {
+                    let cands = self.faces_by_promise(y, u);
+                    let mut tried = FaceSet::new();
+                    if let Some(b) = self.local_search(y, u, &cands, goal, &mut tried) {
+                        return Ok(self.certify(y, b, &tried));
                     }
-                    if let Some(b) = self.try_face_bounded(f, y, *bound) {
-                        *bound = b.d2;
-                        improved = Some(b);
-                    }
-                });
-                Ok(match improved {
-                    Some(b) => Self::finish(b, ProjectionPath::Fallback),
-                    None => Self::finish(local, ProjectionPath::Certified),
-                })
+                }
+                global(y)
             }
-            (SearchGoal::Closest, None) => global(y),
+        }
+    }
+
+    /// Certifies the local search's answer `local` against the hierarchy (faces in
+    /// `tried` are skipped): `Certified` if nothing is strictly closer, else the closest
+    /// projection found, as `Fallback`.
+    fn certify(&self, y: &Vec8, local: Best, tried: &FaceSet) -> Projection {
+        if self.is_zero(&local) {
+            return Self::finish(local, ProjectionPath::Certified);
+        }
+        let mut improved = None;
+        let mut bound = local.d2;
+        let keep = cone::keep_filter(self, y);
+        self.bvh.search_pruned(y, &mut bound, keep, |f, bound| {
+            if tried.contains(f) {
+                return;
+            }
+            if let Some(b) = self.try_face_bounded(f, y, *bound) {
+                *bound = b.d2;
+                improved = Some(b);
+            }
+        });
+        match improved {
+            Some(b) => Self::finish(b, ProjectionPath::Fallback),
+            None => Self::finish(local, ProjectionPath::Certified),
         }
     }
 
