@@ -7,6 +7,7 @@ mod cbuild;
 mod examples;
 mod fuzz;
 mod lines;
+mod policy;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -55,7 +56,9 @@ fn bench(root: &Path, args: &[String]) -> Result<(), String> {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test | cargo xtask fuzz [--seconds N] [--target NAME] | cargo xtask bench NAME [ARGS] | cargo xtask lines\n\n  \
-         test   rustfmt check, clippy (-D warnings), cargo test --workspace, the examples \
+         test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
+         (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
+         and wavg-ffi), cargo doc (-D warnings), the examples \
          (and quickstart.rs as a crate outside the workspace), the C/C++ build (CMake: \
          libwavg, C tests, examples, OpenMesh harness) and ctest, a {SMOKE_SECONDS} s smoke \
          run of every fuzz target\n  \
@@ -147,6 +150,17 @@ fn run_all(root: &Path) -> ExitCode {
             return ExitCode::FAILURE;
         }
     }
+    eprintln!(
+        "==> source policy (files over {} lines, forbid(unsafe_code))",
+        lines::MAX_LINES
+    );
+    if let Err(msg) = lines::run(root).and_then(|()| policy::check_unsafe(root)) {
+        eprintln!("==> source policy FAILED: {msg}");
+        return ExitCode::FAILURE;
+    }
+    if !run_docs(root) {
+        return ExitCode::FAILURE;
+    }
     if let Err(msg) = examples::run(root) {
         eprintln!("==> examples FAILED: {msg}");
         return ExitCode::FAILURE;
@@ -169,6 +183,28 @@ fn run_all(root: &Path) -> ExitCode {
         total.elapsed().as_secs_f64()
     );
     ExitCode::SUCCESS
+}
+
+/// `cargo doc --workspace --no-deps` with warnings as errors (broken or private links,
+/// malformed doc comments).
+fn run_docs(root: &Path) -> bool {
+    eprintln!("==> docs (RUSTDOCFLAGS=-D warnings cargo doc --workspace --no-deps)");
+    let t = Instant::now();
+    let status = Command::new("cargo")
+        .args(["doc", "--workspace", "--no-deps"])
+        .env("RUSTDOCFLAGS", "-D warnings")
+        .current_dir(root)
+        .status();
+    match status {
+        Ok(s) if s.success() => {
+            eprintln!("==> docs ok in {:.1} s", t.elapsed().as_secs_f64());
+            true
+        }
+        other => {
+            eprintln!("==> docs FAILED ({other:?})");
+            false
+        }
+    }
 }
 
 /// Runs one step from the repository root, reporting its time; false when it failed.

@@ -1,0 +1,78 @@
+//! Source policy checked by `cargo xtask test`: `unsafe` code only in the crates that need
+//! it (SIMD and prefetch hints in `wavg-project`, the C ABI in `wavg-ffi`); every other
+//! crate root says `#![forbid(unsafe_code)]`.
+
+use std::path::Path;
+
+/// Crates allowed to contain `unsafe` blocks (each keeps them in one module).
+const UNSAFE_ALLOWED: [&str; 2] = ["wavg-project", "wavg-ffi"];
+
+/// `Err` names every crate root (library or binary) under `crates/` and `xtask` that
+/// lacks `#![forbid(unsafe_code)]` without being allowed `unsafe`.
+pub fn check_unsafe(root: &Path) -> Result<(), String> {
+    let mut dirs: Vec<_> = std::fs::read_dir(root.join("crates"))
+        .map_err(|e| format!("crates: {e}"))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.is_dir())
+        .collect();
+    dirs.push(root.join("xtask"));
+    dirs.sort();
+    let mut missing = Vec::new();
+    for dir in dirs {
+        let name = dir
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
+        if UNSAFE_ALLOWED.contains(&name.as_str()) {
+            continue;
+        }
+        for file in ["src/lib.rs", "src/main.rs"] {
+            let path = dir.join(file);
+            let Ok(text) = std::fs::read_to_string(&path) else {
+                continue;
+            };
+            if !text.lines().any(|l| l.trim() == "#![forbid(unsafe_code)]") {
+                missing.push(format!("{name}/{file}"));
+            }
+        }
+    }
+    if missing.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "#![forbid(unsafe_code)] missing in {}",
+            missing.join(", ")
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_crate_without_forbid_is_named_and_allowed_ones_are_not() {
+        let root = std::env::temp_dir().join(format!("xtask-policy-{}", std::process::id()));
+        let write = |rel: &str, text: &str| {
+            let p = root.join(rel);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, text).unwrap();
+        };
+        write("crates/good/src/lib.rs", "//! ok\n#![forbid(unsafe_code)]\n");
+        write("crates/wavg-ffi/src/lib.rs", "//! the C ABI\n");
+        write("xtask/src/main.rs", "#![forbid(unsafe_code)]\nfn main() {}\n");
+        assert_eq!(check_unsafe(&root), Ok(()));
+        write("crates/bad/src/main.rs", "fn main() {}\n");
+        let err = check_unsafe(&root).unwrap_err();
+        assert!(err.contains("bad/src/main.rs") && !err.contains("good"), "{err}");
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
+    fn this_workspace_follows_the_policy() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+        assert_eq!(check_unsafe(root), Ok(()));
+    }
+}
