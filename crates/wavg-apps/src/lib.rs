@@ -40,7 +40,7 @@ mod transfer;
 pub use error::AppError;
 pub use render::{
     Camera, Colouring, FOV_DEGREES, Image, MAX_DECODED_BYTES, MAX_SIDE, Overlays, RenderOptions,
-    View, render, viridis,
+    RenderReport, View, render, viridis,
 };
 pub use transfer::{
     TextureTransfer, TransferOptions, check_uv, dilate, rasterize_uv, transfer_texture,

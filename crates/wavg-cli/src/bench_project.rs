@@ -23,7 +23,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use wavg::mesh::{SurfacePoint, ValidMesh, VertexId};
 use wavg::project::{
-    EmbeddedMesh, Par, ProjectScratch, Projection, ProjectionPath, Projector, Vec8,
+    EmbeddedMesh, Par, ProjectScratch, Projection, ProjectionBenchReport, ProjectionPath,
+    Projector, Vec8,
 };
 
 use crate::CliError;
@@ -146,21 +147,25 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
     let name = args.mesh.display().to_string();
     if args.json {
-        let j = serde_json::json!({
-            "mesh": name,
-            "vertices": mesh.n_vertices(),
-            "faces": mesh.n_faces(),
-            "queries": args.queries,
-            "init_s": init_s,
-            "bytes_per_face": bytes_per_face,
-            "onsurface_us": onsurface_us,
-            "onsurface_self_fraction": onsurface_self_fraction,
-            "offset_us": offset_us,
-            "offset_bruteforce_agree_fraction": offset_bruteforce_agree_fraction,
-            "onsurface_fallback_fraction": onsurface_fallback_fraction,
-            "offset_fallback_fraction": offset_fallback_fraction,
-            "fallback_us": fallback_us,
-        });
+        let report = ProjectionBenchReport {
+            vertices: mesh.n_vertices(),
+            faces: mesh.n_faces(),
+            queries: args.queries,
+            init_s,
+            bytes_per_face,
+            onsurface_us,
+            onsurface_self_fraction,
+            offset_us,
+            offset_bruteforce_agree_fraction,
+            onsurface_fallback_fraction,
+            offset_fallback_fraction,
+            fallback_us,
+        };
+        let j = serde_json::to_value(JsonReport {
+            mesh: &name,
+            report,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else {
         let paths = |v: &[Result<Projection, _>]| {
@@ -219,6 +224,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// The `--json` object: the library's [`ProjectionBenchReport`] with the mesh's name
+/// (printed through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    mesh: &'a str,
+    #[serde(flatten)]
+    report: ProjectionBenchReport,
 }
 
 type Answer = Result<Projection, wavg::project::ProjectError>;

@@ -3,9 +3,8 @@
 //! described (exit 0), valid or not; a file that cannot be read or parsed exits with
 //! status 2 and a one-line message naming the file and line.
 
-use serde_json::{Value, json};
-use wavg_mesh::{Analysis, ProblemKind, TriMesh, analyze, procedural, repair};
 use wavg_mesh::{LoadNotes, io};
+use wavg_mesh::{MeshInfo, TriMesh, analyze, procedural};
 
 use crate::CliError;
 use crate::common::one_line;
@@ -39,13 +38,27 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
         (None, None) => return Err(CliError::input("give a mesh file or --builtin NAME")),
     };
-    let a = analyze(&mesh);
+    let info = MeshInfo::new(&mesh, notes.as_ref(), &analyze(&mesh));
     if args.json {
-        println!("{}", to_json(&name, &mesh, notes.as_ref(), &a));
+        let j = serde_json::to_value(JsonReport {
+            mesh: &name,
+            info: &info,
+        })
+        .map_err(CliError::failure)?;
+        println!("{j}");
     } else {
-        print!("{}", to_text(&name, &mesh, notes.as_ref(), &a));
+        print!("{}", to_text(&name, &mesh, notes.as_ref(), &info));
     }
     Ok(())
+}
+
+/// The `--json` object: the mesh's [`MeshInfo`] with its name (printed through
+/// `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    mesh: &'a str,
+    #[serde(flatten)]
+    info: &'a MeshInfo,
 }
 
 fn yes_no(b: bool) -> &'static str {
@@ -53,9 +66,8 @@ fn yes_no(b: bool) -> &'static str {
 }
 
 /// The human-readable report.
-pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analysis) -> String {
+pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, s: &MeshInfo) -> String {
     use std::fmt::Write;
-    let s = &a.stats;
     let mut o = String::new();
     let _ = writeln!(o, "mesh:                 {name}");
     let _ = writeln!(o, "vertices:             {}", s.vertices);
@@ -87,20 +99,14 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
         (None, false) => "no".to_string(),
     };
     let _ = writeln!(o, "texture coordinates:  {uv}");
-    if let Some((lo, hi)) = mesh.bounding_box() {
+    if let Some(b) = &s.bounding_box {
         let _ = writeln!(
             o,
             "bounding box:         [{:.6}, {:.6}, {:.6}] .. [{:.6}, {:.6}, {:.6}] (diagonal {:.6})",
-            lo.x,
-            lo.y,
-            lo.z,
-            hi.x,
-            hi.y,
-            hi.z,
-            (hi - lo).norm()
+            b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2], b.diagonal
         );
     }
-    if a.report.is_valid() {
+    if s.valid {
         let _ = writeln!(
             o,
             "valid:                yes (oriented manifold, usable by wavg)"
@@ -109,142 +115,68 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analys
         let _ = writeln!(
             o,
             "valid:                no ({} problems)",
-            a.report.problems.len()
+            s.problem_summary.iter().map(|p| p.count).sum::<usize>()
         );
         let _ = writeln!(o, "problems:");
-        for line in a.report.lines() {
+        for line in &s.problems {
             let _ = writeln!(o, "  - {line}");
         }
-        let r = repair_outcome(mesh);
-        if r.remaining.is_empty() {
-            let added = if r.added_vertices > 0 {
-                format!(", splits off {} vertex copies", r.added_vertices)
+        // Present for every invalid mesh.
+        if let Some(r) = &s.repair {
+            if r.fixes_all {
+                let added = if r.added_vertices > 0 {
+                    format!(", splits off {} vertex copies", r.added_vertices)
+                } else {
+                    String::new()
+                };
+                let _ = writeln!(
+                    o,
+                    "repair:               `wavg repair` fixes every problem \
+                     (removes {} vertices, {} faces{added})",
+                    r.removed_vertices, r.removed_faces
+                );
             } else {
-                String::new()
-            };
-            let _ = writeln!(
-                o,
-                "repair:               `wavg repair` fixes every problem \
-                 (removes {} vertices, {} faces{added})",
-                r.removed_vertices, r.removed_faces
-            );
-        } else {
-            let hint = if r.components > 1 {
-                " (try --largest-component)"
-            } else {
-                ""
-            };
-            let _ = writeln!(
-                o,
-                "repair:               `wavg repair` leaves: {}{hint}",
-                r.remaining.join("; ")
-            );
+                let hint = if r.components > 1 {
+                    " (try --largest-component)"
+                } else {
+                    ""
+                };
+                let _ = writeln!(
+                    o,
+                    "repair:               `wavg repair` leaves: {}{hint}",
+                    r.remaining_problems.join("; ")
+                );
+            }
         }
     }
     o
 }
 
-/// What the default repairs would do to an invalid mesh (tried, not guessed: a duplicate
-/// face also makes non-manifold edges that disappear with it).
-struct RepairOutcome {
-    removed_vertices: usize,
-    /// Copies made by splitting non-manifold vertices.
-    added_vertices: usize,
-    removed_faces: usize,
-    /// Connected components after repair.
-    components: usize,
-    /// Problem lines left after repair (empty: the repaired mesh is valid).
-    remaining: Vec<String>,
-}
+#[cfg(test)]
+mod tests {
+    use wavg_mesh::ProblemKind;
 
-fn repair_outcome(mesh: &TriMesh) -> RepairOutcome {
-    let r = repair::repair_all(mesh, &wavg_mesh::RepairOptions::default());
-    let after = analyze(&r.mesh);
-    RepairOutcome {
-        removed_vertices: r.removed_vertices(),
-        added_vertices: r.added_vertices(),
-        removed_faces: r.removed_faces(mesh.n_faces()),
-        components: after.stats.components,
-        remaining: after
-            .report
-            .summary()
-            .iter()
-            .map(|s| format!("{} {}", s.count, s.kind.describe()))
-            .collect(),
-    }
-}
-
-/// The `--json` object.
-pub fn to_json(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, a: &Analysis) -> Value {
-    let s = &a.stats;
-    let summary: Vec<Value> = a
-        .report
-        .summary()
-        .iter()
-        .map(|p| {
-            json!({
-                "kind": kind_key(p.kind),
-                "description": p.kind.describe(),
-                "count": p.count,
-                "examples": p.examples.iter().map(|e| e.to_string()).collect::<Vec<_>>(),
-                "remedy": p.kind.remedy(),
-            })
-        })
-        .collect();
-    let bbox = mesh.bounding_box().map(|(lo, hi)| {
-        json!({
-            "min": [lo.x, lo.y, lo.z],
-            "max": [hi.x, hi.y, hi.z],
-            "diagonal": (hi - lo).norm(),
-        })
-    });
-    let repair = (!a.report.is_valid()).then(|| {
-        let r = repair_outcome(mesh);
-        json!({
-            "fixes_all": r.remaining.is_empty(),
-            "removed_vertices": r.removed_vertices,
-            "added_vertices": r.added_vertices,
-            "removed_faces": r.removed_faces,
-            "remaining_problems": r.remaining,
-        })
-    });
-    json!({
-        "mesh": name,
-        "vertices": s.vertices,
-        "faces": s.faces,
-        "polygons": notes.map_or(s.faces, |n| n.polygons),
-        "skipped_faces": notes.map_or(0, |n| n.skipped_faces),
-        "uv_dropped": notes.is_some_and(|n| n.uv_dropped),
-        "edges": s.edges,
-        "components": s.components,
-        "boundary_loops": s.boundary_loops,
-        "euler_characteristic": s.euler_characteristic,
-        "genus": s.genus,
-        "manifold": s.manifold,
-        "oriented": s.oriented,
-        "watertight": s.watertight,
-        "valid": a.report.is_valid(),
-        "uv": mesh.uv.is_some(),
-        "bounding_box": bbox,
-        "problems": a.report.lines(),
-        "problem_summary": summary,
-        "repair": repair,
-    })
-}
-
-/// Stable snake_case key of a problem kind for JSON consumers.
-fn kind_key(k: ProblemKind) -> &'static str {
-    match k {
-        ProblemKind::Empty => "empty",
-        ProblemKind::IndexOutOfRange => "index_out_of_range",
-        ProblemKind::NonFiniteCoordinate => "non_finite_coordinate",
-        ProblemKind::RepeatedIndex => "repeated_index",
-        ProblemKind::ZeroAreaFace => "zero_area_face",
-        ProblemKind::DuplicateFace => "duplicate_face",
-        ProblemKind::NonManifoldEdge => "non_manifold_edge",
-        ProblemKind::NonManifoldVertex => "non_manifold_vertex",
-        ProblemKind::InconsistentOrientation => "inconsistent_orientation",
-        ProblemKind::UnreferencedVertex => "unreferenced_vertex",
-        ProblemKind::InvalidTexCoords => "invalid_tex_coords",
+    /// The `kind` keys of `problem_summary` are a contract with JSON consumers.
+    #[test]
+    fn problem_kinds_serialise_to_their_stable_keys() {
+        let keys = [
+            (ProblemKind::Empty, "empty"),
+            (ProblemKind::IndexOutOfRange, "index_out_of_range"),
+            (ProblemKind::NonFiniteCoordinate, "non_finite_coordinate"),
+            (ProblemKind::RepeatedIndex, "repeated_index"),
+            (ProblemKind::ZeroAreaFace, "zero_area_face"),
+            (ProblemKind::DuplicateFace, "duplicate_face"),
+            (ProblemKind::NonManifoldEdge, "non_manifold_edge"),
+            (ProblemKind::NonManifoldVertex, "non_manifold_vertex"),
+            (
+                ProblemKind::InconsistentOrientation,
+                "inconsistent_orientation",
+            ),
+            (ProblemKind::UnreferencedVertex, "unreferenced_vertex"),
+            (ProblemKind::InvalidTexCoords, "invalid_tex_coords"),
+        ];
+        for (kind, key) in keys {
+            assert_eq!(serde_json::to_value(kind).unwrap(), key);
+        }
     }
 }

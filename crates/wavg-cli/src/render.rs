@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use wavg::Vector3;
-use wavg::apps::{Colouring, Image, Overlays, RenderOptions, View, render};
+use wavg::apps::{Colouring, Image, Overlays, RenderOptions, RenderReport, View, render};
 use wavg::mesh::TriMesh;
 
 use crate::CliError;
@@ -63,6 +63,15 @@ pub struct Args {
     /// Print one JSON object on standard output.
     #[arg(long)]
     pub json: bool,
+}
+
+/// The `--json` object: the library's [`RenderReport`] with the output file (printed
+/// through `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    output: &'a Path,
+    #[serde(flatten)]
+    report: RenderReport,
 }
 
 /// Parses `WxH` (or a single `N` for a square).
@@ -201,31 +210,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let img = render(&mesh, &colouring, &overlays, &opts).map_err(|e| what(&e))?;
     write_png(&args.output, &img)?;
     let seconds = t.elapsed().as_secs_f64();
-    let covered = img
-        .pixels
-        .iter()
-        .filter(|p| **p != [255, 255, 255, 255])
-        .count() as f64
-        / img.pixels.len() as f64;
     if args.json {
-        let mut j = serde_json::json!({
-            "output": args.output,
-            "width": width,
-            "height": height,
-            "vertices": mesh.n_vertices(),
-            "faces": mesh.n_faces(),
-            "covered_fraction": covered,
-            "seconds": seconds,
-        });
-        if let Some(s) = &scalars {
-            let (lo, hi) = s
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                    (a.min(x), b.max(x))
-                });
-            j["scalar_min"] = lo.into();
-            j["scalar_max"] = hi.into();
-        }
+        let report = RenderReport::new(&mesh, &img, scalars.as_deref(), seconds);
+        let j = serde_json::to_value(JsonReport {
+            output: &args.output,
+            report,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else {
         println!(

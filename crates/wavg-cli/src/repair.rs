@@ -4,8 +4,8 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use wavg_mesh::RepairOptions;
 use wavg_mesh::repair::repair_all;
+use wavg_mesh::{RepairOptions, RepairReport};
 use wavg_mesh::{analyze, io};
 
 use crate::CliError;
@@ -86,39 +86,31 @@ pub fn run(args: Args) -> Result<(), CliError> {
             std::fs::write(tmp, &text).map_err(|e| format!("{}: {e}", tmp.display()))
         })?;
     }
-    let problems = after.report.lines();
+    let report = RepairReport::new(&mesh, &r, &after);
     if args.json {
-        let j = serde_json::json!({
-            "input": args.input,
-            "output": args.output,
-            "vertices_before": mesh.n_vertices(),
-            "faces_before": mesh.n_faces(),
-            "vertices": r.mesh.n_vertices(),
-            "faces": r.mesh.n_faces(),
-            "removed_vertices": r.removed_vertices(),
-            "added_vertices": r.added_vertices(),
-            "removed_faces": r.removed_faces(mesh.n_faces()),
-            "components": after.stats.components,
-            "valid": after.report.is_valid(),
-            "problems": problems,
-        });
+        let j = serde_json::to_value(JsonReport {
+            input: &args.input,
+            output: &args.output,
+            report: &report,
+        })
+        .map_err(CliError::failure)?;
         println!("{j}");
     } else {
         println!(
             "{} -> {}: {} -> {} vertices, {} -> {} faces, {} component(s)",
             args.input,
             args.output.display(),
-            mesh.n_vertices(),
-            r.mesh.n_vertices(),
-            mesh.n_faces(),
-            r.mesh.n_faces(),
-            after.stats.components
+            report.vertices_before,
+            report.vertices,
+            report.faces_before,
+            report.faces,
+            report.components
         );
-        if after.report.is_valid() {
+        if report.valid {
             println!("valid: yes");
         } else {
             println!("valid: no; remaining problems:");
-            for p in &problems {
+            for p in &report.problems {
                 println!("  - {p}");
             }
         }
@@ -137,6 +129,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
             after.report.problems.len()
         )))
     }
+}
+
+/// The `--json` object: the library's [`RepairReport`] with the files (printed through
+/// `serde_json::Value`, so keys come out sorted).
+#[derive(serde::Serialize)]
+struct JsonReport<'a> {
+    input: &'a str,
+    output: &'a Path,
+    #[serde(flatten)]
+    report: &'a RepairReport,
 }
 
 /// Writes through a temporary file beside `path`, then renames: an interrupted or failed

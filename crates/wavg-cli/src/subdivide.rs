@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use wavg_mesh::subdivide::loop_subdivide;
-use wavg_mesh::{ValidMesh, io};
+use wavg_mesh::{SubdivisionReport, ValidMesh, io};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
@@ -44,24 +44,25 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let seconds = t.elapsed().as_secs_f64();
     io::save(&args.output, &mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    let report = SubdivisionReport {
+        input_vertices: nv0,
+        input_faces: nf0,
+        vertices: mesh.n_vertices(),
+        faces: mesh.n_faces(),
+        levels: args.levels,
+        seconds,
+    };
     if args.json {
-        let report = serde_json::json!({
-            "input_vertices": nv0,
-            "input_faces": nf0,
-            "vertices": mesh.n_vertices(),
-            "faces": mesh.n_faces(),
-            "levels": args.levels,
-            "seconds": seconds,
-        });
-        println!("{report}");
+        let j = serde_json::to_value(&report).map_err(CliError::failure)?;
+        println!("{j}");
     } else {
         println!(
             "{} -> {}: {nv0} -> {} vertices, {nf0} -> {} faces, {} level(s) in {seconds:.2} s",
             args.input,
             args.output.display(),
-            mesh.n_vertices(),
-            mesh.n_faces(),
-            args.levels
+            report.vertices,
+            report.faces,
+            report.levels
         );
     }
     Ok(())

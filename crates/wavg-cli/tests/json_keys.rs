@@ -6,40 +6,8 @@ mod common;
 
 use std::path::Path;
 
-use common::{json_object, sphere_anchors, wavg_ok};
+use common::{assert_keys, json_object, key_paths, s, sphere_anchors, wavg_ok};
 use serde_json::Value;
-
-fn s(p: &Path) -> String {
-    p.to_str().unwrap().to_string()
-}
-
-/// Every key of `v`, nested ones as `parent.child`, sorted.
-fn key_paths(v: &Value) -> Vec<String> {
-    fn walk(prefix: &str, v: &Value, out: &mut Vec<String>) {
-        if let Value::Object(o) = v {
-            for (k, x) in o {
-                let path = if prefix.is_empty() {
-                    k.clone()
-                } else {
-                    format!("{prefix}.{k}")
-                };
-                out.push(path.clone());
-                walk(&path, x, out);
-            }
-        }
-    }
-    let mut out = Vec::new();
-    walk("", v, &mut out);
-    out.sort();
-    out
-}
-
-fn assert_keys(args: &[&str], want: &[&str]) {
-    let (o, _) = json_object(&wavg_ok(args));
-    let mut want: Vec<String> = want.iter().map(|k| k.to_string()).collect();
-    want.sort();
-    assert_eq!(key_paths(&Value::Object(o)), want, "wavg {}", args[0]);
-}
 
 #[test]
 fn precompute_json_keys() {
@@ -405,4 +373,220 @@ fn morph_json_keys() {
     );
     want.sort();
     assert_eq!(key_paths(&Value::Object(o)), want);
+}
+
+/// A fin (three triangles on edge (0, 1)) plus an unreferenced vertex: invalid, and the
+/// default repairs fix it.
+fn fin(dir: &Path) -> String {
+    let p = dir.join("fin.off");
+    std::fs::write(
+        &p,
+        "OFF\n6 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n9 9 9\n3 0 1 2\n3 1 0 3\n3 0 1 4\n",
+    )
+    .unwrap();
+    s(&p)
+}
+
+#[test]
+fn info_json_keys() {
+    let mut keys = vec![
+        "mesh",
+        "vertices",
+        "faces",
+        "polygons",
+        "skipped_faces",
+        "uv_dropped",
+        "edges",
+        "components",
+        "boundary_loops",
+        "euler_characteristic",
+        "genus",
+        "manifold",
+        "oriented",
+        "watertight",
+        "valid",
+        "uv",
+        "bounding_box",
+        "bounding_box.min",
+        "bounding_box.max",
+        "bounding_box.diagonal",
+        "problems",
+        "problem_summary",
+        "repair",
+    ];
+    assert_keys(&["info", "--builtin", "torus", "--json"], &keys);
+    let dir = tempfile::tempdir().unwrap();
+    let fin = fin(dir.path());
+    keys.extend([
+        "repair.fixes_all",
+        "repair.removed_vertices",
+        "repair.added_vertices",
+        "repair.removed_faces",
+        "repair.remaining_problems",
+    ]);
+    assert_keys(&["info", &fin, "--json"], &keys);
+    // `problem_summary` is an array of objects, which `key_paths` does not enter.
+    let (o, _) = json_object(&wavg_ok(&["info", &fin, "--json"]));
+    let summary = o["problem_summary"].as_array().unwrap();
+    assert_eq!(summary.len(), 3);
+    for p in summary {
+        let want = ["count", "description", "examples", "kind", "remedy"];
+        assert_eq!(key_paths(p), want);
+    }
+}
+
+#[test]
+fn repair_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let fin = fin(dir.path());
+    let out = s(&dir.path().join("fixed.obj"));
+    let keys = [
+        "input",
+        "output",
+        "vertices_before",
+        "faces_before",
+        "vertices",
+        "faces",
+        "removed_vertices",
+        "added_vertices",
+        "removed_faces",
+        "components",
+        "valid",
+        "problems",
+    ];
+    assert_keys(&["repair", &fin, "-o", &out, "--json"], &keys);
+}
+
+#[test]
+fn subdivide_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = s(&dir.path().join("fine.ply"));
+    let args = ["subdivide", "builtin:sphere-small", "-o", &out, "--json"];
+    let keys = [
+        "input_vertices",
+        "input_faces",
+        "vertices",
+        "faces",
+        "levels",
+        "seconds",
+    ];
+    assert_keys(&args, &keys);
+}
+
+#[test]
+fn render_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = s(&dir.path().join("a.png"));
+    let args = [
+        "render",
+        "builtin:sphere-small",
+        "-o",
+        &out,
+        "--size",
+        "24x16",
+    ];
+    let mut keys = vec![
+        "output",
+        "width",
+        "height",
+        "vertices",
+        "faces",
+        "covered_fraction",
+        "seconds",
+    ];
+    assert_keys(&[&args[..], &["--json"]].concat(), &keys);
+    let scalars = dir.path().join("s.txt");
+    let text: String = (0..162).map(|i| format!("{}\n", i as f64 / 7.0)).collect();
+    std::fs::write(&scalars, text).unwrap();
+    keys.extend(["scalar_min", "scalar_max"]);
+    assert_keys(
+        &[&args[..], &["--scalar", &s(&scalars), "--json"]].concat(),
+        &keys,
+    );
+}
+
+#[test]
+fn demo_json_keys() {
+    let args = [
+        "demo",
+        "--mesh",
+        "builtin:sphere-small",
+        "--landmarks",
+        "50",
+        "--samples",
+        "20",
+        "--queries",
+        "50",
+        "--json",
+    ];
+    let keys = [
+        "mesh",
+        "vertices",
+        "faces",
+        "landmarks",
+        "precompute_s",
+        "stress",
+        "geodesic_rel_err_p50",
+        "geodesic_rel_err_p90",
+        "anchors",
+        "curve_points",
+        "curve_ok",
+        "curve_us",
+        "roundtrip_queries",
+        "inverse_us",
+        "forward_us",
+        "roundtrip_ok_fraction",
+        "verified_roundtrip_ok_fraction",
+    ];
+    assert_keys(&args, &keys);
+}
+
+#[test]
+fn bench_project_json_keys() {
+    let args = [
+        "bench",
+        "project",
+        "--mesh",
+        "builtin:sphere-small",
+        "--queries",
+        "200",
+        "--json",
+    ];
+    let keys = [
+        "mesh",
+        "vertices",
+        "faces",
+        "queries",
+        "init_s",
+        "bytes_per_face",
+        "onsurface_us",
+        "onsurface_self_fraction",
+        "offset_us",
+        "offset_bruteforce_agree_fraction",
+        "onsurface_fallback_fraction",
+        "offset_fallback_fraction",
+        "fallback_us",
+    ];
+    assert_keys(&args, &keys);
+}
+
+#[test]
+fn bench_load_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let fin = fin(dir.path());
+    let args = ["bench", "load", "--mesh", &fin, "--repeat", "1", "--json"];
+    let keys = [
+        "mesh",
+        "vertices",
+        "faces",
+        "bytes",
+        "repeat",
+        "valid",
+        "topology_built",
+        "read_s",
+        "parse_s",
+        "validate_topology_s",
+        "total_s",
+    ];
+    assert_keys(&args, &keys);
 }

@@ -41,6 +41,7 @@ mod point;
 mod problem;
 pub mod procedural;
 pub mod repair;
+mod report;
 pub mod subdivide;
 mod topology;
 mod valid;
@@ -53,6 +54,11 @@ pub use valid::ValidMesh;
 // Diagnostics.
 pub use analyze::{Analysis, MeshStats, ZERO_AREA_RELATIVE_TOLERANCE, analyze};
 pub use problem::{Problem, ProblemKind, ProblemSummary, ValidationReport};
+
+// Reports for people and programs (with the `serde` feature, serialisable).
+pub use report::{
+    BoundingBox, MeshInfo, ProblemGroup, RepairPreview, RepairReport, SubdivisionReport,
+};
 
 // Points on the surface.
 pub use point::SurfacePoint;

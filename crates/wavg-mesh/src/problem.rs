@@ -97,8 +97,14 @@ pub enum Problem {
     },
 }
 
-/// The kinds of [`Problem`], for grouping and counting.
+/// The kinds of [`Problem`], for grouping and counting. With the `serde` feature a kind
+/// serialises to its stable snake_case name (`non_manifold_edge`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize),
+    serde(rename_all = "snake_case")
+)]
 pub enum ProblemKind {
     /// [`Problem::Empty`]
     Empty,

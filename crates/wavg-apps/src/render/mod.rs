@@ -10,6 +10,7 @@ mod colormap;
 mod font;
 mod image;
 mod raster;
+mod report;
 
 use nalgebra::Vector3;
 use wavg_mesh::TriMesh;
@@ -17,6 +18,7 @@ use wavg_mesh::TriMesh;
 pub use camera::{Camera, FOV_DEGREES, View};
 pub use colormap::viridis;
 pub use image::{Image, MAX_DECODED_BYTES, MAX_SIDE};
+pub use report::RenderReport;
 
 use crate::AppError;
 use raster::VisBuffer;

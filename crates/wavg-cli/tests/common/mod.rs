@@ -39,3 +39,42 @@ pub fn sphere_anchors(dir: &std::path::Path) -> std::path::PathBuf {
     std::fs::write(&p, text).unwrap();
     p
 }
+
+/// A path as a string argument.
+pub fn s(p: &std::path::Path) -> String {
+    p.to_str().unwrap().to_string()
+}
+
+/// Every key of `v`, nested ones as `parent.child`, sorted.
+pub fn key_paths(v: &serde_json::Value) -> Vec<String> {
+    fn walk(prefix: &str, v: &serde_json::Value, out: &mut Vec<String>) {
+        if let serde_json::Value::Object(o) = v {
+            for (k, x) in o {
+                let path = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                out.push(path.clone());
+                walk(&path, x, out);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk("", v, &mut out);
+    out.sort();
+    out
+}
+
+/// Runs `wavg ARGS` and asserts the exact set of key paths of its JSON object.
+pub fn assert_keys(args: &[&str], want: &[&str]) {
+    let (o, _) = json_object(&wavg_ok(args));
+    let mut want: Vec<String> = want.iter().map(|k| k.to_string()).collect();
+    want.sort();
+    assert_eq!(
+        key_paths(&serde_json::Value::Object(o)),
+        want,
+        "wavg {}",
+        args[0]
+    );
+}
