@@ -60,13 +60,22 @@ mod tests {
             std::fs::create_dir_all(p.parent().unwrap()).unwrap();
             std::fs::write(p, text).unwrap();
         };
-        write("crates/good/src/lib.rs", "//! ok\n#![forbid(unsafe_code)]\n");
+        write(
+            "crates/good/src/lib.rs",
+            "//! ok\n#![forbid(unsafe_code)]\n",
+        );
         write("crates/wavg-ffi/src/lib.rs", "//! the C ABI\n");
-        write("xtask/src/main.rs", "#![forbid(unsafe_code)]\nfn main() {}\n");
+        write(
+            "xtask/src/main.rs",
+            "#![forbid(unsafe_code)]\nfn main() {}\n",
+        );
         assert_eq!(check_unsafe(&root), Ok(()));
         write("crates/bad/src/main.rs", "fn main() {}\n");
         let err = check_unsafe(&root).unwrap_err();
-        assert!(err.contains("bad/src/main.rs") && !err.contains("good"), "{err}");
+        assert!(
+            err.contains("bad/src/main.rs") && !err.contains("good"),
+            "{err}"
+        );
         std::fs::remove_dir_all(&root).unwrap();
     }
 

@@ -20,12 +20,14 @@ pub use remesh::{
 pub use spline::{Curve, CurveReport, evaluate_spline};
 
 mod correspond;
+mod ground_truth;
 mod metrics;
 
 pub use correspond::{
     CorrespondOptions, CorrespondTimings, Correspondence, Mapped, ROUND_TRIP_TOLERANCE,
     ReasonCounts, Validity, ValidityTest, correspond_vertices, map_points, vertex_points,
 };
+pub use ground_truth::{ErrorStats, GroundTruthErrors};
 pub use metrics::{Distortion, distortion};
 
 mod decal;

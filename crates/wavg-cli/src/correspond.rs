@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use wavg::apps::{
-    CorrespondOptions, CorrespondTimings, Correspondence, Distortion, ReasonCounts, Validity,
-    ValidityTest, correspond_vertices,
+    CorrespondOptions, CorrespondTimings, Correspondence, Distortion, GroundTruthErrors,
+    ReasonCounts, Validity, ValidityTest, correspond_vertices,
 };
 use wavg::{Anchor, Solver, Surface};
 
@@ -165,43 +165,12 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
     })
 }
 
-/// Mean, 95th percentile and maximum of the errors (0 when empty).
-fn stats(mut e: Vec<f64>) -> serde_json::Value {
-    e.sort_by(f64::total_cmp);
-    let n = e.len();
-    let mean = if n == 0 {
-        0.0
-    } else {
-        e.iter().sum::<f64>() / n as f64
-    };
-    let p95 = e
-        .get(((n as f64 * 0.95) as usize).min(n.saturating_sub(1)))
-        .copied()
-        .unwrap_or(0.0);
-    serde_json::json!({"count": n, "mean": mean, "p95": p95, "max": e.last().copied().unwrap_or(0.0)})
-}
-
 /// Errors of the images against vertex `i` of the target, in bounding-box diagonals of
 /// the target: over the valid vertices and over every answered one.
-fn ground_truth(c: &Computed) -> Result<serde_json::Value, CliError> {
-    let (s, t) = (c.source.mesh(), c.target.mesh());
-    if s.n_vertices() != t.n_vertices() || s.triangles != t.triangles {
-        return Err(CliError::input(
-            "--ground-truth: the source and target do not share connectivity",
-        ));
-    }
-    let diag = t.bounding_box_diagonal();
-    let (mut valid, mut answered) = (Vec::new(), Vec::new());
-    for (v, (m, ok)) in c.map.mapped.iter().zip(&c.map.validity).enumerate() {
-        if let Ok(img) = &m.target {
-            let e = (img.position - t.positions[v]).norm() / diag;
-            answered.push(e);
-            if *ok == Validity::Valid {
-                valid.push(e);
-            }
-        }
-    }
-    Ok(serde_json::json!({"valid": stats(valid), "answered": stats(answered)}))
+fn ground_truth(c: &Computed) -> Result<GroundTruthErrors, CliError> {
+    c.map
+        .ground_truth_errors(c.source.mesh(), c.target.mesh())
+        .map_err(|e| CliError::input(format!("--ground-truth: {e}")))
 }
 
 /// The `--json` object: the map's [`Distortion`] with the CLI's counts and timings
@@ -226,7 +195,7 @@ struct JsonReport<'a> {
     vertices_per_s: f64,
     cpu_seconds: Option<f64>,
     vertices_per_cpu_s: Option<f64>,
-    ground_truth: Option<serde_json::Value>,
+    ground_truth: Option<GroundTruthErrors>,
 }
 
 /// Runs the command.
