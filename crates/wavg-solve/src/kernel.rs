@@ -113,8 +113,14 @@ impl AnchorCoords {
         crate::simd::weighted_sum(self, weights, scale)
     }
 
+    /// The anchors a weight vector of `len` entries covers, and the coordinate arrays.
+    #[inline(always)]
+    pub(crate) fn dims(&self, len: usize) -> (usize, &[Vec<f64>; DIM]) {
+        (self.n.min(len), &self.dims)
+    }
+
     /// The weighted sum as portable loops over [`LANES`]-wide partial sums (what
-    /// [`AnchorCoords::weighted_sum`] runs, compiled for the CPU's SIMD width).
+    /// [`AnchorCoords::weighted_sum`] runs without AVX2, and computes bit for bit with it).
     #[inline(always)]
     pub(crate) fn weighted_sum_portable(&self, weights: &[f64], scale: f64) -> Vec8 {
         let n = self.n.min(weights.len());
