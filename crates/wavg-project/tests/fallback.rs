@@ -82,24 +82,31 @@ fn generated_meshes_match_the_brute_force() {
     assert!(ties * 1000 <= total, "{ties} ties of {total}");
 }
 
+/// Two copies of a 4 x 4 grid in one mesh (two components), the first's positions moved
+/// by `first`, the second's by `second`; the first copy's faces come first.
+fn two_grids(
+    first: impl Fn(&mut nalgebra::Vector3<f64>),
+    second: impl Fn(&mut nalgebra::Vector3<f64>),
+) -> wavg_mesh::TriMesh {
+    let mut mesh = wavg_mesh::procedural::grid(4, 4, 1.0, 1.0);
+    let n = mesh.positions.len() as u32;
+    let mut copy = mesh.positions.clone();
+    copy.iter_mut().for_each(second);
+    mesh.positions.iter_mut().for_each(first);
+    mesh.positions.extend(copy);
+    let tris = mesh.triangles.clone();
+    mesh.triangles
+        .extend(tris.iter().map(|t| [t[0] + n, t[1] + n, t[2] + n]));
+    mesh
+}
+
 /// An exact tie (a query equidistant from two mirror-image triangles) goes to the lowest
 /// face index, as in the brute force.
 #[test]
 fn exact_ties_go_to_the_lowest_face() {
-    let mut mesh = wavg_mesh::procedural::grid(4, 4, 1.0, 1.0);
     // Two sheets, at z = 1 and z = -1 (same corner order, so the same arithmetic up to
     // the sign of z): the plane z = 0 between them is equidistant, to the last bit.
-    let n = mesh.positions.len() as u32;
-    let tris = mesh.triangles.clone();
-    for p in mesh.positions.clone() {
-        mesh.positions.push(nalgebra::Vector3::new(p.x, p.y, -1.0));
-    }
-    for p in &mut mesh.positions[..n as usize] {
-        p.z = 1.0;
-    }
-    for t in tris {
-        mesh.triangles.push([t[0] + n, t[1] + n, t[2] + n]);
-    }
+    let mesh = two_grids(|p| p.z = 1.0, |p| p.z = -1.0);
     let fx = Fixture::new("two sheets", mesh, Embedding::Padded);
     for k in 0..50 {
         let u = |m: f64| (k as f64 * m).fract();
@@ -155,16 +162,8 @@ fn armadillo_matches_the_brute_force() {
 #[test]
 fn a_stranded_walk_searches_again_from_the_nearest_vertex() {
     // Two flat sheets side by side in the plane z = 0: B on [0, 1]^2, A on [3, 4] x [0, 1].
-    let mut mesh = wavg_mesh::procedural::grid(4, 4, 1.0, 1.0);
-    let n = mesh.positions.len() as u32;
-    let tris = mesh.triangles.clone();
-    for p in mesh.positions.clone() {
-        mesh.positions
-            .push(nalgebra::Vector3::new(p.x + 3.0, p.y, p.z));
-    }
-    for t in tris {
-        mesh.triangles.push([t[0] + n, t[1] + n, t[2] + n]);
-    }
+    let mesh = two_grids(|_| {}, |p| p.x += 3.0);
+    let n = mesh.positions.len() as u32 / 2;
     let fx = Fixture::new("side by side", mesh, Embedding::Padded);
     let faces_b = fx.mesh().n_faces() as u32 / 2;
     for k in 0..40 {

@@ -216,35 +216,36 @@ impl Projector {
         };
         match (goal, local) {
             (SearchGoal::FirstHit, Some(b)) => Ok(Self::finish(b, ProjectionPath::Local)),
-            (SearchGoal::FirstHit, None) => {
-                // The walk may end in a local minimum of the distance with no projection
-                // nearby: once more from the nearest vertex (much cheaper than the global
-                // search, and usually its answer).
-                let u = self.nearest_vertex(y);
-                if u != v {
-                    let cands = self.faces_by_promise(y, u);
-                    let mut tried = FaceSet::new();
-                    if let Some(b) = self.local_search(y, u, &cands, goal, &mut tried) {
-                        return Ok(Self::finish(b, ProjectionPath::Local));
-                    }
-                }
-                global(y)
-            }
             (SearchGoal::Closest, Some(b)) => Ok(self.certify(y, b, &tried)),
-            (SearchGoal::Closest, None) => {
-                // As for the first hit: once more from the nearest vertex before the
-                // global search (the walk can end on another sheet that lies close in R^8).
-                let u = self.nearest_vertex(y);
-                if u != v {
-                    let cands = self.faces_by_promise(y, u);
-                    let mut tried = FaceSet::new();
-                    if let Some(b) = self.local_search(y, u, &cands, goal, &mut tried) {
-                        return Ok(self.certify(y, b, &tried));
-                    }
+            // The walk may end in a local minimum of the distance with no projection
+            // nearby (on another sheet that lies close in R^8): once more from the nearest
+            // vertex, much cheaper than the global search and usually its answer.
+            (_, None) => match self.search_from_nearest(y, v, goal) {
+                Some((b, _)) if goal == SearchGoal::FirstHit => {
+                    Ok(Self::finish(b, ProjectionPath::Local))
                 }
-                global(y)
-            }
+                Some((b, tried)) => Ok(self.certify(y, b, &tried)),
+                None => global(y),
+            },
         }
+    }
+
+    /// The local search from the vertex nearest to `y`, unless that is `v` (where the
+    /// search already ran): its answer and the faces it tried.
+    fn search_from_nearest(
+        &self,
+        y: &Vec8,
+        v: VertexId,
+        goal: SearchGoal,
+    ) -> Option<(Best, FaceSet)> {
+        let u = self.nearest_vertex(y);
+        if u == v {
+            return None;
+        }
+        let cands = self.faces_by_promise(y, u);
+        let mut tried = FaceSet::new();
+        self.local_search(y, u, &cands, goal, &mut tried)
+            .map(|b| (b, tried))
     }
 
     /// Certifies the local search's answer `local` against the hierarchy (faces in
