@@ -35,29 +35,56 @@ pub fn spline_weights(
     n_controls: usize,
     samples: usize,
 ) -> Result<Vec<Vec<f64>>, SolveError> {
+    let flat = spline_weights_flat(kind, n_controls, samples)?;
+    Ok(flat.chunks_exact(n_controls).map(<[f64]>::to_vec).collect())
+}
+
+/// [`spline_weights`] as one row-major buffer of `samples * n_controls` weights (row `s`
+/// at `s * n_controls ..`): one allocation for the whole curve.
+///
+/// ```
+/// use wavg_apps::{SplineKind, spline_weights, spline_weights_flat};
+/// let kind = SplineKind::Bezier;
+/// let flat = spline_weights_flat(kind, 4, 9).unwrap();
+/// let rows = spline_weights(kind, 4, 9).unwrap();
+/// assert!(flat.chunks_exact(4).eq(rows.iter().map(|r| r.as_slice())));
+/// ```
+pub fn spline_weights_flat(
+    kind: SplineKind,
+    n_controls: usize,
+    samples: usize,
+) -> Result<Vec<f64>, SolveError> {
     let bad = |m: String| Err(SolveError::InvalidParameter(m));
     if samples == 0 {
         return bad("a curve needs at least one sample".into());
     }
+    let mut out = vec![0.0; samples * n_controls];
     match kind {
-        SplineKind::BSpline { degree: 0, .. } => bad("the spline degree must be at least 1".into()),
-        SplineKind::BSpline { degree, .. } if n_controls < degree + 1 => bad(format!(
-            "a degree-{degree} B-spline needs at least {} control points, got {n_controls}",
-            degree + 1
-        )),
-        SplineKind::Bezier if n_controls < 2 => bad(format!(
-            "a Bézier curve needs at least 2 control points, got {n_controls}"
-        )),
+        SplineKind::BSpline { degree: 0, .. } => {
+            return bad("the spline degree must be at least 1".into());
+        }
+        SplineKind::BSpline { degree, .. } if n_controls < degree + 1 => {
+            return bad(format!(
+                "a degree-{degree} B-spline needs at least {} control points, got {n_controls}",
+                degree + 1
+            ));
+        }
+        SplineKind::Bezier if n_controls < 2 => {
+            return bad(format!(
+                "a Bézier curve needs at least 2 control points, got {n_controls}"
+            ));
+        }
         SplineKind::BSpline {
             degree,
             closed: true,
-        } => Ok(closed_bspline(degree, n_controls, samples)),
+        } => closed_bspline(degree, n_controls, &mut out),
         SplineKind::BSpline {
             degree,
             closed: false,
-        } => Ok(open_bspline(degree, n_controls, samples)),
-        SplineKind::Bezier => Ok(bezier(n_controls, samples)),
+        } => open_bspline(degree, n_controls, &mut out),
+        SplineKind::Bezier => bezier(n_controls, &mut out),
     }
+    Ok(out)
 }
 
 /// Parameter of sample `s` of `samples` in [0, 1], ends included.
@@ -69,85 +96,91 @@ fn unit_parameter(s: usize, samples: usize) -> f64 {
     }
 }
 
-/// Cox-de Boor: the `p + 1` non-zero basis functions of degree `p` at `t` in knot span
-/// `span` (`knots[span] <= t < knots[span + 1]`), for controls `span - p ..= span`.
-fn basis_functions(knots: &[f64], span: usize, t: f64, p: usize) -> Vec<f64> {
-    let mut n = vec![0.0; p + 1];
-    let mut left = vec![0.0; p + 1];
-    let mut right = vec![0.0; p + 1];
-    n[0] = 1.0;
-    for j in 1..=p {
-        left[j] = t - knots[span + 1 - j];
-        right[j] = knots[span + j] - t;
-        let mut saved = 0.0;
-        for r in 0..j {
-            let denom = right[r + 1] + left[j - r];
-            let temp = if denom == 0.0 { 0.0 } else { n[r] / denom };
-            n[r] = saved + right[r + 1] * temp;
-            saved = left[j - r] * temp;
-        }
-        n[j] = saved;
-    }
-    n
+/// Cox-de Boor evaluation with its scratch rows kept between samples.
+struct Basis {
+    n: Vec<f64>,
+    left: Vec<f64>,
+    right: Vec<f64>,
 }
 
-fn open_bspline(p: usize, n: usize, samples: usize) -> Vec<Vec<f64>> {
+impl Basis {
+    fn new(p: usize) -> Self {
+        Basis {
+            n: vec![0.0; p + 1],
+            left: vec![0.0; p + 1],
+            right: vec![0.0; p + 1],
+        }
+    }
+
+    /// The `p + 1` non-zero basis functions of degree `p` at `t` in knot span `span`
+    /// (`knots[span] <= t < knots[span + 1]`), for controls `span - p ..= span`.
+    fn eval(&mut self, knots: &[f64], span: usize, t: f64) -> &[f64] {
+        let p = self.n.len() - 1;
+        let (n, left, right) = (&mut self.n, &mut self.left, &mut self.right);
+        n[0] = 1.0;
+        for j in 1..=p {
+            left[j] = t - knots[span + 1 - j];
+            right[j] = knots[span + j] - t;
+            let mut saved = 0.0;
+            for r in 0..j {
+                let denom = right[r + 1] + left[j - r];
+                let temp = if denom == 0.0 { 0.0 } else { n[r] / denom };
+                n[r] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            n[j] = saved;
+        }
+        n
+    }
+}
+
+fn open_bspline(p: usize, n: usize, out: &mut [f64]) {
     // Clamped uniform knots: p + 1 zeros, interior steps of 1 / (n - p), p + 1 ones.
     let segments = n - p;
     let mut knots = vec![0.0; p + 1];
     knots.extend((1..segments).map(|i| i as f64 / segments as f64));
     knots.extend(std::iter::repeat_n(1.0, p + 1));
-    (0..samples)
-        .map(|s| {
-            let t = unit_parameter(s, samples);
-            // The span holding t; t = 1 belongs to the last non-empty span.
-            let span = ((t * segments as f64).floor() as usize).min(segments - 1) + p;
-            let b = basis_functions(&knots, span, t, p);
-            let mut w = vec![0.0; n];
-            for (k, bk) in b.iter().enumerate() {
-                w[span - p + k] = *bk;
-            }
-            w
-        })
-        .collect()
+    let samples = out.len() / n;
+    let mut basis = Basis::new(p);
+    for (s, w) in out.chunks_exact_mut(n).enumerate() {
+        let t = unit_parameter(s, samples);
+        // The span holding t; t = 1 belongs to the last non-empty span.
+        let span = ((t * segments as f64).floor() as usize).min(segments - 1) + p;
+        w[span - p..=span].copy_from_slice(basis.eval(&knots, span, t));
+    }
 }
 
-fn closed_bspline(p: usize, n: usize, samples: usize) -> Vec<Vec<f64>> {
+fn closed_bspline(p: usize, n: usize, out: &mut [f64]) {
     // Integer knots; on [p, p + 1) the basis functions 0..=p are the uniform blend.
     let knots: Vec<f64> = (0..=2 * p + 1).map(|k| k as f64).collect();
     // Centre the blend so that parameter j lies near control j.
     let shift = (p - 1) / 2;
-    (0..samples)
-        .map(|s| {
-            let t = s as f64 * n as f64 / samples as f64;
-            let i = (t.floor() as usize).min(n - 1);
-            let b = basis_functions(&knots, p, p as f64 + (t - i as f64), p);
-            let mut w = vec![0.0; n];
-            for (k, bk) in b.iter().enumerate() {
-                w[(i + n * p + k - shift) % n] += bk;
-            }
-            w
-        })
-        .collect()
+    let samples = out.len() / n;
+    let mut basis = Basis::new(p);
+    for (s, w) in out.chunks_exact_mut(n).enumerate() {
+        let t = s as f64 * n as f64 / samples as f64;
+        let i = (t.floor() as usize).min(n - 1);
+        let b = basis.eval(&knots, p, p as f64 + (t - i as f64));
+        for (k, bk) in b.iter().enumerate() {
+            w[(i + n * p + k - shift) % n] += bk;
+        }
+    }
 }
 
-fn bezier(n: usize, samples: usize) -> Vec<Vec<f64>> {
+fn bezier(n: usize, out: &mut [f64]) {
     let deg = n - 1;
-    (0..samples)
-        .map(|s| {
-            let t = unit_parameter(s, samples);
-            // Bernstein polynomials by de Casteljau's triangle on the unit vectors.
-            let mut w = vec![0.0; n];
-            w[0] = 1.0;
-            for j in 1..=deg {
-                for k in (0..=j).rev() {
-                    let prev = if k > 0 { w[k - 1] } else { 0.0 };
-                    w[k] = w[k] * (1.0 - t) + prev * t;
-                }
+    let samples = out.len() / n;
+    for (s, w) in out.chunks_exact_mut(n).enumerate() {
+        let t = unit_parameter(s, samples);
+        // Bernstein polynomials by de Casteljau's triangle on the unit vectors.
+        w[0] = 1.0;
+        for j in 1..=deg {
+            for k in (0..=j).rev() {
+                let prev = if k > 0 { w[k - 1] } else { 0.0 };
+                w[k] = w[k] * (1.0 - t) + prev * t;
             }
-            w
-        })
-        .collect()
+        }
+    }
 }
 
 #[cfg(test)]
@@ -230,6 +263,25 @@ mod tests {
         for (row, want) in w.iter().zip(want) {
             for (a, b) in row.iter().zip(want) {
                 assert!((a - b).abs() < 1e-14, "{row:?} vs {want:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn clamped_spline_without_interior_knots_is_the_bezier_curve() {
+        // With degree + 1 controls the clamped knot vector has no interior knots, and
+        // the B-spline basis is the Bernstein basis: every degree, same weights.
+        for degree in 1..8 {
+            let n = degree + 1;
+            let b = spline_weights_flat(SplineKind::Bezier, n, 33).unwrap();
+            let kind = SplineKind::BSpline {
+                degree,
+                closed: false,
+            };
+            let s = spline_weights_flat(kind, n, 33).unwrap();
+            assert_eq!(b.len(), s.len());
+            for (x, y) in b.iter().zip(&s) {
+                assert!((x - y).abs() < 1e-13, "degree {degree}: {x} vs {y}");
             }
         }
     }

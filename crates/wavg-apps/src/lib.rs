@@ -12,7 +12,7 @@ mod basis;
 mod remesh;
 mod spline;
 
-pub use basis::{SplineKind, spline_weights};
+pub use basis::{SplineKind, spline_weights, spline_weights_flat};
 pub use remesh::{
     BaseMesh, DEFAULT_MAX_BASE_DISTANCE, MAX_LEVELS, MAX_POLYGON, RemeshError, RemeshReport,
     RemeshResult, Remesher, polygons_to_obj,

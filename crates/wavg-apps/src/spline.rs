@@ -4,7 +4,7 @@
 
 use wavg_solve::{ForwardOptions, ForwardResult, SolveError, Solver};
 
-use crate::basis::{SplineKind, spline_weights};
+use crate::basis::{SplineKind, spline_weights_flat};
 
 /// A sampled curve on the surface.
 #[derive(Clone, Debug)]
@@ -82,7 +82,8 @@ pub fn evaluate_spline(
     samples: usize,
     chunk: usize,
 ) -> Result<Curve, SolveError> {
-    let weights = spline_weights(kind, solver.n_anchors(), samples)?;
+    let flat = spline_weights_flat(kind, solver.n_anchors(), samples)?;
+    let weights: Vec<&[f64]> = flat.chunks_exact(solver.n_anchors()).collect();
     let samples = solver.forward_batch_warm(&weights, &ForwardOptions::default(), chunk.max(1));
     Ok(Curve {
         samples,
