@@ -31,6 +31,10 @@ use std::io::{self, BufRead, Write};
 
 use rayon::prelude::*;
 
+mod scan;
+
+use scan::tokens;
+
 /// Lines parsed or formatted by one task: large enough to amortise scheduling, small
 /// enough to spread a chunk over every thread.
 const LINES_PER_TASK: usize = 2048;
@@ -114,27 +118,46 @@ impl<R: BufRead> LineChunks<R> {
 /// is the number of the first line of `text`. Returns each point with its line number;
 /// the error is the first malformed line's.
 pub fn parse_points(text: &str, first_line: usize) -> Result<Vec<(usize, PointSpec)>, LineError> {
-    parse_lines(text, first_line, point_line)
+    parse_lines(text, first_line, |line, l, toks: &mut Vec<&str>| {
+        tokens(l, toks);
+        if toks.is_empty() {
+            return Ok(None);
+        }
+        point_line(line, toks).map(Some)
+    })
 }
 
 /// Parses weight lines (whitespace-separated finite numbers) in parallel; `first_line` is
 /// the number of the first line of `text`. Returns each row with its line number; the
 /// error is the first malformed line's. Row lengths are not checked here.
 pub fn parse_weights(text: &str, first_line: usize) -> Result<Vec<(usize, Vec<f64>)>, LineError> {
-    parse_lines(text, first_line, |line, toks| {
-        toks.iter()
-            .enumerate()
-            .map(|(i, tok)| number(tok, line, WeightNo(i)))
-            .collect()
-    })
+    parse_lines(
+        text,
+        first_line,
+        |line, l, (row, toks): &mut (Vec<f64>, Vec<&str>)| {
+            if scan::numbers(l, row) {
+                return Ok((!row.is_empty()).then(|| row.clone()));
+            }
+            tokens(l, toks);
+            if toks.is_empty() {
+                return Ok(None);
+            }
+            toks.iter()
+                .enumerate()
+                .map(|(i, tok)| number(tok, line, WeightNo(i)))
+                .collect::<Result<_, _>>()
+                .map(Some)
+        },
+    )
 }
 
-/// Runs `parse` on the tokens of every content line, in parallel over groups of lines,
-/// keeping input order and reporting the first error.
-fn parse_lines<T: Send>(
-    text: &str,
+/// Runs `parse` (line number, line, a scratch value of each task) on every line, in
+/// parallel over groups of lines, keeping input order, dropping lines without content
+/// (`None`) and reporting the first error.
+fn parse_lines<'t, T: Send, S: Default>(
+    text: &'t str,
     first_line: usize,
-    parse: impl Fn(usize, &[&str]) -> Result<T, LineError> + Sync,
+    parse: impl Fn(usize, &'t str, &mut S) -> Result<Option<T>, LineError> + Sync,
 ) -> Result<Vec<(usize, T)>, LineError> {
     let lines: Vec<&str> = text.lines().collect();
     let groups: Vec<Result<Vec<(usize, T)>, LineError>> = lines
@@ -142,14 +165,11 @@ fn parse_lines<T: Send>(
         .enumerate()
         .map(|(g, group)| {
             let mut out = Vec::with_capacity(group.len());
-            let mut toks = Vec::new();
+            let mut scratch = S::default();
             for (i, l) in group.iter().enumerate() {
-                let l = l.split_once('#').map_or(*l, |(a, _)| a);
-                toks.clear();
-                toks.extend(l.split_whitespace());
-                if !toks.is_empty() {
-                    let line = first_line + g * LINES_PER_TASK + i;
-                    out.push((line, parse(line, &toks)?));
+                let line = first_line + g * LINES_PER_TASK + i;
+                if let Some(t) = parse(line, l, &mut scratch)? {
+                    out.push((line, t));
                 }
             }
             Ok(out)
