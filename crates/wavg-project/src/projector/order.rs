@@ -9,12 +9,16 @@ use super::*;
 pub struct FaceOrder {
     pub(super) faces: [FaceId; 64],
     pub(super) n: usize,
+    /// How far outside the first face the Euclidean projection of the query onto its
+    /// plane falls (negative inside; infinite when not computed).
+    pub(super) first_outside: f32,
 }
 
 impl FaceOrder {
     pub(super) const EMPTY: Self = Self {
         faces: [0; 64],
         n: 0,
+        first_outside: f32::INFINITY,
     };
 
     /// The faces, most promising first.
@@ -168,6 +172,12 @@ impl Projector {
         FaceOrder {
             faces: std::array::from_fn(|j| order[j].1),
             n: m,
+            // Scores are outside measures only for rings of up to 64 vertices.
+            first_outside: if m > 0 && ring.len() <= 64 {
+                order[0].0
+            } else {
+                f32::INFINITY
+            },
         }
     }
 

@@ -66,11 +66,10 @@ impl FaceSet {
     }
 }
 
-/// How far outside the triangle `(p0, p1, p2)` the Euclidean projection of `y` onto its
-/// plane falls: the smallest barycentric coordinate, negated (negative inside; infinite
-/// for a degenerate triangle). In walk coordinates: it only orders the candidates.
+/// Barycentric coordinates of the Euclidean projection of `y` onto the plane of the
+/// triangle `(p0, p1, p2)`, in walk coordinates; `None` for a degenerate triangle.
 #[inline]
-fn outside(p: [[f32; 8]; 3], y: &[f32; 8]) -> f32 {
+fn plane_bary(p: [[f32; 8]; 3], y: &[f32; 8]) -> Option<[f32; 3]> {
     let (mut a, mut b, mut cc, mut d, mut e) = (0.0f32, 0.0, 0.0, 0.0, 0.0);
     for k in 0..8 {
         let e1 = p[1][k] - p[0][k];
@@ -84,13 +83,23 @@ fn outside(p: [[f32; 8]; 3], y: &[f32; 8]) -> f32 {
     }
     let det = a * cc - b * b;
     if det.is_nan() || det <= 0.0 {
-        return f32::INFINITY;
+        return None;
     }
     let l1 = (cc * d - b * e) / det;
     let l2 = (a * e - b * d) / det;
-    let l0 = 1.0 - l1 - l2;
-    (-l0).max(-l1).max(-l2)
+    Some([1.0 - l1 - l2, l1, l2])
 }
+
+/// How far outside the triangle `(p0, p1, p2)` the Euclidean projection of `y` onto its
+/// plane falls: the smallest barycentric coordinate, negated (negative inside; infinite
+/// for a degenerate triangle). In walk coordinates: it only orders the candidates.
+#[inline]
+fn outside(p: [[f32; 8]; 3], y: &[f32; 8]) -> f32 {
+    plane_bary(p, y).map_or(f32::INFINITY, |[l0, l1, l2]| (-l0).max(-l1).max(-l2))
+}
+
+/// Faces the closest goal's point-location walk may step through.
+const LOCATE_STEPS: usize = 8;
 
 impl Projector {
     /// The local search from the walk's end `v`, the faces around it in the order `cands`
@@ -122,6 +131,17 @@ impl Projector {
         }
         let mut level = 0..seen.n;
         let mut best: Option<Best> = None;
+        if !first_hit {
+            // Where the walk ended beside rather than at the face holding the projection,
+            // walk over faces to it first: one Newton solve instead of a ring or two.
+            if let Some(f) = self.locate_face(y, cands, &seen) {
+                tried.push(f);
+                best = self.try_face(f, y);
+                if best.as_ref().is_some_and(|b| self.is_zero(b)) {
+                    return best;
+                }
+            }
+        }
         loop {
             for &(_, f) in &order[..level.len()] {
                 if first_hit {
@@ -196,6 +216,35 @@ impl Projector {
                     .sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             }
         }
+    }
+
+    /// The face, outside the first ring `ring0`, over which the Euclidean projection of
+    /// `y` onto its plane falls, found by stepping across the edge opposite the most
+    /// negative barycentric coordinate from the most promising candidate of `cands`
+    /// (a point-location walk in walk coordinates); `None` when that candidate already
+    /// holds it or the walk does not arrive within [`LOCATE_STEPS`].
+    fn locate_face(&self, y: &Vec8, cands: &FaceOrder, ring0: &FaceSet) -> Option<FaceId> {
+        let &first = cands.as_slice().first()?;
+        if cands.first_outside <= 0.0 {
+            return None;
+        }
+        let topo = self.emb.mesh().topology();
+        let mesh = self.emb.mesh();
+        let yw = self.walk_point(y);
+        let mut f = first;
+        for _ in 0..LOCATE_STEPS {
+            let t = mesh.triangles[f as usize];
+            let l = plane_bary(t.map(|u| self.walk_coords[u as usize].unpack()), &yw)?;
+            let k = (0..3).min_by(|&a, &b| l[a].total_cmp(&l[b]))?;
+            if l[k] >= 0.0 {
+                return (!ring0.contains(f)).then_some(f);
+            }
+            f = topo.face_neighbors(f)[(k + 1) % 3];
+            if f == NONE {
+                return None;
+            }
+        }
+        None
     }
 
     /// The search after the walk: the local search from `v` (candidates `cands`), then
@@ -319,6 +368,40 @@ impl Projector {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use wavg_mesh::{ValidMesh, procedural};
+
+    /// From any vertex near a face, the point-location walk arrives at the face holding a
+    /// query in it, unless that face is already around the vertex.
+    #[test]
+    fn locating_walks_over_faces_to_the_one_holding_the_query() {
+        let mesh = Arc::new(ValidMesh::new(procedural::grid(10, 10, 1.0, 1.0)).unwrap());
+        let emb = Arc::new(EmbeddedMesh::from_positions(mesh.clone()));
+        let p = Projector::new(emb.clone()).unwrap();
+        let topo = mesh.topology();
+        let mut walked = 0;
+        for f in 0..mesh.n_faces() as FaceId {
+            let point = SurfacePoint::new(f, [0.3, 0.3, 0.4]);
+            let (y, at) = (emb.point(&point), point.position(&mesh));
+            for v in 0..mesh.n_vertices() as VertexId {
+                if (mesh.positions[v as usize] - at).norm() > 0.25 {
+                    continue;
+                }
+                let cands = p.faces_by_promise(&y, v);
+                let mut ring0 = FaceSet::new();
+                for &g in topo.ring_faces(v) {
+                    ring0.push(g);
+                }
+                let found = p.locate_face(&y, &cands, &ring0);
+                if ring0.contains(f) {
+                    assert_eq!(found, None, "face {f} is around vertex {v}");
+                } else {
+                    assert_eq!(found, Some(f), "from vertex {v}");
+                    walked += 1;
+                }
+            }
+        }
+        assert!(walked > 100, "only {walked} queries needed a walk");
+    }
 
     #[test]
     fn outside_orders_by_the_smallest_barycentric() {
