@@ -203,6 +203,7 @@ impl Projector {
                 }),
         );
         let starts = StartGrid::new(&walk_coords);
+        let reach = super::reach::Reach::new(mesh.n_vertices());
         Ok(Self {
             emb,
             verts,
@@ -210,6 +211,7 @@ impl Projector {
             faces,
             bvh,
             cones: std::sync::OnceLock::new(),
+            reach,
             walk_origin,
             walk_inv_step,
             walk_coords,

@@ -30,6 +30,7 @@ mod layout;
 mod locate;
 mod nearest;
 mod order;
+mod reach;
 mod search;
 mod walk;
 
@@ -83,6 +84,8 @@ pub struct Projector {
     bvh: Bvh,
     /// Built on first use: most workloads' searches end before they would ask.
     cones: std::sync::OnceLock<Cones>,
+    /// Per-vertex reach, filled on first use.
+    reach: reach::Reach,
     walk_origin: Vec8,
     walk_inv_step: f64,
     walk_coords: Vec<WalkPoint>,
@@ -119,6 +122,7 @@ impl Projector {
             + std::mem::size_of_val(&self.faces[..])
             + self.bvh.bytes()
             + self.cones.get().map_or(0, Cones::bytes)
+            + self.reach.bytes()
             + std::mem::size_of_val(&self.walk_coords[..])
             + self.starts.bytes()
             + std::mem::size_of_val(self.emb.coords())

@@ -22,7 +22,9 @@ const HINT_MARGIN: f64 = 0.0;
 pub enum SearchGoal {
     /// The closest valid projection: the local search tests the faces around the walk's
     /// end, then rings of their neighbours until one holds a projection, then certifies
-    /// its best answer against the bounding volume hierarchy. When nothing is found within
+    /// its best answer: at once when the query's ball of that radius lies within the reach
+    /// of the walk's end (no triangle not around that vertex comes so close), otherwise
+    /// against the bounding volume hierarchy. When nothing is found within
     /// [`LOCAL_BUDGET`] faces, the search runs again from the vertex nearest to the query,
     /// then the global search answers. Path [`ProjectionPath::Certified`] or
     /// [`ProjectionPath::Fallback`].
@@ -265,28 +267,28 @@ impl Projector {
         };
         match (goal, local) {
             (SearchGoal::FirstHit, Some(b)) => Ok(Self::finish(b, ProjectionPath::Local)),
-            (SearchGoal::Closest, Some(b)) => Ok(self.certify(y, b, &tried)),
+            (SearchGoal::Closest, Some(b)) => Ok(self.certify(y, b, v, &tried)),
             // The walk may end in a local minimum of the distance with no projection
             // nearby (on another sheet that lies close in R^8): once more from the nearest
             // vertex, much cheaper than the global search and usually its answer.
             (_, None) => match self.search_from_nearest(y, v, goal) {
-                Some((b, _)) if goal == SearchGoal::FirstHit => {
+                Some((b, _, _)) if goal == SearchGoal::FirstHit => {
                     Ok(Self::finish(b, ProjectionPath::Local))
                 }
-                Some((b, tried)) => Ok(self.certify(y, b, &tried)),
+                Some((b, u, tried)) => Ok(self.certify(y, b, u, &tried)),
                 None => global(y),
             },
         }
     }
 
     /// The local search from the vertex nearest to `y`, unless that is `v` (where the
-    /// search already ran): its answer and the faces it tried.
+    /// search already ran): its answer, that vertex and the faces it tried.
     fn search_from_nearest(
         &self,
         y: &Vec8,
         v: VertexId,
         goal: SearchGoal,
-    ) -> Option<(Best, FaceSet)> {
+    ) -> Option<(Best, VertexId, FaceSet)> {
         let u = self.nearest_vertex(y);
         if u == v {
             return None;
@@ -294,14 +296,15 @@ impl Projector {
         let cands = self.faces_by_promise(y, u);
         let mut tried = FaceSet::new();
         self.local_search(y, u, &cands, goal, &mut tried)
-            .map(|b| (b, tried))
+            .map(|b| (b, u, tried))
     }
 
-    /// Certifies the local search's answer `local` against the hierarchy (faces in
+    /// Certifies the local search's answer `local` (from the walk's end `v`): by its zero
+    /// distance, by `v`'s reach (see the `reach` module) or against the hierarchy (faces in
     /// `tried` are skipped): `Certified` if nothing is strictly closer, else the closest
     /// projection found, as `Fallback`.
-    fn certify(&self, y: &Vec8, local: Best, tried: &FaceSet) -> Projection {
-        if self.is_zero(&local) {
+    fn certify(&self, y: &Vec8, local: Best, v: VertexId, tried: &FaceSet) -> Projection {
+        if self.is_zero(&local) || self.certified_by_reach(y, &local, v, tried) {
             return Self::finish(local, ProjectionPath::Certified);
         }
         let mut improved = None;
