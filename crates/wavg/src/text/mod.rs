@@ -73,6 +73,8 @@ pub struct LineChunks<R> {
     reader: R,
     next_line: usize,
     lines_per_chunk: usize,
+    /// Bytes of the last chunk: the next one is allocated that large at once.
+    last_bytes: usize,
 }
 
 /// Consecutive whole lines of a stream.
@@ -91,20 +93,32 @@ impl<R: BufRead> LineChunks<R> {
             reader,
             next_line: 1,
             lines_per_chunk: lines_per_chunk.max(1),
+            last_bytes: 0,
         }
     }
 
     /// The next chunk, or `None` at the end of the stream. Text that is not UTF-8 is an
     /// [`io::ErrorKind::InvalidData`] error.
     pub fn next_chunk(&mut self) -> io::Result<Option<Chunk>> {
-        let mut text = String::new();
+        // Bytes first, checked once per chunk; sized like the last chunk, so a stream of
+        // similar lines is read without growing (and copying) the buffer.
+        let mut bytes = Vec::with_capacity(self.last_bytes + self.last_bytes / 8);
         let mut lines = 0;
-        while lines < self.lines_per_chunk && self.reader.read_line(&mut text)? > 0 {
+        while lines < self.lines_per_chunk && self.reader.read_until(b'\n', &mut bytes)? > 0 {
             lines += 1;
         }
         if lines == 0 {
             return Ok(None);
         }
+        self.last_bytes = bytes.len();
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let line = self.next_line + valid.iter().filter(|&&b| b == b'\n').count();
+            io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("line {line}: the text is not valid UTF-8"),
+            )
+        })?;
         let chunk = Chunk {
             first_line: self.next_line,
             text,
@@ -435,7 +449,9 @@ mod tests {
     #[test]
     fn non_utf8_is_an_error() {
         let mut chunks = LineChunks::new(&b"0.5 0.5\n\xff\n"[..], 10);
-        assert!(chunks.next_chunk().is_err());
+        let e = chunks.next_chunk().unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::InvalidData);
+        assert!(e.to_string().starts_with("line 2:"), "{e}");
     }
 
     #[test]
