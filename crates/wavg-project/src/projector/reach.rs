@@ -2,17 +2,20 @@
 //! the vertex comes. A certified search whose local search tried every face around its
 //! walk's end `v` is done without the global search when its answer's distance `r` and the
 //! query `y` satisfy `|y - x_v| + r <= reach(v)`: every other triangle's convex hull, which
-//! holds its Phong points, is then at least `r` from `y`. Computed for a vertex the first
-//! time a search asks (one nearest-triangle search of the hierarchy), like the cone
-//! bounds: workloads that never certify pay nothing.
+//! holds its Phong points, is then at least `r` from `y`. A reach costs about as much as
+//! one global search, so it is computed the second time a search asks for a vertex's
+//! (queries that come back to a region pay it once; one-off queries never do), like the
+//! cone bounds on first use: workloads that never certify pay nothing.
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use super::search::FaceSet;
 use super::*;
 
-/// Bits of a reach not computed yet (a NaN: never a valid reach).
+/// Bits of a reach nobody asked for yet, and of one asked for once (NaNs: never valid
+/// reaches).
 const UNSET: u32 = u32::MAX;
+const ASKED: u32 = u32::MAX - 1;
 
 /// The reach of every vertex, as `f32` bits, filled on first use.
 pub(super) struct Reach(Vec<AtomicU32>);
@@ -31,17 +34,28 @@ impl Reach {
 
 impl Projector {
     /// A lower bound of the distance from vertex `v`'s embedded position to the convex hull
-    /// of every triangle that does not have `v` as a corner (infinite when there is none).
-    /// Racing threads compute the same value.
-    pub(super) fn reach(&self, v: VertexId) -> f64 {
+    /// of every triangle that does not have `v` as a corner (infinite when there is none),
+    /// computed now if needed. Racing threads compute the same value.
+    fn reach(&self, v: VertexId) -> f64 {
         let slot = &self.reach.0[v as usize];
         let bits = slot.load(Ordering::Relaxed);
-        if bits != UNSET {
+        if bits != UNSET && bits != ASKED {
             return f32::from_bits(bits) as f64;
         }
         let r = self.compute_reach(v);
         slot.store(r.to_bits(), Ordering::Relaxed);
         r as f64
+    }
+
+    /// `v`'s reach if a search asked for it before (computed now if needed); `None` the
+    /// first time, which is recorded.
+    fn reach_if_asked_before(&self, v: VertexId) -> Option<f64> {
+        let slot = &self.reach.0[v as usize];
+        if slot.load(Ordering::Relaxed) == UNSET {
+            slot.store(ASKED, Ordering::Relaxed);
+            return None;
+        }
+        Some(self.reach(v))
     }
 
     fn compute_reach(&self, v: VertexId) -> f32 {
@@ -83,8 +97,8 @@ impl Projector {
         if !around.iter().all(|&f| tried.contains(f)) {
             return false;
         }
-        let x = &self.verts[v as usize].x;
-        (y - x).norm() + local.d2.sqrt() <= self.reach(v)
+        let need = (y - self.verts[v as usize].x).norm() + local.d2.sqrt();
+        self.reach_if_asked_before(v).is_some_and(|r| need <= r)
     }
 }
 
@@ -115,7 +129,9 @@ mod tests {
                     let w = closest_point_barycentric(&x, &a, &b, &c);
                     brute = brute.min((a * w[0] + b * w[1] + c * w[2] - x).norm());
                 }
-                let r = p.reach(v);
+                // Asked once: not computed, and recorded.
+                assert_eq!(p.reach_if_asked_before(v), None);
+                let r = p.reach_if_asked_before(v).unwrap();
                 assert!(
                     r <= brute && r >= brute * (1.0 - 1e-5),
                     "{v}: {r} vs {brute}"
@@ -123,6 +139,78 @@ mod tests {
                 // Asked again: the stored value.
                 assert_eq!(p.reach(v), r);
             }
+        }
+    }
+
+    /// Answers of `queries` projections from the given start vertices, each asked twice
+    /// (the second time certified by reach where it can be), against the brute force;
+    /// returns how many reaches were computed.
+    fn check_against_brute_force(p: &Projector, queries: &[(Vec8, VertexId)]) -> usize {
+        let h = p.embedded().mean_edge_length();
+        for (y, start) in queries {
+            let brute = p.project_brute_force(y).unwrap();
+            for _ in 0..2 {
+                let got = p.project(y, *start).unwrap();
+                let at = |q: &SurfacePoint| p.embedded().point(q);
+                let same = (at(&got.point) - at(&brute.point)).norm() <= 1e-9 * h;
+                let tie = (got.distance - brute.distance).abs() <= 1e-12 * h;
+                assert!(same || tie, "{got:?} vs brute force {brute:?}");
+            }
+        }
+        (p.reach.0.iter())
+            .filter(|b| !matches!(b.load(Ordering::Relaxed), UNSET | ASKED))
+            .count()
+    }
+
+    /// Near and a little off a noisy torus, and between two parallel sheets (where the
+    /// other sheet is often the closer one): the brute force's answers, with the reach
+    /// path taken.
+    #[test]
+    fn answers_certified_by_reach_are_the_brute_forces() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let torus = procedural::with_noise(procedural::torus(24, 12, 1.0, 0.3), 0.02, 5);
+        // Two 10 x 10 grids of cell 0.1, at z = 0 and z = 0.15.
+        let mut sheets = procedural::grid(10, 10, 1.0, 1.0);
+        let n = sheets.positions.len() as u32;
+        let lifted: Vec<_> = (sheets.positions.iter())
+            .map(|q| nalgebra::Vector3::new(q.x, q.y, 0.15))
+            .collect();
+        sheets.positions.iter_mut().for_each(|q| q.z = 0.0);
+        sheets.positions.extend(lifted);
+        let tris = sheets.triangles.clone();
+        (sheets.triangles).extend(tris.iter().map(|t| t.map(|v| v + n)));
+        for (mesh, gap) in [(torus, None), (sheets, Some(0.15))] {
+            let mesh = Arc::new(ValidMesh::new(mesh).unwrap());
+            let emb = Arc::new(EmbeddedMesh::from_positions(mesh.clone()));
+            let p = Projector::new(emb.clone()).unwrap();
+            let h = emb.mean_edge_length();
+            let queries: Vec<(Vec8, VertexId)> = (0..1500)
+                .map(|_| {
+                    let faces = match gap {
+                        Some(_) => mesh.n_faces() as FaceId / 2,
+                        None => mesh.n_faces() as FaceId,
+                    };
+                    let f = rng.random_range(0..faces);
+                    let (a, b) = (rng.random::<f64>(), rng.random::<f64>());
+                    let (a, b) = if a + b > 1.0 {
+                        (1.0 - a, 1.0 - b)
+                    } else {
+                        (a, b)
+                    };
+                    let mut y = emb.point(&SurfacePoint::new(f, [1.0 - a - b, a, b]));
+                    match gap {
+                        Some(g) => y[2] += g * rng.random_range(0.3..0.7),
+                        None => {
+                            let dir = Vec8::from_fn(|_, _| rng.random::<f64>() - 0.5);
+                            y += dir.normalize() * (h * rng.random_range(0.01..0.5));
+                        }
+                    }
+                    (y, mesh.triangles[f as usize][0])
+                })
+                .collect();
+            let computed = check_against_brute_force(&p, &queries);
+            assert!(computed > 50, "only {computed} reaches computed");
         }
     }
 }
