@@ -3,9 +3,9 @@
 //! walk's end `v` is done without the global search when its answer's distance `r` and the
 //! query `y` satisfy `|y - x_v| + r <= reach(v)`: every other triangle's convex hull, which
 //! holds its Phong points, is then at least `r` from `y`. A reach costs about as much as
-//! one global search, so it is computed the second time a search asks for a vertex's
-//! (queries that come back to a region pay it once; one-off queries never do), like the
-//! cone bounds on first use: workloads that never certify pay nothing.
+//! one global search, so it is computed the second time a search asks for it (queries
+//! that come back to a region pay it once; one-off queries never do); workloads that never
+//! certify pay nothing.
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
