@@ -3,12 +3,14 @@
 use std::io::Write;
 
 use std::path::PathBuf;
+
+use rayon::prelude::*;
 use wavg::text;
 
-use wavg_solve::{ForwardOptions, Normalization, SearchMode, SolveError};
+use wavg_solve::{ForwardOptions, ForwardScratch, Normalization, Par, SearchMode, SolveError};
 
 use crate::CliError;
-use crate::stream::{Format, Sink, stream_queries};
+use crate::stream::{Format, NpyRow, Sink, stream_queries};
 use crate::textio::{self, located};
 
 const LONG_ABOUT: &str = "\
@@ -69,26 +71,38 @@ pub fn run(args: Args) -> Result<(), CliError> {
         normalization,
         warm_start: None,
     };
-    // Every line is checked before anything of its chunk is computed, so errors name their line.
-    let check = |rows: &[(usize, Vec<f64>)]| {
-        rows.iter().try_for_each(|(line, w)| {
-            wavg_solve::validate_weights(w, solver.n_anchors(), normalization)
-                .map(|_| ())
-                .map_err(|e| located(&args.weights, *line, &e))
-        })
+    // A line's weights as the forward problem checks them, its error naming the line.
+    let validate = |line: usize, w: &[f64]| {
+        wavg_solve::validate_weights(w, solver.n_anchors(), normalization)
+            .map(|_| ())
+            .map_err(|e| located(&args.weights, line, &e))
     };
-    let solve = |rows: Vec<(usize, Vec<f64>)>, sink: &mut Sink| -> Result<(), CliError> {
-        let weights: Vec<&[f64]> = rows.iter().map(|(_, w)| &w[..]).collect();
-        let results = if args.warm {
-            solver.forward_batch_warm(&weights, &opts, 256)
+    // The first pass for outputs that cannot be written atomically (in parallel; the
+    // error reported is the first bad line's).
+    let check = |rows: &[(usize, WeightRow)]| {
+        let bad = rows
+            .par_iter()
+            .position_first(|(line, w)| validate(*line, w.as_ref()).is_err());
+        bad.map_or(Ok(()), |i| validate(rows[i].0, rows[i].1.as_ref()))
+    };
+    // The batch's buffers live across chunks (no fresh memory to fault in per chunk).
+    let (mut scratch, mut results) = (ForwardScratch::default(), Vec::new());
+    let solve = |rows: Vec<(usize, WeightRow)>, sink: &mut Sink| -> Result<(), CliError> {
+        let weights: Vec<&[f64]> = rows.iter().map(|(_, w)| w.as_ref()).collect();
+        // `Par::Rayon` always starts.
+        let _ = if args.warm {
+            solver.forward_batch_warm_into(&weights, &opts, 256, &mut results, Par::Rayon)
         } else {
-            solver.forward_batch(&weights, &opts)
+            solver.forward_batch_into(&weights, &opts, &mut scratch, &mut results, Par::Rayon)
         };
-        // Anything but "no average" after validation is a bug or a broken mesh: fail whole.
-        for (r, (line, _)) in results.iter().zip(&rows) {
+        // The forward problem checks each row's weights: the first row it refused names its
+        // line (an input error). Anything else but "no average" is a bug or a broken mesh:
+        // fail whole.
+        for (r, (line, w)) in results.iter().zip(&rows) {
             if let Err(e) = r
                 && *e != SolveError::NoWeightedAverage
             {
+                validate(*line, w.as_ref())?;
                 return Err(CliError::failure(format!(
                     "{}:{line}: {e}",
                     args.weights.display()
@@ -120,9 +134,30 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     textio::with_threads(args.problem.threads, || {
         let format = Format {
-            text: text::parse_weights,
-            npy: |_, row| Ok(row.to_vec()),
+            text: |text, first| {
+                let rows = text::parse_weights(text, first)?;
+                Ok(rows
+                    .into_iter()
+                    .map(|(l, w)| (l, WeightRow::Text(w)))
+                    .collect())
+            },
+            npy: |_, row| Ok(WeightRow::Npy(row)),
         };
         stream_queries(&args.weights, &args.problem.output, format, 7, check, solve)
     })?
+}
+
+/// One query's weights as read: a parsed text line, or a row of a `.npy` block.
+enum WeightRow {
+    Text(Vec<f64>),
+    Npy(NpyRow),
+}
+
+impl AsRef<[f64]> for WeightRow {
+    fn as_ref(&self) -> &[f64] {
+        match self {
+            WeightRow::Text(w) => w,
+            WeightRow::Npy(row) => row,
+        }
+    }
 }

@@ -6,7 +6,7 @@ use wavg::text::{self, PointSpec};
 use wavg_solve::{BatchWeights, DEFAULT_TOLERANCE, RoundTrip, Verified};
 
 use crate::CliError;
-use crate::stream::{Format, Sink, stream_queries};
+use crate::stream::{Format, NpyRow, Sink, stream_queries};
 use crate::textio;
 
 const LONG_ABOUT: &str = "\
@@ -115,9 +115,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
 }
 
 /// A `.npy` point row: `FACE B0 B1 B2` (the face index as a float holding an integer).
-fn npy_point(line: usize, row: &[f64]) -> Result<PointSpec, wavg::text::LineError> {
+fn npy_point(line: usize, row: NpyRow) -> Result<PointSpec, wavg::text::LineError> {
     let err = |message: String| wavg::text::LineError { line, message };
-    let [face, b0, b1, b2] = row else {
+    let [face, b0, b1, b2] = &row[..] else {
         return Err(err(format!(
             "a point row has 4 values (FACE B0 B1 B2), got {}",
             row.len()

@@ -2,11 +2,12 @@
 //! in, text or `.npy` out, a bounded chunk of rows at a time, with atomic outputs.
 //!
 //! Three stages overlap: a reader thread reads and parses the rows of chunk k+1 while a
-//! compute thread checks, solves and formats chunk k (parsing, solving and formatting are
+//! compute thread solves and formats chunk k (parsing, solving and formatting are
 //! parallel over the command's threads) and the calling thread writes the answers
-//! formatted so far, a block at a time. The stages hand work over without queues, so
-//! memory holds about two chunks of parsed input, two parts of raw input and two blocks
-//! of output.
+//! formatted so far, a block at a time. The reader may run one chunk ahead of the
+//! compute stage (its parts wait in a bounded queue) and the writer takes one block at a
+//! time, so memory holds about three chunks of parsed input, one part of raw input and
+//! two blocks of output.
 
 use std::fs::File;
 use std::io::{BufReader, Write};
@@ -21,7 +22,7 @@ use wavg::text::{LineChunks, LineError};
 use crate::CliError;
 use crate::textio::{located, write_atomic};
 
-/// Rows read, checked, computed and written per round.
+/// Rows read, computed and written per round.
 const CHUNK_ROWS: usize = 1 << 16;
 
 /// Rows read and parsed at a time (a quarter of a chunk, to keep the input in flight
@@ -48,7 +49,23 @@ pub struct Format<T> {
     /// Parses a chunk of text lines.
     pub text: ParseChunk<T>,
     /// Reads one `.npy` row.
-    pub npy: fn(usize, &[f64]) -> Result<T, LineError>,
+    pub npy: fn(usize, NpyRow) -> Result<T, LineError>,
+}
+
+/// One row of a `.npy` input, sharing the block it was read in (rows are not copied
+/// one by one).
+#[derive(Clone, Debug)]
+pub struct NpyRow {
+    block: Arc<Vec<f64>>,
+    start: usize,
+    len: usize,
+}
+
+impl std::ops::Deref for NpyRow {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        &self.block[self.start..self.start + self.len]
+    }
 }
 
 /// Whether `path` names a NumPy file.
@@ -194,14 +211,17 @@ fn parse<T: Send>(raw: Raw, input: &Path, format: &Format<T>) -> Result<Vec<(usi
             cols,
             values,
         } => {
-            let rows = if cols == 0 {
-                Vec::new()
-            } else {
-                values.chunks_exact(cols).collect()
-            };
-            rows.into_iter()
-                .enumerate()
-                .map(|(i, row)| Ok((first + i, (format.npy)(first + i, row).map_err(bad)?)))
+            let n = values.len().checked_div(cols).unwrap_or(0);
+            let block = Arc::new(values);
+            (0..n)
+                .map(|i| {
+                    let row = NpyRow {
+                        block: Arc::clone(&block),
+                        start: i * cols,
+                        len: cols,
+                    };
+                    Ok((first + i, (format.npy)(first + i, row).map_err(bad)?))
+                })
                 .collect()
         }
     }
@@ -217,9 +237,14 @@ fn read_all<T: Send>(
     tx: SyncSender<Result<Vec<(usize, T)>, CliError>>,
 ) {
     loop {
+        // Text is parsed in parallel on the pool; a `.npy` part is only copied into rows,
+        // which this thread does on its own, leaving the pool's threads to the solving.
         let next = source.next_raw(input).and_then(|raw| {
-            raw.map(|r| pool.install(|| parse(r, input, format)))
-                .transpose()
+            raw.map(|r| match r {
+                Raw::Text(_) => pool.install(|| parse(r, input, format)),
+                Raw::Npy { .. } => parse(r, input, format),
+            })
+            .transpose()
         });
         let stop = !matches!(next, Ok(Some(_)));
         let Some(item) = next.transpose() else { return };
@@ -229,20 +254,18 @@ fn read_all<T: Send>(
     }
 }
 
-/// Checks the rows from `rx` and computes them a chunk at a time on `pool`; `each` puts
-/// the answers in `sink`. Waiting for rows happens outside the pool, so the reader's
-/// parsing always finds the pool's threads free, whatever their number.
+/// Computes the rows from `rx` a chunk at a time on `pool`; `each` puts the answers in
+/// `sink` (and reports bad rows itself). Waiting for rows happens outside the pool, so
+/// the reader's parsing always finds the pool's threads free, whatever their number.
 fn compute_all<T: Send>(
     rx: Receiver<Result<Vec<(usize, T)>, CliError>>,
     mut sink: Sink,
     pool: &rayon::ThreadPool,
-    check: impl Fn(&[(usize, T)]) -> Result<(), CliError> + Sync,
     mut each: impl FnMut(Vec<(usize, T)>, &mut Sink) -> Result<(), CliError> + Send,
 ) -> Result<(), CliError> {
     let mut chunk = Vec::new();
     for part in rx {
-        let part = part?;
-        let mut part = pool.install(|| check(&part).map(|()| part))?;
+        let mut part = part?;
         chunk.append(&mut part);
         if chunk.len() >= CHUNK_ROWS {
             let rows = std::mem::take(&mut chunk);
@@ -272,13 +295,13 @@ impl Dest<'_> {
 }
 
 /// Streams the query file `input` through bounded memory: each chunk of rows is parsed
-/// (text in parallel), checked by `check` (errors name their line, or row for `.npy`), and
-/// handed to `each`, which puts its answers in the sink: text, or with an `output`
-/// ending in `.npy` rows of `npy_cols` values. Reading, computing and writing overlap
-/// (see the module documentation). The output goes to a temporary file renamed on
-/// success, so a bad row anywhere leaves nothing; for stdout (`-`), and to count the rows
-/// of a `.npy` output from a text input, a first pass parses and checks the whole file
-/// before anything is written.
+/// (text in parallel) and handed to `each`, which puts its answers in the sink (text,
+/// or with an `output` ending in `.npy` rows of `npy_cols` values) and fails on the
+/// chunk's first bad row (errors name their line, or row for `.npy`). Reading, computing
+/// and writing overlap (see the module documentation). The output goes to a temporary
+/// file renamed on success, so a bad row anywhere leaves nothing; for stdout (`-`), and
+/// to count the rows of a `.npy` output from a text input, a first pass parses the
+/// whole file and runs `check` (the same errors as `each`'s) before anything is written.
 pub fn stream_queries<T: Send>(
     input: &Path,
     output: &Path,
@@ -317,9 +340,10 @@ pub fn stream_queries<T: Send>(
         } else {
             Dest::Text(w)
         };
-        // Rendezvous channels: each stage holds one piece of work while it waits for the
-        // next to take it.
-        let (raw_tx, raw_rx) = sync_channel(0);
+        // The reader may run a whole chunk ahead, so the next chunk's input is ready when
+        // the current one is solved; the writer's channel is a rendezvous (the compute
+        // stage holds one block while the writer writes the previous one).
+        let (raw_tx, raw_rx) = sync_channel(CHUNK_ROWS / READ_ROWS);
         let (block_tx, block_rx) = sync_channel(0);
         let (computed, written) = std::thread::scope(|s| {
             s.spawn(|| read_all(source, input, &format, &pool, raw_tx));
@@ -329,7 +353,7 @@ pub fn stream_queries<T: Send>(
                     spare: Arc::clone(&spare),
                     tx: block_tx,
                 };
-                compute_all(raw_rx, sink, &pool, check, each)
+                compute_all(raw_rx, sink, &pool, each)
             });
             let mut written = Ok(());
             for block in &block_rx {

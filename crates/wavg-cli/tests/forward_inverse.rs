@@ -463,6 +463,37 @@ fn long_files_stream_in_chunks() {
         out.stdout.is_empty(),
         "stdout got output before the bad line"
     );
+    // Weights that do not sum to 1 in the third chunk, as text and as `.npy`: the same.
+    let k = 140_000;
+    let mut rows = weights.clone();
+    rows[k][0] += 0.5;
+    let text: String = rows
+        .iter()
+        .map(|r| {
+            r.iter()
+                .map(|v| format!("{v:?}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+                + "\n"
+        })
+        .collect();
+    let bad_w = write(dir.path(), "bad_w.txt", &text);
+    let bad_npy = dir.path().join("bad_w.npy");
+    write_npy(&bad_npy, rows[0].len(), &rows.concat());
+    for (input, output) in [(&bad_w, &back), (&bad_npy, &dir.path().join("back.npy"))] {
+        let name = input.file_name().unwrap().to_string_lossy().into_owned();
+        expect_input_error(
+            &solve_args("forward", s(&anchors), s(input), s(output), &[]),
+            output,
+            &format!("{name}:{}:", k + 1),
+        );
+        let out = wavg(&solve_args("forward", s(&anchors), s(input), "-", &[]));
+        assert_eq!(out.status.code(), Some(2));
+        assert!(
+            out.stdout.is_empty(),
+            "stdout got output before the bad line"
+        );
+    }
 }
 
 /// Writes a row-major `rows x cols` array as `.npy`.

@@ -160,7 +160,10 @@ pub struct NpyReader<R: Read> {
     inner: R,
     header: Header,
     rows_read: usize,
-    buf: Vec<u8>,
+    /// `float32` bytes as read (at most [`READ_BLOCK`]).
+    bytes: Vec<u8>,
+    /// One row for [`NpyReader::read_row`].
+    row: Vec<f64>,
 }
 
 impl<R: Read> NpyReader<R> {
@@ -172,13 +175,17 @@ impl<R: Read> NpyReader<R> {
                 "Fortran-order arrays cannot be streamed by rows (save with C order)",
             ));
         }
-        let width = if header.f32 { 4 } else { 8 };
-        Ok(Self {
+        Ok(Self::with_header(inner, header))
+    }
+
+    fn with_header(inner: R, header: Header) -> Self {
+        Self {
             inner,
             header,
             rows_read: 0,
-            buf: vec![0; header.cols * width],
-        })
+            bytes: Vec::new(),
+            row: Vec::new(),
+        }
     }
 
     /// Rows the header declares.
@@ -203,53 +210,110 @@ impl<R: Read> NpyReader<R> {
                 self.header.cols
             )));
         }
-        if let Err(e) = self.inner.read_exact(&mut self.buf) {
-            return Err(match e.kind() {
-                std::io::ErrorKind::UnexpectedEof => NpyError::Truncated {
-                    values_read: self.rows_read * self.header.cols,
-                    expected: self.header.rows * self.header.cols,
+        let mut row = std::mem::take(&mut self.row);
+        row.clear();
+        let read = self.read_rows(&mut row, 1);
+        if read.is_ok() {
+            out.copy_from_slice(&row);
+        }
+        self.row = row;
+        read.map(|_| true)
+    }
+
+    /// Appends up to `max_rows` further rows to `out` (row after row); returns how many
+    /// were read, 0 after the last row. Memory grows with the data actually read, a block
+    /// at a time, whatever the header declares.
+    pub fn read_rows(&mut self, out: &mut Vec<f64>, max_rows: usize) -> Result<usize, NpyError> {
+        let h = self.header;
+        let n = max_rows.min(h.rows - self.rows_read);
+        let start = out.len();
+        // Room for the rows asked for, up to what a few blocks hold (a header may declare
+        // more than the file has).
+        out.reserve((n * h.cols).min(16 * READ_BLOCK / 8));
+        if let Err(e) = self.read_values(out, n * h.cols) {
+            let values = (out.len() - start) + self.rows_read * h.cols;
+            out.truncate(start);
+            return Err(match e {
+                NpyError::Truncated { .. } => NpyError::Truncated {
+                    values_read: values - values % h.cols.max(1),
+                    expected: h.rows * h.cols,
                 },
-                _ => e.into(),
+                e => e,
             });
         }
+        self.rows_read += n;
+        Ok(n)
+    }
+
+    /// Appends `count` values to `out`, a block at a time; on a short input the values
+    /// of the whole blocks read stay appended and the error is `Truncated`.
+    fn read_values(&mut self, out: &mut Vec<f64>, count: usize) -> Result<(), NpyError> {
         let h = self.header;
-        if h.f32 {
-            for (o, b) in out.iter_mut().zip(self.buf.chunks_exact(4)) {
-                let b: [u8; 4] = b.try_into().expect("4 bytes");
-                *o = f64::from(if h.big_endian {
-                    f32::from_be_bytes(b)
+        let width = if h.f32 { 4 } else { 8 };
+        let mut left = count;
+        while left > 0 {
+            let piece = left.min(READ_BLOCK / width);
+            let start = out.len();
+            let got = if h.f32 {
+                self.bytes.resize(piece * 4, 0);
+                let got = read_full(&mut self.inner, &mut self.bytes)?;
+                let convert = if h.big_endian {
+                    f32::from_be_bytes
                 } else {
-                    f32::from_le_bytes(b)
+                    f32::from_le_bytes
+                };
+                out.extend(
+                    self.bytes[..got - got % 4]
+                        .chunks_exact(4)
+                        .map(|b| f64::from(convert(b.try_into().expect("4 bytes")))),
+                );
+                got
+            } else {
+                // Straight into `out`'s memory (one copy from the reader), then to native
+                // byte order in place (nothing to do for little-endian data on a
+                // little-endian machine).
+                out.resize(start + piece, 0.0);
+                let got = read_full(&mut self.inner, bytemuck::cast_slice_mut(&mut out[start..]))?;
+                out.truncate(start + got / 8);
+                if h.big_endian {
+                    for v in &mut out[start..] {
+                        *v = f64::from_be_bytes(v.to_ne_bytes());
+                    }
+                } else if cfg!(target_endian = "big") {
+                    for v in &mut out[start..] {
+                        *v = f64::from_le_bytes(v.to_ne_bytes());
+                    }
+                }
+                got
+            };
+            if got < piece * width {
+                return Err(NpyError::Truncated {
+                    values_read: 0,
+                    expected: 0,
                 });
             }
-        } else {
-            for (o, b) in out.iter_mut().zip(self.buf.chunks_exact(8)) {
-                let b: [u8; 8] = b.try_into().expect("8 bytes");
-                *o = if h.big_endian {
-                    f64::from_be_bytes(b)
-                } else {
-                    f64::from_le_bytes(b)
-                };
-            }
+            left -= piece;
         }
-        self.rows_read += 1;
-        Ok(true)
+        Ok(())
     }
 }
 
-impl<R: Read> NpyReader<R> {
-    /// Appends up to `max_rows` further rows to `out` (row after row); returns how many
-    /// were read, 0 after the last row.
-    pub fn read_rows(&mut self, out: &mut Vec<f64>, max_rows: usize) -> Result<usize, NpyError> {
-        let cols = self.header.cols;
-        let mut row = vec![0.0; cols];
-        let mut n = 0;
-        while n < max_rows && self.read_row(&mut row)? {
-            out.extend_from_slice(&row);
-            n += 1;
+/// Bytes read at a time by [`NpyReader::read_rows`]: memory for the values grows by this
+/// much only as data arrives.
+const READ_BLOCK: usize = 1 << 20;
+
+/// Reads until `buf` is full or the input ends; returns the bytes read.
+fn read_full(inner: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut got = 0;
+    while got < buf.len() {
+        match inner.read(&mut buf[got..]) {
+            Ok(0) => break,
+            Ok(k) => got += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
         }
-        Ok(n)
     }
+    Ok(got)
 }
 
 /// Reads a whole array (C or Fortran order) as `(rows, cols, row-major values)`.
@@ -263,22 +327,17 @@ pub fn read_matrix(inner: impl Read) -> Result<(usize, usize, Vec<f64>), NpyErro
     } else {
         (rows, cols)
     };
-    let mut reader = NpyReader {
+    let mut reader = NpyReader::with_header(
         inner,
-        header: Header {
+        Header {
             rows: r,
             cols: c,
             fortran: false,
             ..header
         },
-        rows_read: 0,
-        buf: vec![0; c * if header.f32 { 4 } else { 8 }],
-    };
+    );
     let mut data = Vec::new();
-    let mut row = vec![0.0; c];
-    while reader.read_row(&mut row)? {
-        data.extend_from_slice(&row);
-    }
+    while reader.read_rows(&mut data, 1 << 16)? > 0 {}
     if header.fortran {
         let mut t = vec![0.0; data.len()];
         for i in 0..rows {
@@ -363,11 +422,16 @@ impl<W: Write> NpyWriter<W> {
                 self.cols
             )));
         }
-        let mut bytes = Vec::with_capacity(8 * values.len().min(1 << 16));
-        for part in values.chunks(1 << 16) {
-            bytes.clear();
-            bytes.extend(part.iter().flat_map(|v| v.to_le_bytes()));
-            self.inner.write_all(&bytes)?;
+        if cfg!(target_endian = "little") {
+            // The values' own bytes are the file's.
+            self.inner.write_all(bytemuck::cast_slice(values))?;
+        } else {
+            let mut bytes = Vec::with_capacity(8 * values.len().min(1 << 16));
+            for part in values.chunks(1 << 16) {
+                bytes.clear();
+                bytes.extend(part.iter().flat_map(|v| v.to_le_bytes()));
+                self.inner.write_all(&bytes)?;
+            }
         }
         self.written += rows;
         Ok(())
@@ -410,7 +474,6 @@ mod tests {
         }
     }
 
-    /// Bytes NumPy 1.26 writes for `np.save(f, np.array([[1.5, -2.0], [3.0, 4.25]]))`.
     #[test]
     fn rows_in_blocks_match_rows_one_by_one() {
         let (rows, cols) = (700, 93);
@@ -434,6 +497,81 @@ mod tests {
         assert_eq!(back, data);
     }
 
+    /// Reading rows in blocks larger than [`READ_BLOCK`] gives the values row by row
+    /// reading gives, for every element type, and a file cut short inside a later block
+    /// is truncated after its last whole row.
+    #[test]
+    fn block_reads_cross_read_blocks_for_every_element_type() {
+        let (rows, cols) = (2100, 93);
+        for descr in ["<f8", ">f8", "<f4", ">f4"] {
+            let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+            let dict = format!(
+                "{{'descr': '{descr}', 'fortran_order': False, 'shape': ({rows}, {cols}), }}\n"
+            );
+            bytes.extend((dict.len() as u16).to_le_bytes());
+            bytes.extend(dict.as_bytes());
+            let header = bytes.len();
+            let value = |i: usize| ((i as f64) * 0.37).sin() * 100.0;
+            for i in 0..rows * cols {
+                let v = value(i);
+                bytes.extend(match descr {
+                    "<f8" => v.to_le_bytes().to_vec(),
+                    ">f8" => v.to_be_bytes().to_vec(),
+                    "<f4" => (v as f32).to_le_bytes().to_vec(),
+                    _ => (v as f32).to_be_bytes().to_vec(),
+                });
+            }
+            let mut one = NpyReader::new(&bytes[..]).unwrap();
+            let (mut by_row, mut row) = (Vec::new(), vec![0.0; cols]);
+            while one.read_row(&mut row).unwrap() {
+                by_row.extend_from_slice(&row);
+            }
+            assert_eq!(by_row.len(), rows * cols);
+            let mut blocks = NpyReader::new(&bytes[..]).unwrap();
+            let mut back = Vec::new();
+            assert_eq!(blocks.read_rows(&mut back, 1500).unwrap(), 1500);
+            assert_eq!(blocks.read_rows(&mut back, 1500).unwrap(), rows - 1500);
+            assert_eq!(blocks.read_rows(&mut back, 1500).unwrap(), 0);
+            assert_eq!(back, by_row, "{descr}");
+            let width = if descr.ends_with('8') { 8 } else { 4 };
+            let cut = header + (1900 * cols + 5) * width;
+            let mut short = NpyReader::new(&bytes[..cut]).unwrap();
+            let mut some = Vec::new();
+            assert_eq!(short.read_rows(&mut some, 1000).unwrap(), 1000);
+            let err = short.read_rows(&mut some, 2000).unwrap_err();
+            assert!(
+                matches!(err, NpyError::Truncated { values_read, expected }
+                    if values_read == 1900 * cols && expected == rows * cols),
+                "{descr}: {err}"
+            );
+        }
+    }
+
+    /// A header that declares far more data than the file holds costs memory for the
+    /// data present only, and reads as truncated.
+    #[test]
+    fn declared_sizes_beyond_the_data_are_truncated_without_allocating_them() {
+        for shape in ["(1, 100000000000)", "(100000000000, 3)", "(100000000000,)"] {
+            let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+            let dict = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': {shape}, }}\n");
+            bytes.extend((dict.len() as u16).to_le_bytes());
+            bytes.extend(dict.as_bytes());
+            bytes.extend([0u8; 40]);
+            assert!(
+                matches!(read_matrix(&bytes[..]), Err(NpyError::Truncated { .. })),
+                "{shape}"
+            );
+            let mut r = NpyReader::new(&bytes[..]).unwrap();
+            let mut out = Vec::new();
+            assert!(matches!(
+                r.read_rows(&mut out, 1 << 16),
+                Err(NpyError::Truncated { .. })
+            ));
+            assert!(out.is_empty(), "{shape}: a failed read appends nothing");
+        }
+    }
+
+    /// Bytes NumPy 1.26 writes for `np.save(f, np.array([[1.5, -2.0], [3.0, 4.25]]))`.
     #[test]
     fn reads_numpy_output() {
         let mut bytes = b"\x93NUMPY\x01\x00\x76\x00".to_vec();
