@@ -5,7 +5,7 @@ A benchmark tool, not part of the build (standard library only). Starts at verte
 repeatedly adds the vertex farthest (Dijkstra over edge lengths) from those chosen, so the
 same ids serve every mesh that shares the connectivity (pose pairs).
 
-    python3 tools/fps_anchors.py MESH.obj[.gz] K OUT.txt
+    python3 tools/fps_anchors.py MESH.{obj,off}[.gz] K OUT.txt
 """
 import gzip
 import heapq
@@ -13,10 +13,22 @@ import math
 import sys
 
 
-def load_obj(path):
+def load_mesh(path):
     opener = gzip.open if path.endswith(".gz") else open
     verts, faces = [], []
     with opener(path, "rt") as f:
+        if path.removesuffix(".gz").endswith(".off"):
+            words = f.read().split()
+            nv, nf = int(words[1]), int(words[2])
+            at = 4
+            for _ in range(nv):
+                verts.append(tuple(map(float, words[at : at + 3])))
+                at += 3
+            for _ in range(nf):
+                k = int(words[at])
+                faces.append([int(x) for x in words[at + 1 : at + 1 + k]])
+                at += 1 + k
+            return verts, faces
         for line in f:
             p = line.split()
             if not p:
@@ -30,7 +42,7 @@ def load_obj(path):
 
 def main():
     path, k, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-    verts, faces = load_obj(path)
+    verts, faces = load_mesh(path)
     adj = [dict() for _ in verts]
     for f in faces:
         for i in range(len(f)):
