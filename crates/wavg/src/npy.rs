@@ -337,7 +337,8 @@ pub fn read_matrix(inner: impl Read) -> Result<(usize, usize, Vec<f64>), NpyErro
         },
     );
     let mut data = Vec::new();
-    while reader.read_rows(&mut data, 1 << 16)? > 0 {}
+    // (Rows without values hold no data: nothing to read, however many.)
+    while c > 0 && reader.read_rows(&mut data, 1 << 16)? > 0 {}
     if header.fortran {
         let mut t = vec![0.0; data.len()];
         for i in 0..rows {
@@ -569,6 +570,15 @@ mod tests {
             ));
             assert!(out.is_empty(), "{shape}: a failed read appends nothing");
         }
+        // Rows without values hold no data, however many are declared.
+        let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+        let dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (1000000000000, 0), }\n";
+        bytes.extend((dict.len() as u16).to_le_bytes());
+        bytes.extend(dict.as_bytes());
+        assert_eq!(
+            read_matrix(&bytes[..]).unwrap(),
+            (1_000_000_000_000, 0, vec![])
+        );
     }
 
     /// Bytes NumPy 1.26 writes for `np.save(f, np.array([[1.5, -2.0], [3.0, 4.25]]))`.
