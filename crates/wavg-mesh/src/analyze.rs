@@ -1,6 +1,8 @@
 //! One pass over a raw mesh: every validation problem, the statistics `wavg info` prints,
 //! and (when the mesh is valid) its topology.
 
+use rayon::prelude::*;
+
 use crate::mesh::TriMesh;
 use crate::problem::{Problem, ValidationReport};
 use crate::topology::{self, Topology};
@@ -160,23 +162,31 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
     let adj = edges.manifold_adjacency(nf);
     let incidence = topology::VertexFaces::build(nv, &mesh.triangles, &usable);
     let mut vertex_manifold = true;
-    let (mut fan_seen, mut fan_stack) = (Vec::new(), Vec::new());
+    // Fans per vertex (0 for an unreferenced vertex), in parallel; the problems are then
+    // listed in vertex order.
+    let fans: Vec<usize> = (0..nv)
+        .into_par_iter()
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |(seen, stack), v| {
+                topology::count_fans(
+                    v as u32,
+                    incidence.faces(v),
+                    &mesh.triangles,
+                    &adj,
+                    seen,
+                    stack,
+                )
+            },
+        )
+        .collect();
     let mut referenced = 0usize;
-    for v in 0..nv {
-        let faces = incidence.faces(v);
-        if faces.is_empty() {
+    for (v, &fans) in fans.iter().enumerate() {
+        if fans == 0 {
             problems.push(Problem::UnreferencedVertex { vertex: v as u32 });
             continue;
         }
         referenced += 1;
-        let fans = topology::count_fans(
-            v as u32,
-            faces,
-            &mesh.triangles,
-            &adj,
-            &mut fan_seen,
-            &mut fan_stack,
-        );
         if fans > 1 {
             vertex_manifold = false;
             problems.push(Problem::NonManifoldVertex {
