@@ -388,7 +388,7 @@ pub fn correspond_vertices(
 /// The local test (see the module docs): per vertex, whether most of its measured
 /// triangles map flipped (against `normals`, per face) or stretched beyond `max_stretch`
 /// times the overall symmetrised stretch, with `answered[v]` the image of vertex `v`.
-fn inconsistent_vertices(
+pub fn inconsistent_vertices(
     mesh: &ValidMesh,
     answered: &[Option<Vector3<f64>>],
     normals: &[Option<Vector3<f64>>],

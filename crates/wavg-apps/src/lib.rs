@@ -30,6 +30,15 @@ pub use correspond::{
 pub use ground_truth::{ErrorStats, GroundTruthErrors};
 pub use metrics::{Distortion, distortion};
 
+/// Internals for the benchmarks and experiments of this workspace.
+///
+/// **Unstable**: not part of the public API; anything here may change or disappear in any
+/// release.
+#[doc(hidden)]
+pub mod internal {
+    pub use crate::correspond::inconsistent_vertices;
+}
+
 mod decal;
 mod morph;
 

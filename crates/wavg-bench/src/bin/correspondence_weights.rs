@@ -91,8 +91,9 @@ fn continued(s: &Solver, rows: &[Vec<f64>], anchors: &[u32]) -> Vec<Option<Forwa
     out
 }
 
-/// The local test's verdict (majority of ring faces flipped or over-stretched), with the
-/// ground truth's face normals as the reference.
+/// The library's local test (majority of ring faces flipped or over-stretched, 4x the
+/// map's stretch), with the ground truth's face normals as the reference, and the round
+/// trip: whether each vertex is kept.
 fn local_valid(
     src: &ValidMesh,
     tgt: &ValidMesh,
@@ -109,23 +110,19 @@ fn local_valid(
             Some((p[1] - p[0]).cross(&(p[2] - p[0])))
         })
         .collect();
-    let d = wavg::apps::distortion(&src.positions, &src.triangles, &pos, &normals);
-    let bad: Vec<bool> = d
-        .flipped
-        .iter()
-        .zip(&d.face_stretch)
-        .map(|(&f, s)| f || s.is_some_and(|s| s > 4.0 * d.stretch))
-        .collect();
-    let topo = src.topology();
+    let bad = wavg::apps::internal::inconsistent_vertices(src, &pos, &normals, 4.0);
     (0..src.n_vertices())
-        .map(|v| {
-            let faces = topo.ring_faces(v as u32);
-            let measured = faces
-                .iter()
-                .filter(|&&f| d.flipped[f as usize] || d.face_stretch[f as usize].is_some())
-                .count();
-            let n_bad = faces.iter().filter(|&&f| bad[f as usize]).count();
-            ok[v] && img[v].is_some() && 2 * n_bad <= measured
+        .map(|v| ok[v] && img[v].is_some() && !bad[v])
+        .collect()
+}
+
+/// Whether the forward problem on `s` of each row returns to its point.
+fn round_trips(s: &Solver, rows: &[Vec<f64>], points: &[SurfacePoint], tol: f64) -> Vec<bool> {
+    rows.par_iter()
+        .zip(points)
+        .map(|(r, p)| {
+            s.forward(r, &ForwardOptions::default())
+                .is_ok_and(|f| (f.position - p.position(s.mesh())).norm() <= tol)
         })
         .collect()
 }
@@ -217,14 +214,7 @@ fn main() {
     stats("paper weights, default start", t.mesh(), &default);
     let cont = continued(&t, &rows, &anchors);
     stats("paper weights, continued", t.mesh(), &cont);
-    let back_default: Vec<bool> = rows
-        .par_iter()
-        .zip(&points)
-        .map(|(r, p)| {
-            s.forward(r, &ForwardOptions::default())
-                .is_ok_and(|f| (f.position - p.position(mesh)).norm() <= tol)
-        })
-        .collect();
+    let back_default = round_trips(&s, &rows, &points, tol);
     let back_cont = continued(&s, &rows, &anchors);
     let ok_cont = back_cont
         .iter()
@@ -269,15 +259,13 @@ fn main() {
             .map(|f| SurfacePoint::new(f, b))
             .collect();
         let w = s.inverse_batch(&pts);
-        let ok = pts
-            .par_iter()
-            .enumerate()
-            .filter(|(i, p)| {
-                w.get(*i).is_ok_and(|r| {
-                    s.forward(r, &ForwardOptions::default())
-                        .is_ok_and(|f| (f.position - p.position(mesh)).norm() <= tol)
-                })
-            })
+        let rows: Vec<Vec<f64>> = w
+            .iter()
+            .map(|r| r.map(|r| r.to_vec()).unwrap_or_default())
+            .collect();
+        let ok = round_trips(&s, &rows, &pts, tol)
+            .iter()
+            .filter(|&&b| b)
             .count();
         println!("{name}: round trip {:.3}", ok as f64 / pts.len() as f64);
     }
@@ -300,14 +288,7 @@ fn main() {
                 .unwrap_or_default()
             })
             .collect();
-        let back: Vec<bool> = rows
-            .par_iter()
-            .zip(&points)
-            .map(|(r, p)| {
-                s.forward(r, &ForwardOptions::default())
-                    .is_ok_and(|f| (f.position - p.position(mesh)).norm() <= tol)
-            })
-            .collect();
+        let back = round_trips(&s, &rows, &points, tol);
         let img: Vec<Option<ForwardResult>> = rows
             .par_iter()
             .map(|r| t.forward(r, &ForwardOptions::default()).ok())
