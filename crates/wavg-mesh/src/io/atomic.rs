@@ -1,6 +1,8 @@
 //! Atomic file output: write to a temporary file beside the destination, flush it to disk,
 //! then rename it into place, so an interrupted or failed write (even `SIGKILL`) never
-//! leaves a partial file under the final name.
+//! leaves a partial file under the final name. A destination that exists and is not a
+//! regular file (`/dev/null`, a named pipe, a terminal) is written in place instead:
+//! renaming over it would replace the device or pipe with a file.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -8,11 +10,18 @@ use std::path::{Path, PathBuf};
 /// Writes `path` atomically with `body`. On any error the destination is untouched and
 /// the temporary file is removed (a killed process can leave a `.wavg-tmp-*` file beside
 /// the destination, never a partial destination). The result gets the permissions a new
-/// file would (0666 minus the umask).
+/// file would (0666 minus the umask). A destination that exists and is not a regular file
+/// (a device such as `/dev/null`, a named pipe) is opened and written directly.
 pub fn write_atomic(
     path: &Path,
     body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
+    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        let file = std::fs::OpenOptions::new().write(true).open(path)?;
+        let mut w = std::io::BufWriter::new(file);
+        body(&mut w)?;
+        return w.flush();
+    }
     let dir: PathBuf = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -58,5 +67,31 @@ mod tests {
         assert_eq!(std::fs::read(&path).unwrap(), b"hello");
         let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(names.len(), 1);
+    }
+
+    /// Writing to a named pipe writes through it and leaves the pipe in place (a rename
+    /// would replace it, or `/dev/null`, with a regular file).
+    #[cfg(unix)]
+    #[test]
+    fn a_named_pipe_is_written_in_place() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if !made.is_ok_and(|s| s.success()) {
+            eprintln!("skipped: mkfifo is not available");
+            return;
+        }
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).unwrap())
+        };
+        write_atomic(&fifo, |w| w.write_all(b"through the pipe")).unwrap();
+        // Checked before waiting for the reader, which would wait for ever on a replaced pipe.
+        let m = std::fs::symlink_metadata(&fifo).unwrap();
+        assert!(m.file_type().is_fifo(), "the pipe was replaced by a file");
+        assert_eq!(reader.join().unwrap(), b"through the pipe");
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(names.len(), 1, "no temporary file is left");
     }
 }
