@@ -299,9 +299,10 @@ impl Dest<'_> {
 /// or with an `output` ending in `.npy` rows of `npy_cols` values) and fails on the
 /// chunk's first bad row (errors name their line, or row for `.npy`). Reading, computing
 /// and writing overlap (see the module documentation). The output goes to a temporary
-/// file renamed on success, so a bad row anywhere leaves nothing; for stdout (`-`), and
-/// to count the rows of a `.npy` output from a text input, a first pass parses the
-/// whole file and runs `check` (the same errors as `each`'s) before anything is written.
+/// file renamed on success, so a bad row anywhere leaves nothing; for stdout (`-`) and
+/// other destinations that are not regular files (devices, pipes), and to count the rows
+/// of a `.npy` output from a text input, a first pass parses the whole file and runs
+/// `check` (the same errors as `each`'s) before anything is written.
 pub fn stream_queries<T: Send>(
     input: &Path,
     output: &Path,
@@ -312,7 +313,10 @@ pub fn stream_queries<T: Send>(
 ) -> Result<(), CliError> {
     let npy_out = is_npy(output);
     let mut rows = None;
-    if output == Path::new("-") || (npy_out && !is_npy(input)) {
+    // A device or pipe is written as the rows come (no rename can take back a bad row):
+    // like stdout, it gets the first pass.
+    let special = std::fs::metadata(output).is_ok_and(|m| !m.is_file() && !m.is_dir());
+    if output == Path::new("-") || special || (npy_out && !is_npy(input)) {
         let mut source = Source::open(input)?;
         let mut n = 0;
         while let Some(raw) = source.next_raw(input)? {
