@@ -255,22 +255,57 @@ pub fn push_number(out: &mut Vec<u8>, x: f64) {
         return;
     }
     let mut buf = zmij::Buffer::new();
-    let s = buf.format_finite(x);
+    let s = buf.format_finite(x).as_bytes();
     // zmij writes the same layout as `{:?}` between 1e-4 and 1e16, and below 1e-5 where
     // both write a negative exponent (tested); elsewhere `{:?}` uses exponent notation of
     // its own style.
     let a = x.abs();
-    if x == 0.0 || (1e-4..1e16).contains(&a) || (a < 1e-5 && s.contains("e-")) {
-        out.extend_from_slice(s.as_bytes());
+    let same = if a < 1e-5 {
+        // Zero ("0.0") or a negative exponent, whose `e` is among the last five bytes.
+        x == 0.0 || s.iter().rev().take(5).any(|&c| c == b'e')
     } else {
-        // Between 1e-5 and 1e-4 zmij writes `0.0000DDD`, where `{:?}` writes `D.DDe-5`.
+        (1e-4..1e16).contains(&a)
+    };
+    if same {
+        out.extend_from_slice(s);
+    } else if !push_fraction_as_exponent(out, s) {
         push_exponent_form(out, s);
     }
 }
 
+/// Rewrites a number below one written in fixed notation, `[-]0.000DDD`, as `{:?}` writes
+/// it in exponent notation (`D.DDe-4`): the common case between 1e-5 and 1e-4, where zmij
+/// writes fixed notation and `{:?}` does not. Returns `false`, writing nothing, for any
+/// other text.
+fn push_fraction_as_exponent(out: &mut Vec<u8>, s: &[u8]) -> bool {
+    let negative = s.first() == Some(&b'-');
+    let Some(body) = s[usize::from(negative)..].strip_prefix(b"0.") else {
+        return false;
+    };
+    let zeros = body.iter().take_while(|&&d| d == b'0').count();
+    let digits = &body[zeros..];
+    let digits = &digits[..digits.len() - digits.iter().rev().take_while(|&&d| d == b'0').count()];
+    if digits.is_empty() || zeros > 8 || !digits.iter().all(u8::is_ascii_digit) {
+        return false;
+    }
+    if negative {
+        out.push(b'-');
+    }
+    out.push(digits[0]);
+    if digits.len() > 1 {
+        out.push(b'.');
+        out.extend_from_slice(&digits[1..]);
+    }
+    // The exponent is -(zeros + 1), a single digit here.
+    out.extend_from_slice(&[b'e', b'-', b'1' + zeros as u8]);
+    true
+}
+
 /// Rewrites a number written by zmij (fixed `0.00001` or exponent `1.5e-7`, `1e+20`) as
 /// `{:?}` writes it in exponent notation: `1e-5`, `1.5e-7`, `1e20`.
-fn push_exponent_form(out: &mut Vec<u8>, s: &str) {
+fn push_exponent_form(out: &mut Vec<u8>, s: &[u8]) {
+    // zmij writes ASCII only.
+    let s = std::str::from_utf8(s).unwrap_or_default();
     let (negative, s) = match s.strip_prefix('-') {
         Some(rest) => (true, rest),
         None => (false, s),
@@ -509,7 +544,7 @@ mod tests {
         if x == 0.0 || (1e-4..1e16).contains(&x.abs()) {
             out.extend_from_slice(s.as_bytes());
         } else {
-            push_exponent_form(&mut out, s);
+            push_exponent_form(&mut out, s.as_bytes());
         }
         out
     }
@@ -522,6 +557,21 @@ mod tests {
             let mut out = Vec::new();
             push_number(&mut out, x);
             prop_assert_eq!(out, general_form(x));
+        }
+
+        /// Between 1e-6 and 1e-3, where zmij's fixed notation is rewritten, the text is
+        /// `{:?}`'s up to the last digit of a tie, and reads back.
+        #[test]
+        fn rewritten_fractions_are_debugs(m in 1.0f64..10.0, e in -6i32..-3, neg: bool) {
+            let x = if neg { -m } else { m } * 10f64.powi(e);
+            let mut out = Vec::new();
+            push_number(&mut out, x);
+            let text = String::from_utf8(out).unwrap();
+            let debug = format!("{x:?}");
+            prop_assert_eq!(text.parse::<f64>().unwrap(), x);
+            prop_assert_eq!(text.len(), debug.len(), "{} vs {}", text, debug);
+            let differing = text.bytes().zip(debug.bytes()).filter(|(a, b)| a != b).count();
+            prop_assert!(differing <= 1, "{} vs {}", text, debug);
         }
 
         #[test]
