@@ -39,6 +39,9 @@ type Spare = Arc<Mutex<Vec<Vec<u8>>>>;
 /// Bytes of input read ahead.
 const READ_BUFFER: usize = 1 << 22;
 
+/// Bytes of a `.npy` input's buffer: enough for its header.
+const NPY_HEADER_BUFFER: usize = 1 << 16;
+
 /// A text chunk parser: the chunk's text and first line number to numbered rows.
 pub type ParseChunk<T> = fn(&str, usize) -> Result<Vec<(usize, T)>, LineError>;
 
@@ -56,7 +59,7 @@ pub struct Format<T> {
 /// one by one).
 #[derive(Clone, Debug)]
 pub struct NpyRow {
-    block: Arc<Vec<f64>>,
+    block: Arc<NpyBlock>,
     start: usize,
     len: usize,
 }
@@ -64,7 +67,31 @@ pub struct NpyRow {
 impl std::ops::Deref for NpyRow {
     type Target = [f64];
     fn deref(&self) -> &[f64] {
-        &self.block[self.start..self.start + self.len]
+        &self.block.values[self.start..self.start + self.len]
+    }
+}
+
+/// `.npy` blocks whose rows are all dropped, for the reader to read over again: the
+/// same memory serves the whole file, without fresh pages to clear and fault in.
+type BlockPool = Arc<Mutex<Vec<Vec<f64>>>>;
+
+/// `.npy` blocks kept for reuse: as many as can be in flight (a chunk being solved and
+/// one read ahead, in parts, and the part being read).
+const SPARE_BLOCKS: usize = 3 * CHUNK_ROWS / READ_ROWS;
+
+/// The values of one part of a `.npy` input; handed back to its pool when dropped.
+#[derive(Debug)]
+struct NpyBlock {
+    values: Vec<f64>,
+    pool: BlockPool,
+}
+
+impl Drop for NpyBlock {
+    fn drop(&mut self) {
+        let mut pool = self.pool.lock().unwrap_or_else(|e| e.into_inner());
+        if pool.len() < SPARE_BLOCKS {
+            pool.push(std::mem::take(&mut self.values));
+        }
     }
 }
 
@@ -155,26 +182,37 @@ enum Raw {
     Npy {
         first: usize,
         cols: usize,
-        values: Vec<f64>,
+        block: NpyBlock,
     },
 }
 
 /// The rows of a query file, text or `.npy`, a chunk at a time.
 enum Source {
     Text(LineChunks<BufReader<File>>),
-    Npy(NpyReader<BufReader<File>>, usize),
+    Npy {
+        reader: NpyReader<BufReader<File>>,
+        done: usize,
+        pool: BlockPool,
+    },
 }
 
 impl Source {
     fn open(input: &Path) -> Result<Self, CliError> {
         let file =
             File::open(input).map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
-        let reader = BufReader::with_capacity(READ_BUFFER, file);
         Ok(if is_npy(input) {
-            let r = NpyReader::new(reader)
+            // A small buffer for the header: the values' reads, larger, then go past it
+            // straight into their blocks.
+            let reader = BufReader::with_capacity(NPY_HEADER_BUFFER, file);
+            let reader = NpyReader::new(reader)
                 .map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
-            Source::Npy(r, 0)
+            Source::Npy {
+                reader,
+                done: 0,
+                pool: BlockPool::default(),
+            }
         } else {
+            let reader = BufReader::with_capacity(READ_BUFFER, file);
             Source::Text(LineChunks::new(reader, READ_ROWS))
         })
     }
@@ -184,17 +222,21 @@ impl Source {
         let io = |e: &dyn std::fmt::Display| CliError::input(format!("{}: {e}", input.display()));
         match self {
             Source::Text(chunks) => Ok(chunks.next_chunk().map_err(|e| io(&e))?.map(Raw::Text)),
-            Source::Npy(reader, done) => {
-                let mut values = Vec::new();
+            Source::Npy { reader, done, pool } => {
+                let spare = pool.lock().unwrap_or_else(|e| e.into_inner()).pop();
+                let mut values = spare.unwrap_or_default();
                 let n = reader
-                    .read_rows(&mut values, READ_ROWS)
+                    .read_rows_over(&mut values, READ_ROWS)
                     .map_err(|e| io(&e))?;
                 let first = *done + 1;
                 *done += n;
-                Ok((n > 0).then_some(Raw::Npy {
+                Ok((n > 0).then(|| Raw::Npy {
                     first,
                     cols: reader.cols(),
-                    values,
+                    block: NpyBlock {
+                        values,
+                        pool: Arc::clone(pool),
+                    },
                 }))
             }
         }
@@ -206,13 +248,9 @@ fn parse<T: Send>(raw: Raw, input: &Path, format: &Format<T>) -> Result<Vec<(usi
     let bad = |e: LineError| located(input, e.line, &e.message);
     match raw {
         Raw::Text(chunk) => (format.text)(&chunk.text, chunk.first_line).map_err(bad),
-        Raw::Npy {
-            first,
-            cols,
-            values,
-        } => {
-            let n = values.len().checked_div(cols).unwrap_or(0);
-            let block = Arc::new(values);
+        Raw::Npy { first, cols, block } => {
+            let n = block.values.len().checked_div(cols).unwrap_or(0);
+            let block = Arc::new(block);
             (0..n)
                 .map(|i| {
                     let row = NpyRow {
@@ -327,8 +365,8 @@ pub fn stream_queries<T: Send>(
         rows = Some(n);
     }
     let source = Source::open(input)?;
-    if let (Source::Npy(r, _), None) = (&source, rows) {
-        rows = Some(r.rows());
+    if let (Source::Npy { reader, .. }, None) = (&source, rows) {
+        rows = Some(reader.rows());
     }
     // The compute stage gets a pool of its own, as large as the one this runs in.
     let threads = rayon::current_num_threads();

@@ -224,13 +224,39 @@ impl<R: Read> NpyReader<R> {
     /// were read, 0 after the last row. Memory grows with the data actually read, a block
     /// at a time, whatever the header declares.
     pub fn read_rows(&mut self, out: &mut Vec<f64>, max_rows: usize) -> Result<usize, NpyError> {
+        let start = out.len();
+        self.rows_at(out, start, max_rows)
+    }
+
+    /// Replaces `out`'s values by up to `max_rows` further rows, as [`NpyReader::read_rows`]
+    /// reads them: the values `out` already holds are read over in place, without clearing
+    /// them first, so a buffer used again costs no fresh memory.
+    pub fn read_rows_over(
+        &mut self,
+        out: &mut Vec<f64>,
+        max_rows: usize,
+    ) -> Result<usize, NpyError> {
+        self.rows_at(out, 0, max_rows)
+    }
+
+    /// Reads up to `max_rows` rows into `out` from position `start` on (values at and
+    /// after `start` are read over); `out` ends after the last value read.
+    fn rows_at(
+        &mut self,
+        out: &mut Vec<f64>,
+        start: usize,
+        max_rows: usize,
+    ) -> Result<usize, NpyError> {
         let h = self.header;
         let n = max_rows.min(h.rows - self.rows_read);
-        let start = out.len();
         // Room for the rows asked for, up to what a few blocks hold (a header may declare
         // more than the file has).
-        out.reserve((n * h.cols).min(16 * READ_BLOCK / 8));
-        if let Err(e) = self.read_values(out, n * h.cols) {
+        out.reserve(
+            (start + n * h.cols)
+                .min(start + 16 * READ_BLOCK / 8)
+                .saturating_sub(out.len()),
+        );
+        if let Err(e) = self.read_values(out, start, n * h.cols) {
             let values = (out.len() - start) + self.rows_read * h.cols;
             out.truncate(start);
             return Err(match e {
@@ -241,19 +267,26 @@ impl<R: Read> NpyReader<R> {
                 e => e,
             });
         }
+        out.truncate(start + n * h.cols);
         self.rows_read += n;
         Ok(n)
     }
 
-    /// Appends `count` values to `out`, a block at a time; on a short input the values
-    /// of the whole blocks read stay appended and the error is `Truncated`.
-    fn read_values(&mut self, out: &mut Vec<f64>, count: usize) -> Result<(), NpyError> {
+    /// Reads `count` values into `out` from position `start` on, a block at a time (values
+    /// `out` already holds there are read over, missing ones added); `out` ends after the
+    /// last value read. On a short input the values of the whole blocks read stay and the
+    /// error is `Truncated`.
+    fn read_values(
+        &mut self,
+        out: &mut Vec<f64>,
+        mut start: usize,
+        count: usize,
+    ) -> Result<(), NpyError> {
         let h = self.header;
         let width = if h.f32 { 4 } else { 8 };
         let mut left = count;
         while left > 0 {
             let piece = left.min(READ_BLOCK / width);
-            let start = out.len();
             let got = if h.f32 {
                 self.bytes.resize(piece * 4, 0);
                 let got = read_full(&mut self.inner, &mut self.bytes)?;
@@ -262,6 +295,7 @@ impl<R: Read> NpyReader<R> {
                 } else {
                     f32::from_le_bytes
                 };
+                out.truncate(start);
                 out.extend(
                     self.bytes[..got - got % 4]
                         .chunks_exact(4)
@@ -271,16 +305,24 @@ impl<R: Read> NpyReader<R> {
             } else {
                 // Straight into `out`'s memory (one copy from the reader), then to native
                 // byte order in place (nothing to do for little-endian data on a
-                // little-endian machine).
-                out.resize(start + piece, 0.0);
-                let got = read_full(&mut self.inner, bytemuck::cast_slice_mut(&mut out[start..]))?;
-                out.truncate(start + got / 8);
+                // little-endian machine). Only values `out` does not hold yet are zeroed.
+                if out.len() < start + piece {
+                    out.resize(start + piece, 0.0);
+                }
+                let got = read_full(
+                    &mut self.inner,
+                    bytemuck::cast_slice_mut(&mut out[start..start + piece]),
+                )?;
+                if got < piece * 8 {
+                    out.truncate(start + got / 8);
+                }
+                let values = &mut out[start..start + got / 8];
                 if h.big_endian {
-                    for v in &mut out[start..] {
+                    for v in values {
                         *v = f64::from_be_bytes(v.to_ne_bytes());
                     }
                 } else if cfg!(target_endian = "big") {
-                    for v in &mut out[start..] {
+                    for v in values {
                         *v = f64::from_le_bytes(v.to_ne_bytes());
                     }
                 }
@@ -293,7 +335,9 @@ impl<R: Read> NpyReader<R> {
                 });
             }
             left -= piece;
+            start += piece;
         }
+        out.truncate(start);
         Ok(())
     }
 }
@@ -534,6 +578,19 @@ mod tests {
             assert_eq!(blocks.read_rows(&mut back, 1500).unwrap(), rows - 1500);
             assert_eq!(blocks.read_rows(&mut back, 1500).unwrap(), 0);
             assert_eq!(back, by_row, "{descr}");
+            // Reading over a used buffer, longer or shorter than the rows, gives the same.
+            let mut over = NpyReader::new(&bytes[..]).unwrap();
+            let mut buf = vec![f64::NAN; 2000 * cols];
+            let mut again = Vec::new();
+            for (max, len) in [(1100, 1100), (600, 600), (1500, rows - 1700)] {
+                assert_eq!(over.read_rows_over(&mut buf, max).unwrap(), len);
+                assert_eq!(buf.len(), len * cols);
+                again.extend_from_slice(&buf);
+                buf.resize(if len == 1100 { 10 } else { 3000 * cols }, f64::NAN);
+            }
+            assert_eq!(over.read_rows_over(&mut buf, 5).unwrap(), 0);
+            assert!(buf.is_empty());
+            assert_eq!(again, by_row, "{descr} over a used buffer");
             let width = if descr.ends_with('8') { 8 } else { 4 };
             let cut = header + (1900 * cols + 5) * width;
             let mut short = NpyReader::new(&bytes[..cut]).unwrap();

@@ -1,0 +1,58 @@
+//! `.npy` inputs longer than several chunks: every row reaches the answer it has in the
+//! text format, with the blocks the reader reuses read over in place.
+
+mod common;
+
+use common::{s, sphere_anchors, wavg_ok};
+
+#[test]
+fn long_npy_weights_give_the_text_answers() {
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = sphere_anchors(dir.path());
+    let k = 31;
+    // Rows that differ from each other, so a row read from a stale block would show.
+    let n = 300_000;
+    let rows: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            let mut w: Vec<f64> = (0..k)
+                .map(|j| 1.0 + ((i * 31 + j * 17) % 97) as f64)
+                .collect();
+            let sum: f64 = w.iter().sum();
+            w.iter_mut().for_each(|x| *x /= sum);
+            w
+        })
+        .collect();
+    let mut text = String::new();
+    for w in &rows {
+        let line: Vec<String> = w.iter().map(|x| format!("{x:?}")).collect();
+        text.push_str(&line.join(" "));
+        text.push('\n');
+    }
+    let w_txt = dir.path().join("w.txt");
+    std::fs::write(&w_txt, text).unwrap();
+    let w_npy = dir.path().join("w.npy");
+    let mut bytes = Vec::new();
+    let mut writer = wavg::npy::NpyWriter::new(&mut bytes, n, k).unwrap();
+    writer.write_rows(&rows.concat()).unwrap();
+    writer.finish().unwrap();
+    std::fs::write(&w_npy, bytes).unwrap();
+    let run = |weights: &std::path::Path, out: &str| {
+        let out = dir.path().join(out);
+        wavg_ok(&[
+            "forward",
+            "--mesh",
+            "builtin:icosphere",
+            "--anchors",
+            &s(&anchors),
+            "--weights",
+            &s(weights),
+            "-o",
+            &s(&out),
+        ]);
+        std::fs::read(out).unwrap()
+    };
+    let from_text = run(&w_txt, "from_text.txt");
+    let from_npy = run(&w_npy, "from_npy.txt");
+    assert_eq!(from_text.iter().filter(|&&b| b == b'\n').count(), n);
+    assert!(from_text == from_npy, "the .npy rows give other answers");
+}
