@@ -353,7 +353,7 @@ pub fn stream_queries<T: Send>(
     let mut rows = None;
     // A device or pipe is written as the rows come (no rename can take back a bad row):
     // like stdout, it gets the first pass.
-    let special = std::fs::metadata(output).is_ok_and(|m| !m.is_file() && !m.is_dir());
+    let special = wavg::mesh::io::is_special_destination(output);
     if output == Path::new("-") || special || (npy_out && !is_npy(input)) {
         let mut source = Source::open(input)?;
         let mut n = 0;

@@ -7,6 +7,13 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// Whether `path` exists and is neither a regular file nor a directory (a device such as
+/// `/dev/null`, a named pipe): such a destination cannot be replaced by a rename, so
+/// [`write_atomic`] writes it in place, as the rows come.
+pub fn is_special_destination(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
 /// Writes `path` atomically with `body`. On any error the destination is untouched and
 /// the temporary file is removed (a killed process can leave a `.wavg-tmp-*` file beside
 /// the destination, never a partial destination). The result gets the permissions a new
@@ -16,7 +23,7 @@ pub fn write_atomic(
     path: &Path,
     body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    if std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+    if is_special_destination(path) {
         let file = std::fs::OpenOptions::new().write(true).open(path)?;
         let mut w = std::io::BufWriter::new(file);
         body(&mut w)?;

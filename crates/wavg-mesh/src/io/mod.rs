@@ -28,7 +28,7 @@ mod text;
 use std::io::{Read, Write};
 use std::path::Path;
 
-pub use atomic::write_atomic;
+pub use atomic::{is_special_destination, write_atomic};
 use format::{Format, LoadNotes};
 
 use crate::error::MeshError;
