@@ -33,9 +33,9 @@ mod quality;
 mod simd;
 
 // The precomputation and its settings.
-pub use decimate::{DecimateOptions, Decimated, decimate, select_landmarks};
+pub use decimate::{Bounds, DecimateOptions, Decimated, decimate, select_landmarks};
 pub use mds::MdsOptions;
-pub use pipeline::{PrecomputeOptions, Report, StageSeconds, precompute};
+pub use pipeline::{LANDMARK_ASPECT_RATIO, PrecomputeOptions, Report, StageSeconds, precompute};
 
 // Its result (saved and loaded by the `file` module).
 pub use embedding::{Embedding, EmbeddingParams};

@@ -23,7 +23,9 @@ pub struct PrecomputeOptions {
     /// Seed of the random choices (the quality-check pairs; every other stage is
     /// deterministic).
     pub seed: u64,
-    /// Decimation settings; `decimate.target` is ignored (set from `landmarks`).
+    /// Decimation settings; `decimate.target` is ignored (set from `landmarks`). The
+    /// default adds an aspect-ratio bound ([`LANDMARK_ASPECT_RATIO`]) to
+    /// [`DecimateOptions::default`].
     pub decimate: DecimateOptions,
     /// When the mesh has more vertices than this, the landmark-to-landmark geodesics run on
     /// the landmark decimation's intermediate state with this many vertices (its vertices
@@ -59,6 +61,12 @@ pub struct PrecomputeOptions {
     pub lsmesh_coarse_vertices: usize,
 }
 
+/// Aspect-ratio bound of the landmark decimation by default. Quadric errors alone let thin
+/// parts (fingers, tails, tubes) decimate into long triangles that keep landmarks along
+/// one side only; the least-squares mesh then folds the other side onto it. With round
+/// triangles every cross-section keeps landmarks all around.
+pub const LANDMARK_ASPECT_RATIO: f64 = 10.0;
+
 /// Vertex visits (sources x vertices) above which the quality check uses fewer sources.
 pub(crate) const QUALITY_SOURCE_VERTICES: usize = 16_000_000;
 
@@ -67,7 +75,10 @@ impl Default for PrecomputeOptions {
         Self {
             landmarks: 1000,
             seed: 0,
-            decimate: DecimateOptions::default(),
+            decimate: DecimateOptions {
+                max_aspect_ratio: Some(LANDMARK_ASPECT_RATIO),
+                ..DecimateOptions::default()
+            },
             geodesic_vertices: crate::geodesic::DEFAULT_GEODESIC_VERTICES,
             refine_near_pairs: true,
             mds: MdsOptions::default(),

@@ -27,7 +27,8 @@ pub(super) struct Decimator<'a> {
     pub(super) flip_deg: f64,
     pub(super) min_cos: f64,
     pub(super) cone_deg: Option<f64>,
-    pub(super) relaxations: Vec<(f64, Option<f64>)>,
+    pub(super) aspect: Option<f64>,
+    pub(super) relaxations: Vec<Bounds>,
     /// Vertices by their best collapse (OpenMesh's updatable `HeapT`).
     pub(super) heap: IndexedHeap,
     pub(super) best: Vec<u32>,
@@ -115,6 +116,7 @@ impl<'a> Decimator<'a> {
             flip_deg,
             min_cos: flip_deg.to_radians().cos(),
             cone_deg: opts.max_normal_cone_deg,
+            aspect: opts.max_aspect_ratio,
             relaxations: Vec::new(),
             heap: IndexedHeap::new(n),
             best: vec![NONE; n],
@@ -255,9 +257,15 @@ impl<'a> Decimator<'a> {
         self.quadric[u as usize].eval_sum(&self.quadric[v as usize], &self.pos[v as usize])
     }
 
-    /// The binary modules (normal flipping, normal cone) for `h`, given the outgoing
-    /// halfedges `out` of `u`.
-    pub(super) fn geometry_legal(&self, h: u32, out: &[u32]) -> bool {
+    /// The binary modules (normal flipping, normal cone, aspect ratio) for `h`, given the
+    /// outgoing halfedges `out` of `u`; `worst_before` caches the worst aspect ratio around
+    /// `u` between calls for the same `u`.
+    pub(super) fn geometry_legal(
+        &self,
+        h: u32,
+        out: &[u32],
+        worst_before: &mut Option<f64>,
+    ) -> bool {
         let v = self.to(h);
         let pv = self.pos[v as usize];
         let fl = h / 3;
@@ -272,6 +280,8 @@ impl<'a> Decimator<'a> {
             self.opp[next(o) as usize]
         };
         let fc = if c == NONE { NONE } else { c / 3 };
+        // The worst aspect ratio of the faces that stay, for ModAspectRatioT.
+        let mut worst_after = 0.0f64;
         for &g in out {
             let f = g / 3;
             if f == fl || f == fr {
@@ -292,6 +302,13 @@ impl<'a> Decimator<'a> {
             if nn.dot(&self.normal[f as usize]) < self.min_cos {
                 return false;
             }
+            if self.aspect.is_some() {
+                let longest = e1
+                    .norm_squared()
+                    .max(e2.norm_squared())
+                    .max((p2 - p1).norm_squared());
+                worst_after = worst_after.max(longest / len);
+            }
             if let Some(max_cone) = self.cone_deg {
                 let mut cone = self.cone[f as usize].merged(&Cone { n: nn, angle: 0.0 });
                 if f == fb {
@@ -305,7 +322,26 @@ impl<'a> Decimator<'a> {
                 }
             }
         }
-        true
+        // ModAspectRatioT: the faces that stay must be within the bound, or better than
+        // the worst face around `u` before the collapse.
+        match self.aspect {
+            Some(bound) if worst_after > bound => {
+                worst_after < *worst_before.get_or_insert_with(|| self.worst_aspect_around(out))
+            }
+            _ => true,
+        }
+    }
+
+    /// The worst aspect ratio of the faces around the vertex whose outgoing halfedges are
+    /// `out`.
+    fn worst_aspect_around(&self, out: &[u32]) -> f64 {
+        out.iter()
+            .map(|&g| {
+                let [a, b, c] =
+                    [g, next(g), prev(g)].map(|k| self.pos[self.corner[k as usize] as usize]);
+                aspect_ratio(a, b, c)
+            })
+            .fold(0.0, f64::max)
     }
 
     /// Recomputes vertex `x`'s best collapse and (re)inserts it in the heap.
@@ -330,6 +366,7 @@ impl<'a> Decimator<'a> {
         }
         let mut best = None;
         let mut deg = None;
+        let mut worst_before = None;
         while !cands.is_empty() {
             let mut m = 0;
             for (i, c) in cands.iter().enumerate().skip(1) {
@@ -340,7 +377,7 @@ impl<'a> Decimator<'a> {
             }
             let c = cands.swap_remove(m);
             let d = *deg.get_or_insert_with(|| self.mark_ring(&hs));
-            if self.topo_legal_marked(c.3, d) && self.geometry_legal(c.3, &hs) {
+            if self.topo_legal_marked(c.3, d) && self.geometry_legal(c.3, &hs, &mut worst_before) {
                 best = Some(c);
                 break;
             }
@@ -485,9 +522,13 @@ impl<'a> Decimator<'a> {
         self.vh[x as usize] = h;
     }
 
-    /// Loosens the normal bounds; false if there is nothing left to loosen.
+    /// Loosens the bounds (aspect ratio first, then the normal cone, then the flipping
+    /// bound); false if there is nothing left to loosen.
     pub(super) fn relax(&mut self) -> bool {
-        let changed = if let Some(c) = self.cone_deg {
+        let changed = if let Some(a) = self.aspect {
+            self.aspect = (a < 1e3).then_some(a * 2.0);
+            true
+        } else if let Some(c) = self.cone_deg {
             self.cone_deg = if c * 1.5 >= 360.0 {
                 None
             } else {
@@ -506,7 +547,11 @@ impl<'a> Decimator<'a> {
             } else {
                 self.flip_deg.to_radians().cos()
             };
-            self.relaxations.push((self.flip_deg, self.cone_deg));
+            self.relaxations.push(Bounds {
+                max_normal_deviation_deg: self.flip_deg,
+                max_normal_cone_deg: self.cone_deg,
+                max_aspect_ratio: self.aspect,
+            });
         }
         changed
     }
@@ -532,5 +577,20 @@ impl<'a> Decimator<'a> {
             landmarks,
             relaxations: self.relaxations.clone(),
         }
+    }
+}
+
+/// Longest edge squared over twice the area of the triangle `(a, b, c)` (OpenMesh's
+/// aspect ratio; 2/sqrt(3) for an equilateral triangle, infinite for a degenerate one).
+fn aspect_ratio(a: Vector3<f64>, b: Vector3<f64>, c: Vector3<f64>) -> f64 {
+    let longest = (b - a)
+        .norm_squared()
+        .max((c - b).norm_squared())
+        .max((a - c).norm_squared());
+    let twice_area = (b - a).cross(&(c - a)).norm();
+    if twice_area > 0.0 {
+        longest / twice_area
+    } else {
+        f64::INFINITY
     }
 }

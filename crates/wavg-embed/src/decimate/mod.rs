@@ -1,6 +1,6 @@
 //! Landmark selection by incremental decimation (halfedge collapses), after OpenMesh's
 //! `DecimaterT` with the modules `ModQuadricT` (priority), `ModNormalFlippingT` and
-//! optionally `ModNormalDeviationT` (binary constraints).
+//! optionally `ModNormalDeviationT` and `ModAspectRatioT` (binary constraints).
 //!
 //! # What is mirrored from OpenMesh
 //!
@@ -25,6 +25,11 @@
 //!   the two removed) would turn by more than `max_normal_deviation_deg` against its
 //!   *current* normal (face normals are updated after each collapse, as
 //!   `DecimaterT::decimate` does with `update_normals`).
+//! * **`ModAspectRatioT`** (optional, `max_aspect_ratio`): a collapse is illegal if the
+//!   worst aspect ratio (longest edge squared over twice the area) of the faces that stay
+//!   around `u` would exceed the bound and not improve on the worst around `u` before.
+//!   Without it, quadric errors let thin parts decimate into long triangles along one
+//!   side; the landmark pipeline turns it on ([`crate::LANDMARK_ASPECT_RATIO`]).
 //! * **`ModNormalDeviationT`** (optional, `max_normal_cone_deg`): per face a normal cone
 //!   (`NormalConeT`, merged by SLERP) accumulates all normals the face region had; a
 //!   collapse is illegal if a resulting cone's full aperture would exceed the bound.
@@ -44,8 +49,8 @@
 //! * **Relaxation**: OpenMesh stops when the heap is empty. Here, if the target is not yet
 //!   reached, every vertex is first re-evaluated (vertices whose popped collapse had become
 //!   illegal left the heap, but may have another legal one); if that finds nothing, the
-//!   normal bounds are relaxed (cone bound x1.5 until it is switched off, then the flipping
-//!   bound +15 degrees up to 90) and everything is re-evaluated again. Only when nothing can
+//!   bounds are relaxed (aspect-ratio bound x2 until it is switched off, cone bound x1.5
+//!   until it is switched off, then the flipping bound +15 degrees up to 90) and everything is re-evaluated again. Only when nothing can
 //!   be collapsed even with a 90-degree flipping bound (a topological limit, for example
 //!   a torus below 7 vertices) is it an error. The relaxations applied are reported in
 //!   [`Decimated::relaxations`].
@@ -91,6 +96,11 @@ pub struct DecimateOptions {
     /// `ModNormalDeviationT` bound (degrees): the largest full aperture of the normal cone
     /// a face may accumulate over the whole decimation; `None` disables the module.
     pub max_normal_cone_deg: Option<f64>,
+    /// `ModAspectRatioT` bound: a collapse may not leave a triangle around the kept vertex
+    /// with an aspect ratio (longest edge squared over twice the area; 1.15 for an
+    /// equilateral triangle) above this, unless it improves the worst ratio around the
+    /// removed vertex; `None` disables the module.
+    pub max_aspect_ratio: Option<f64>,
     /// Vertices that must survive (OpenMesh's locked status): never removed, though others
     /// may collapse into them.
     pub locked: Vec<u32>,
@@ -105,10 +115,22 @@ impl Default for DecimateOptions {
             target: 1000,
             max_normal_deviation_deg: 45.0,
             max_normal_cone_deg: None,
+            max_aspect_ratio: None,
             locked: Vec::new(),
             relax: true,
         }
     }
+}
+
+/// The legality bounds of a decimation, as [`DecimateOptions`] names them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    /// The normal-flipping bound, degrees.
+    pub max_normal_deviation_deg: f64,
+    /// The normal-cone bound, degrees, if any.
+    pub max_normal_cone_deg: Option<f64>,
+    /// The aspect-ratio bound, if any.
+    pub max_aspect_ratio: Option<f64>,
 }
 
 /// The result of a decimation: the coarse mesh on the surviving original vertices.
@@ -118,9 +140,9 @@ pub struct Decimated {
     pub mesh: TriMesh,
     /// The surviving original vertex ids, ascending.
     pub landmarks: Vec<u32>,
-    /// The normal bounds `(flipping, cone)` in degrees after each relaxation that was
-    /// needed to reach the target (empty if none was).
-    pub relaxations: Vec<(f64, Option<f64>)>,
+    /// The bounds after each relaxation that was needed to reach the target (empty if
+    /// none was).
+    pub relaxations: Vec<Bounds>,
 }
 
 impl Decimated {
@@ -223,8 +245,9 @@ pub fn decimate_with_snapshots(
             if !opts.relax || !d.relax() {
                 return Err(EmbedError::InvalidArgument(format!(
                     "cannot decimate to {} vertices: no legal collapse left at {} vertices \
-                     (normal bounds {:.0} deg / {:?}); ask for more landmarks",
-                    opts.target, d.n_alive, d.flip_deg, d.cone_deg
+                     (normal bounds {:.0} deg / {:?}, aspect ratio {:?}); ask for more \
+                     landmarks",
+                    opts.target, d.n_alive, d.flip_deg, d.cone_deg, d.aspect
                 )));
             }
             check_cancel(progress)?;
@@ -264,6 +287,14 @@ fn check_options(n: usize, opts: &DecimateOptions) -> Result<(), EmbedError> {
         if !(c > 0.0 && c <= 360.0) {
             return Err(EmbedError::InvalidArgument(format!(
                 "max_normal_cone_deg = {c} is not in (0, 360]"
+            )));
+        }
+    }
+    if let Some(a) = opts.max_aspect_ratio {
+        // An equilateral triangle's ratio, 2 / sqrt(3), is the smallest there is.
+        if !(a.is_finite() && a >= 2.0 / 3f64.sqrt()) {
+            return Err(EmbedError::InvalidArgument(format!(
+                "max_aspect_ratio = {a} is not finite and at least 2/sqrt(3) (equilateral)"
             )));
         }
     }
@@ -538,6 +569,30 @@ mod tests {
         eprintln!("relaxations {:?}", d.relaxations);
         let strict = DecimateOptions { relax: false, ..o };
         assert!(decimate(&mesh, &strict, &NoProgress).is_err());
+    }
+
+    #[test]
+    fn aspect_bounds_are_checked_and_relaxed() {
+        let mesh = valid(procedural::with_noise(procedural::icosphere(4), 0.3, 8));
+        for bad in [f64::NAN, f64::INFINITY, 1.0] {
+            let o = DecimateOptions {
+                max_aspect_ratio: Some(bad),
+                ..opts(40)
+            };
+            assert!(decimate(&mesh, &o, &NoProgress).is_err(), "{bad}");
+        }
+        // Near-equilateral only: blocked long before the target, relaxed until reached.
+        let o = DecimateOptions {
+            max_aspect_ratio: Some(1.2),
+            ..opts(40)
+        };
+        let d = decimate(&mesh, &o, &NoProgress).unwrap();
+        check(&mesh, &d, 40);
+        assert!(
+            d.relaxations[0].max_aspect_ratio > Some(1.2),
+            "{:?}",
+            d.relaxations
+        );
     }
 
     #[test]
