@@ -25,9 +25,11 @@ malformed, have the wrong count, non-finite values, or do not sum to 1 (without
 --normalize) are input errors: the command exits with status 2 naming the line, and writes
 nothing.
 
-Searches start from the vertex of the highest-weight anchor (the paper's method) and are
-certified against a bounding volume hierarchy; --exact searches all triangles; --warm
-starts each line from the previous line's answer (for sequences of nearby queries).";
+Each search walks from a vertex near the average (the highest-weight anchor's, or a closer
+one found on a grid) and returns the first valid projection it meets, as the paper does;
+when none is met nearby, a search of the whole mesh answers. --exact searches all
+triangles for the closest projection; --warm starts each line from the previous line's
+answer (for sequences of nearby queries).";
 
 /// Arguments.
 #[derive(clap::Args)]
