@@ -13,7 +13,8 @@ use crate::common::one_line;
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("source").required(true).args(["mesh", "builtin"])))]
 pub struct Args {
-    /// Mesh file: .obj, .off or .ply, optionally gzip-compressed (.gz).
+    /// Mesh file: .obj, .off or .ply, optionally gzip-compressed (.gz), or builtin:NAME
+    /// (as the other commands take it).
     pub mesh: Option<String>,
     /// Describe a procedural mesh instead of a file (icosphere, sphere-small, torus, grid,
     /// bump, noisy-sphere).
@@ -26,7 +27,12 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let (name, mesh, notes) = match (&args.mesh, &args.builtin) {
+    let builtin = args.builtin.as_deref().or_else(|| {
+        args.mesh
+            .as_deref()
+            .and_then(|m| m.strip_prefix(crate::common::BUILTIN_PREFIX))
+    });
+    let (name, mesh, notes) = match (&args.mesh, builtin) {
         (_, Some(b)) => {
             let m = procedural::builtin(b).map_err(CliError::input)?;
             (format!("builtin:{b}"), m, None)

@@ -70,6 +70,14 @@ fn builtin_json_and_unknown_builtin() {
     let out = wavg(&["info", "--builtin", "teapot"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("teapot"));
+    // `builtin:NAME`, as the other commands (and their hints) spell it, works too.
+    let out = wavg(&["info", "builtin:torus", "--json"]);
+    assert_eq!(out.status.code(), Some(0));
+    let j: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        (j["genus"].clone(), j["mesh"].clone()),
+        (1.into(), "builtin:torus".into())
+    );
 }
 
 #[test]
