@@ -61,11 +61,34 @@ pub struct PrecomputeOptions {
     pub lsmesh_coarse_vertices: usize,
 }
 
-/// Aspect-ratio bound of the landmark decimation by default. Quadric errors alone let thin
-/// parts (fingers, tails, tubes) decimate into long triangles that keep landmarks along
-/// one side only; the least-squares mesh then folds the other side onto it. With round
+/// Aspect-ratio bound of the landmark decimation by default (raised to twice the input's
+/// 90th-percentile ratio where that is larger). Quadric errors alone let thin parts
+/// (fingers, tails, tubes) decimate into long triangles that keep landmarks along one
+/// side only; the least-squares mesh then folds the other side onto it. With round
 /// triangles every cross-section keeps landmarks all around.
 pub const LANDMARK_ASPECT_RATIO: f64 = 10.0;
+
+/// The aspect-ratio bound of the landmark decimation: the one asked for, but at least
+/// twice the input's 90th-percentile ratio. Demanding rounder triangles than most of the
+/// mesh's own would let the bound, not the shape, steer the decimation (a mesh of slivers
+/// then loses every landmark of some regions).
+fn landmark_aspect_bound(mesh: &ValidMesh, asked: Option<f64>) -> Option<f64> {
+    let asked = asked?;
+    let mut ratios: Vec<f64> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            crate::decimate::aspect_ratio(a, b, c)
+        })
+        .collect();
+    if ratios.is_empty() {
+        return Some(asked);
+    }
+    let k = ratios.len() * 9 / 10;
+    let (_, p90, _) = ratios.select_nth_unstable_by(k, f64::total_cmp);
+    Some(asked.max(2.0 * *p90))
+}
 
 /// Vertex visits (sources x vertices) above which the quality check uses fewer sources.
 pub(crate) const QUALITY_SOURCE_VERTICES: usize = 16_000_000;
@@ -211,6 +234,7 @@ pub fn precompute(
             } else {
                 let d = DecimateOptions {
                     target: opts.landmarks,
+                    max_aspect_ratio: landmark_aspect_bound(mesh, opts.decimate.max_aspect_ratio),
                     ..opts.decimate.clone()
                 };
                 if use_coarse || two_level {
@@ -403,6 +427,19 @@ mod tests {
         let back = crate::file::decode(&bytes, &mesh, std::path::Path::new("x")).unwrap();
         assert_eq!(back.coords, emb.coords);
         (emb, r)
+    }
+
+    /// The landmark decimation's aspect bound is the one asked for on well-shaped meshes
+    /// and rises to twice the 90th percentile on a mesh of slivers.
+    #[test]
+    fn landmark_aspect_bound_follows_slivers() {
+        let round = ValidMesh::new(procedural::icosphere(3)).unwrap();
+        assert_eq!(landmark_aspect_bound(&round, Some(10.0)), Some(10.0));
+        assert_eq!(landmark_aspect_bound(&round, None), None);
+        // Cells 100 times wider than tall: every triangle's ratio is about 100.
+        let slivers = ValidMesh::new(procedural::grid(4, 4, 1.0, 0.01)).unwrap();
+        let b = landmark_aspect_bound(&slivers, Some(10.0)).unwrap();
+        assert!((190.0..=210.0).contains(&b), "{b}");
     }
 
     #[test]

@@ -582,7 +582,7 @@ impl<'a> Decimator<'a> {
 
 /// Longest edge squared over twice the area of the triangle `(a, b, c)` (OpenMesh's
 /// aspect ratio; 2/sqrt(3) for an equilateral triangle, infinite for a degenerate one).
-fn aspect_ratio(a: Vector3<f64>, b: Vector3<f64>, c: Vector3<f64>) -> f64 {
+pub(crate) fn aspect_ratio(a: Vector3<f64>, b: Vector3<f64>, c: Vector3<f64>) -> f64 {
     let longest = (b - a)
         .norm_squared()
         .max((c - b).norm_squared())

@@ -79,6 +79,7 @@ mod collapse;
 mod heap;
 mod quadric;
 
+pub(crate) use collapse::aspect_ratio;
 use collapse::*;
 use heap::*;
 use quadric::*;
