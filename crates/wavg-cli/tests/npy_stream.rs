@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{s, sphere_anchors, wavg_ok};
+use common::{icosphere_forward, sphere_anchors};
 
 #[test]
 fn long_npy_weights_give_the_text_answers() {
@@ -38,17 +38,12 @@ fn long_npy_weights_give_the_text_answers() {
     std::fs::write(&w_npy, bytes).unwrap();
     let run = |weights: &std::path::Path, out: &str| {
         let out = dir.path().join(out);
-        wavg_ok(&[
-            "forward",
-            "--mesh",
-            "builtin:icosphere",
-            "--anchors",
-            &s(&anchors),
-            "--weights",
-            &s(weights),
-            "-o",
-            &s(&out),
-        ]);
+        let run = icosphere_forward(&anchors, weights, &out);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
         std::fs::read(out).unwrap()
     };
     let from_text = run(&w_txt, "from_text.txt");

@@ -6,7 +6,7 @@ mod common;
 
 use std::os::unix::fs::FileTypeExt;
 
-use common::{s, sphere_anchors, wavg};
+use common::{icosphere_forward, sphere_anchors};
 
 #[test]
 fn a_named_pipe_gets_nothing_when_a_later_chunk_is_bad() {
@@ -38,17 +38,7 @@ fn a_named_pipe_gets_nothing_when_a_later_chunk_is_bad() {
         let fifo = fifo.clone();
         std::thread::spawn(move || std::fs::read(fifo).unwrap())
     };
-    let out = wavg(&[
-        "forward",
-        "--mesh",
-        "builtin:icosphere",
-        "--anchors",
-        &s(&anchors),
-        "--weights",
-        &s(&weights),
-        "-o",
-        &s(&fifo),
-    ]);
+    let out = icosphere_forward(&anchors, &weights, &fifo);
     assert_eq!(
         out.status.code(),
         Some(2),

@@ -40,6 +40,26 @@ pub fn sphere_anchors(dir: &std::path::Path) -> std::path::PathBuf {
     p
 }
 
+/// `wavg forward` on `builtin:icosphere` with the anchors of [`sphere_anchors`]: runs it
+/// with `weights` and output `out`.
+pub fn icosphere_forward(
+    anchors: &std::path::Path,
+    weights: &std::path::Path,
+    out: &std::path::Path,
+) -> Output {
+    wavg(&[
+        "forward",
+        "--mesh",
+        "builtin:icosphere",
+        "--anchors",
+        &s(anchors),
+        "--weights",
+        &s(weights),
+        "-o",
+        &s(out),
+    ])
+}
+
 /// A path as a string argument.
 pub fn s(p: &std::path::Path) -> String {
     p.to_str().unwrap().to_string()

@@ -285,19 +285,10 @@ fn push_fraction_as_exponent(out: &mut Vec<u8>, s: &[u8]) -> bool {
     let zeros = body.iter().take_while(|&&d| d == b'0').count();
     let digits = &body[zeros..];
     let digits = &digits[..digits.len() - digits.iter().rev().take_while(|&&d| d == b'0').count()];
-    if digits.is_empty() || zeros > 8 || !digits.iter().all(u8::is_ascii_digit) {
+    if digits.is_empty() || !digits.iter().all(u8::is_ascii_digit) {
         return false;
     }
-    if negative {
-        out.push(b'-');
-    }
-    out.push(digits[0]);
-    if digits.len() > 1 {
-        out.push(b'.');
-        out.extend_from_slice(&digits[1..]);
-    }
-    // The exponent is -(zeros + 1), a single digit here.
-    out.extend_from_slice(&[b'e', b'-', b'1' + zeros as u8]);
+    push_scientific(out, negative, digits, -(zeros as i32 + 1));
     true
 }
 
@@ -327,6 +318,12 @@ fn push_exponent_form(out: &mut Vec<u8>, s: &[u8]) {
     let end = digits.len() - digits.iter().rev().take_while(|&&d| d == b'0').count();
     let digits = &digits[..end.max(1)];
     let exponent = exponent + int.len() as i32 - 1 - lead as i32;
+    push_scientific(out, negative, digits, exponent);
+}
+
+/// Writes `[-]D[.DDD]e[-]X` as `{:?}` does: the significant digits `digits` (at least
+/// one, no trailing zeros) and the exponent of the first one.
+fn push_scientific(out: &mut Vec<u8>, negative: bool, digits: &[u8], exponent: i32) {
     if negative {
         out.push(b'-');
     }
