@@ -36,8 +36,8 @@ pub struct PairArgs {
     /// A .wavg embedding of the target (default: precompute one in memory).
     #[arg(long)]
     pub target_embedding: Option<PathBuf>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
+    /// Worker threads (default: all cores; at most 4 per CPU, or 64).
+    #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
 }
 

@@ -55,8 +55,8 @@ pub struct Args {
     /// Number of random query points N.
     #[arg(long, default_value_t = 100_000)]
     pub queries: usize,
-    /// Worker threads T (default: all cores).
-    #[arg(long)]
+    /// Worker threads T (default: all cores; at most 4 per CPU, or 64).
+    #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
     /// Seed of the anchors and the query points.
     #[arg(long, default_value_t = 0)]

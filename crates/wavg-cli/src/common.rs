@@ -75,3 +75,29 @@ pub fn cpu_seconds(thread: bool) -> Option<f64> {
         None
     }
 }
+
+/// The largest `--threads` accepted: 4 per CPU this process may use, and at least 64.
+/// Far more threads than cores only add overhead (thousands of them take seconds to start
+/// and to hand work to).
+pub fn max_threads() -> usize {
+    let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
+    (4 * cpus).max(64)
+}
+
+/// Parses a `--threads` value: an integer from 1 to [`max_threads`].
+pub fn parse_threads(s: &str) -> Result<usize, String> {
+    let n: usize = s
+        .parse()
+        .map_err(|_| format!("'{s}' is not a whole number of threads"))?;
+    let max = max_threads();
+    if n == 0 {
+        return Err("at least 1 thread is needed".into());
+    }
+    if n > max {
+        return Err(format!(
+            "{n} threads is more than {max}, the limit on this machine (4 per CPU, at least \
+             64): more threads than cores only add overhead"
+        ));
+    }
+    Ok(n)
+}

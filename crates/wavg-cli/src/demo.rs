@@ -33,12 +33,17 @@ With --out DIR it writes DIR/mesh.obj, DIR/mesh.wavg, DIR/anchors.txt, DIR/curve
 as an OBJ polyline, to view over mesh.obj), and pictures (PNG): spline.png (the curve and
 anchors over the mesh), distance.png (distance in the embedding from the first anchor,
 viridis), texture_source.png and texture_target.png (a checkerboard on a generated
-UV-mapped sheet, carried by texture transfer onto a bent, stretched copy).
+UV-mapped sheet, carried by texture transfer onto a bent, stretched copy), remesh.png (a
+cube's quads put on the surface, refined and smoothed) and decal.png (a checkerboard decal
+around the first anchor). A picture whose application does not apply to the surface (for
+example remeshing a cube onto a torus) is not drawn; the reason is printed and the demo
+goes on.
 
 --json prints one object: mesh, vertices, faces, landmarks, precompute_s, stress,
 geodesic_rel_err_p50, geodesic_rel_err_p90, anchors, curve_points, curve_ok, curve_us,
 roundtrip_queries, inverse_us, forward_us, roundtrip_ok_fraction,
-verified_roundtrip_ok_fraction.")]
+verified_roundtrip_ok_fraction; with --out also pictures (paths written) and
+skipped_pictures (\"NAME: REASON\" each).")]
 pub struct Args {
     /// Mesh file or builtin:NAME.
     #[arg(long, default_value = "builtin:bump")]
@@ -90,6 +95,12 @@ struct JsonReport<'a> {
     forward_us: f64,
     roundtrip_ok_fraction: f64,
     verified_roundtrip_ok_fraction: f64,
+    /// With `--out`: the pictures written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pictures: Option<Vec<String>>,
+    /// With `--out`: the pictures not drawn, as "NAME: REASON".
+    #[serde(skip_serializing_if = "Option::is_none")]
+    skipped_pictures: Option<Vec<String>>,
 }
 
 /// Weights (one per anchor) of `samples` points along the closed cubic B-spline whose
@@ -198,12 +209,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let vok = points.iter().zip(&vfwd).filter(|(p, r)| back(p, r)).count();
     let n = points.len() as f64;
 
-    let mut pictures = Vec::new();
+    let mut pictures = None;
     if let Some(dir) = &args.out {
         write_outputs(dir, &mesh, &emb, &anchor_ids, &curve)?;
         let t0 = Instant::now();
         let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
-        pictures = crate::demo_pictures::write_pictures(
+        let drawn = crate::demo_pictures::write_pictures(
             dir,
             &mesh,
             &coords,
@@ -212,6 +223,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
             &solver,
             args.seed,
         )?;
+        for (name, why) in &drawn.skipped {
+            eprintln!("wavg demo: {name} not drawn: {why}");
+        }
+        pictures = Some(drawn);
         say(&format!(
             "pictures drawn in {:.2} s",
             t0.elapsed().as_secs_f64()
@@ -236,6 +251,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
             forward_us,
             roundtrip_ok_fraction: ok as f64 / n,
             verified_roundtrip_ok_fraction: vok as f64 / n,
+            pictures: pictures
+                .as_ref()
+                .map(|p| p.written.iter().map(|p| p.display().to_string()).collect()),
+            skipped_pictures: pictures.as_ref().map(|p| {
+                p.skipped
+                    .iter()
+                    .map(|(name, why)| format!("{name}: {why}"))
+                    .collect()
+            }),
         })
         .map_err(CliError::failure)?;
         println!("{j}");
@@ -265,8 +289,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 "written        {0}/mesh.obj, mesh.wavg, anchors.txt, curve.txt, curve.obj",
                 d.display()
             );
-            for p in &pictures {
+            for p in pictures.iter().flat_map(|p| &p.written) {
                 println!("picture        {}", p.display());
+            }
+            for (name, why) in pictures.iter().flat_map(|p| &p.skipped) {
+                println!("not drawn      {name}: {why}");
             }
         }
         None => println!("(pass --out DIR to keep the mesh, embedding, anchors and curve)"),

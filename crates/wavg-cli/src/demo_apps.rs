@@ -22,12 +22,19 @@ pub fn remesh_picture(solver: &Solver, opts: &RenderOptions) -> Result<Image, Cl
     let mesh = solver.mesh().mesh();
     let (lo, hi) = mesh.bounding_box().ok_or_else(|| fail(&"empty mesh"))?;
     let (c, half) = ((lo + hi) / 2.0, (hi - lo) / 2.0);
-    // A cube whose corners lie near a sphere through the surface's extent.
+    // A cube whose corners lie near a sphere through the surface's extent, each moved to
+    // the surface's vertex nearest to it (the base mesh must lie on the surface).
     let s = half / 3f64.sqrt();
     let positions = (0..8)
         .map(|i| {
             let sign = |bit: u32| if i & bit != 0 { 1.0 } else { -1.0 };
-            c + Vector3::new(sign(1) * s.x, sign(2) * s.y, sign(4) * s.z)
+            let corner = c + Vector3::new(sign(1) * s.x, sign(2) * s.y, sign(4) * s.z);
+            let d = |p: &&Vector3<f64>| (*p - corner).norm_squared();
+            *mesh
+                .positions
+                .iter()
+                .min_by(|a, b| d(a).total_cmp(&d(b)))
+                .unwrap_or(&corner)
         })
         .collect();
     let faces = [

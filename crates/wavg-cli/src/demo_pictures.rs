@@ -20,7 +20,17 @@ use crate::render::write_png;
 /// Picture size of the demo.
 const SIZE: (u32, u32) = (640, 480);
 
-/// Draws the demo's pictures into `dir` and returns their paths.
+/// The pictures drawn, and those skipped with the reason (the applications that depend on
+/// the user's surface may not apply to it, and a picture should not sink the demo).
+#[derive(Default)]
+pub struct Pictures {
+    /// Paths of the pictures written.
+    pub written: Vec<PathBuf>,
+    /// `(file name, reason)` of each picture not drawn.
+    pub skipped: Vec<(String, String)>,
+}
+
+/// Draws the demo's pictures into `dir`.
 pub fn write_pictures(
     dir: &Path,
     mesh: &ValidMesh,
@@ -29,7 +39,7 @@ pub fn write_pictures(
     curve: &[Result<ForwardResult, SolveError>],
     solver: &wavg::Solver,
     seed: u64,
-) -> Result<Vec<PathBuf>, CliError> {
+) -> Result<Pictures, CliError> {
     let fail = |what: &str, e: &dyn std::fmt::Display| {
         CliError::failure(format!("{}: {what}: {}", dir.display(), one_line(e)))
     };
@@ -44,11 +54,16 @@ pub fn write_pictures(
         ..Default::default()
     };
     let dots: Vec<Vector3<f64>> = anchors.iter().map(|&v| tri.positions[v as usize]).collect();
-    let mut written = Vec::new();
-    let mut save = |name: &str, img: &Image| -> Result<(), CliError> {
-        let p = dir.join(name);
-        write_png(&p, img)?;
-        written.push(p);
+    let mut pictures = Pictures::default();
+    let mut save = |name: &str, img: Result<Image, CliError>| -> Result<(), CliError> {
+        match img {
+            Ok(img) => {
+                let p = dir.join(name);
+                write_png(&p, &img)?;
+                pictures.written.push(p);
+            }
+            Err(e) => pictures.skipped.push((name.to_string(), e.message)),
+        }
         Ok(())
     };
 
@@ -63,7 +78,7 @@ pub fn write_pictures(
     };
     let img = wavg::apps::render(tri, &Colouring::Plain, &ov, &opts)
         .map_err(|e| fail("spline.png", &e))?;
-    save("spline.png", &img)?;
+    save("spline.png", Ok(img))?;
 
     // A per-vertex scalar: distance in the embedding from the first anchor.
     let a = coords[anchors[0] as usize];
@@ -74,7 +89,7 @@ pub fn write_pictures(
     };
     let img = wavg::apps::render(tri, &Colouring::Scalars(&dist), &ov, &opts)
         .map_err(|e| fail("distance.png", &e))?;
-    save("distance.png", &img)?;
+    save("distance.png", Ok(img))?;
 
     // Texture transfer between two generated shapes.
     let (src, dst) = (sheet(false), sheet(true));
@@ -113,14 +128,16 @@ pub fn write_pictures(
     let none = Overlays::default();
     let img = wavg::apps::render(&src, &Colouring::Texture(&checker), &none, &view)
         .map_err(|e| fail("texture_source.png", &e))?;
-    save("texture_source.png", &img)?;
+    save("texture_source.png", Ok(img))?;
     let img = wavg::apps::render(&dst, &Colouring::Texture(&moved.image), &none, &view)
         .map_err(|e| fail("texture_target.png", &e))?;
-    save("texture_target.png", &img)?;
+    save("texture_target.png", Ok(img))?;
 
     // Remeshing: a cube's quads on the surface, three levels, five smoothing steps.
-    let img = crate::demo_apps::remesh_picture(solver, &opts)?;
-    save("remesh.png", &img)?;
+    save(
+        "remesh.png",
+        crate::demo_apps::remesh_picture(solver, &opts),
+    )?;
 
     // A decal around the first anchor; outside the square the board is transparent.
     let mut board = checkerboard(256, 8).map_err(|e| fail("checkerboard", &e))?;
@@ -129,9 +146,9 @@ pub fn write_pictures(
             board.set(x, y, [0; 4]);
         }
     }
-    let img = crate::demo_apps::decal_picture(solver, anchors[0], &board, &opts)?;
-    save("decal.png", &img)?;
-    Ok(written)
+    let img = crate::demo_apps::decal_picture(solver, anchors[0], &board, &opts);
+    save("decal.png", img)?;
+    Ok(pictures)
 }
 
 /// A UV-mapped 2 x 2 sheet with a bump (u, v from x, y); `bent` stretches it by 1.25

@@ -62,8 +62,8 @@ pub struct Args {
     /// The base vertex dragged by --frames.
     #[arg(long, default_value_t = 0)]
     pub drag: usize,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
+    /// Worker threads (default: all cores; at most 4 per CPU, or 64).
+    #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
     /// Output OBJ file (`-` for standard output; written atomically).
     #[arg(short = 'o', long = "output")]

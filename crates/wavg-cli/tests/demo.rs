@@ -31,15 +31,19 @@ fn demo_reports_and_writes_its_outputs() {
             "inverse_us",
             "landmarks",
             "mesh",
+            "pictures",
             "precompute_s",
             "roundtrip_ok_fraction",
             "roundtrip_queries",
+            "skipped_pictures",
             "stress",
             "verified_roundtrip_ok_fraction",
             "vertices",
         ]
     );
     assert_eq!(o["vertices"], 2562);
+    assert_eq!(o["pictures"].as_array().unwrap().len(), 6);
+    assert_eq!(o["skipped_pictures"], serde_json::json!([]));
     assert_eq!(o["curve_ok"], o["curve_points"]);
     assert!(o["verified_roundtrip_ok_fraction"].as_f64().unwrap() >= 0.99);
     // The outputs: a mesh that loads, an embedding that matches it, a curve on it.
@@ -88,4 +92,39 @@ fn demo_rejects_bad_arguments() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--anchors"));
     let out = wavg(&["demo", "--mesh", "builtin:teapot"]);
     assert_eq!(out.status.code(), Some(2));
+}
+
+/// A picture whose application does not apply to the user's surface (here remeshing a cube
+/// onto a thin torus, which may fail) is reported as not drawn, and the demo goes on.
+#[test]
+fn demo_pictures_that_do_not_apply_are_skipped_with_a_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("thin.obj");
+    let torus = wavg_mesh::procedural::torus(64, 8, 1.0, 0.01);
+    let valid = wavg_mesh::ValidMesh::new(torus).unwrap();
+    wavg_mesh::io::save(&mesh, &valid).unwrap();
+    let out_dir = dir.path().join("demo");
+    let out = wavg_ok(&[
+        "demo",
+        "--mesh",
+        mesh.to_str().unwrap(),
+        "--json",
+        "--queries",
+        "50",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let (o, _) = json_object(&out);
+    let written = o["pictures"].as_array().unwrap();
+    let skipped = o["skipped_pictures"].as_array().unwrap();
+    assert_eq!(written.len() + skipped.len(), 6, "{o:?}");
+    for p in written {
+        let bytes = std::fs::read(p.as_str().unwrap()).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG");
+    }
+    for s in skipped {
+        let (name, why) = s.as_str().unwrap().split_once(": ").unwrap();
+        assert!(name.ends_with(".png") && !why.is_empty(), "{s}");
+        assert!(!out_dir.join(name).exists());
+    }
 }

@@ -28,8 +28,8 @@ pub struct ProblemArgs {
     /// Output file ('-' for stdout).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
+    /// Worker threads (default: all cores; at most 4 per CPU, or 64).
+    #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
 }
 
