@@ -113,7 +113,7 @@ pub struct MorphReport {
 }
 
 /// `frames` positions blending linearly from `from` (frame 0) to `to` (the last frame);
-/// one frame is `from`.
+/// a single frame is `to`, the morph's result.
 pub fn morph_frames(
     from: &[Vector3<f64>],
     to: &[Vector3<f64>],
@@ -124,7 +124,7 @@ pub fn morph_frames(
             let t = if frames > 1 {
                 k as f64 / (frames - 1) as f64
             } else {
-                0.0
+                1.0
             };
             from.iter().zip(to).map(|(a, b)| a + (b - a) * t).collect()
         })
@@ -182,6 +182,6 @@ mod tests {
         assert_eq!(f[0], a);
         assert_eq!(f[2], b);
         assert_eq!(f[1][1], Vector3::new(2.0, 0.0, 0.0));
-        assert_eq!(morph_frames(&a, &b, 1), vec![a]);
+        assert_eq!(morph_frames(&a, &b, 1), vec![b]);
     }
 }

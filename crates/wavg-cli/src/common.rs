@@ -101,3 +101,11 @@ pub fn parse_threads(s: &str) -> Result<usize, String> {
     }
     Ok(n)
 }
+
+/// Whether two paths name the same existing file (after resolving links and `..`).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}

@@ -39,7 +39,7 @@ pub struct Args {
     #[arg(long)]
     pub points: PathBuf,
     /// How much more distance off the tangent plane counts than distance along it.
-    #[arg(long, default_value_t = wavg_solve::DEFAULT_GAMMA)]
+    #[arg(long, default_value_t = wavg_solve::DEFAULT_GAMMA, allow_negative_numbers = true)]
     pub gamma: f64,
     /// Check each answer by the forward problem; penalise the average's offset where the
     /// paper's weights do not lead back.

@@ -26,7 +26,8 @@ excluded), plus the per-reason counts and the output folder.")]
 pub struct Args {
     #[command(flatten)]
     pub map: MapArgs,
-    /// Number of frames (at least 1; the first is the source, the last the mapped shape).
+    /// Number of frames (at least 1; the first is the source, the last the mapped shape; a
+    /// single frame is the mapped shape).
     #[arg(long, default_value_t = 10)]
     pub frames: usize,
     /// Output folder.

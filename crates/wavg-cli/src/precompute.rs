@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -54,10 +54,40 @@ pub struct Args {
     pub json: bool,
 }
 
+/// Refuses arguments that would be silently ignored or destroy the input: an intermediate
+/// geodesic mesh no larger than the landmark set, and an output that is the input mesh or
+/// has a mesh file's extension.
+fn check_args(args: &Args) -> Result<(), CliError> {
+    if let Some(g) = args
+        .geodesic_vertices
+        .filter(|&g| g != 0 && g <= args.landmarks)
+    {
+        return Err(CliError::input(format!(
+            "--geodesic-vertices {g} must be 0 (the full mesh) or more than --landmarks ({})",
+            args.landmarks
+        )));
+    }
+    let out = &args.output;
+    if crate::common::same_file(Path::new(&args.mesh), out) {
+        return Err(CliError::input(format!(
+            "the output {} is the input mesh; write the embedding to a .wavg file",
+            out.display()
+        )));
+    }
+    if wavg_mesh::Format::from_path(out).is_ok() {
+        return Err(CliError::input(format!(
+            "the output {} has a mesh file's extension; the embedding is a .wavg file",
+            out.display()
+        )));
+    }
+    Ok(())
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     // Ctrl-C asks the pipeline to stop at its next check; the output is only written after
     // success, so an interrupted run leaves no file behind.
+    check_args(&args)?;
     let interrupted = Arc::new(AtomicBool::new(false));
     let flag = interrupted.clone();
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));

@@ -54,7 +54,7 @@ pub struct Args {
     #[arg(long, default_value_t = 3)]
     pub smooth: usize,
     /// Largest distance of a base vertex from the surface, over the bounding-box diagonal.
-    #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_BASE_DISTANCE)]
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_BASE_DISTANCE, allow_negative_numbers = true)]
     pub max_distance: f64,
     /// Recomputations to time while dragging a base vertex (0: none).
     #[arg(long, default_value_t = 10)]

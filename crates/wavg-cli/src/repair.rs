@@ -64,6 +64,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.weld
         )));
     }
+    // The output's format, from its extension, before any work.
+    wavg_mesh::Format::from_path(&args.output).map_err(|e| CliError::input(one_line(&e)))?;
     let mesh = load_mesh(&args.input)?;
     let options = RepairOptions {
         weld: (!args.no_weld).then_some(args.weld),
@@ -74,17 +76,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let r = repair_all(&mesh, &options);
     let after = analyze(&r.mesh);
-    write_atomically(&args.output, |tmp| {
-        io::save(tmp, &r.mesh).map_err(|e| one_line(&e))
-    })?;
+    // Written atomically (a temporary file beside it, renamed on success).
+    io::save(&args.output, &r.mesh).map_err(|e| CliError::failure(one_line(&e)))?;
     if let Some(map) = &args.map {
         let mut text = String::with_capacity(r.vertex_map.len() * 7);
         for v in &r.vertex_map {
             let _ = writeln!(text, "{v}");
         }
-        write_atomically(map, |tmp| {
-            std::fs::write(tmp, &text).map_err(|e| format!("{}: {e}", tmp.display()))
-        })?;
+        crate::textio::write_atomic(map, |w| w.write_all(text.as_bytes()))?;
     }
     let report = RepairReport::new(&mesh, &r, &after);
     if args.json {
@@ -139,26 +138,4 @@ struct JsonReport<'a> {
     output: &'a Path,
     #[serde(flatten)]
     report: &'a RepairReport,
-}
-
-/// Writes through a temporary file beside `path`, then renames: an interrupted or failed
-/// run never leaves a half-written file under the final name.
-fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), CliError> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    // Keep the extension(s) last so format detection by extension still works.
-    let tmp = path.with_file_name(format!(".tmp-{}-{name}", std::process::id()));
-    if let Err(e) = write(&tmp) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(CliError::failure(e));
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        CliError::failure(format!("{}: {e}", path.display()))
-    })
 }

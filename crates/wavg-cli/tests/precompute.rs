@@ -221,3 +221,42 @@ fn interrupt_stops_cleanly_without_output() {
         "{names:?}"
     );
 }
+
+/// Arguments that would be silently ignored or destroy the input are refused before any
+/// work, and the input stays as it was.
+#[test]
+fn arguments_that_would_be_ignored_or_overwrite_the_input_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = write(dir.path(), "m.obj", &procedural::icosphere(2));
+    let before = std::fs::read(&mesh).unwrap();
+    let wavg_out = dir.path().join("m.wavg");
+    let w = wavg_out.to_str().unwrap();
+    let other = dir.path().join("other.obj");
+    for (args, needle) in [
+        (
+            vec![
+                "precompute",
+                &mesh,
+                "-o",
+                w,
+                "--landmarks",
+                "100",
+                "--geodesic-vertices",
+                "99",
+            ],
+            "more than --landmarks",
+        ),
+        (vec!["precompute", &mesh, "-o", &mesh], "is the input mesh"),
+        (
+            vec!["precompute", &mesh, "-o", other.to_str().unwrap()],
+            "mesh file's extension",
+        ),
+    ] {
+        let out = wavg(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+    assert_eq!(std::fs::read(&mesh).unwrap(), before);
+    assert!(!wavg_out.exists() && !other.exists());
+}

@@ -138,3 +138,26 @@ fn remaining_problems_exit_1_and_components_need_opt_in() {
     let out = wavg(&["repair", "/nonexistent.obj", "-o", output.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// An output without a mesh extension is refused before the repair, naming the user's path
+/// (not a temporary file's).
+#[test]
+fn an_output_without_a_mesh_extension_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.obj");
+    io::save(&input, &ValidMesh::new(procedural::icosphere(1)).unwrap()).unwrap();
+    let output = dir.path().join("fixed");
+    let out = wavg(&[
+        "repair",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(output.to_str().unwrap()) && !err.contains(".tmp-"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}

@@ -191,6 +191,14 @@ pub fn precompute(
 ) -> Result<(Embedding, Report), EmbedError> {
     let start = Instant::now();
     let n = mesh.n_vertices();
+    let largest = mesh.positions.iter().map(|p| p.amax()).fold(0.0, f64::max);
+    if largest > wavg_mesh::MAX_COORDINATE {
+        return Err(EmbedError::InvalidArgument(format!(
+            "the mesh's coordinates reach {largest:e}, beyond the supported magnitude of {:e}: \
+             scale the mesh down",
+            wavg_mesh::MAX_COORDINATE
+        )));
+    }
     let components = mesh.topology().n_components();
     if components != 1 {
         return Err(EmbedError::InvalidArgument(format!(
@@ -397,6 +405,38 @@ mod tests {
     use std::sync::Mutex;
     use std::sync::atomic::{AtomicBool, Ordering};
     use wavg_mesh::{TriMesh, procedural};
+
+    /// Coordinates beyond what single-precision lengths hold are refused with the remedy;
+    /// just inside the limit the embedding keeps the unit mesh's distances (within 1%).
+    #[test]
+    fn coordinates_beyond_the_supported_range_are_refused() {
+        let scaled = |s: f64| {
+            let mut m = procedural::icosphere(2);
+            m.positions.iter_mut().for_each(|p| *p *= s);
+            ValidMesh::new(m).unwrap()
+        };
+        let o = PrecomputeOptions {
+            landmarks: 40,
+            quality_pairs: 0,
+            ..Default::default()
+        };
+        let err = precompute(&scaled(1e40), &o, &NoProgress).unwrap_err();
+        assert!(err.to_string().contains("scale the mesh down"), "{err}");
+        let (unit, _) = precompute(&scaled(1.0), &o, &NoProgress).unwrap();
+        let s = 2f64.powi(120); // about 1.3e36; a power of two scales without rounding
+        let (big, _) = precompute(&scaled(s), &o, &NoProgress).unwrap();
+        // The same distances (the embedding itself is determined up to a rigid motion).
+        let d = |c: &[[f64; 8]], i: usize| {
+            (0..8)
+                .map(|k| (c[i][k] - c[0][k]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        for i in 1..unit.coords.len() {
+            let (a, b) = (d(&unit.coords, i) * s, d(&big.coords, i));
+            assert!((a - b).abs() <= 1e-2 * a, "vertex {i}: {a} vs {b}");
+        }
+    }
 
     fn opts(landmarks: usize) -> PrecomputeOptions {
         PrecomputeOptions {

@@ -69,3 +69,9 @@ pub use repair::types::{RepairOptions, Repaired};
 
 // Errors.
 pub use error::MeshError;
+
+/// The largest coordinate magnitude the embedding and the projector accept (their fast
+/// marching and hierarchy store lengths in single precision, up to about 3.4e38, with room
+/// for sums of a few of them). Larger meshes are refused with an error that says to scale
+/// them down; valid meshes beyond it can still be inspected and repaired.
+pub const MAX_COORDINATE: f64 = 1e37;

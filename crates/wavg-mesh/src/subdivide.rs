@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 
 use crate::error::MeshError;
-use crate::mesh::{NONE, TriMesh, VertexId};
+use crate::mesh::{NONE, TexCoords, TriMesh, VertexId};
 use crate::valid::ValidMesh;
 
 /// Largest vertex count [`loop_subdivide`] will produce (vertex ids are `u32`).
@@ -14,8 +14,9 @@ pub const MAX_VERTICES: usize = u32::MAX as usize / 2;
 /// One level of Loop subdivision of a valid mesh: old vertices first (same ids, smoothed
 /// positions), then one new vertex per edge; four triangles per triangle, in face order
 /// (children of face `f` are faces `4f..4f+4`, the corner children first, the middle last).
-/// Texture coordinates are dropped. Boundaries keep their cubic B-spline rules, so the
-/// boundary curve only depends on boundary vertices.
+/// Texture coordinates are subdivided linearly (each child corner gets its parent's corner
+/// or the midpoint of its parent's edge, so seams stay seams). Boundaries keep their cubic
+/// B-spline rules, so the boundary curve only depends on boundary vertices.
 ///
 /// ```
 /// use wavg_mesh::{ValidMesh, procedural, subdivide::loop_subdivide};
@@ -99,13 +100,65 @@ pub fn loop_subdivide(mesh: &ValidMesh) -> Result<TriMesh, MeshError> {
         let [a, b, c] = *t;
         faces.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
     }
-    Ok(TriMesh::new(out, faces))
+    let mut result = TriMesh::new(out, faces);
+    result.uv = mesh.uv.as_ref().map(subdivide_uv);
+    Ok(result)
+}
+
+/// Linear subdivision of per-corner texture coordinates, children in the order of
+/// [`loop_subdivide`]'s faces; a midpoint is shared by the faces that share both ends.
+fn subdivide_uv(uv: &TexCoords) -> TexCoords {
+    let mut coords = uv.coords.clone();
+    let mut mid = std::collections::HashMap::new();
+    let mut midpoint = |a: u32, b: u32| -> u32 {
+        *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+            coords.push((uv.coords[a as usize] + uv.coords[b as usize]) * 0.5);
+            (coords.len() - 1) as u32
+        })
+    };
+    let mut faces = Vec::with_capacity(4 * uv.faces.len());
+    for &[a, b, c] in &uv.faces {
+        let (ab, bc, ca) = (midpoint(a, b), midpoint(b, c), midpoint(c, a));
+        faces.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+    }
+    TexCoords { coords, faces }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::procedural;
+
+    /// Every child corner's (u, v) is its parent's corner or the midpoint of its parent's
+    /// edge, and faces that share an edge share its midpoint.
+    #[test]
+    fn texture_coordinates_are_subdivided_linearly() {
+        let mut mesh = procedural::grid(4, 3, 2.0, 1.0);
+        let coords = mesh.positions.iter().map(|p| p.xy() * 0.5).collect();
+        let faces = mesh.triangles.clone();
+        mesh.uv = Some(TexCoords { coords, faces });
+        let m = ValidMesh::new(mesh.clone()).unwrap();
+        let s = loop_subdivide(&m).unwrap();
+        let (uv, parent) = (s.uv.as_ref().unwrap(), mesh.uv.as_ref().unwrap());
+        assert_eq!(uv.faces.len(), 4 * parent.faces.len());
+        // One midpoint per edge: (3 F + boundary edges) / 2.
+        let boundary = m.topology().boundary_loops().iter().flatten().count();
+        let edges = (3 * m.n_faces() + boundary) / 2;
+        assert_eq!(uv.coords.len(), parent.coords.len() + edges);
+        for (f, t) in parent.faces.iter().enumerate() {
+            let [a, b, c] = t.map(|i| parent.coords[i as usize]);
+            let want = [
+                [a, (a + b) / 2.0, (c + a) / 2.0],
+                [(a + b) / 2.0, b, (b + c) / 2.0],
+            ];
+            for (k, w) in want.iter().enumerate() {
+                let got = uv.faces[4 * f + k].map(|i| uv.coords[i as usize]);
+                for j in 0..3 {
+                    assert!((got[j] - w[j]).norm() < 1e-15, "face {f} child {k}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn counts_and_topology_are_preserved() {

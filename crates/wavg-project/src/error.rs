@@ -19,6 +19,18 @@ pub enum ProjectError {
         /// The offending vertex.
         vertex: VertexId,
     },
+    /// A vertex's embedded coordinates are beyond [`wavg_mesh::MAX_COORDINATE`] in magnitude
+    /// (the hierarchy's boxes and bounds are stored in single precision).
+    #[error(
+        "embedded coordinates of vertex {vertex} reach {value:e}, beyond the supported \
+         magnitude of 1e37: scale the mesh down"
+    )]
+    OutOfRange {
+        /// The offending vertex.
+        vertex: VertexId,
+        /// Its largest coordinate in magnitude.
+        value: f64,
+    },
     /// The mesh has no faces to project onto.
     #[error("the mesh has no faces")]
     EmptyMesh,

@@ -150,6 +150,14 @@ fn embedding_errors_are_typed() {
         EmbeddedMesh::new(mesh.clone(), bad).unwrap_err(),
         wavg_project::ProjectError::NonFinite { vertex: 5 }
     );
+    // Beyond single precision's range (with a margin): refused, not silently wrong.
+    let mut huge = vec![wavg_project::Vec8::zeros(); n];
+    huge[7][2] = -2e37;
+    let emb = Arc::new(EmbeddedMesh::new(mesh.clone(), huge).unwrap());
+    assert!(matches!(
+        Projector::new(emb),
+        Err(wavg_project::ProjectError::OutOfRange { vertex: 7, value }) if value == 2e37
+    ));
     let p = Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap();
     let y = wavg_project::Vec8::repeat(f64::INFINITY);
     assert_eq!(

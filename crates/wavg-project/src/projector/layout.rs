@@ -104,6 +104,13 @@ impl Projector {
             return Err(ProjectError::EmptyMesh);
         }
         let coords = emb.coords();
+        let big = |c: &Vec8| c.amax() > wavg_mesh::MAX_COORDINATE;
+        if let Some(v) = coords.iter().position(big) {
+            return Err(ProjectError::OutOfRange {
+                vertex: v as u32,
+                value: coords[v].amax(),
+            });
+        }
         let topo = mesh.topology();
         let chunk = 4096;
         let mut verts = crate::hugepage::filled(

@@ -216,12 +216,13 @@ fn point_line(line: usize, t: &[&str]) -> Result<PointSpec, LineError> {
     }
 }
 
-/// Names the `i`-th weight of a line in messages (formatted only on error).
+/// Names the `i`-th weight of a line (from 0) in messages, counting from 1 as line
+/// numbers do (formatted only on error).
 struct WeightNo(usize);
 
 impl fmt::Display for WeightNo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "weight {}", self.0)
+        write!(f, "weight {} of the line", self.0 + 1)
     }
 }
 
@@ -448,7 +449,7 @@ mod tests {
         assert_eq!(w, vec![(1, vec![0.5, 0.5]), (3, vec![0.1, 0.9])]);
         let e = parse_weights("0.5 0.5\n0.5 inf\n", 1).unwrap_err();
         assert_eq!(e.line, 2);
-        assert!(e.message.contains("weight 1"));
+        assert!(e.message.contains("weight 2 of the line"), "{}", e.message);
     }
 
     #[test]
