@@ -103,10 +103,10 @@ pub struct DecalReport {
     pub vertices: usize,
     /// Unmarked vertices over all vertices (0 for an empty mesh).
     pub valid_fraction: f64,
-    /// [`Distortion::stretch`].
-    pub stretch: f64,
-    /// [`Distortion::stretch_best95`].
-    pub stretch_best95: f64,
+    /// [`Distortion::stretch`]; `None` when no face was measured unflipped.
+    pub stretch: Option<f64>,
+    /// [`Distortion::stretch_best95`]; `None` when no face was measured unflipped.
+    pub stretch_best95: Option<f64>,
     /// [`Distortion::flipped_faces`].
     pub flipped_faces: usize,
     /// [`Distortion::flipped_area_fraction`].
@@ -122,8 +122,8 @@ impl Decal {
         DecalReport {
             vertices: n,
             valid_fraction: unmarked as f64 / n.max(1) as f64,
-            stretch: d.stretch,
-            stretch_best95: d.stretch_best95,
+            stretch: d.has_stretch().then_some(d.stretch),
+            stretch_best95: d.has_stretch().then_some(d.stretch_best95),
             flipped_faces: d.flipped_faces,
             flipped_area_fraction: d.flipped_area_fraction,
         }

@@ -20,17 +20,15 @@
 use nalgebra::Vector3;
 
 /// Distortion of a map (see the module docs). With the `serde` feature it serialises its
-/// totals (not the per-face vectors) to the keys of `wavg correspond --json`.
+/// totals (not the per-face vectors) to the keys of `wavg correspond --json`, the stretches
+/// as `null` when no face was measured unflipped ([`Distortion::has_stretch`]).
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Distortion {
     /// Per source face: the symmetrised stretch of the face (`None` where a corner is not
     /// mapped or the face is flipped).
-    #[cfg_attr(feature = "serde", serde(skip))]
     pub face_stretch: Vec<Option<f64>>,
     /// Per source face: flipped (mapped orientation disagrees with the reference normal,
     /// or the mapped triangle is degenerate).
-    #[cfg_attr(feature = "serde", serde(skip))]
     pub flipped: Vec<bool>,
     /// Faces whose three corners are mapped.
     pub measured_faces: usize,
@@ -45,6 +43,29 @@ pub struct Distortion {
     /// The same over the best 95% of those faces by per-face stretch (the worst 5% left
     /// out), so a few bad triangles do not dominate.
     pub stretch_best95: f64,
+}
+
+impl Distortion {
+    /// Whether any measured face is unflipped, so that [`Distortion::stretch`] and
+    /// [`Distortion::stretch_best95`] measure something (they are 1 otherwise).
+    pub fn has_stretch(&self) -> bool {
+        self.measured_faces > self.flipped_faces
+    }
+}
+
+#[cfg(feature = "serde")]
+impl serde::Serialize for Distortion {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let measured = self.has_stretch();
+        let mut st = s.serialize_struct("Distortion", 5)?;
+        st.serialize_field("measured_faces", &self.measured_faces)?;
+        st.serialize_field("flipped_faces", &self.flipped_faces)?;
+        st.serialize_field("flipped_area_fraction", &self.flipped_area_fraction)?;
+        st.serialize_field("stretch", &measured.then_some(self.stretch))?;
+        st.serialize_field("stretch_best95", &measured.then_some(self.stretch_best95))?;
+        st.end()
+    }
 }
 
 /// Per face: source area, stretch squared of the map and of the inverse (both unnormalised).

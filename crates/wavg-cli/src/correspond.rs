@@ -66,7 +66,7 @@ weights are not. `paper` is the paper's test: the weights round-trip and none is
 Output: one line per source vertex, `FACE B0 B1 B2 X Y Z` on the target, or `none REASON`
 (unanswered, no-round-trip, negative-weight, inconsistent). --json prints one object:
 source_vertices, valid_fraction, flipped_faces, flipped_area_fraction, stretch (symmetrised
-L2 stretch over the valid part), stretch_best95, seconds, vertices_per_s, plus cpu_seconds and
+L2 stretch over the valid part; null when no face is measured), stretch_best95, seconds, vertices_per_s, plus cpu_seconds and
 vertices_per_cpu_s (CPU time of the map, all threads), counts per reason and, with
 --ground-truth, the error of the images against vertex i of the target as fractions of the
 target's bounding-box diagonal.
@@ -234,10 +234,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         println!("{j}");
     } else if args.output != Path::new("-") {
         println!(
-            "{} of {n} vertices valid ({:.1}%), stretch {:.4}, {} flipped faces, {:.0} vertices/s -> {}",
+            "{} of {n} vertices valid ({:.1}%), stretch {}, {} flipped faces, {:.0} vertices/s -> {}",
             c.map.valid(),
             100.0 * c.map.valid_fraction(),
-            d.stretch,
+            if d.has_stretch() {
+                format!("{:.4}", d.stretch)
+            } else {
+                "- (no face measured)".into()
+            },
             d.flipped_faces,
             per_s,
             args.output.display()

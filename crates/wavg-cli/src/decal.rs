@@ -24,7 +24,8 @@ meaningful: they do not return to it through the forward problem, or one is belo
 
 Output: an OBJ of the mesh with one `vt` per vertex and faces `f a/a b/b c/c`. --json prints
 one object: vertices, valid_fraction (unmarked vertices), stretch (symmetrised L2 stretch of
-the surface-to-plane map over faces with three unmarked corners), flipped_faces (against the
+the surface-to-plane map over faces with three unmarked corners; null when there is none),
+flipped_faces (against the
 decal's own orientation), seconds, marked (the marked vertex ids), plus mesh and anchors.")]
 pub struct Args {
     /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
@@ -136,10 +137,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else if args.output != std::path::Path::new("-") {
         let n = report.vertices;
         println!(
-            "{} of {n} vertices unmarked ({:.1}%), stretch {:.4}, {} flipped faces -> {}",
+            "{} of {n} vertices unmarked ({:.1}%), stretch {}, {} flipped faces -> {}",
             n - marked.len(),
             100.0 * report.valid_fraction,
-            report.stretch,
+            report
+                .stretch
+                .map_or("- (no face measured)".into(), |s| format!("{s:.4}")),
             report.flipped_faces,
             args.output.display()
         );

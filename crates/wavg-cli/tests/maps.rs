@@ -349,3 +349,29 @@ fn bad_input_writes_nothing() {
         expect_2(&args, what);
     }
 }
+
+/// A decal whose faces are all marked (one anchor: no weights are meaningful) measures no
+/// stretch, and says so with null rather than a perfect 1.
+#[test]
+fn a_decal_without_measured_faces_reports_no_stretch() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, uv) = (dir.path().join("a.txt"), dir.path().join("uv.txt"));
+    std::fs::write(&a, "v 0\n").unwrap();
+    std::fs::write(&uv, "0 0\n").unwrap();
+    let out = dir.path().join("d.obj");
+    let r = wavg_ok(&[
+        "decal",
+        "--mesh",
+        "builtin:icosphere",
+        "--anchors",
+        &s(&a),
+        "--uv",
+        &s(&uv),
+        "-o",
+        &s(&out),
+        "--json",
+    ]);
+    let (o, _) = json_object(&r);
+    assert!(o["valid_fraction"].as_f64().unwrap() < 0.01, "{o:?}");
+    assert!(o["stretch"].is_null() && o["stretch_best95"].is_null(), "{o:?}");
+}
