@@ -81,7 +81,8 @@ pub struct TextureTransfer {
 pub fn check_uv<'a>(mesh: &'a TriMesh, what: &str) -> Result<&'a TexCoords, AppError> {
     let uv = mesh.uv.as_ref().ok_or_else(|| {
         AppError::Input(format!(
-            "the {what} mesh has no texture coordinates (OBJ `vt`)"
+            "the {what} mesh has no texture coordinates (they need a `vt` on every face's \
+             corners: `wavg info MESH` tells whether some faces lacked them)"
         ))
     })?;
     check_layout(uv, mesh.triangles.len(), what)?;

@@ -373,5 +373,8 @@ fn a_decal_without_measured_faces_reports_no_stretch() {
     ]);
     let (o, _) = json_object(&r);
     assert!(o["valid_fraction"].as_f64().unwrap() < 0.01, "{o:?}");
-    assert!(o["stretch"].is_null() && o["stretch_best95"].is_null(), "{o:?}");
+    assert!(
+        o["stretch"].is_null() && o["stretch_best95"].is_null(),
+        "{o:?}"
+    );
 }

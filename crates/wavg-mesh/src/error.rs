@@ -19,7 +19,7 @@ pub enum MeshError {
         source: std::io::Error,
     },
     /// A file could not be parsed.
-    #[error("{path}:{line}: {message}")]
+    #[error("{}{}: {message}", path.display(), LineNo(*line))]
     Parse {
         /// The file.
         path: PathBuf,
@@ -42,4 +42,16 @@ pub enum MeshError {
     /// An argument was out of range (for example an unknown builtin mesh name).
     #[error("{0}")]
     InvalidArgument(String),
+}
+
+/// `:LINE` after a file name, or nothing for line 0 (no lines: binary data, compression).
+struct LineNo(usize);
+
+impl std::fmt::Display for LineNo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            0 => Ok(()),
+            n => write!(f, ":{n}"),
+        }
+    }
 }

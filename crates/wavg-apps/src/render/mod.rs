@@ -123,7 +123,13 @@ fn check(mesh: &TriMesh, colouring: &Colouring, opts: &RenderOptions) -> Result<
     match colouring {
         Colouring::Plain => {}
         Colouring::Texture(_) => match &mesh.uv {
-            None => return bad("the mesh has no texture coordinates (OBJ `vt`)".into()),
+            None => {
+                return bad(
+                    "the mesh has no texture coordinates (they need a `vt` on every face's \
+                        corners: `wavg info MESH` tells whether some faces lacked them)"
+                        .into(),
+                );
+            }
             Some(uv) => {
                 if uv.faces.len() != mesh.triangles.len()
                     || uv
