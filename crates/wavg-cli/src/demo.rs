@@ -158,8 +158,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
         seed: args.seed,
         ..Default::default()
     };
-    let (emb, _) = wavg_embed::precompute(&mesh, &opts, &wavg_embed::NoProgress)
-        .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))?;
+    let (emb, _) =
+        wavg_embed::precompute(&mesh, &opts, &wavg_embed::NoProgress).map_err(|e| match e {
+            // The mesh or the arguments do not suit (exit status 2, as `wavg precompute`).
+            wavg_embed::EmbedError::InvalidArgument(m) => {
+                CliError::input(format!("precompute: {m}"))
+            }
+            e => CliError::failure(format!("precompute: {}", one_line(&e))),
+        })?;
     let precompute_s = t0.elapsed().as_secs_f64();
     let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
     let embedded = EmbeddedMesh::new(mesh.clone(), coords)

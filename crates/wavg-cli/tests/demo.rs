@@ -92,6 +92,23 @@ fn demo_rejects_bad_arguments() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--anchors"));
     let out = wavg(&["demo", "--mesh", "builtin:teapot"]);
     assert_eq!(out.status.code(), Some(2));
+    // A mesh the embedding cannot take (two components) is an input error too.
+    let dir = tempfile::tempdir().unwrap();
+    let two = dir.path().join("two.obj");
+    let mut mesh = wavg_mesh::procedural::icosphere(1);
+    let n = mesh.positions.len() as u32;
+    let far: Vec<_> = mesh.positions.iter().map(|p| p.add_scalar(5.0)).collect();
+    let tris: Vec<_> = mesh.triangles.iter().map(|t| t.map(|v| v + n)).collect();
+    mesh.positions.extend(far);
+    mesh.triangles.extend(tris);
+    std::fs::write(
+        &two,
+        wavg_mesh::io::to_bytes(&mesh, wavg_mesh::Format::Obj).unwrap(),
+    )
+    .unwrap();
+    let out = wavg(&["demo", "--mesh", two.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("components"));
 }
 
 /// A picture whose application does not apply to the user's surface (here remeshing a cube
