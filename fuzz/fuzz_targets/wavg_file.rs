@@ -13,6 +13,7 @@ static MESH: LazyLock<TriMesh> = LazyLock::new(|| wavg::mesh::procedural::icosph
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(e) = wavg::embed::file::decode(data, &MESH, Path::new("fuzz.wavg")) {
-        e.validate(MESH.n_vertices()).expect("decoded embeddings are valid");
+        e.validate(MESH.n_vertices())
+            .expect("decoded embeddings are valid");
     }
 });
