@@ -119,6 +119,12 @@ const STEPS: &[Step] = &[
         args: &["fmt", "--all", "--check"],
     },
     Step {
+        // The fuzz crate is outside the workspace (it needs its own lock file).
+        name: "format (fuzz)",
+        program: "cargo",
+        args: &["fmt", "--manifest-path", "fuzz/Cargo.toml", "--check"],
+    },
+    Step {
         name: "clippy",
         program: "cargo",
         args: &[
