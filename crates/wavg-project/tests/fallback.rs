@@ -182,35 +182,3 @@ fn a_stranded_walk_searches_again_from_the_nearest_vertex() {
         assert!((fx.emb.point(&fast.point) - fx.emb.point(&brute.point)).norm() <= 1e-12);
     }
 }
-
-/// A walk that ends on another sheet lying close in R^8 (a projection there, but not the
-/// closest) searches once more from the vertex nearest to the query, and the zero-distance
-/// answer it finds there is certified without the global search.
-#[test]
-fn a_walk_on_the_wrong_sheet_searches_again_from_the_nearest_vertex() {
-    // Two stacked sheets: A at z = 0 (faces first), B at z = 0.2, less than an edge (0.25)
-    // apart but more than any point of B is from its nearest vertex of B.
-    let mesh = two_grids(|_| {}, |p| p.z = 0.2);
-    let n = mesh.positions.len() as u32 / 2;
-    let fx = Fixture::new("stacked", mesh, Embedding::Padded);
-    let faces_a = fx.mesh().n_faces() as u32 / 2;
-    for k in 0..40 {
-        let u = |m: f64| (k as f64 * m).fract();
-        // A point of sheet B, and the start on sheet A nearest below it: the walk stays there.
-        let p = fx.point(0.5 + u(0.618) * 0.5, u(0.755), u(0.57));
-        assert!(p.face >= faces_a);
-        let y = fx.emb.point(&p);
-        let start = (0..n)
-            .min_by(|&a, &b| {
-                let d = |v: u32| (fx.emb.coords()[v as usize] - y).norm();
-                d(a).total_cmp(&d(b))
-            })
-            .unwrap();
-        let fast = fx.proj.project(&y, start).unwrap();
-        let brute = fx.proj.project_brute_force(&y).unwrap();
-        assert_eq!(fast.path, ProjectionPath::Certified, "{fast:?}");
-        assert!(fast.point.face >= faces_a, "{fast:?}");
-        assert!(fast.distance <= 1e-12, "{fast:?}");
-        assert!((fx.emb.point(&fast.point) - fx.emb.point(&brute.point)).norm() <= 1e-12);
-    }
-}

@@ -23,10 +23,8 @@ pub enum SearchGoal {
     /// The closest valid projection: the local search tests the faces around the walk's
     /// end, then rings of their neighbours until one holds a projection, then certifies
     /// its best answer: at once when the query's ball of that radius lies within the reach
-    /// of the walk's end (no triangle not around that vertex comes so close), or when the
-    /// local search from the vertex nearest to the query finds a closer answer certified
-    /// the same way (the walk stopped on another sheet), otherwise against the bounding
-    /// volume hierarchy. When nothing is found within
+    /// of the walk's end (no triangle not around that vertex comes so close), otherwise
+    /// against the bounding volume hierarchy. When nothing is found within
     /// [`LOCAL_BUDGET`] faces, the search runs again from the vertex nearest to the query,
     /// then the global search answers. Path [`ProjectionPath::Certified`] or
     /// [`ProjectionPath::Fallback`].
@@ -302,26 +300,15 @@ impl Projector {
     }
 
     /// Certifies the local search's answer `local` (from the walk's end `v`): by its zero
-    /// distance, by `v`'s reach (see the `reach` module), by a strictly closer answer of
-    /// the local search from the vertex nearest to `y` that is certified the same way (the
-    /// walk can stop on another sheet that lies close in R^8, where the nearest vertex is
-    /// usually a corner of the face holding the answer), or against the hierarchy (faces
-    /// in `tried` are skipped): `Certified` if the hierarchy holds nothing strictly closer
-    /// than the local searches' answer, else the closest projection found, as `Fallback`.
+    /// distance, by `v`'s reach (see the `reach` module) or against the hierarchy (faces in
+    /// `tried` are skipped): `Certified` if nothing is strictly closer, else the closest
+    /// projection found, as `Fallback`.
     fn certify(&self, y: &Vec8, local: Best, v: VertexId, tried: &FaceSet) -> Projection {
         if self.is_zero(&local) || self.certified_by_reach(y, &local, v, tried) {
             return Self::finish(local, ProjectionPath::Certified);
         }
-        let mut answer = local;
-        let retry = self.search_from_nearest(y, v, SearchGoal::Closest);
-        if let Some((b, u, tried_u)) = retry.filter(|r| r.0.d2 < local.d2) {
-            if self.is_zero(&b) || self.certified_by_reach(y, &b, u, &tried_u) {
-                return Self::finish(b, ProjectionPath::Certified);
-            }
-            answer = b;
-        }
         let mut improved = None;
-        let mut bound = answer.d2;
+        let mut bound = local.d2;
         let keep = cone::keep_filter(self, y);
         self.bvh.search_pruned(y, &mut bound, keep, |f, bound| {
             if tried.contains(f) {
@@ -334,7 +321,7 @@ impl Projector {
         });
         match improved {
             Some(b) => Self::finish(b, ProjectionPath::Fallback),
-            None => Self::finish(answer, ProjectionPath::Certified),
+            None => Self::finish(local, ProjectionPath::Certified),
         }
     }
 
