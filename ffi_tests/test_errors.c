@@ -113,6 +113,16 @@ int main(void) {
     CHECK(n == 20);
     wavg_surface_free(s3);
   }
+  /* Nor can a single triangle (fewer than 4 vertices), whatever the options. */
+  {
+    const double tri_xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const uint32_t tri_idx[] = {0, 1, 2};
+    wavg_surface *one = NULL;
+    CHECK_OK(wavg_surface_from_arrays(tri_xyz, 3, tri_idx, 1, &one));
+    o = wavg_precompute_options_default();
+    CHECK_FAILS(WAVG_STATUS_INVALID_MESH, wavg_surface_precompute(one, &o, NULL, NULL));
+    wavg_surface_free(one);
+  }
   /* A mesh with two components cannot be embedded. */
   {
     double *x2 = malloc(sizeof(double) * 6 * nv);
@@ -169,6 +179,9 @@ int main(void) {
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_solver_new(s, with_bad, NA, &solver));
   with_bad[2] = bad_bary;
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_solver_new(s, with_bad, NA, &solver));
+  /* A count whose array cannot exist (its byte size overflows) is refused, not wrapped. */
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT,
+              wavg_solver_new(s, anchors, (size_t)1 << (sizeof(size_t) * 8 - 1), &solver));
   CHECK(solver == (wavg_solver *)SENTINEL_PTR);
   CHECK_OK(wavg_solver_new(s, anchors, NA, &solver));
   CHECK(wavg_solver_anchor_count(NULL) == 0);
@@ -195,6 +208,8 @@ int main(void) {
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_forward(solver, NULL, 1, out, oxyz, st));
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_forward(solver, w, 0, out, oxyz, st));
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_forward(solver, w, 1, NULL, oxyz, st));
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT,
+              wavg_forward(solver, w, SIZE_MAX / 4, out, oxyz, st));
   CHECK(memcmp(out, out0, sizeof out) == 0);
   CHECK(memcmp(oxyz, oxyz0, sizeof oxyz) == 0);
   CHECK(memcmp(st, st0, sizeof st) == 0);

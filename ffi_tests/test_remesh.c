@@ -68,6 +68,8 @@ int main(void) {
   /* Bad arguments: a status, a message, nothing changed. */
   wavg_remesher *none = NULL;
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_remesher_run(r, 9, 0));
+  /* Too many smoothing steps: refused, not allocated for. */
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_remesher_run(r, 1, UINT32_MAX));
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_remesher_run(NULL, 1, 0));
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_remesher_move_vertex(r, NB, target));
   wavg_point bad = target;

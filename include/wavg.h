@@ -296,10 +296,11 @@ enum wavg_status wavg_remesher_new(const struct wavg_surface *surface,
                                    double max_distance,
                                    struct wavg_remesher **out);
 
-// Refines the base `levels` times (0 to 8) and smooths `smooth` steps; the result is
-// kept for the count functions and `wavg_remesher_get`. With the same `levels` and
-// `smooth` as the previous successful run, every search starts from that run's answer
-// (the interactive case). Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL, `levels > 8`),
+// Refines the base `levels` times (0 to 8) and smooths `smooth` steps (0 to 1000); the
+// result is kept for the count functions and `wavg_remesher_get`. With the same `levels`
+// and `smooth` as the previous successful run, every search starts from that run's answer
+// (the interactive case). Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL, `levels > 8`,
+// `smooth > 1000`),
 // `WAVG_STATUS_NO_SOLUTION` (an average without a projection; the previous result is
 // kept).
 //

@@ -2,7 +2,8 @@
 //! `(u, v)`; a surface point with weights `w` (inverse problem, the paper's weights, which
 //! vary continuously over the surface) gets `uv = sum_i w_i uv_i`. Where the weights are not
 //! meaningful (they do not return to the point through the forward problem, or one is
-//! strongly negative) the coordinates are still computed but the point is marked.
+//! strongly negative) the coordinates are still computed but the point is marked; a point
+//! whose weighted sum overflows (huge anchor coordinates) is marked with (0, 0).
 
 use nalgebra::Vector3;
 use wavg_mesh::SurfacePoint;
@@ -71,8 +72,10 @@ pub fn decal_uv(
                     p[1] += wi * c[1];
                 }
                 let min = w.iter().copied().fold(f64::INFINITY, f64::min);
-                out.push(p);
-                marked.push(!trip || min < max_negative);
+                // Huge (u, v) can overflow the weighted sum: such a point is not usable.
+                let finite = p.iter().all(|x| x.is_finite());
+                out.push(if finite { p } else { [0.0, 0.0] });
+                marked.push(!trip || min < max_negative || !finite);
             }
             Err(_) => {
                 out.push([0.0, 0.0]);

@@ -14,8 +14,8 @@ mod spline;
 
 pub use basis::{SplineKind, spline_weights, spline_weights_flat};
 pub use remesh::{
-    BaseMesh, DEFAULT_MAX_BASE_DISTANCE, MAX_LEVELS, MAX_POLYGON, RemeshError, RemeshReport,
-    RemeshResult, Remesher, polygons_to_obj,
+    BaseMesh, DEFAULT_MAX_BASE_DISTANCE, MAX_LEVELS, MAX_POLYGON, MAX_SMOOTH_STEPS, RemeshError,
+    RemeshReport, RemeshResult, Remesher, polygons_to_obj,
 };
 pub use spline::{Curve, CurveReport, evaluate_spline};
 

@@ -2,8 +2,9 @@
 
 use wavg::apps::{SplineKind, evaluate_spline};
 
+use crate::boundary::optional;
 use crate::boundary::{Failure, guard, handle, product, slice_mut};
-use crate::solver::{optional, wavg_solver, write_points};
+use crate::solver::{wavg_solver, write_points};
 use crate::types::{wavg_point, wavg_status};
 
 /// Samples a curve on the surface whose control points are the solver's anchors, in
@@ -54,8 +55,8 @@ pub unsafe extern "C" fn wavg_spline(
         let (points, xyz, statuses) = unsafe {
             (
                 slice_mut(out_points, n_samples, "out_points")?,
-                optional(out_xyz, product(n_samples, 3, "n_samples")?),
-                optional(out_statuses, n_samples),
+                optional(out_xyz, product(n_samples, 3, "n_samples")?, "out_xyz")?,
+                optional(out_statuses, n_samples, "out_statuses")?,
             )
         };
         let curve = evaluate_spline(s.inner(), kind, n_samples, 256)

@@ -115,7 +115,9 @@ pub(crate) unsafe fn slice<'a, T>(
     if ptr.is_null() {
         return Err(Failure::arg(format!("{what} is NULL")));
     }
-    // SAFETY: non-NULL, and the caller guarantees `len` readable elements.
+    check_len::<T>(len, what)?;
+    // SAFETY: non-NULL, the size fits in `isize`, and the caller guarantees `len` readable
+    // elements.
     Ok(unsafe { std::slice::from_raw_parts(ptr, len) })
 }
 
@@ -131,8 +133,39 @@ pub(crate) unsafe fn slice_mut<'a, T>(
     if ptr.is_null() {
         return Err(Failure::arg(format!("{what} is NULL")));
     }
-    // SAFETY: non-NULL, and the caller guarantees `len` writable, unaliased elements.
+    check_len::<T>(len, what)?;
+    // SAFETY: non-NULL, the size fits in `isize`, and the caller guarantees `len` writable,
+    // unaliased elements.
     Ok(unsafe { std::slice::from_raw_parts_mut(ptr, len) })
+}
+
+/// An optional output array: `None` for NULL; a length whose byte size does not fit in
+/// `isize` is an invalid-argument failure.
+///
+/// # Safety
+/// `ptr` must be NULL or hold `len` writable, unaliased elements.
+pub(crate) unsafe fn optional<'a, T>(
+    ptr: *mut T,
+    len: usize,
+    what: &str,
+) -> Result<Option<&'a mut [T]>, Failure> {
+    if ptr.is_null() {
+        return Ok(None);
+    }
+    // SAFETY: per this function's contract.
+    unsafe { slice_mut(ptr, len, what) }.map(Some)
+}
+
+/// No array of `len` elements of `T` can exist when its size in bytes overflows `isize`
+/// (the caller's count is wrong): an invalid-argument failure, checked before a slice is
+/// made of it.
+fn check_len<T>(len: usize, what: &str) -> Result<(), Failure> {
+    match len.checked_mul(std::mem::size_of::<T>()) {
+        Some(bytes) if bytes <= isize::MAX as usize => Ok(()),
+        _ => Err(Failure::arg(format!(
+            "{what}: {len} elements is too large for an array"
+        ))),
+    }
 }
 
 /// `a * b`, or an invalid-argument failure when it overflows.

@@ -6,8 +6,9 @@ use wavg::apps::{
     CorrespondOptions, Validity, ValidityTest, correspond_vertices, decal_uv, map_points,
 };
 
+use crate::boundary::optional;
 use crate::boundary::{Failure, guard, handle, product, slice, slice_mut};
-use crate::solver::{optional, wavg_solver, write_image};
+use crate::solver::{wavg_solver, write_image};
 use crate::types::{wavg_point, wavg_status};
 
 /// The status of an answered point that fails the validity test.
@@ -110,8 +111,8 @@ pub unsafe extern "C" fn wavg_correspond(
         let (out, xyz, statuses) = unsafe {
             (
                 slice_mut(out, n, "out")?,
-                optional(out_xyz, product(n, 3, "n")?),
-                optional(out_statuses, n),
+                optional(out_xyz, product(n, 3, "n")?, "out_xyz")?,
+                optional(out_statuses, n, "out_statuses")?,
             )
         };
         let mapped = map_points(s.inner(), t.inner(), &query, verified)
@@ -186,8 +187,8 @@ pub unsafe extern "C" fn wavg_correspond_vertices(
         let (out, mut xyz, statuses) = unsafe {
             (
                 slice_mut(out, n, "out")?,
-                optional(out_xyz, product(n, 3, "n_vertices")?),
-                optional(out_statuses, n),
+                optional(out_xyz, product(n, 3, "n_vertices")?, "out_xyz")?,
+                optional(out_statuses, n, "out_statuses")?,
             )
         };
         let mut each = Vec::with_capacity(n);
@@ -243,7 +244,7 @@ pub unsafe extern "C" fn wavg_decal_uv(
         let (out, statuses) = unsafe {
             (
                 slice_mut(out_uv, product(n, 2, "n")?, "out_uv")?,
-                optional(out_statuses, n),
+                optional(out_statuses, n, "out_statuses")?,
             )
         };
         // Which points failed outright: their inverse problem, asked again for the message.

@@ -6,8 +6,8 @@ use wavg::SurfacePoint;
 use wavg::Vector3;
 use wavg::apps::{BaseMesh, RemeshError, RemeshResult, Remesher};
 
+use crate::boundary::optional;
 use crate::boundary::{Failure, guard, guard_value, handle, handle_mut, product, slice};
-use crate::solver::optional;
 use crate::surface::wavg_surface;
 use crate::types::{wavg_point, wavg_status};
 
@@ -117,10 +117,11 @@ pub unsafe extern "C" fn wavg_remesher_new(
     })
 }
 
-/// Refines the base `levels` times (0 to 8) and smooths `smooth` steps; the result is
-/// kept for the count functions and `wavg_remesher_get`. With the same `levels` and
-/// `smooth` as the previous successful run, every search starts from that run's answer
-/// (the interactive case). Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL, `levels > 8`),
+/// Refines the base `levels` times (0 to 8) and smooths `smooth` steps (0 to 1000); the
+/// result is kept for the count functions and `wavg_remesher_get`. With the same `levels`
+/// and `smooth` as the previous successful run, every search starts from that run's answer
+/// (the interactive case). Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL, `levels > 8`,
+/// `smooth > 1000`),
 /// `WAVG_STATUS_NO_SOLUTION` (an average without a projection; the previous result is
 /// kept).
 ///
@@ -247,10 +248,10 @@ pub unsafe extern "C" fn wavg_remesher_get(
         // SAFETY: per this function's contract.
         let (points, xyz, sizes, idx) = unsafe {
             (
-                optional(out_points, nv),
-                optional(out_xyz, 3 * nv),
-                optional(out_face_sizes, nf),
-                optional(out_face_indices, ni),
+                optional(out_points, nv, "out_points")?,
+                optional(out_xyz, 3 * nv, "out_xyz")?,
+                optional(out_face_sizes, nf, "out_face_sizes")?,
+                optional(out_face_indices, ni, "out_face_indices")?,
             )
         };
         if let Some(points) = points {

@@ -10,7 +10,8 @@ use wavg::solve::SolveError;
 use wavg::{BatchWeights, ForwardOptions, RoundTrip, Solver, SurfacePoint};
 
 use crate::boundary::{
-    Failure, Outcome, guard, guard_value, handle, handle_mut, product, slice, slice_mut, status_of,
+    Failure, Outcome, guard, guard_value, handle, handle_mut, optional, product, slice, slice_mut,
+    status_of,
 };
 use crate::surface::wavg_surface;
 use crate::types::{wavg_point, wavg_status};
@@ -210,8 +211,8 @@ pub unsafe extern "C" fn wavg_forward(
             (
                 slice(weights, len, "weights")?,
                 slice_mut(out_points, n_queries, "out_points")?,
-                optional(out_xyz, product(n_queries, 3, "n_queries")?),
-                optional(out_statuses, n_queries),
+                optional(out_xyz, product(n_queries, 3, "n_queries")?, "out_xyz")?,
+                optional(out_statuses, n_queries, "out_statuses")?,
             )
         };
         let rows: Vec<&[f64]> = weights.chunks_exact(n).collect();
@@ -351,15 +352,6 @@ fn verified_rows(
         .collect()
 }
 
-/// An optional output array: `None` for NULL.
-///
-/// # Safety
-/// `ptr` must be NULL or hold `len` writable, unaliased elements.
-pub(crate) unsafe fn optional<'a, T>(ptr: *mut T, len: usize) -> Option<&'a mut [T]> {
-    // SAFETY: per this function's contract.
-    (!ptr.is_null()).then(|| unsafe { std::slice::from_raw_parts_mut(ptr, len) })
-}
-
 /// Inverse problem for `n_points` surface points, in parallel: writes each point's
 /// anchor weights (a row of `n_anchors` doubles summing to 1) into `out_weights`
 /// (`n_points * n_anchors` doubles, row-major) and, unless NULL, `out_statuses[i]`.
@@ -400,7 +392,7 @@ pub unsafe extern "C" fn wavg_inverse(
                     product(n_points, n, "n_points")?,
                     "out_weights",
                 )?,
-                optional(out_statuses, n_points),
+                optional(out_statuses, n_points, "out_statuses")?,
             )
         };
         let rows = if verified {

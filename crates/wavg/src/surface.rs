@@ -94,6 +94,22 @@ impl Surface {
                  one (keep the largest with `wavg repair --largest-component`)"
             )));
         }
+        let n = self.inner.mesh.n_vertices();
+        if n < 4 {
+            return Err(Error::Unsuitable(format!(
+                "the mesh has {n} vertices; the embedding needs at least 4"
+            )));
+        }
+        let largest = (self.inner.mesh.positions.iter())
+            .map(|p| p.amax())
+            .fold(0.0, f64::max);
+        if largest > wavg_mesh::MAX_COORDINATE {
+            return Err(Error::Unsuitable(format!(
+                "the mesh's coordinates reach {largest:e}, beyond the supported magnitude of \
+                 {:e}: scale the mesh down",
+                wavg_mesh::MAX_COORDINATE
+            )));
+        }
         let (embedding, report) = wavg_embed::precompute(&self.inner.mesh, options, progress)?;
         self.set_embedding(embedding)?;
         Ok(report)

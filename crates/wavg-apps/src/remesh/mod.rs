@@ -37,6 +37,11 @@ use plan::{Plan, Stencils};
 /// Most levels of splitting accepted (each multiplies the face count by about four).
 pub const MAX_LEVELS: usize = 8;
 
+/// Most smoothing steps [`Remesher::remesh`] takes: each step's answers are kept as the
+/// next run's warm starts, so memory grows with the steps (a few are typical; smoothing
+/// has long converged after this many).
+pub const MAX_SMOOTH_STEPS: usize = 1000;
+
 /// Default largest distance of a base vertex from the surface, over the surface's
 /// bounding-box diagonal: generous, since the control cage of a subdivision surface lies
 /// several percent of the diagonal off the surface, yet a base in other coordinates (or
@@ -296,7 +301,8 @@ impl Remesher {
         }
     }
 
-    /// Splits `levels` times (at most [`MAX_LEVELS`]) and smooths `smooth` steps. When the
+    /// Splits `levels` times (at most [`MAX_LEVELS`]) and smooths `smooth` steps (at most
+    /// [`MAX_SMOOTH_STEPS`]). When the
     /// previous run had the same `levels` and `smooth`, every search starts from that
     /// run's answer for the same vertex and stage; otherwise from the stencil's first
     /// point. On error the previous run's answers are kept.
@@ -304,6 +310,11 @@ impl Remesher {
         if levels > MAX_LEVELS {
             return Err(RemeshError::InvalidParameter(format!(
                 "at most {MAX_LEVELS} levels, got {levels}"
+            )));
+        }
+        if smooth > MAX_SMOOTH_STEPS {
+            return Err(RemeshError::InvalidParameter(format!(
+                "at most {MAX_SMOOTH_STEPS} smoothing steps, got {smooth}"
             )));
         }
         let (plan, faces) = self.plan_for(levels);
