@@ -49,6 +49,10 @@ pub struct Args {
     /// Write the mesh the embedding belongs to (after --largest-component) to this file.
     #[arg(long, value_name = "MESH")]
     pub repaired_mesh: Option<PathBuf>,
+    /// Worker threads (default: all cores; at most 4 per CPU, or 64). The embedding does
+    /// not depend on it.
+    #[arg(long, value_parser = crate::common::parse_threads)]
+    pub threads: Option<usize>,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -114,7 +118,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ..defaults
     };
     let bars = Bars::new(std::io::stderr().is_terminal(), interrupted);
-    let result = embed::precompute(&mesh, &opts, &bars);
+    let result =
+        crate::textio::with_threads(args.threads, || embed::precompute(&mesh, &opts, &bars))?;
     bars.clear();
     let (embedding, report) = result.map_err(|e| match e {
         embed::EmbedError::InvalidArgument(m) => CliError::input(format!("{}: {m}", args.mesh)),

@@ -260,3 +260,15 @@ fn arguments_that_would_be_ignored_or_overwrite_the_input_are_refused() {
     assert_eq!(std::fs::read(&mesh).unwrap(), before);
     assert!(!wavg_out.exists() && !other.exists());
 }
+
+/// `--threads` limits the workers and does not change the embedding, byte for byte.
+#[test]
+fn the_thread_count_does_not_change_the_embedding() {
+    let dir = tempfile::tempdir().unwrap();
+    let (one, two) = (dir.path().join("1.wavg"), dir.path().join("2.wavg"));
+    for (out, threads) in [(&one, "1"), (&two, "2")] {
+        let o = out.to_str().unwrap();
+        wavg_ok(&["precompute", "builtin:torus", "-o", o, "--threads", threads]);
+    }
+    assert_eq!(std::fs::read(&one).unwrap(), std::fs::read(&two).unwrap());
+}
