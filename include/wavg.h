@@ -141,7 +141,8 @@ extern "C" {
 #endif // __cplusplus
 
 // Samples a curve on the surface whose control points are the solver's anchors, in
-// anchor order: with `bezier`, a Bézier curve of degree `n_anchors - 1`; otherwise a
+// anchor order: with `bezier`, a Bézier curve of degree `n_anchors - 1` (`degree` and
+// `closed` are then ignored); otherwise a
 // uniform B-spline of `degree` (at least 1, with at least `degree + 1` anchors), clamped
 // (from the first anchor to the last) or, with `closed`, periodic (a loop). Each of the
 // `n_samples` samples (uniform in the curve parameter) is the weighted average of the
