@@ -4,7 +4,7 @@
 
 mod common;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use common::{json_object, sphere_anchors, wavg, wavg_ok};
 
@@ -71,14 +71,21 @@ fn correspond_a_surface_onto_itself() {
     }
 }
 
-#[test]
-fn decal_writes_one_vt_per_vertex() {
-    let dir = tempfile::tempdir().unwrap();
-    let a = dir.path().join("a.txt");
-    std::fs::write(&a, "v 0\nv 1\nv 2\nv 3\n").unwrap();
-    let uv = dir.path().join("uv.txt");
-    std::fs::write(&uv, "0 0\n1 0\n0 1\n1 1\n").unwrap();
-    let out = dir.path().join("d.obj");
+/// `wavg decal --json` on `builtin:icosphere` with these anchors and (u, v) lines, into
+/// `dir/d.obj`: the JSON object, its keys and the output path.
+fn decal_json(
+    dir: &Path,
+    anchors: &str,
+    uv: &str,
+) -> (
+    serde_json::Map<String, serde_json::Value>,
+    Vec<String>,
+    PathBuf,
+) {
+    let (a, u) = (dir.join("a.txt"), dir.join("uv.txt"));
+    std::fs::write(&a, anchors).unwrap();
+    std::fs::write(&u, uv).unwrap();
+    let out = dir.join("d.obj");
     let r = wavg_ok(&[
         "decal",
         "--mesh",
@@ -86,12 +93,19 @@ fn decal_writes_one_vt_per_vertex() {
         "--anchors",
         &s(&a),
         "--uv",
-        &s(&uv),
+        &s(&u),
         "-o",
         &s(&out),
         "--json",
     ]);
     let (o, keys) = json_object(&r);
+    (o, keys, out)
+}
+
+#[test]
+fn decal_writes_one_vt_per_vertex() {
+    let dir = tempfile::tempdir().unwrap();
+    let (o, keys, out) = decal_json(dir.path(), "v 0\nv 1\nv 2\nv 3\n", "0 0\n1 0\n0 1\n1 1\n");
     has_keys(
         &keys,
         &[
@@ -355,23 +369,7 @@ fn bad_input_writes_nothing() {
 #[test]
 fn a_decal_without_measured_faces_reports_no_stretch() {
     let dir = tempfile::tempdir().unwrap();
-    let (a, uv) = (dir.path().join("a.txt"), dir.path().join("uv.txt"));
-    std::fs::write(&a, "v 0\n").unwrap();
-    std::fs::write(&uv, "0 0\n").unwrap();
-    let out = dir.path().join("d.obj");
-    let r = wavg_ok(&[
-        "decal",
-        "--mesh",
-        "builtin:icosphere",
-        "--anchors",
-        &s(&a),
-        "--uv",
-        &s(&uv),
-        "-o",
-        &s(&out),
-        "--json",
-    ]);
-    let (o, _) = json_object(&r);
+    let (o, _, _) = decal_json(dir.path(), "v 0\n", "0 0\n");
     assert!(o["valid_fraction"].as_f64().unwrap() < 0.01, "{o:?}");
     assert!(
         o["stretch"].is_null() && o["stretch_best95"].is_null(),
