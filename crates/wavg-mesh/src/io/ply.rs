@@ -117,6 +117,16 @@ fn read(bytes: &[u8]) -> Result<(Vec<PlyVertex>, Vec<PlyFace>)> {
         let mut reader = Reader::new(bytes);
         let header = Parser::<PlyVertex>::new().read_header(&mut reader)?;
         let (mut verts, mut faces) = (Vec::new(), Vec::new());
+        // An element without properties takes no bytes per record in binary files, so no
+        // end of data stops its count: bound it by the file's length instead.
+        if let Some(def) =
+            (header.elements.values()).find(|d| d.properties.is_empty() && d.count > bytes.len())
+        {
+            return Ok(Err(format!(
+                "element '{}' has no properties but declares {} records",
+                def.name, def.count
+            )));
+        }
         for (name, def) in &header.elements {
             match name.as_str() {
                 "vertex" => {
@@ -142,10 +152,11 @@ fn read(bytes: &[u8]) -> Result<(Vec<PlyVertex>, Vec<PlyFace>)> {
                 }
             }
         }
-        Ok::<_, ply_rs_bw::parser::ParseError>((verts, faces))
+        Ok::<_, ply_rs_bw::parser::ParseError>(Ok((verts, faces)))
     });
     match res {
-        Ok(Ok(elements)) => Ok(elements),
+        Ok(Ok(Ok(elements))) => Ok(elements),
+        Ok(Ok(Err(message))) => Err(ParseError::new(0, format!("PLY: {message}"))),
         Ok(Err(e)) => Err(ParseError::new(
             e.line().unwrap_or(0),
             format!(
@@ -367,6 +378,24 @@ property int vertex2\nend_header\n"
     }
 
     /// What `write` produces reads back the same, texture coordinates included.
+    #[test]
+    fn an_element_without_properties_cannot_declare_more_records_than_bytes() {
+        // Found by the fuzzer: no property, so no record consumes data and only the count
+        // bounded the work (an out-of-memory).
+        let mut file = b"ply\nformat binary_little_endian 1.0\nelement vertex 888888888880\n\
+                         end_header\n"
+            .to_vec();
+        file.extend_from_slice(&[0u8; 64]);
+        let err = parse(&file).unwrap_err();
+        assert!(err.message.contains("no properties"), "{}", err.message);
+        // A handful of such records is fine (they are skipped).
+        let ok = b"ply\nformat ascii 1.0\nelement extra 2\nelement vertex 3\nproperty float x\n\
+                   property float y\nproperty float z\nelement face 1\n\
+                   property list uchar int vertex_indices\nend_header\n\n\n0 0 0\n1 0 0\n0 1 0\n\
+                   3 0 1 2\n";
+        assert_eq!(parse(ok).unwrap().0.n_faces(), 1);
+    }
+
     #[test]
     fn written_binary_reads_back() {
         let positions = vec![
