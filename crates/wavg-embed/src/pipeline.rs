@@ -191,13 +191,8 @@ pub fn precompute(
 ) -> Result<(Embedding, Report), EmbedError> {
     let start = Instant::now();
     let n = mesh.n_vertices();
-    let largest = mesh.positions.iter().map(|p| p.amax()).fold(0.0, f64::max);
-    if largest > wavg_mesh::MAX_COORDINATE {
-        return Err(EmbedError::InvalidArgument(format!(
-            "the mesh's coordinates reach {largest:e}, beyond the supported magnitude of {:e}: \
-             scale the mesh down",
-            wavg_mesh::MAX_COORDINATE
-        )));
+    if let Some(why) = wavg_mesh::coordinates_out_of_range(mesh) {
+        return Err(EmbedError::InvalidArgument(why));
     }
     let components = mesh.topology().n_components();
     if components != 1 {

@@ -75,3 +75,21 @@ pub use error::MeshError;
 /// for sums of a few of them). Larger meshes are refused with an error that says to scale
 /// them down; valid meshes beyond it can still be inspected and repaired.
 pub const MAX_COORDINATE: f64 = 1e37;
+
+/// Why `mesh` is beyond [`MAX_COORDINATE`] (a message that names the remedy), or `None`.
+///
+/// ```
+/// let mut m = wavg_mesh::procedural::icosphere(0);
+/// assert!(wavg_mesh::coordinates_out_of_range(&m).is_none());
+/// m.positions[3].x = -2e38;
+/// assert!(wavg_mesh::coordinates_out_of_range(&m).unwrap().contains("scale the mesh down"));
+/// ```
+pub fn coordinates_out_of_range(mesh: &TriMesh) -> Option<String> {
+    let largest = mesh.positions.iter().map(|p| p.amax()).fold(0.0, f64::max);
+    (largest > MAX_COORDINATE).then(|| {
+        format!(
+            "the mesh's coordinates reach {largest:e}, beyond the supported magnitude of \
+             {MAX_COORDINATE:e}: scale the mesh down"
+        )
+    })
+}

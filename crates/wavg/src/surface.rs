@@ -100,15 +100,8 @@ impl Surface {
                 "the mesh has {n} vertices; the embedding needs at least 4"
             )));
         }
-        let largest = (self.inner.mesh.positions.iter())
-            .map(|p| p.amax())
-            .fold(0.0, f64::max);
-        if largest > wavg_mesh::MAX_COORDINATE {
-            return Err(Error::Unsuitable(format!(
-                "the mesh's coordinates reach {largest:e}, beyond the supported magnitude of \
-                 {:e}: scale the mesh down",
-                wavg_mesh::MAX_COORDINATE
-            )));
+        if let Some(why) = wavg_mesh::coordinates_out_of_range(&self.inner.mesh) {
+            return Err(Error::Unsuitable(why));
         }
         let (embedding, report) = wavg_embed::precompute(&self.inner.mesh, options, progress)?;
         self.set_embedding(embedding)?;
