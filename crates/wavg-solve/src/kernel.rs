@@ -156,6 +156,20 @@ pub struct InverseScratch {
 
 /// Solves the inverse problem for one point: `psi` is the tangent plane at the point,
 /// `yhat` its embedded position; writes one weight per anchor into `out` (cleared first).
+/// The error for kernel distances that are not finite: NaN comes from non-finite
+/// coordinates; infinity with finite coordinates from `gamma` times a squared distance
+/// overflowing.
+pub(crate) fn distance_overflow(nan: bool, gamma: f64) -> SolveError {
+    SolveError::InvalidParameter(if nan {
+        "non-finite anchor or point coordinates".into()
+    } else {
+        format!(
+            "gamma {gamma:e} is too large for these anchors: gamma times a squared distance \
+             overflows"
+        )
+    })
+}
+
 /// The weights sum to 1 (renormalised, so to rounding), are one-hot (split evenly among
 /// coincident anchors) when the point is exactly at an anchor, and tend to that smoothly.
 ///
@@ -295,9 +309,7 @@ pub(crate) fn kernel(
         bad |= d.is_nan();
     }
     if bad || !dmax.is_finite() {
-        return Err(SolveError::InvalidParameter(
-            "non-finite anchor or point coordinates".into(),
-        ));
+        return Err(distance_overflow(bad, gamma));
     }
     if dmin <= 0.0 {
         one_hot(&ds[..n], &mut out[..n]);

@@ -81,8 +81,9 @@ impl PenaltySystem {
             })
             .collect();
         if d.iter().any(|x| !x.is_finite()) {
-            return Err(SolveError::InvalidParameter(
-                "non-finite anchor or point coordinates".into(),
+            return Err(crate::kernel::distance_overflow(
+                d.iter().any(|x| x.is_nan()),
+                gamma,
             ));
         }
         let mut sorted = d.clone();

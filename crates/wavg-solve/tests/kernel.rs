@@ -206,6 +206,35 @@ fn degenerate_inputs_are_typed_errors() {
     ));
 }
 
+/// A `gamma` whose product with a squared distance overflows is named as the cause;
+/// NaN coordinates are named as theirs.
+#[test]
+fn overflowing_distances_name_their_cause() {
+    let mut psi = Mat2x8::zeros();
+    psi[(0, 0)] = 1.0;
+    psi[(1, 1)] = 1.0;
+    let p = |x: f64, y: f64, z: f64| Vec8::from_fn(|k, _| [x, y, z, 0.0, 0.0, 0.0, 0.0, 0.0][k]);
+    let ys = [p(0.0, 0.0, 10.0), p(1.0, 0.0, 10.0), p(0.0, 1.0, 10.0)];
+    let at = p(0.2, 0.2, 0.0);
+    let message = |r: Result<Vec<f64>, SolveError>| match r {
+        Err(SolveError::InvalidParameter(m)) => m,
+        other => panic!("expected an invalid parameter, got {other:?}"),
+    };
+    assert!(solve(&psi, &at, &ys, 1e300).is_ok());
+    let m = message(solve(&psi, &at, &ys, 1e308));
+    assert!(m.contains("gamma 1e308 is too large"), "{m}");
+    let m = message(wavg_solve::internal::penalized_weights(
+        &psi,
+        &at,
+        &AnchorCoords::from_points(&ys),
+        1e308,
+        10.0,
+    ));
+    assert!(m.contains("gamma 1e308 is too large"), "{m}");
+    let m = message(solve(&psi, &p(f64::NAN, 0.0, 0.0), &ys, 10.0));
+    assert!(m.contains("non-finite"), "{m}");
+}
+
 #[test]
 fn locality_far_anchors_get_small_weights() {
     // Anchors on a line-free spread in the plane; the point sits next to anchor 0.

@@ -4,7 +4,8 @@
 //! of steps that grows with the mesh's resolution (about the square root of its vertex
 //! count) times the distance to cover; a greedy walk over the grid's cells, each step
 //! comparing the neighbouring cells' vertices in all eight coordinates, covers most of the
-//! distance in steps of a cell.
+//! distance in steps of a cell. Each cell keeps a copy of its vertex's coordinates, so a
+//! step reads a few neighbouring rows of the grid rather than 26 scattered vertex records.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -21,6 +22,14 @@ const MAX_CELLS: u32 = 128;
 /// on from where it stopped).
 const MAX_CELL_STEPS: usize = 64;
 
+/// A cell's vertex and a copy of its walk coordinates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
+struct Cell {
+    c: [u16; 8],
+    v: VertexId,
+}
+
 /// The grid: cell `(i, j, k)` over walk axes `axes` holds a vertex: the most central one
 /// inside it, or for an empty cell that of the nearest cell with one.
 #[derive(Clone, Debug)]
@@ -30,7 +39,7 @@ pub(super) struct StartGrid {
     /// Cells per walk unit.
     inv_cell: f32,
     dims: [u32; 3],
-    cells: Vec<u32>,
+    cells: Vec<Cell>,
 }
 
 impl StartGrid {
@@ -87,28 +96,34 @@ impl StartGrid {
                 let key = (u64::from(d2.to_bits()) << 32) | v as u64;
                 best[cell].fetch_min(key, Ordering::Relaxed);
             });
-        grid.cells = best
+        let mut ids: Vec<VertexId> = best
             .into_iter()
             .map(|b| match b.into_inner() {
                 u64::MAX => NONE,
                 k => k as u32,
             })
             .collect();
-        grid.fill_empty_cells();
+        grid.fill_empty_cells(&mut ids);
+        grid.cells = ids
+            .into_iter()
+            .map(|v| Cell {
+                c: walk[v as usize].c,
+                v,
+            })
+            .collect();
         grid
     }
 
     /// Gives every empty cell the vertex of the nearest cell holding one (breadth-first
     /// over face-adjacent cells from all occupied cells in index order: deterministic).
-    fn fill_empty_cells(&mut self) {
-        let mut queue: std::collections::VecDeque<usize> = (0..self.cells.len())
-            .filter(|&c| self.cells[c] != NONE)
-            .collect();
+    fn fill_empty_cells(&self, cells: &mut [VertexId]) {
+        let mut queue: std::collections::VecDeque<usize> =
+            (0..cells.len()).filter(|&c| cells[c] != NONE).collect();
         while let Some(c) = queue.pop_front() {
-            let v = self.cells[c];
+            let v = cells[c];
             for n in self.neighbours(c, false).into_iter().flatten() {
-                if self.cells[n] == NONE {
-                    self.cells[n] = v;
+                if cells[n] == NONE {
+                    cells[n] = v;
                     queue.push_back(n);
                 }
             }
@@ -162,20 +177,26 @@ impl StartGrid {
     }
 
     /// Greedy walk over the cells from the one holding walk point `p`: moves to the
-    /// neighbouring cell whose vertex is closest to `p` (squared distance `dist2`) while
-    /// that improves; returns the last cell's vertex and its squared distance.
+    /// neighbouring cell whose vertex is closest to `p` (squared distance in walk units)
+    /// while that improves; returns the last cell's vertex and its squared distance.
     #[inline]
-    pub(super) fn walk(&self, p: &[f32; 8], dist2: impl Fn(VertexId) -> f32) -> (VertexId, f32) {
+    pub(super) fn walk(&self, p: &[f32; 8]) -> (VertexId, f32) {
+        let dist2 = |cell: &Cell| {
+            #[cfg(target_arch = "x86_64")]
+            return crate::arch::dist2_u16(&cell.c, p);
+            #[cfg(not(target_arch = "x86_64"))]
+            super::layout::wdist2(&cell.c.map(f32::from), p)
+        };
         let mut c = self.cell_of(p).0;
-        let mut v = self.cells[c];
-        let mut d = dist2(v);
+        let mut v = self.cells[c].v;
+        let mut d = dist2(&self.cells[c]);
         for _ in 0..MAX_CELL_STEPS {
             let mut next = c;
             for n in self.neighbours(c, true).into_iter().flatten() {
-                let u = self.cells[n];
-                let du = dist2(u);
+                let cell = &self.cells[n];
+                let du = dist2(cell);
                 if du < d {
-                    (next, v, d) = (n, u, du);
+                    (next, v, d) = (n, cell.v, du);
                 }
             }
             if next == c {
@@ -220,9 +241,7 @@ impl Projector {
             return start;
         }
         let yw = self.walk_point(y);
-        let (v, d) = self
-            .starts
-            .walk(&yw, |u| self.walk_coords[u as usize].dist2(&yw));
+        let (v, d) = self.starts.walk(&yw);
         if d < ws.dist2(&yw) { v } else { start }
     }
 }
@@ -240,12 +259,14 @@ mod tests {
         let emb = Arc::new(EmbeddedMesh::from_positions(m));
         let p = Projector::new(emb.clone()).unwrap();
         let g = &p.starts;
-        assert!(g.cells.len() > 100 && g.cells.iter().all(|&v| v != NONE));
+        assert!(g.cells.len() > 100 && g.cells.iter().all(|c| c.v != NONE));
         let mut own = vec![false; g.cells.len()];
         for (v, w) in p.walk_coords.iter().enumerate() {
             own[g.cell_of(&w.unpack()).0] = true;
             // A vertex's cell holds a vertex of that cell.
-            let u = g.cells[g.cell_of(&w.unpack()).0];
+            let cell = g.cells[g.cell_of(&w.unpack()).0];
+            assert_eq!(cell.c, p.walk_coords[cell.v as usize].c);
+            let u = cell.v;
             assert_eq!(
                 g.cell_of(&p.walk_coords[u as usize].unpack()).0,
                 g.cell_of(&w.unpack()).0,
