@@ -154,8 +154,6 @@ pub struct InverseScratch {
     d: Vec<f64>,
 }
 
-/// Solves the inverse problem for one point: `psi` is the tangent plane at the point,
-/// `yhat` its embedded position; writes one weight per anchor into `out` (cleared first).
 /// The error for kernel distances that are not finite: NaN comes from non-finite
 /// coordinates; infinity with finite coordinates from `gamma` times a squared distance
 /// overflowing.
@@ -170,6 +168,8 @@ pub(crate) fn distance_overflow(nan: bool, gamma: f64) -> SolveError {
     })
 }
 
+/// Solves the inverse problem for one point: `psi` is the tangent plane at the point,
+/// `yhat` its embedded position; writes one weight per anchor into `out` (cleared first).
 /// The weights sum to 1 (renormalised, so to rounding), are one-hot (split evenly among
 /// coincident anchors) when the point is exactly at an anchor, and tend to that smoothly.
 ///

@@ -377,7 +377,6 @@ property int vertex2\nend_header\n"
         assert!(parse(&b[..b.len() - 12]).is_err());
     }
 
-    /// What `write` produces reads back the same, texture coordinates included.
     #[test]
     fn an_element_without_properties_cannot_declare_more_records_than_bytes() {
         // Found by the fuzzer: no property, so no record consumes data and only the count
@@ -396,6 +395,7 @@ property int vertex2\nend_header\n"
         assert_eq!(parse(ok).unwrap().0.n_faces(), 1);
     }
 
+    /// What `write` produces reads back the same, texture coordinates included.
     #[test]
     fn written_binary_reads_back() {
         let positions = vec![

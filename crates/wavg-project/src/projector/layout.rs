@@ -38,10 +38,7 @@ impl WalkPoint {
     /// [`WalkPoint::unpack`], bit for bit, with the conversion done four lanes at a time.
     #[inline(always)]
     pub(super) fn dist2(&self, y: &[f32; 8]) -> f32 {
-        #[cfg(target_arch = "x86_64")]
-        return crate::arch::dist2_u16(&self.c, y);
-        #[cfg(not(target_arch = "x86_64"))]
-        wdist2(&self.unpack(), y)
+        dist2_packed(&self.c, y)
     }
 
     #[inline(always)]
@@ -61,6 +58,16 @@ impl WalkPoint {
             topo.ring_faces(v)
         }
     }
+}
+
+/// [`wdist2`] from packed 16-bit walk coordinates `c` to `y`, bit for bit, with the
+/// conversion done four lanes at a time where the target allows.
+#[inline(always)]
+pub(super) fn dist2_packed(c: &[u16; 8], y: &[f32; 8]) -> f32 {
+    #[cfg(target_arch = "x86_64")]
+    return crate::arch::dist2_u16(c, y);
+    #[cfg(not(target_arch = "x86_64"))]
+    wdist2(&c.map(f32::from), y)
 }
 
 #[cfg_attr(target_arch = "x86_64", allow(dead_code))] // the reference for `dist2`

@@ -181,12 +181,7 @@ impl StartGrid {
     /// while that improves; returns the last cell's vertex and its squared distance.
     #[inline]
     pub(super) fn walk(&self, p: &[f32; 8]) -> (VertexId, f32) {
-        let dist2 = |cell: &Cell| {
-            #[cfg(target_arch = "x86_64")]
-            return crate::arch::dist2_u16(&cell.c, p);
-            #[cfg(not(target_arch = "x86_64"))]
-            super::layout::wdist2(&cell.c.map(f32::from), p)
-        };
+        let dist2 = |cell: &Cell| super::layout::dist2_packed(&cell.c, p);
         let mut c = self.cell_of(p).0;
         let mut v = self.cells[c].v;
         let mut d = dist2(&self.cells[c]);
