@@ -1,6 +1,7 @@
-//! The Rust examples step of `cargo xtask test`: runs every example of the facade crate,
-//! then builds and runs `quickstart.rs` unchanged in a crate outside the workspace that
-//! depends only on `wavg` (by path), as a new user's project would.
+//! The Rust examples step of `cargo xtask test`: runs every example of the facade crate
+//! (built by the test step, which compiles examples), then builds and runs `quickstart.rs`
+//! unchanged in a crate outside the workspace that depends only on `wavg` (by path), as a
+//! new user's project would.
 
 use std::path::Path;
 use std::process::Command;
@@ -17,40 +18,25 @@ pub fn run(root: &Path) -> Result<(), String> {
         })
         .collect();
     names.sort();
+    let bin_dir = root.join("target/debug/examples");
     for name in &names {
-        cargo(
-            root,
-            &[
-                "run",
-                "--release",
-                "--quiet",
-                "-p",
-                "wavg",
-                "--example",
-                name,
-            ],
-        )?;
+        let exe = bin_dir.join(name);
+        eprintln!("    {}", exe.display());
+        let ok = Command::new(&exe)
+            .current_dir(root)
+            .status()
+            .is_ok_and(|s| s.success());
+        if !ok {
+            return Err(format!(
+                "example {name} failed (or was not built: `cargo test --workspace` builds it)"
+            ));
+        }
     }
     outside_crate(root)
 }
 
-fn cargo(dir: &Path, args: &[&str]) -> Result<(), String> {
-    eprintln!("==> cargo {}", args.join(" "));
-    let ok = Command::new("cargo")
-        .args(args)
-        .current_dir(dir)
-        .env("CARGO_TARGET_DIR", dir.join("target"))
-        .status()
-        .is_ok_and(|s| s.success());
-    if ok {
-        Ok(())
-    } else {
-        Err(format!("cargo {} failed", args.join(" ")))
-    }
-}
-
 /// A crate in `target/outside-quickstart` with `wavg` as its only dependency and the
-/// workspace's lock file and release profile, so it reuses the built dependencies.
+/// workspace's lock file and dev profile, so it reuses the built dependencies.
 fn outside_crate(root: &Path) -> Result<(), String> {
     let dir = root.join("target/outside-quickstart");
     let src = dir.join("src");
@@ -58,7 +44,8 @@ fn outside_crate(root: &Path) -> Result<(), String> {
     let manifest = format!(
         "[package]\nname = \"outside-quickstart\"\nversion = \"0.0.0\"\nedition = \"2024\"\n\
          publish = false\n\n[dependencies]\nwavg = {{ path = {:?} }}\n\n\
-         [profile.release]\ndebug = \"line-tables-only\"\n\n[workspace]\n",
+         [profile.dev]\nopt-level = 2\ndebug = \"line-tables-only\"\n\n\
+         [profile.dev.package.\"*\"]\nopt-level = 3\n\n[workspace]\n",
         root.join("crates/wavg").display().to_string()
     );
     let write = |name: &Path, body: &[u8]| {
@@ -72,7 +59,7 @@ fn outside_crate(root: &Path) -> Result<(), String> {
     write(&src.join("main.rs"), &quickstart)?;
     eprintln!("==> quickstart.rs as a crate outside the workspace");
     let ok = Command::new("cargo")
-        .args(["run", "--release", "--quiet"])
+        .args(["run", "--quiet"])
         .current_dir(&dir)
         .env("CARGO_TARGET_DIR", root.join("target"))
         .status()

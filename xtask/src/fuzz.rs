@@ -1,9 +1,13 @@
-//! `cargo xtask fuzz [--seconds N] [--target NAME]`: builds the coverage-guided fuzz targets in `fuzz/`
-//! (cargo-fuzz, libFuzzer, no sanitizer, so the stable toolchain suffices), seeds their
-//! corpora from meshes the project generates, and runs each target for N seconds.
+//! `cargo xtask fuzz [--seconds N] [--target NAME]`: builds the coverage-guided fuzz targets
+//! in `fuzz/` (libFuzzer through libfuzzer-sys, with the coverage instrumentation cargo-fuzz
+//! would add and no sanitizer, so the stable toolchain and plain cargo suffice; no
+//! cargo-fuzz to install), seeds their corpora from meshes the project generates, and runs
+//! each target for N seconds.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+use crate::steps;
 
 /// The fuzz targets, in the order they run.
 pub const TARGETS: &[&str] = &[
@@ -24,29 +28,67 @@ fn max_len(target: &str) -> Option<usize> {
     (target == "mesh_read").then_some(4096)
 }
 
-/// Runs every target (or only `only`) for `seconds` each; `Err` names the first failure.
+/// The smoke run of `cargo xtask test`: the build and `seconds` of every target, as two
+/// timed steps of `log`.
+pub fn smoke(root: &Path, seconds: u64, log: &mut steps::Log) -> bool {
+    let mut bin_dir = PathBuf::new();
+    log.run("fuzz build", || {
+        bin_dir = build(root)?;
+        Ok(())
+    }) && log.run(
+        &format!("fuzz smoke ({} targets x {seconds} s)", TARGETS.len()),
+        || run_built(root, &bin_dir, seconds, None),
+    )
+}
+
+/// Builds and runs every target (or only `only`) for `seconds` each; `Err` names the first
+/// failure.
 pub fn run(root: &Path, seconds: u64, only: Option<&str>) -> Result<(), String> {
-    ensure_cargo_fuzz()?;
+    let bin_dir = build(root)?;
+    run_built(root, &bin_dir, seconds, only)
+}
+
+/// Builds the targets with libFuzzer's instrumentation on the workspace's own crates (see
+/// [`crate::sancov`]), in the dev profile (optimised, debug assertions and overflow checks
+/// on, as cargo-fuzz builds); returns the folder of the binaries.
+fn build(root: &Path) -> Result<PathBuf, String> {
+    let xtask = std::env::current_exe().map_err(|e| format!("xtask's own path: {e}"))?;
+    let xtask = xtask.to_string_lossy();
+    steps::command_env(
+        root,
+        "cargo",
+        &["build", "-p", "wavg-fuzz", "--bins"],
+        &[
+            ("RUSTC_WORKSPACE_WRAPPER", &xtask),
+            (crate::sancov::ENV, "1"),
+        ],
+    )?;
+    Ok(root.join("target/debug"))
+}
+
+/// Runs the built targets from `bin_dir`.
+fn run_built(root: &Path, bin_dir: &Path, seconds: u64, only: Option<&str>) -> Result<(), String> {
     let fuzz_dir = root.join("fuzz");
     seed_corpora(root, &fuzz_dir)?;
     for target in TARGETS.iter().filter(|t| only.is_none_or(|o| o == **t)) {
         eprintln!("==> fuzz {target} for {seconds} s");
         let corpus = fuzz_dir.join("corpus").join(target);
         std::fs::create_dir_all(&corpus).map_err(|e| format!("{}: {e}", corpus.display()))?;
-        let status = Command::new("cargo")
-            .args(["fuzz", "run", "--sanitizer", "none", target])
+        let artifacts = fuzz_dir.join("artifacts").join(target);
+        std::fs::create_dir_all(&artifacts).map_err(|e| format!("{}: {e}", artifacts.display()))?;
+        let status = Command::new(bin_dir.join(target))
             .arg(&corpus)
             .args([
-                "--",
-                &format!("-max_total_time={seconds}"),
-                "-rss_limit_mb=4096",
-                "-timeout=20",
-                "-print_final_stats=1",
+                format!("-artifact_prefix={}/", artifacts.display()),
+                format!("-max_total_time={seconds}"),
+                "-rss_limit_mb=4096".into(),
+                "-timeout=20".into(),
+                "-print_final_stats=1".into(),
             ])
             .args(max_len(target).map(|n| format!("-max_len={n}")))
             .current_dir(&fuzz_dir)
             .status()
-            .map_err(|e| format!("could not start cargo fuzz: {e}"))?;
+            .map_err(|e| format!("could not start {target}: {e}"))?;
         if !status.success() {
             return Err(format!(
                 "fuzz target {target} failed ({status}); the input is in fuzz/artifacts/{target}/: \
@@ -55,26 +97,6 @@ pub fn run(root: &Path, seconds: u64, only: Option<&str>) -> Result<(), String> 
         }
     }
     Ok(())
-}
-
-fn ensure_cargo_fuzz() -> Result<(), String> {
-    let have = Command::new("cargo")
-        .args(["fuzz", "--version"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if have {
-        return Ok(());
-    }
-    eprintln!("==> installing cargo-fuzz (cargo install cargo-fuzz --locked)");
-    let ok = Command::new("cargo")
-        .args(["install", "cargo-fuzz", "--locked"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if ok {
-        Ok(())
-    } else {
-        Err("cargo-fuzz is missing and `cargo install cargo-fuzz --locked` failed".into())
-    }
 }
 
 /// Writes seed inputs made by the `wavg` binary from built-in meshes (and two small
@@ -86,15 +108,10 @@ fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
     if mesh_dir.is_dir() && file_dir.is_dir() && seeds.join("png_texture").is_dir() {
         return Ok(());
     }
-    let status = Command::new("cargo")
-        .args(["build", "--release", "--quiet", "-p", "wavg-cli"])
-        .current_dir(root)
-        .status()
-        .map_err(|e| format!("cargo build: {e}"))?;
-    if !status.success() {
-        return Err("building wavg for the seed corpora failed".into());
-    }
-    let wavg = root.join("target/release/wavg");
+    // The everyday build's feature set, so that after the tests nothing is rebuilt.
+    steps::cargo_workspace(root, &["build", "--all-targets"], &[])
+        .map_err(|e| format!("building wavg for the seed corpora: {e}"))?;
+    let wavg = root.join("target/debug/wavg");
     let tmp = seeds.join("tmp");
     for d in [&mesh_dir, &file_dir, &tmp] {
         std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;

@@ -8,15 +8,23 @@ mod examples;
 mod fuzz;
 mod lines;
 mod policy;
+mod sancov;
+mod steps;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
-use std::time::Instant;
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if std::env::var_os(sancov::ENV).is_some() {
+        return sancov::wrap(&args);
+    }
     match args.first().map(String::as_str) {
-        Some("test") => run_all(&workspace_root()),
+        Some("test") => match args.get(1).map(String::as_str) {
+            None => run_all(&workspace_root(), false),
+            Some("--quick") => run_all(&workspace_root(), true),
+            Some(_) => usage(),
+        },
         Some("fuzz") => match fuzz_args(&args[1..]) {
             Some((seconds, target)) => {
                 report(fuzz::run(&workspace_root(), seconds, target.as_deref()))
@@ -55,13 +63,14 @@ fn bench(root: &Path, args: &[String]) -> Result<(), String> {
 
 fn usage() -> ExitCode {
     eprintln!(
-        "usage: cargo xtask test | cargo xtask fuzz [--seconds N] [--target NAME] | cargo xtask bench NAME [ARGS] | cargo xtask lines\n\n  \
+        "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | cargo xtask bench NAME [ARGS] | cargo xtask lines\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
          and wavg-ffi), cargo doc (-D warnings), the examples \
          (and quickstart.rs as a crate outside the workspace), the C/C++ build (CMake: \
          libwavg, C tests, examples, OpenMesh harness) and ctest, a {SMOKE_SECONDS} s smoke \
-         run of every fuzz target\n  \
+         run of every fuzz target; a table of step times at the end\n  \
+         test --quick   rustfmt check, clippy and the unit tests, for the edit loop\n  \
          fuzz   every fuzz target (or only NAME) for N seconds (default 60) each\n  \
          bench  the timing script or experiment NAME (crates/wavg-bench/src/bin/NAME.rs) with ARGS\n  \
          lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])",
@@ -105,132 +114,69 @@ fn workspace_root() -> PathBuf {
         .to_path_buf()
 }
 
-/// One check: a name and a command line.
-struct Step {
-    name: &'static str,
-    program: &'static str,
-    args: &'static [&'static str],
-}
-
-const STEPS: &[Step] = &[
-    Step {
-        name: "format",
-        program: "cargo",
-        args: &["fmt", "--all", "--check"],
-    },
-    Step {
-        // The fuzz crate is outside the workspace (it needs its own lock file).
-        name: "format (fuzz)",
-        program: "cargo",
-        args: &["fmt", "--manifest-path", "fuzz/Cargo.toml", "--check"],
-    },
-    Step {
-        name: "clippy",
-        program: "cargo",
-        args: &[
-            "clippy",
-            "--workspace",
-            "--all-targets",
-            "--",
-            "-D",
-            "warnings",
-        ],
-    },
-    Step {
-        name: "tests",
-        program: "cargo",
-        args: &["test", "--workspace"],
-    },
-];
-
-fn run_all(root: &Path) -> ExitCode {
+/// `cargo xtask test [--quick]`: every check in CI's order, or with `--quick` the edit
+/// loop's (format, clippy, unit tests); a table of step times at the end either way.
+fn run_all(root: &Path, quick: bool) -> ExitCode {
     if let Err(msg) = check_tools() {
         eprintln!("xtask: {msg}");
         return ExitCode::FAILURE;
     }
     let data_dir = report_data_dir(root);
-    let total = Instant::now();
-    for step in STEPS {
-        let args: Vec<String> = step.args.iter().map(|a| a.to_string()).collect();
-        if !run_step(root, step.name, step.program, &args) {
-            return ExitCode::FAILURE;
-        }
-    }
-    eprintln!(
-        "==> source policy (files over {} lines, forbid(unsafe_code))",
-        lines::MAX_LINES
-    );
-    if let Err(msg) = lines::run(root).and_then(|()| policy::check_unsafe(root)) {
-        eprintln!("==> source policy FAILED: {msg}");
-        return ExitCode::FAILURE;
-    }
-    if !run_docs(root) {
-        return ExitCode::FAILURE;
-    }
-    if let Err(msg) = examples::run(root) {
-        eprintln!("==> examples FAILED: {msg}");
-        return ExitCode::FAILURE;
-    }
-    if let Err(msg) = cbuild::ensure_packages() {
-        eprintln!("xtask: {msg}");
-        return ExitCode::FAILURE;
-    }
-    for (name, program, args) in cbuild::steps(root, &data_dir) {
-        if !run_step(root, name, &program, &args) {
-            return ExitCode::FAILURE;
-        }
-    }
-    if let Err(msg) = fuzz::run(root, SMOKE_SECONDS, None) {
-        eprintln!("==> fuzz smoke FAILED: {msg}");
-        return ExitCode::FAILURE;
-    }
-    eprintln!(
-        "==> all checks passed in {:.1} s",
-        total.elapsed().as_secs_f64()
-    );
-    ExitCode::SUCCESS
-}
-
-/// `cargo doc --workspace --no-deps` with warnings as errors (broken or private links,
-/// malformed doc comments).
-fn run_docs(root: &Path) -> bool {
-    eprintln!("==> docs (RUSTDOCFLAGS=-D warnings cargo doc --workspace --no-deps)");
-    let t = Instant::now();
-    let status = Command::new("cargo")
-        .args(["doc", "--workspace", "--no-deps"])
-        .env("RUSTDOCFLAGS", "-D warnings")
-        .current_dir(root)
-        .status();
-    match status {
-        Ok(s) if s.success() => {
-            eprintln!("==> docs ok in {:.1} s", t.elapsed().as_secs_f64());
-            true
-        }
-        other => {
-            eprintln!("==> docs FAILED ({other:?})");
-            false
-        }
+    let mut log = steps::Log::default();
+    let ok = run_checks(root, &data_dir, quick, &mut log);
+    log.print_table();
+    if ok {
+        eprintln!("==> all checks passed");
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
     }
 }
 
-/// Runs one step from the repository root, reporting its time; false when it failed.
-fn run_step(root: &Path, name: &str, program: &str, args: &[String]) -> bool {
-    eprintln!("==> {name} ({program} {})", args.join(" "));
-    let t = Instant::now();
-    match Command::new(program).args(args).current_dir(root).status() {
-        Ok(s) if s.success() => {
-            eprintln!("==> {name} ok in {:.1} s", t.elapsed().as_secs_f64());
-            true
-        }
-        Ok(s) => {
-            eprintln!("==> {name} FAILED ({s})");
-            false
-        }
-        Err(e) => {
-            eprintln!("==> {name} could not start {program}: {e}");
-            false
-        }
+/// The checks, stopping at the first failure. One optimised dev build serves the tests, the
+/// examples, the C library and the fuzz seeds.
+fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -> bool {
+    let cargo = |args: &[&str]| steps::command(root, "cargo", args);
+    let ok = log.run("format", || cargo(&["fmt", "--all", "--check"]))
+        && log.run("clippy", || {
+            steps::cargo_workspace(
+                root,
+                &["clippy", "--all-targets"],
+                &["--", "-D", "warnings"],
+            )
+        });
+    if !ok {
+        return false;
     }
+    if quick {
+        return log.run("unit tests", || {
+            steps::cargo_workspace(root, &["test", "--lib", "--bins"], &[])
+        });
+    }
+    log.run("tests (unit, integration, doc; examples built)", || {
+        steps::cargo_workspace(root, &["test"], &[])
+    }) && log.run(
+        &format!(
+            "source policy (files over {} lines, forbid(unsafe_code))",
+            lines::MAX_LINES
+        ),
+        || lines::run(root).and_then(|()| policy::check_unsafe(root)),
+    ) && log.run("docs (cargo doc, warnings as errors)", || {
+        steps::command_env(
+            root,
+            "cargo",
+            &[&["doc", "--workspace"], steps::EXCLUDED, &["--no-deps"]].concat(),
+            &[("RUSTDOCFLAGS", "-D warnings")],
+        )
+    }) && log.run("examples", || examples::run(root))
+        && log.run("C/C++ packages", cbuild::ensure_packages)
+        && cbuild::steps(root, data_dir)
+            .into_iter()
+            .all(|(name, program, args)| {
+                let args: Vec<&str> = args.iter().map(String::as_str).collect();
+                log.run(name, || steps::command(root, &program, &args))
+            })
+        && fuzz::smoke(root, SMOKE_SECONDS, log)
 }
 
 /// rustfmt and clippy ship as rustup components; they cannot be downloaded from here, so
