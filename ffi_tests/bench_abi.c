@@ -1,8 +1,8 @@
 /* Timings of the C interface's batch calls (not a test): wavg_forward, wavg_inverse and
  * the verified wavg_inverse on QUERIES random points, best of ROUNDS.
  *   bench_abi MESH [QUERIES=100000] [ROUNDS=5] [ANCHORS=32]
- * The Rust side of the comparison, in the same process, is the abi_overhead example of
- * crates/wavg-ffi. */
+ * The Rust side of the comparison, in the same process, is the lab's abi_overhead program
+ * (cargo xtask lab abi_overhead). */
 #include <time.h>
 
 #include "check.h"

@@ -6,6 +6,7 @@
 mod cbuild;
 mod examples;
 mod fuzz;
+mod lab;
 mod lines;
 mod policy;
 mod sancov;
@@ -32,38 +33,14 @@ fn main() -> ExitCode {
             None => usage(),
         },
         Some("lines") => report(lines::run(&workspace_root())),
-        Some("bench") if args.len() > 1 => report(bench(&workspace_root(), &args[1..])),
+        Some("lab") => report(lab::run(&workspace_root(), &args[1..])),
         _ => usage(),
-    }
-}
-
-/// `cargo xtask bench NAME [ARGS...]`: runs the timing script or experiment NAME (a binary
-/// of the `wavg-bench` crate) in release mode with ARGS.
-fn bench(root: &Path, args: &[String]) -> Result<(), String> {
-    let mut cmd = Command::new("cargo");
-    cmd.args([
-        "run",
-        "--release",
-        "--quiet",
-        "-p",
-        "wavg-bench",
-        "--bin",
-        &args[0],
-        "--",
-    ])
-    .args(&args[1..])
-    .current_dir(root);
-    let ok = cmd.status().is_ok_and(|s| s.success());
-    if ok {
-        Ok(())
-    } else {
-        Err(format!("bench {} failed", args[0]))
     }
 }
 
 fn usage() -> ExitCode {
     eprintln!(
-        "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | cargo xtask bench NAME [ARGS] | cargo xtask lines\n\n  \
+        "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | cargo xtask lab [NAME ARGS] | cargo xtask lines\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
          and wavg-ffi), cargo doc (-D warnings), the examples \
@@ -72,7 +49,8 @@ fn usage() -> ExitCode {
          run of every fuzz target; a table of step times at the end\n  \
          test --quick   rustfmt check, clippy and the unit tests, for the edit loop\n  \
          fuzz   every fuzz target (or only NAME) for N seconds (default 60) each\n  \
-         bench  the timing script or experiment NAME (crates/wavg-bench/src/bin/NAME.rs) with ARGS\n  \
+         lab    build the lab (lab/, not a default member), or run its program NAME \
+         (lab/src/bin/NAME.rs, release mode) with ARGS\n  \
          lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])",
         MAX = lines::MAX_LINES
     );

@@ -7,7 +7,7 @@ use std::path::Path;
 /// Crates allowed to contain `unsafe` blocks (each keeps them in one module).
 const UNSAFE_ALLOWED: [&str; 2] = ["wavg-project", "wavg-ffi"];
 
-/// `Err` names every crate root (library or binary) under `crates/` and `xtask` that
+/// `Err` names every crate root (library or binary) under `crates/`, `xtask` and `lab` that
 /// lacks `#![forbid(unsafe_code)]` without being allowed `unsafe`.
 pub fn check_unsafe(root: &Path) -> Result<(), String> {
     let mut dirs: Vec<_> = std::fs::read_dir(root.join("crates"))
@@ -17,6 +17,7 @@ pub fn check_unsafe(root: &Path) -> Result<(), String> {
         .filter(|p| p.is_dir())
         .collect();
     dirs.push(root.join("xtask"));
+    dirs.push(root.join("lab"));
     dirs.sort();
     let mut missing = Vec::new();
     for dir in dirs {

@@ -1,7 +1,7 @@
 //! Asymmetry of the full landmark distance matrix (fast marching from every landmark) and
 //! the time of those runs: the measure behind the fast-marching symmetry test.
 //!
-//! `cargo run --release -p wavg-bench --bin symmetry -- [--landmarks N]
+//! `cargo xtask lab symmetry [--landmarks N]
 //! [--near-field EDGES] [MESH...]`
 //! (default meshes: pig, camelhead, fertility from the shared data folder). `WORST=1` lists
 //! the most asymmetric pairs with both distances in mean edge lengths.
@@ -24,7 +24,7 @@ fn main() {
         near_field = args[i + 1].parse().expect("--near-field EDGES");
         args.drain(i..i + 2);
     }
-    let Some(paths) = wavg_bench::mesh_paths(
+    let Some(paths) = wavg_lab::mesh_paths(
         &args,
         &["pig.off", "camelhead.off", "fertility.off"],
         "symmetry",

@@ -13,7 +13,7 @@
 //!   smoothing on the target, and the verdict of the library's local validity test (with
 //!   the ground truth's normals as the reference).
 //!
-//! `cargo run --release -p wavg-bench --bin correspondence_weights -- SRC SRC.wavg TGT
+//! `cargo xtask lab correspondence_weights SRC SRC.wavg TGT
 //! TGT.wavg ANCHORS` (ANCHORS: a file of `v VERTEX` lines, or `fps:K` for K farthest-point
 //! vertices of the source, written to `fps-anchors.txt`)
 

@@ -5,7 +5,7 @@
 //! threads (from `/proc/self/task/*/schedstat`; CPU time is what a loaded machine distorts
 //! least).
 //!
-//! `cargo run --release -p wavg-bench --bin verified_stages -- MESH EMB.wavg ANCHORS QUERIES [THREADS]`
+//! `cargo xtask lab verified_stages MESH EMB.wavg ANCHORS QUERIES [THREADS]`
 
 use std::sync::Arc;
 use std::time::Instant;

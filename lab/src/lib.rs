@@ -1,6 +1,6 @@
-//! wavg's timing scripts and experiments, one binary each in `src/bin/`; run one with
-//! `cargo run --release -p wavg-bench --bin NAME -- ARGS` or `cargo xtask bench NAME ARGS`.
-//! Not published; the figures they produce are in `BENCHMARKS.md`.
+//! wavg's lab: timing programs and experiments, one binary each in `src/bin/`; run one
+//! with `cargo xtask lab NAME ARGS` (see `lab/README.md`). Not published and not a default
+//! workspace member; the figures they produce are in `BENCHMARKS.md` and `lab/TRIED.md`.
 
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]

@@ -3,7 +3,7 @@
 
 A benchmark tool, not part of the build: it needs `pip install numpy pygeodesic`.
 
-    python3 tools/exact_geodesics.py MESH EMBEDDING.wavg [--sources 32] [--targets 32] [--seed 0] [--json]
+    python3 lab/tools/exact_geodesics.py MESH EMBEDDING.wavg [--sources 32] [--targets 32] [--seed 0] [--json]
 
 For `sources x targets` seeded random vertex pairs it compares the embedding's Euclidean
 distance d with the exact geodesic distance g and reports:

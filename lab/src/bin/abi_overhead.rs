@@ -4,7 +4,7 @@
 //!
 //! ```text
 //! cargo build --release -p wavg-ffi
-//! cargo run --release -p wavg-bench --bin abi_overhead -- \
+//! cargo xtask lab abi_overhead \
 //!     target/release/libwavg.so MESH [QUERIES=100000] [ROUNDS=5] [ANCHORS=32]
 //! ```
 //! Prints one line per operation: best-of-rounds milliseconds for Rust and for C, and

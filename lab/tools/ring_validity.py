@@ -10,7 +10,7 @@ edge-length ratio (`stretch`). Prints, per test, the fraction kept, the mean err
 kept vertices (fraction of the target's bounding-box diagonal), how many vertices with an
 error above 2% it rejects, and how many below 1% it rejects.
 
-    python3 tools/ring_validity.py SOURCE.obj.gz TARGET.obj.gz MAP.txt
+    python3 lab/tools/ring_validity.py SOURCE.obj.gz TARGET.obj.gz MAP.txt
 
 MAP.txt: `wavg correspond ... --validity paper --max-negative -100` (every answered vertex).
 """

@@ -1,6 +1,6 @@
 //! Times landmark selection (decimation) and the landmark geodesics on real meshes.
 //!
-//! `cargo run --release -p wavg-bench --bin landmark_timing -- [MESH...] [--landmarks N]
+//! `cargo xtask lab landmark_timing [MESH...] [--landmarks N]
 //! [--coarse N,M,...] [--snapshot] [--decimate-only] [--runs-only]` (default meshes: pig, armadillo,
 //! horse, igea from the shared data folder).
 //!
@@ -43,7 +43,7 @@ fn main() {
     args.retain(|a| a != "--runs-only");
     let decimate_only = args.iter().any(|a| a == "--decimate-only");
     args.retain(|a| a != "--decimate-only");
-    let Some(paths) = wavg_bench::mesh_paths(
+    let Some(paths) = wavg_lab::mesh_paths(
         &args,
         &["pig.off", "armadillo.obj.gz", "horse.off.gz", "igea.off.gz"],
         "landmark_timing",

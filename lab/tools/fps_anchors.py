@@ -5,7 +5,7 @@ A benchmark tool, not part of the build (standard library only). Starts at verte
 repeatedly adds the vertex farthest (Dijkstra over edge lengths) from those chosen, so the
 same ids serve every mesh that shares the connectivity (pose pairs).
 
-    python3 tools/fps_anchors.py MESH.{obj,off}[.gz] K OUT.txt
+    python3 lab/tools/fps_anchors.py MESH.{obj,off}[.gz] K OUT.txt
 """
 import gzip
 import heapq
