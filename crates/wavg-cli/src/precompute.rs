@@ -15,9 +15,9 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
-use wavg::embed::{self, PrecomputeOptions, Progress, Stage};
+use wavg::embed;
 use wavg::mesh::repair;
-use wavg::{MeshError, ValidMesh};
+use wavg::{EmbedError, MeshError, PrecomputeOptions, Progress, Report, Stage, ValidMesh};
 
 use crate::CliError;
 use crate::common::{load_mesh, one_line};
@@ -123,8 +123,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         crate::textio::with_threads(args.threads, || embed::precompute(&mesh, &opts, &bars))?;
     bars.clear();
     let (embedding, report) = result.map_err(|e| match e {
-        embed::EmbedError::InvalidArgument(m) => CliError::input(format!("{}: {m}", args.mesh)),
-        embed::EmbedError::Cancelled => CliError {
+        EmbedError::InvalidArgument(m) => CliError::input(format!("{}: {m}", args.mesh)),
+        EmbedError::Cancelled => CliError {
             code: 130,
             message: format!("interrupted; {} was not written", args.output.display()),
         },
@@ -208,7 +208,7 @@ struct JsonReport<'a> {
     mesh: &'a str,
     output: &'a std::path::Path,
     #[serde(flatten)]
-    report: &'a embed::Report,
+    report: &'a Report,
     load_seconds: f64,
     save_seconds: f64,
     removed_by_largest_component: Option<Removed>,
