@@ -68,7 +68,7 @@ pub fn surface_and_anchors(mesh: &str, anchors: &Path) -> Result<(Surface, Vec<A
         .map(|&(line, s)| spec_anchor(s).map_err(|m| located(anchors, line, &m)))
         .collect::<Result<Vec<_>, _>>()?;
     for (&(line, _), a) in specs.iter().zip(&list) {
-        wavg::solve::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
+        wavg::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
     let surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
     Ok((surface, list))

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use wavg_mesh::{analyze, io};
+use wavg::mesh::{analyze, io};
 
 use crate::CliError;
 use crate::common::one_line;

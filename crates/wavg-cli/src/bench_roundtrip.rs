@@ -1,4 +1,4 @@
-//! `wavg bench roundtrip`: the paper's Table 1 protocol ([`wavg_solve::round_trip`]).
+//! `wavg bench roundtrip`: the paper's Table 1 protocol ([`wavg::round_trip`]).
 //!
 //! K anchors by farthest-point sampling (edge-graph distance, seeded) and the solver are set
 //! up here; the library samples N surface points uniform by area (seed + 1), times the
@@ -9,8 +9,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use serde::Serialize;
-use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
-use wavg_solve::{Anchor, RoundTripOptions, RoundTripReport, SearchMode, SolveError, Solver};
+use wavg::sampling::{FpsMetric, farthest_point_vertices};
+use wavg::{Anchor, RoundTripOptions, RoundTripReport, SearchMode, SolveError, Solver};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
@@ -144,7 +144,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         verified: args.verified,
         cpu_clock: Some(process_cpu_seconds),
     };
-    let report = textio::with_threads(Some(threads), || wavg_solve::round_trip(&solver, &opts))?
+    let report = textio::with_threads(Some(threads), || wavg::round_trip(&solver, &opts))?
         .map_err(|e| match e {
             SolveError::InvalidParameter(_) => CliError::input(one_line(&e)),
             e => CliError::failure(one_line(&e)),
@@ -225,17 +225,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
 /// `--precompute`: the embedding pipeline with default parameters.
 fn precompute_embedding(
-    mesh: &std::sync::Arc<wavg_mesh::ValidMesh>,
-) -> Result<std::sync::Arc<wavg_solve::EmbeddedMesh>, CliError> {
-    let opts = wavg_embed::PrecomputeOptions::default();
-    let (emb, _) = wavg_embed::precompute(mesh, &opts, &wavg_embed::NoProgress)
+    mesh: &std::sync::Arc<wavg::ValidMesh>,
+) -> Result<std::sync::Arc<wavg::EmbeddedMesh>, CliError> {
+    let opts = wavg::PrecomputeOptions::default();
+    let (emb, _) = wavg::embed::precompute(mesh, &opts, &wavg::NoProgress)
         .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))?;
-    let coords = emb
-        .coords
-        .iter()
-        .map(|c| wavg_solve::Vec8::from(*c))
-        .collect();
-    wavg_solve::EmbeddedMesh::new(mesh.clone(), coords)
+    let coords = emb.coords.iter().map(|c| wavg::Vec8::from(*c)).collect();
+    wavg::EmbeddedMesh::new(mesh.clone(), coords)
         .map(std::sync::Arc::new)
         .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))
 }

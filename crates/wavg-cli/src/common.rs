@@ -4,7 +4,8 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use wavg_mesh::{MeshError, TriMesh, ValidMesh, io, procedural};
+use wavg::mesh::{io, procedural};
+use wavg::{MeshError, TriMesh, ValidMesh};
 
 use crate::CliError;
 

@@ -10,10 +10,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use wavg_mesh::{SurfacePoint, ValidMesh};
-use wavg_solve::DEFAULT_TOLERANCE;
-use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
-use wavg_solve::{Anchor, EmbeddedMesh, ForwardOptions, Solver, Vec8};
+use wavg::DEFAULT_TOLERANCE;
+use wavg::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
+use wavg::{Anchor, EmbeddedMesh, ForwardOptions, Solver, Vec8};
+use wavg::{SurfacePoint, ValidMesh};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
@@ -73,8 +73,8 @@ pub struct Args {
 
 /// The `--json` object (printed through `serde_json::Value`, so keys come out sorted). Its
 /// own figures rather than the library's reports flattened: the demo times its own
-/// batches, and the keys of `wavg_embed::Report`, `wavg_apps::CurveReport` and
-/// `wavg_solve::RoundTripReport` are not these (`curve_points`, not `samples`; no stage
+/// batches, and the keys of `wavg::embed::Report`, `wavg::apps::CurveReport` and
+/// `wavg::RoundTripReport` are not these (`curve_points`, not `samples`; no stage
 /// times).
 #[derive(serde::Serialize)]
 struct JsonReport<'a> {
@@ -153,17 +153,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         mesh.n_faces()
     ));
     let t0 = Instant::now();
-    let opts = wavg_embed::PrecomputeOptions {
+    let opts = wavg::PrecomputeOptions {
         landmarks,
         seed: args.seed,
         ..Default::default()
     };
     let (emb, _) =
-        wavg_embed::precompute(&mesh, &opts, &wavg_embed::NoProgress).map_err(|e| match e {
+        wavg::embed::precompute(&mesh, &opts, &wavg::NoProgress).map_err(|e| match e {
             // The mesh or the arguments do not suit (exit status 2, as `wavg precompute`).
-            wavg_embed::EmbedError::InvalidArgument(m) => {
-                CliError::input(format!("precompute: {m}"))
-            }
+            wavg::EmbedError::InvalidArgument(m) => CliError::input(format!("precompute: {m}")),
             e => CliError::failure(format!("precompute: {}", one_line(&e))),
         })?;
     let precompute_s = t0.elapsed().as_secs_f64();
@@ -201,7 +199,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let fwd = solver.forward_batch(&rows, &ForwardOptions::default());
     let forward_us = t0.elapsed().as_secs_f64() / points.len() as f64 * 1e6;
     let tol = DEFAULT_TOLERANCE * solver.mean_edge_length();
-    let back = |p: &SurfacePoint, r: &Result<wavg_solve::ForwardResult, _>| {
+    let back = |p: &SurfacePoint, r: &Result<wavg::ForwardResult, _>| {
         r.as_ref()
             .is_ok_and(|r| (r.position - p.position(&mesh)).norm() <= tol)
     };
@@ -311,16 +309,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
 fn write_outputs(
     dir: &Path,
     mesh: &ValidMesh,
-    emb: &wavg_embed::Embedding,
+    emb: &wavg::Embedding,
     anchors: &[u32],
-    curve: &[Result<wavg_solve::ForwardResult, wavg_solve::SolveError>],
+    curve: &[Result<wavg::ForwardResult, wavg::SolveError>],
 ) -> Result<(), CliError> {
     let fail = |what: &str, e: &dyn std::fmt::Display| {
         CliError::failure(format!("{}: {what}: {e}", dir.display()))
     };
     std::fs::create_dir_all(dir).map_err(|e| fail("cannot create", &e))?;
-    wavg_mesh::io::save(&dir.join("mesh.obj"), mesh).map_err(|e| fail("mesh.obj", &e))?;
-    wavg_embed::file::save(&dir.join("mesh.wavg"), emb, mesh).map_err(|e| fail("mesh.wavg", &e))?;
+    wavg::mesh::io::save(&dir.join("mesh.obj"), mesh).map_err(|e| fail("mesh.obj", &e))?;
+    wavg::embed::file::save(&dir.join("mesh.wavg"), emb, mesh)
+        .map_err(|e| fail("mesh.wavg", &e))?;
     textio::write_atomic(&dir.join("anchors.txt"), |w: &mut dyn Write| {
         anchors.iter().try_for_each(|v| writeln!(w, "v {v}"))
     })?;

@@ -4,8 +4,9 @@
 
 use wavg::Vector3;
 use wavg::apps::{BaseMesh, Colouring, Image, Overlays, Remesher, RenderOptions};
-use wavg::mesh::{TexCoords, TriMesh, geometry};
+use wavg::mesh::geometry;
 use wavg::{Anchor, Solver};
+use wavg::{TexCoords, TriMesh};
 
 use crate::CliError;
 

@@ -8,10 +8,10 @@ use std::path::{Path, PathBuf};
 
 use wavg::Vector3;
 use wavg::apps::{Colouring, Image, Overlays, RenderOptions, TransferOptions, View};
-use wavg::mesh::{TexCoords, TriMesh, ValidMesh};
+use wavg::sampling::{FpsMetric, farthest_point_vertices};
+use wavg::{ForwardResult, SolveError, Vec8};
 use wavg::{NoProgress, PrecomputeOptions, Surface};
-use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
-use wavg_solve::{ForwardResult, SolveError, Vec8};
+use wavg::{TexCoords, TriMesh, ValidMesh};
 
 use crate::CliError;
 use crate::common::one_line;

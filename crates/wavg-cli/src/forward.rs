@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use rayon::prelude::*;
 use wavg::text;
 
-use wavg_solve::{ForwardOptions, ForwardScratch, Normalization, Par, SearchMode, SolveError};
+use wavg::{ForwardOptions, ForwardScratch, Normalization, Par, SearchMode, SolveError};
 
 use crate::CliError;
 use crate::stream::{Format, NpyRow, Sink, stream_queries};
@@ -75,7 +75,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     // A line's weights as the forward problem checks them, its error naming the line.
     let validate = |line: usize, w: &[f64]| {
-        wavg_solve::validate_weights(w, solver.n_anchors(), normalization)
+        wavg::validate_weights(w, solver.n_anchors(), normalization)
             .map(|_| ())
             .map_err(|e| located(&args.weights, line, &e))
     };

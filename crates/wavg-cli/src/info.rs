@@ -3,8 +3,10 @@
 //! described (exit 0), valid or not; a file that cannot be read or parsed exits with
 //! status 2 and a one-line message naming the file and line.
 
-use wavg_mesh::{LoadNotes, io};
-use wavg_mesh::{MeshInfo, TriMesh, analyze, procedural};
+use wavg::LoadNotes;
+use wavg::mesh::io;
+use wavg::mesh::{analyze, procedural};
+use wavg::{MeshInfo, TriMesh};
 
 use crate::CliError;
 use crate::common::one_line;
@@ -160,7 +162,7 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, s: &MeshIn
 
 #[cfg(test)]
 mod tests {
-    use wavg_mesh::ProblemKind;
+    use wavg::ProblemKind;
 
     /// The `kind` keys of `problem_summary` are a contract with JSON consumers.
     #[test]

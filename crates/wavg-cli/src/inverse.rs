@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use wavg::text::{self, PointSpec};
-use wavg_solve::{BatchWeights, DEFAULT_TOLERANCE, RoundTrip, Verified};
+use wavg::{BatchWeights, DEFAULT_TOLERANCE, RoundTrip, Verified};
 
 use crate::CliError;
 use crate::stream::{Format, NpyRow, Sink, stream_queries};
@@ -39,7 +39,7 @@ pub struct Args {
     #[arg(long)]
     pub points: PathBuf,
     /// How much more distance off the tangent plane counts than distance along it.
-    #[arg(long, default_value_t = wavg_solve::DEFAULT_GAMMA, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = wavg::DEFAULT_GAMMA, allow_negative_numbers = true)]
     pub gamma: f64,
     /// Check each answer by the forward problem; penalise the average's offset where the
     /// paper's weights do not lead back.
@@ -138,7 +138,7 @@ fn npy_point(line: usize, row: NpyRow) -> Result<PointSpec, wavg::text::LineErro
 }
 
 /// `none REASON` for a point without weights.
-fn none(out: &mut Vec<u8>, e: &wavg_solve::SolveError) {
+fn none(out: &mut Vec<u8>, e: &wavg::SolveError) {
     out.extend_from_slice(format!("none {}", crate::common::one_line(e)).as_bytes());
 }
 
@@ -152,7 +152,7 @@ struct VerifiedSummary {
 }
 
 impl VerifiedSummary {
-    fn add(&mut self, batch: &[Result<Verified, wavg_solve::SolveError>]) {
+    fn add(&mut self, batch: &[Result<Verified, wavg::SolveError>]) {
         for (i, r) in batch.iter().enumerate() {
             match r {
                 Ok(v) if matches!(v.round_trip, RoundTrip::Penalized(_)) => self.penalised += 1,

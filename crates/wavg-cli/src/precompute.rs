@@ -1,5 +1,5 @@
 //! `wavg precompute MESH -o OUT.wavg`: the 8-D embedding of a mesh, written as a `.wavg`
-//! file (format: `wavg_embed::file`).
+//! file (format: `wavg::embed::file`).
 //!
 //! Progress bars appear on stderr only when it is a terminal. `--json` prints one object:
 //! `seconds` (the precomputation itself, excluding loading the mesh and writing the file,
@@ -15,8 +15,9 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
-use wavg::embed::{self, PrecomputeOptions, Progress, Stage};
-use wavg_mesh::{MeshError, ValidMesh, repair};
+use wavg::embed;
+use wavg::mesh::repair;
+use wavg::{EmbedError, MeshError, PrecomputeOptions, Progress, Report, Stage, ValidMesh};
 
 use crate::CliError;
 use crate::common::{load_mesh, one_line};
@@ -78,7 +79,7 @@ fn check_args(args: &Args) -> Result<(), CliError> {
             out.display()
         )));
     }
-    if wavg_mesh::Format::from_path(out).is_ok() {
+    if wavg::mesh::Format::from_path(out).is_ok() {
         return Err(CliError::input(format!(
             "the output {} has a mesh file's extension; the embedding is a .wavg file",
             out.display()
@@ -105,7 +106,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let mesh = validate(&args.mesh, mesh)?;
     if let Some(path) = &args.repaired_mesh {
-        wavg_mesh::io::save(path, &mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+        wavg::mesh::io::save(path, &mesh).map_err(|e| CliError::failure(one_line(&e)))?;
     }
     let load_seconds = t_load.elapsed().as_secs_f64();
 
@@ -122,8 +123,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         crate::textio::with_threads(args.threads, || embed::precompute(&mesh, &opts, &bars))?;
     bars.clear();
     let (embedding, report) = result.map_err(|e| match e {
-        embed::EmbedError::InvalidArgument(m) => CliError::input(format!("{}: {m}", args.mesh)),
-        embed::EmbedError::Cancelled => CliError {
+        EmbedError::InvalidArgument(m) => CliError::input(format!("{}: {m}", args.mesh)),
+        EmbedError::Cancelled => CliError {
             code: 130,
             message: format!("interrupted; {} was not written", args.output.display()),
         },
@@ -207,7 +208,7 @@ struct JsonReport<'a> {
     mesh: &'a str,
     output: &'a std::path::Path,
     #[serde(flatten)]
-    report: &'a embed::Report,
+    report: &'a Report,
     load_seconds: f64,
     save_seconds: f64,
     removed_by_largest_component: Option<Removed>,
@@ -221,8 +222,8 @@ struct Removed {
 }
 
 /// Validates with a message naming the problems and the repair options.
-fn validate(name: &str, mesh: wavg_mesh::TriMesh) -> Result<ValidMesh, CliError> {
-    let components = wavg_mesh::analyze(&mesh).stats.components;
+fn validate(name: &str, mesh: wavg::TriMesh) -> Result<ValidMesh, CliError> {
+    let components = wavg::mesh::analyze(&mesh).stats.components;
     match ValidMesh::new(mesh) {
         Ok(m) => {
             if m.topology().n_components() != 1 {

@@ -5,9 +5,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use wavg::TriMesh;
 use wavg::Vector3;
 use wavg::apps::{Colouring, Image, Overlays, RenderOptions, RenderReport, View, render};
-use wavg::mesh::TriMesh;
 
 use crate::CliError;
 use crate::common::{load_mesh, one_line};

@@ -4,9 +4,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use wavg_mesh::repair::repair_all;
-use wavg_mesh::{RepairOptions, RepairReport};
-use wavg_mesh::{analyze, io};
+use wavg::mesh::repair::repair_all;
+use wavg::mesh::{analyze, io};
+use wavg::{RepairOptions, RepairReport};
 
 use crate::CliError;
 use crate::common::{load_mesh, one_line};
@@ -65,7 +65,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )));
     }
     // The output's format, from its extension, before any work.
-    wavg_mesh::Format::from_path(&args.output).map_err(|e| CliError::input(one_line(&e)))?;
+    wavg::mesh::Format::from_path(&args.output).map_err(|e| CliError::input(one_line(&e)))?;
     let mesh = load_mesh(&args.input)?;
     let options = RepairOptions {
         weld: (!args.no_weld).then_some(args.weld),

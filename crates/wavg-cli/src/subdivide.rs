@@ -4,8 +4,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use wavg_mesh::subdivide::loop_subdivide;
-use wavg_mesh::{SubdivisionReport, ValidMesh, io};
+use wavg::mesh::io;
+use wavg::mesh::subdivide::loop_subdivide;
+use wavg::{SubdivisionReport, ValidMesh};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};

@@ -2,7 +2,7 @@
 
 use std::process::Command;
 
-use wavg_mesh::{io, procedural};
+use wavg::mesh::{io, procedural};
 
 #[test]
 fn bench_load_reports_every_stage() {

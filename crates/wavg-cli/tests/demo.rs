@@ -47,9 +47,9 @@ fn demo_reports_and_writes_its_outputs() {
     assert_eq!(o["curve_ok"], o["curve_points"]);
     assert!(o["verified_roundtrip_ok_fraction"].as_f64().unwrap() >= 0.99);
     // The outputs: a mesh that loads, an embedding that matches it, a curve on it.
-    let mesh = wavg_mesh::io::load(&out_dir.join("mesh.obj")).unwrap();
+    let mesh = wavg::mesh::io::load(&out_dir.join("mesh.obj")).unwrap();
     assert_eq!(mesh.n_vertices(), 2562);
-    let emb = wavg_embed::file::load(&out_dir.join("mesh.wavg"), &mesh).unwrap();
+    let emb = wavg::embed::file::load(&out_dir.join("mesh.wavg"), &mesh).unwrap();
     assert_eq!(emb.coords.len(), 2562);
     let curve = std::fs::read_to_string(out_dir.join("curve.txt")).unwrap();
     assert_eq!(curve.lines().count(), 400);
@@ -60,7 +60,7 @@ fn demo_reports_and_writes_its_outputs() {
             .collect();
         assert_eq!(t.len(), 7);
         assert!((t[1] + t[2] + t[3] - 1.0).abs() < 1e-9);
-        let p = wavg_mesh::SurfacePoint::new(t[0] as u32, [t[1], t[2], t[3]]).position(&mesh);
+        let p = wavg::mesh::SurfacePoint::new(t[0] as u32, [t[1], t[2], t[3]]).position(&mesh);
         assert!((p.x - t[4]).abs() + (p.y - t[5]).abs() + (p.z - t[6]).abs() < 1e-6);
     }
     let obj = std::fs::read_to_string(out_dir.join("curve.obj")).unwrap();
@@ -95,7 +95,7 @@ fn demo_rejects_bad_arguments() {
     // A mesh the embedding cannot take (two components) is an input error too.
     let dir = tempfile::tempdir().unwrap();
     let two = dir.path().join("two.obj");
-    let mut mesh = wavg_mesh::procedural::icosphere(1);
+    let mut mesh = wavg::mesh::procedural::icosphere(1);
     let n = mesh.positions.len() as u32;
     let far: Vec<_> = mesh.positions.iter().map(|p| p.add_scalar(5.0)).collect();
     let tris: Vec<_> = mesh.triangles.iter().map(|t| t.map(|v| v + n)).collect();
@@ -103,7 +103,7 @@ fn demo_rejects_bad_arguments() {
     mesh.triangles.extend(tris);
     std::fs::write(
         &two,
-        wavg_mesh::io::to_bytes(&mesh, wavg_mesh::Format::Obj).unwrap(),
+        wavg::mesh::io::to_bytes(&mesh, wavg::mesh::Format::Obj).unwrap(),
     )
     .unwrap();
     let out = wavg(&["demo", "--mesh", two.to_str().unwrap()]);
@@ -117,9 +117,9 @@ fn demo_rejects_bad_arguments() {
 fn demo_pictures_that_do_not_apply_are_skipped_with_a_reason() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = dir.path().join("thin.obj");
-    let torus = wavg_mesh::procedural::torus(64, 8, 1.0, 0.01);
-    let valid = wavg_mesh::ValidMesh::new(torus).unwrap();
-    wavg_mesh::io::save(&mesh, &valid).unwrap();
+    let torus = wavg::mesh::procedural::torus(64, 8, 1.0, 0.01);
+    let valid = wavg::mesh::ValidMesh::new(torus).unwrap();
+    wavg::mesh::io::save(&mesh, &valid).unwrap();
     let out_dir = dir.path().join("demo");
     let out = wavg_ok(&[
         "demo",

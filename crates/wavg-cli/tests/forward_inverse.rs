@@ -68,11 +68,11 @@ fn parse_floats(line: &str) -> Vec<f64> {
 fn inverse_then_forward_returns_the_points() {
     let dir = tempfile::tempdir().unwrap();
     // Compare 3-D positions with the library's positions of the original points.
-    let mesh = wavg_mesh::procedural::builtin("sphere-small").unwrap();
+    let mesh = wavg::mesh::procedural::builtin("sphere-small").unwrap();
     let originals = [
-        wavg_mesh::SurfacePoint::new(10, [0.2, 0.3, 0.5]).position(&mesh),
+        wavg::mesh::SurfacePoint::new(10, [0.2, 0.3, 0.5]).position(&mesh),
         mesh.positions[40],
-        wavg_mesh::SurfacePoint::new(100, [0.6, 0.2, 0.2]).position(&mesh),
+        wavg::mesh::SurfacePoint::new(100, [0.6, 0.2, 0.2]).position(&mesh),
         mesh.corners(7)[0],
     ];
     let points = "f 10 0.2 0.3 0.5\n# comment\n\nv 40\nf 100 0.6 0.2 0.2\nf 7 1 0 0\n";
@@ -344,11 +344,11 @@ fn inverse_forward_back(
 #[test]
 fn verified_inverse_keeps_the_format_and_returns() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = wavg_mesh::procedural::builtin("sphere-small").unwrap();
+    let mesh = wavg::mesh::procedural::builtin("sphere-small").unwrap();
     let originals = [
-        wavg_mesh::SurfacePoint::new(10, [0.2, 0.3, 0.5]).position(&mesh),
+        wavg::mesh::SurfacePoint::new(10, [0.2, 0.3, 0.5]).position(&mesh),
         mesh.positions[40],
-        wavg_mesh::SurfacePoint::new(100, [0.6, 0.2, 0.2]).position(&mesh),
+        wavg::mesh::SurfacePoint::new(100, [0.6, 0.2, 0.2]).position(&mesh),
     ];
     let points = "f 10 0.2 0.3 0.5\nv 40\nf 100 0.6 0.2 0.2\n";
     let err = inverse_forward_back(dir.path(), points, &["--verified"], &originals);

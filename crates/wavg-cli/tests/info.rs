@@ -7,7 +7,7 @@ use common::{wavg, wavg_ok};
 use std::path::Path;
 
 use serde_json::Value;
-use wavg_mesh::{io, procedural};
+use wavg::mesh::{io, procedural};
 use wavg_testdata as data;
 
 fn info_json(path: &Path) -> Value {
@@ -144,7 +144,7 @@ fn invalid_but_parseable_file_exits_zero_and_lists_problems() {
         })
         .collect();
     let mpath = dir.path().join("moebius.obj");
-    io::save(&mpath, &wavg_mesh::TriMesh::new(positions, triangles)).unwrap();
+    io::save(&mpath, &wavg::mesh::TriMesh::new(positions, triangles)).unwrap();
     let j = info_json(&mpath);
     assert_eq!(j["repair"]["fixes_all"], false);
     let out = wavg(&["info", mpath.to_str().unwrap()]);

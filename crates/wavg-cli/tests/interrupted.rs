@@ -8,7 +8,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use rand::{Rng, SeedableRng};
-use wavg_mesh::{io, procedural};
+use wavg::mesh::{io, procedural};
 
 /// Runs `wavg ARGS` to completion and returns its wall time.
 fn timed_run(args: &[&str]) -> Duration {

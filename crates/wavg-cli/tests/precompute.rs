@@ -8,7 +8,7 @@ use std::path::Path;
 use std::process::Command;
 
 use serde_json::Value;
-use wavg_mesh::{TriMesh, ValidMesh, io, procedural};
+use wavg::mesh::{TriMesh, ValidMesh, io, procedural};
 
 fn write(dir: &Path, name: &str, mesh: &TriMesh) -> String {
     let path = dir.join(name);

@@ -8,7 +8,7 @@ use common::{wavg, wavg_ok};
 use std::path::Path;
 
 use serde_json::Value;
-use wavg_mesh::{ValidMesh, io, procedural};
+use wavg::mesh::{ValidMesh, io, procedural};
 
 /// `wavg repair IN -o OUT --map MAP --json`, which must succeed; its JSON.
 fn repair_with_map(input: &Path, output: &Path, map: &Path) -> Value {
@@ -94,7 +94,7 @@ fn remaining_problems_exit_1_and_components_need_opt_in() {
     // A fin (three faces on one edge) comes apart into three sheets; the map names the
     // input vertex of every copy. With --keep-nonmanifold it stays broken: output
     // written, exit 1.
-    let fin = wavg_mesh::TriMesh::new(
+    let fin = wavg::mesh::TriMesh::new(
         vec![
             nalgebra::Vector3::new(0.0, 0.0, 0.0),
             nalgebra::Vector3::new(1.0, 0.0, 0.0),

@@ -46,7 +46,7 @@ fn open_closed_and_bezier_curves() {
     let curve = lines(&out);
     assert_eq!(curve.len(), 300);
     // Clamped: the first sample is vertex 0, the last vertex 2500 (icosphere level 4).
-    let mesh = wavg_mesh::procedural::icosphere(4);
+    let mesh = wavg::mesh::procedural::icosphere(4);
     let (first, last) = (&curve[0][4..7], &curve[299][4..7]);
     for (p, v) in [(first, 0usize), (last, 2500)] {
         let q = mesh.positions[v];

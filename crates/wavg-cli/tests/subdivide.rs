@@ -4,7 +4,7 @@
 mod common;
 
 use common::{json_object, wavg, wavg_ok};
-use wavg_mesh::{ValidMesh, io, procedural};
+use wavg::mesh::{ValidMesh, io, procedural};
 
 #[test]
 fn two_levels_of_a_torus() {

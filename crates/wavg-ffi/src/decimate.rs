@@ -32,7 +32,7 @@ pub unsafe extern "C" fn wavg_surface_decimate(
                 "target_vertices = {target_vertices} is not in 1..={n}"
             )));
         }
-        let opts = wavg::embed::DecimateOptions {
+        let opts = wavg::DecimateOptions {
             target: target_vertices,
             ..Default::default()
         };

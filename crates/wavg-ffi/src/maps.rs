@@ -57,7 +57,7 @@ unsafe fn queries(points: *const wavg_point, n: usize) -> Result<Vec<SurfacePoin
         .collect())
 }
 
-fn solve_failure(e: &wavg::solve::SolveError) -> (wavg_status, String) {
+fn solve_failure(e: &wavg::SolveError) -> (wavg_status, String) {
     let e = wavg::Error::from(e.clone());
     (crate::boundary::status_of(e.kind()), e.to_string())
 }

@@ -1,12 +1,12 @@
 //! `wavg_solver`: forward and inverse problems for one anchor set (wraps
-//! `wavg_solve::Solver`), answered in parallel batches.
+//! `wavg::Solver`), answered in parallel batches.
 
 use std::sync::Mutex;
 
 use rayon::prelude::*;
 
-use wavg::project::internal::prefetch_point_data;
-use wavg::solve::SolveError;
+use wavg::SolveError;
+use wavg::internal::prefetch_point_data;
 use wavg::{BatchWeights, ForwardOptions, RoundTrip, Solver, SurfacePoint};
 
 use crate::boundary::{
@@ -26,10 +26,7 @@ pub struct wavg_solver {
     solver: Solver,
     /// Reused output of the inverse batches (taken when free, so concurrent calls never
     /// wait for each other).
-    scratch: Mutex<(
-        BatchWeights,
-        Vec<Result<RoundTrip, wavg::solve::SolveError>>,
-    )>,
+    scratch: Mutex<(BatchWeights, Vec<Result<RoundTrip, wavg::SolveError>>)>,
 }
 
 impl wavg_solver {
@@ -227,7 +224,7 @@ pub(crate) fn write_image(
     out: &mut [wavg_point],
     xyz: Option<&mut [f64]>,
     i: usize,
-    image: &Result<wavg::ForwardResult, wavg::solve::SolveError>,
+    image: &Result<wavg::ForwardResult, wavg::SolveError>,
 ) {
     let (p, x) = match image {
         Ok(r) => (
@@ -328,9 +325,9 @@ fn verified_rows(
         Some(b) => (&mut b.0, &mut b.1),
         None => (&mut owned.0, &mut owned.1),
     };
-    let tol = wavg::solve::DEFAULT_TOLERANCE;
+    let tol = wavg::DEFAULT_TOLERANCE;
     // `Par::Rayon` always starts.
-    let _ = solver.inverse_verified_batch_into(&points, tol, batch, trips, wavg::solve::Par::Rayon);
+    let _ = solver.inverse_verified_batch_into(&points, tol, batch, trips, wavg::Par::Rayon);
     let n = solver.n_anchors();
     out.par_chunks_exact_mut(n)
         .enumerate()

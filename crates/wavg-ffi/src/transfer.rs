@@ -1,7 +1,7 @@
 //! Texture transfer through the C ABI, over RGBA8 buffers and UV arrays.
 
+use wavg::TexCoords;
 use wavg::apps::{AppError, Image, TransferOptions, transfer_texture_with_uv};
-use wavg::mesh::TexCoords;
 
 use crate::boundary::{Failure, guard, handle, product, slice, slice_mut};
 use crate::solver::wavg_solver;

@@ -42,12 +42,14 @@ mod problem;
 pub mod procedural;
 pub mod repair;
 mod report;
+mod rings;
 pub mod subdivide;
 mod topology;
 mod valid;
 
 // Meshes and their validation.
 pub use mesh::{FaceId, NONE, TexCoords, TriMesh, VertexId};
+pub use rings::RingSearch;
 pub use topology::Topology;
 pub use valid::ValidMesh;
 

@@ -42,7 +42,6 @@ mod hugepage;
 mod ort;
 mod par;
 mod projector;
-mod report;
 mod triangle;
 
 // The embedded mesh and its projector.
@@ -53,9 +52,6 @@ pub use projector::{
 
 // How batches run.
 pub use par::Par;
-
-// The benchmark's figures (with the `serde` feature, serialisable).
-pub use report::ProjectionBenchReport;
 
 // Tangent frames and geometry in R^8.
 pub use euclid::closest_point_barycentric;

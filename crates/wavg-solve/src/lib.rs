@@ -10,8 +10,9 @@
 //! Also: [`AnchorSet`] (editable anchor sets), [`resolve_anchor`] and [`check_point`]
 //! (validating user locations), [`validate_weights`], [`inverse_weights`] (the inverse
 //! problem's kernel on its own), [`sampling`] (seeded anchors and query points for
-//! benchmarks and tests), and [`round_trip`] (the paper's Table 1 round-trip protocol;
-//! its report serialises with the `serde` feature).
+//! benchmarks and tests), [`round_trip`] (the paper's Table 1 round-trip protocol) and
+//! [`projection_bench`] (the projection benchmark); their reports serialise with the
+//! `serde` feature.
 //!
 //! ```
 //! use std::sync::Arc;
@@ -39,6 +40,7 @@ mod error;
 mod kernel;
 mod penalty;
 mod points;
+pub mod projbench;
 pub mod roundtrip;
 pub mod sampling;
 mod simd;
@@ -63,6 +65,9 @@ pub use weights::{Normalization, WEIGHT_SUM_TOLERANCE, validate_weights};
 pub use roundtrip::{
     RoundTripOptions, RoundTripReport, VerifiedRoundTripReport, round_trip, round_trip_at,
 };
+
+// The projection benchmark protocol.
+pub use projbench::{ProjectionBenchOptions, ProjectionBenchReport, projection_bench};
 
 // The embedded mesh and projector the solver works on.
 pub use wavg_project::{

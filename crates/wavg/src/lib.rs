@@ -26,7 +26,10 @@
 //! ```
 //!
 //! The workspace crates stay reachable as modules ([`mesh`], [`embed`], [`project`],
-//! [`solve`]) for what the front door does not cover.
+//! [`solve`], [`apps`]) for what the front door does not cover: mesh files
+//! ([`mesh::io`]), procedural meshes, repair and subdivision ([`mesh::procedural`],
+//! [`mesh::repair`], [`mesh::subdivide`]), `.wavg` files ([`embed::file`]) and the
+//! applications ([`apps`]).
 
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
@@ -50,6 +53,41 @@ pub use wavg_solve::{
     ProjectionPath, RoundTrip, SearchGoal, SearchMode, Solver, Verified,
 };
 pub use wavg_solve::{RoundTripOptions, RoundTripReport, VerifiedRoundTripReport, round_trip};
+
+// The projection benchmark protocol, beside the round trip's.
+pub use wavg_solve::{ProjectionBenchOptions, ProjectionBenchReport, projection_bench};
+
+// The layers' own errors, for callers that tell failures apart before they become an
+// [`Error`].
+pub use wavg_embed::EmbedError;
+pub use wavg_mesh::MeshError;
+pub use wavg_solve::SolveError;
+
+// The layer under a [`Solver`]: the mesh embedded in R^8 and its Phong projector.
+pub use wavg_solve::{EmbeddedMesh, Projector, Vec8};
+
+// Defaults and checks of the forward and inverse problems' inputs.
+pub use wavg_solve::{DEFAULT_GAMMA, DEFAULT_TOLERANCE, resolve_anchor, validate_weights};
+
+// Reports and options of the mesh tools (inspection, repair, subdivision, decimation) and
+// texture coordinates.
+pub use wavg_embed::DecimateOptions;
+pub use wavg_mesh::{
+    LoadNotes, MeshInfo, ProblemKind, RepairOptions, RepairReport, SubdivisionReport, TexCoords,
+};
+
+/// Seeded sampling of surface points and anchor vertices, as the benchmarks and the demo
+/// draw them.
+pub use wavg_solve::sampling;
+
+/// Hints for this workspace's C ABI.
+///
+/// **Unstable**: not part of the public API; anything here may change or disappear in any
+/// release.
+#[doc(hidden)]
+pub mod internal {
+    pub use wavg_project::internal::prefetch_point_data;
+}
 
 pub use wavg_apps as apps;
 pub use wavg_embed as embed;

@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use wavg_mesh::{SurfacePoint, ValidMesh};
-use wavg_solve::{Anchor, EmbeddedMesh, Projector, Solver, Vec8};
+use wavg::{Anchor, EmbeddedMesh, Projector, Solver, Vec8};
+use wavg::{SurfacePoint, ValidMesh};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
@@ -41,7 +41,7 @@ pub fn load_embedded(
     let Some(path) = embedding else {
         return Ok(Arc::new(EmbeddedMesh::from_positions(mesh)));
     };
-    let e = wavg_embed::file::load(path, &mesh).map_err(|e| CliError::input(one_line(&e)))?;
+    let e = wavg::embed::file::load(path, &mesh).map_err(|e| CliError::input(one_line(&e)))?;
     let coords: Vec<Vec8> = e.coords.iter().map(|c| Vec8::from(*c)).collect();
     let emb = EmbeddedMesh::new(mesh, coords)
         .map_err(|e| CliError::input(format!("{}: {}", path.display(), one_line(&e))))?;
@@ -65,7 +65,7 @@ pub fn resolve_points(
         .iter()
         .map(|&(line, spec)| {
             let a = spec_anchor(spec).map_err(|m| located(file, line, &m))?;
-            wavg_solve::resolve_anchor(mesh, &a).map_err(|e| located(file, line, &e))
+            wavg::resolve_anchor(mesh, &a).map_err(|e| located(file, line, &e))
         })
         .collect()
 }
@@ -102,7 +102,7 @@ pub fn load_solver(
         .collect::<Result<Vec<_>, _>>()?;
     // Validate each anchor with its line number before building anything expensive.
     for (&(line, _), a) in specs.iter().zip(&anchor_list) {
-        wavg_solve::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
+        wavg::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
     let emb = load_embedded(mesh, embedding)?;
     let proj = build_projector(emb)?;
