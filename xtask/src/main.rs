@@ -7,6 +7,7 @@ mod cbuild;
 mod examples;
 mod fuzz;
 mod lines;
+mod man;
 mod policy;
 
 use std::path::{Path, PathBuf};
@@ -24,6 +25,9 @@ fn main() -> ExitCode {
             None => usage(),
         },
         Some("lines") => report(lines::run(&workspace_root())),
+        Some("man") if args.len() <= 2 => {
+            report(man::run(&workspace_root(), args.get(1).map(String::as_str)))
+        }
         Some("bench") if args.len() > 1 => report(bench(&workspace_root(), &args[1..])),
         _ => usage(),
     }
@@ -55,7 +59,7 @@ fn bench(root: &Path, args: &[String]) -> Result<(), String> {
 
 fn usage() -> ExitCode {
     eprintln!(
-        "usage: cargo xtask test | cargo xtask fuzz [--seconds N] [--target NAME] | cargo xtask bench NAME [ARGS] | cargo xtask lines\n\n  \
+        "usage: cargo xtask test | cargo xtask fuzz [--seconds N] [--target NAME] | cargo xtask bench NAME [ARGS] | cargo xtask lines | cargo xtask man [DIR]\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
          and wavg-ffi), cargo doc (-D warnings), the examples \
@@ -64,8 +68,10 @@ fn usage() -> ExitCode {
          run of every fuzz target\n  \
          fuzz   every fuzz target (or only NAME) for N seconds (default 60) each\n  \
          bench  the timing script or experiment NAME (crates/wavg-bench/src/bin/NAME.rs) with ARGS\n  \
-         lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])",
-        MAX = lines::MAX_LINES
+         lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])\n  \
+         man    man pages of wavg and every subcommand into DIR (default {MAN_DIR})",
+        MAX = lines::MAX_LINES,
+        MAN_DIR = man::DEFAULT_DIR
     );
     ExitCode::from(2)
 }
