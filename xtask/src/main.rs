@@ -8,6 +8,7 @@ mod examples;
 mod fuzz;
 mod lab;
 mod lines;
+mod man;
 mod policy;
 mod sancov;
 mod steps;
@@ -34,13 +35,17 @@ fn main() -> ExitCode {
         },
         Some("lines") => report(lines::run(&workspace_root())),
         Some("lab") => report(lab::run(&workspace_root(), &args[1..])),
+        Some("man") if args.len() <= 2 => {
+            report(man::run(&workspace_root(), args.get(1).map(String::as_str)))
+        }
         _ => usage(),
     }
 }
 
 fn usage() -> ExitCode {
     eprintln!(
-        "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | cargo xtask lab [NAME ARGS] | cargo xtask lines\n\n  \
+        "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
+         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR]\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
          and wavg-ffi), cargo doc (-D warnings), the examples \
@@ -51,7 +56,8 @@ fn usage() -> ExitCode {
          fuzz   every fuzz target (or only NAME) for N seconds (default 60) each\n  \
          lab    build the lab (lab/, not a default member), or run its program NAME \
          (lab/src/bin/NAME.rs, release mode) with ARGS\n  \
-         lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])",
+         lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])\n  \
+         man    man pages of wavg and every subcommand into DIR (default target/man)",
         MAX = lines::MAX_LINES
     );
     ExitCode::from(2)

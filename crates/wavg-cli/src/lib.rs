@@ -1,0 +1,132 @@
+//! The `wavg` command line: diagnostics, precomputation, forward/inverse problems, benchmarks.
+//!
+//! The binary calls [`main`]; [`command`] gives the command definition to tools that
+//! write its man pages or shell completions.
+
+#![forbid(unsafe_code)]
+
+mod apps_common;
+mod bench_load;
+mod bench_project;
+mod bench_roundtrip;
+mod common;
+mod completions;
+mod correspond;
+mod decal;
+mod demo;
+mod demo_apps;
+mod demo_pictures;
+mod error;
+mod forward;
+mod info;
+mod inverse;
+pub mod man;
+mod morph;
+mod precompute;
+mod remesh;
+mod render;
+mod repair;
+mod spline;
+mod stream;
+mod subdivide;
+mod textio;
+mod transfer_texture;
+
+use std::process::ExitCode;
+
+use clap::{CommandFactory, Parser, Subcommand};
+
+pub use error::CliError;
+
+/// Weighted averages of points on triangle meshes (Panozzo et al., SIGGRAPH 2013).
+#[derive(Parser)]
+#[command(name = "wavg", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run the whole method on a generated mesh: embedding, a spline, round trips.
+    Demo(demo::Args),
+    /// Describe a mesh: counts, topology, and every validation problem.
+    Info(info::Args),
+    /// Repair a mesh (weld, drop degenerate/duplicate faces, ...) and write it.
+    Repair(repair::Args),
+    /// Compute the 8-D embedding of a mesh and write it as a .wavg file.
+    Precompute(precompute::Args),
+    /// Forward problem: anchors + weights -> points on the surface.
+    Forward(forward::Args),
+    /// Inverse problem: anchors + surface points -> weights.
+    Inverse(inverse::Args),
+    /// A B-spline or Bézier curve on the surface through control points.
+    Spline(spline::Args),
+    /// Loop subdivision: make a larger mesh from a smaller one.
+    Subdivide(subdivide::Args),
+    /// Map every vertex of one surface onto another through paired anchors.
+    Correspond(correspond::Args),
+    /// A decal: (u, v) coordinates for every vertex from anchors that carry them.
+    Decal(decal::Args),
+    /// Morph one surface into another: the source's mesh moved onto the target, in frames.
+    Morph(morph::Args),
+    /// Semiregular remeshing of a coarse polygon mesh on the surface, with smoothing.
+    Remesh(remesh::Args),
+    /// A picture (PNG) of a mesh: shaded, textured or scalar-coloured, with curves and dots.
+    Render(render::Args),
+    /// Carry a texture from one mesh to another through corresponding anchors.
+    TransferTexture(transfer_texture::Args),
+    /// Benchmarks (report timings and quality figures).
+    #[command(subcommand)]
+    Bench(BenchCommand),
+    /// Print a shell completion script (bash, zsh or fish) to standard output.
+    Completions(completions::Args),
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Load + validate + topology time of a mesh file.
+    Load(bench_load::Args),
+    /// Phong projection speed and accuracy on random surface points.
+    Project(bench_project::Args),
+    /// The paper's Table 1 protocol: inverse then forward round trips.
+    Roundtrip(bench_roundtrip::Args),
+}
+
+/// The `wavg` command: every subcommand with its options and help text.
+pub fn command() -> clap::Command {
+    Cli::command()
+}
+
+/// Parses the process's arguments, runs the command and reports a failure on stderr as
+/// `wavg: MESSAGE`; the exit status is the binary's.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Demo(a) => demo::run(a),
+        Command::Info(a) => info::run(a),
+        Command::Repair(a) => repair::run(a),
+        Command::Precompute(a) => precompute::run(a),
+        Command::Forward(a) => forward::run(a),
+        Command::Inverse(a) => inverse::run(a),
+        Command::Spline(a) => spline::run(a),
+        Command::Subdivide(a) => subdivide::run(a),
+        Command::Correspond(a) => correspond::run(a),
+        Command::Decal(a) => decal::run(a),
+        Command::Morph(a) => morph::run(a),
+        Command::Remesh(a) => remesh::run(a),
+        Command::Render(a) => render::run(a),
+        Command::TransferTexture(a) => transfer_texture::run(a),
+        Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
+        Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
+        Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),
+        Command::Completions(a) => completions::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("wavg: {}", e.message);
+            ExitCode::from(e.code)
+        }
+    }
+}
