@@ -26,17 +26,16 @@
 //! ```
 //!
 //! The workspace crates stay reachable as modules ([`mesh`], [`embed`], [`project`],
-//! [`solve`]) for what the front door does not cover.
+//! [`solve`]) for what the front door does not cover; the file formats are [`text`] and
+//! [`npy`] (the `wavg-io` crate).
 
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
 
 mod decimate;
 mod error;
-pub mod npy;
 mod oneoff;
 mod surface;
-pub mod text;
 
 pub use decimate::Decimation;
 pub use error::{Error, ErrorKind, Result};
@@ -50,6 +49,8 @@ pub use wavg_solve::{
     ProjectionPath, RoundTrip, SearchGoal, SearchMode, Solver, Verified,
 };
 pub use wavg_solve::{RoundTripOptions, RoundTripReport, VerifiedRoundTripReport, round_trip};
+/// The file formats: plain-text surface points and weights, NumPy `.npy` arrays.
+pub use wavg_io::{npy, text};
 
 pub use wavg_apps as apps;
 pub use wavg_embed as embed;
