@@ -43,14 +43,14 @@ pub use nalgebra::Vector3;
 pub use oneoff::{barycentric_weights, weighted_average};
 pub use surface::Surface;
 pub use wavg_embed::{Embedding, NoProgress, PrecomputeOptions, Progress, Report, Stage};
+/// The file formats: plain-text surface points and weights, NumPy `.npy` arrays.
+pub use wavg_io::{npy, text};
 pub use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, VertexId};
 pub use wavg_solve::{
     Anchor, BatchWeights, ForwardOptions, ForwardResult, ForwardScratch, Normalization, Par,
     ProjectionPath, RoundTrip, SearchGoal, SearchMode, Solver, Verified,
 };
 pub use wavg_solve::{RoundTripOptions, RoundTripReport, VerifiedRoundTripReport, round_trip};
-/// The file formats: plain-text surface points and weights, NumPy `.npy` arrays.
-pub use wavg_io::{npy, text};
 
 pub use wavg_apps as apps;
 pub use wavg_embed as embed;
