@@ -1,51 +1,7 @@
 //! The `.wavg` file: an embedding together with a fingerprint of the mesh it belongs to.
+//! [`load`] checks everything a reader must check; [`save`] writes atomically.
 //!
-//! # Format, version 1
-//!
-//! A small hand-written binary so that C and C++ programs can read it without a library.
-//! Every number is **little-endian**; `f64` is IEEE-754 binary64 stored as its bit pattern.
-//! Offsets are in bytes from the start of the file.
-//!
-//! | offset | type     | field                                                             |
-//! |-------:|----------|-------------------------------------------------------------------|
-//! |      0 | `[u8;8]` | magic `"WAVGEMB\0"` = `57 41 56 47 45 4D 42 00`                   |
-//! |      8 | `u32`    | format version = `1`                                              |
-//! |     12 | `u32`    | `dim`, the embedding dimension, `1..=8` (wavg writes 8)           |
-//! |     16 | `u64`    | `n_vertices` of the mesh                                          |
-//! |     24 | `u64`    | `n_faces` of the mesh                                             |
-//! |     32 | `u64`    | `mesh_hash`: FNV-1a 64 of the mesh, see below                     |
-//! |     40 | `u64`    | `n_landmarks`, number of landmark ids stored (`<= n_vertices`)    |
-//! |     48 | `u64`    | parameter: landmarks requested                                    |
-//! |     56 | `u64`    | parameter: random seed                                            |
-//! |     64 | `u64`    | parameter: MDS (SMACOF) iteration limit                           |
-//! |     72 | `f64`    | parameter: MDS relative stress-change tolerance                   |
-//! |     80 | `u64`    | parameter: vertices of the mesh the geodesics ran on (0 = the mesh itself) |
-//! |     88 | `f64`    | MDS stress of the landmarks (finite, `>= 0`, see [`crate::Report::stress`]) |
-//! |     96 | `f64`    | geodesic relative error, median (NaN = not measured)              |
-//! |    104 | `f64`    | geodesic relative error, 90th percentile (NaN = not measured)     |
-//! |    112 | `[u8;16]`| reserved, must be zero                                            |
-//! |    128 | `f64` x `n_vertices * dim` | coordinates, vertex-major: vertex 0's `dim` values, then vertex 1's, ... (all finite) |
-//! |      C | `u32` x `n_landmarks` | landmark vertex ids (distinct, `< n_vertices`), `C = 128 + 8 n_vertices dim` |
-//! |      P | `u8` x (0 or 4) | zero padding so that the checksum starts at a multiple of 8 |
-//! |  L - 8 | `u64`    | checksum: FNV-1a 64 of bytes `0 .. L-8` (everything before it)    |
-//!
-//! The file length is therefore exactly
-//! `L = 128 + 8 n_vertices dim + 4 n_landmarks + (4 if n_landmarks is odd else 0) + 8`.
-//!
-//! **FNV-1a 64**: `h = 0xcbf29ce484222325`; for each byte `b`: `h = (h XOR b) * 0x100000001b3`
-//! (wrapping 64-bit multiplication). Because each step is a bijection of `h`, any change of a
-//! single byte always changes the checksum.
-//!
-//! **Mesh fingerprint** (`mesh_hash`): FNV-1a 64 over the byte stream
-//! `n_vertices` as `u64`, `n_faces` as `u64`, then every vertex position `x, y, z` as `f64`
-//! (bit pattern, so `-0.0 != 0.0`), then every triangle's three vertex ids as `u32`, all
-//! little-endian, in the mesh's order. It identifies the positions exactly as the mesh loader
-//! produced them; any edit of the mesh (even reordering) makes the file refuse to load.
-//!
-//! A reader must refuse a file whose magic, version, length, checksum, reserved or padding
-//! bytes, counts or fingerprint do not match, or whose values are out of range. [`load`] does
-//! all of that; [`save`] writes atomically (temporary file in the same directory, `fsync`,
-//! rename), so an interrupted run never leaves a partial file under the final name.
+#![doc = include_str!("../FORMAT.md")]
 
 use std::io::Read;
 use std::path::Path;

@@ -29,17 +29,15 @@
 //! [`solve`], [`apps`]) for what the front door does not cover: mesh files
 //! ([`mesh::io`]), procedural meshes, repair and subdivision ([`mesh::procedural`],
 //! [`mesh::repair`], [`mesh::subdivide`]), `.wavg` files ([`embed::file`]) and the
-//! applications ([`apps`]).
+//! applications ([`apps`]); the file formats are [`text`] and [`npy`] (the `wavg-io` crate).
 
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
 
 mod decimate;
 mod error;
-pub mod npy;
 mod oneoff;
 mod surface;
-pub mod text;
 
 pub use decimate::Decimation;
 pub use error::{Error, ErrorKind, Result};
@@ -47,6 +45,8 @@ pub use nalgebra::Vector3;
 pub use oneoff::{barycentric_weights, weighted_average};
 pub use surface::Surface;
 pub use wavg_embed::{Embedding, NoProgress, PrecomputeOptions, Progress, Report, Stage};
+/// The file formats: plain-text surface points and weights, NumPy `.npy` arrays.
+pub use wavg_io::{npy, text};
 pub use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, VertexId};
 pub use wavg_solve::{
     Anchor, BatchWeights, ForwardOptions, ForwardResult, ForwardScratch, Normalization, Par,

@@ -1,12 +1,6 @@
-//! The plain-text formats of `wavg forward` / `wavg inverse` and atomic output files.
-//!
-//! Input files have one item per line. `#` starts a comment that runs to the end of the
-//! line; blank (or comment-only) lines are skipped. Line numbers in errors count every
-//! physical line from 1.
-//!
-//! * Surface points (anchors, query points): `v VERTEX` (a mesh vertex, 0-based) or
-//!   `f FACE B0 B1 B2` (0-based face, barycentric coordinates of its three corners).
-//! * Weights: whitespace-separated decimal numbers, one query per line.
+//! The command line's use of the point and weight files (the formats are described and
+//! parsed in `wavg::text`): reading them with errors located as `file:line`, the problem
+//! they pose (mesh, embedding, anchors), and atomic output files.
 
 mod files;
 mod parse;

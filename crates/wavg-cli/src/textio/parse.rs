@@ -1,9 +1,10 @@
-//! The text of the formats for `--help`; the formats themselves are parsed by
-//! `wavg::text`.
+//! The formats' summary for `--help`; the formats themselves are described and parsed in
+//! `wavg::text` and `wavg::npy`.
 
 pub use wavg::text::PointSpec;
 
-/// Text of the formats for `--help` (kept next to the parser so they cannot drift apart).
+/// The formats' summary for `--help` (the full description is `wavg::text`'s and
+/// `wavg::npy`'s).
 pub const FORMAT_HELP: &str = "\
 FILE FORMATS (plain text, one item per line; '#' starts a comment to the end of the line;
 blank lines are skipped; errors name the 1-based physical line):

@@ -1,20 +1,9 @@
-//! The plain-text formats of surface points and weights, parsed and written in parallel a
-//! chunk of lines at a time, so files of any length stream through bounded memory.
-//!
-//! Files have one item per line. `#` starts a comment that runs to the end of the line;
-//! blank (or comment-only) lines are skipped. Line numbers in errors count every physical
-//! line from 1.
-//!
-//! * Surface points (anchors, query points): `v VERTEX` (a mesh vertex, 0-based) or
-//!   `f FACE B0 B1 B2` (0-based face, barycentric coordinates of its three corners).
-//! * Weights: whitespace-separated decimal numbers, one query per line.
-//!
-//! Numbers are written in the shortest form that reads back to the same `f64`, laid out as
-//! Rust's `{:?}` writes them (where two shortest forms are equally close, the digits may
-//! differ from `{:?}`'s in the last place).
+//! The plain-text formats of surface points and weights (described in the [crate
+//! docs](crate)), parsed and written in parallel a chunk of lines at a time, so files of
+//! any length stream through bounded memory.
 //!
 //! ```
-//! use wavg::text::{LineChunks, PointSpec, parse_points, push_numbers};
+//! use wavg_io::text::{LineChunks, PointSpec, parse_points, push_numbers};
 //! let text = "# two anchors\nv 3\nf 2 0.25 0.25 0.5\n";
 //! let mut chunks = LineChunks::new(text.as_bytes(), 1000);
 //! let chunk = chunks.next_chunk()?.expect("one chunk");
