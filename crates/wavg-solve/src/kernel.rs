@@ -120,11 +120,13 @@ impl AnchorCoords {
     fn weighted_sum_with<S: pulp::Simd>(&self, simd: S, weights: &[f64], scale: f64) -> Vec8 {
         let n = self.n.min(weights.len());
         let w = &weights[..n];
-        Vec8::from(
-            self.dims
-                .each_ref()
-                .map(|dim| dot(simd, w, &dim[..n]) * scale),
-        )
+        // A loop, not a closure: a closure is compiled without `S`'s instruction set, and
+        // `S`'s operations would not inline into it.
+        let mut out = [0.0; DIM];
+        for (o, dim) in out.iter_mut().zip(&self.dims) {
+            *o = dot(simd, w, &dim[..n]) * scale;
+        }
+        Vec8::from(out)
     }
 }
 
