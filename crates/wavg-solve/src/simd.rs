@@ -36,13 +36,12 @@ pub(crate) fn sum_lanes(l: [f64; LANES]) -> f64 {
 #[inline(always)]
 pub(crate) fn dot<S: pulp::Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let whole = n / LANES * LANES;
+    let (ac, bc) = (a[..n].chunks_exact(LANES), b[..n].chunks_exact(LANES));
+    let (ar, br) = (ac.remainder(), bc.remainder());
     let lanes = if S::F64_LANES == LANES {
-        let (ah, _) = S::as_simd_f64s(&a[..whole]);
-        let (bh, _) = S::as_simd_f64s(&b[..whole]);
         let mut acc = simd.splat_f64s(0.0);
-        for (&x, &y) in ah.iter().zip(bh) {
+        for (x, y) in ac.zip(bc) {
+            let (x, y) = (S::as_simd_f64s(x).0[0], S::as_simd_f64s(y).0[0]);
             acc = simd.add_f64s(acc, simd.mul_f64s(x, y));
         }
         let mut l = [0.0; LANES];
@@ -50,10 +49,7 @@ pub(crate) fn dot<S: pulp::Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
         l
     } else {
         let mut acc = [0.0; LANES];
-        for (x, y) in a[..whole]
-            .chunks_exact(LANES)
-            .zip(b[..whole].chunks_exact(LANES))
-        {
+        for (x, y) in ac.zip(bc) {
             for k in 0..LANES {
                 acc[k] += x[k] * y[k];
             }
@@ -61,7 +57,7 @@ pub(crate) fn dot<S: pulp::Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
         acc
     };
     let mut s = sum_lanes(lanes);
-    for (x, y) in a[whole..].iter().zip(&b[whole..]) {
+    for (x, y) in ar.iter().zip(br) {
         s += x * y;
     }
     s
