@@ -1,5 +1,20 @@
-//! Explicit SIMD through `pulp` (safe; the CPU's widest instruction set is picked at run
-//! time): the SMACOF coefficient column.
+//! Run-time SIMD dispatch and the crate's explicit-SIMD loop, the SMACOF coefficient column.
+//!
+//! The same convention as `wavg-solve`: a hot loop is one function generic over
+//! `S: pulp::Simd`, wrapped in a [`pulp::WithSimd`] operation and run through [`dispatch`]
+//! once per call, which picks the build for the widest instruction set this CPU has. No
+//! `unsafe`.
+
+use std::sync::LazyLock;
+
+/// The instruction sets of this CPU, detected once.
+static ARCH: LazyLock<pulp::Arch> = LazyLock::new(pulp::Arch::new);
+
+/// Runs `op` compiled for this CPU's widest SIMD instruction set.
+#[inline(always)]
+pub(crate) fn dispatch<Op: pulp::WithSimd>(op: Op) -> Op::Output {
+    ARCH.dispatch(op)
+}
 
 /// Turns Gram column `j` into coefficients `c_ij = 1/(Q_ij d_ij)` (0 where `d_ij = 0` or on
 /// the diagonal); returns the column's stress `Σ_i (d_ij/Q_ij - 1)²` and `Σ_i c_ij`.
@@ -14,7 +29,7 @@ pub(crate) fn coefficient_column(
     inv_col: &[f64],
 ) -> (f64, f64) {
     let n = col.len();
-    pulp::Arch::new().dispatch(CoefficientColumn {
+    dispatch(CoefficientColumn {
         col,
         sq: &sq[..n],
         sj: sq[j],
@@ -22,6 +37,7 @@ pub(crate) fn coefficient_column(
     })
 }
 
+/// [`coefficient_column`] as one SIMD operation.
 struct CoefficientColumn<'a> {
     col: &'a mut [f64],
     sq: &'a [f64],

@@ -4,6 +4,11 @@
 //! None of them changes a result: a prefetch is only a hint, the SSE2 distance equals the
 //! portable one bit for bit (tested in the projector), and the advice only picks the page
 //! size of memory this process just allocated.
+//!
+//! Nothing here is dispatched at run time: every instruction used is in the x86-64 baseline
+//! (SSE, SSE2), so the walk inlines the distance. Run-time dispatched SIMD goes through
+//! `pulp` in the other crates' `simd.rs` modules; `pulp::Simd` has no 16-bit to `f32`
+//! conversion, which the walk's distance needs (ARCHITECTURE.md, "Public API and `unsafe`").
 
 /// Hints the processor to load the first `lines` cache lines (64 bytes each) starting at
 /// `r` into cache; no effect on results, a no-op off x86-64.

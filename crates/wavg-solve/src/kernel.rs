@@ -18,13 +18,11 @@
 //! `d_min` is zero.
 
 use crate::error::SolveError;
+use crate::simd::{LANES, dispatch, dot, sum_lanes};
 use crate::{DIM, Mat2x8, Vec8};
 
 /// Default `gamma`: how much more the distance off the tangent plane counts (the paper's 10).
 pub const DEFAULT_GAMMA: f64 = 10.0;
-
-/// Lanes of the per-anchor reductions; storage is padded to a multiple of this.
-pub(crate) const LANES: usize = 4;
 
 /// Anchor coordinates in R^8, one array per coordinate (structure of arrays) so the
 /// per-anchor loops vectorise; each array is padded with zeros to a multiple of the SIMD lane count (4).
@@ -110,39 +108,42 @@ impl AnchorCoords {
     /// CPU's SIMD width at run time; every build gives the same bits (same operations, same
     /// order).
     pub fn weighted_sum(&self, weights: &[f64], scale: f64) -> Vec8 {
-        crate::simd::weighted_sum(self, weights, scale)
+        dispatch(WeightedSum {
+            coords: self,
+            weights,
+            scale,
+        })
     }
 
-    /// The anchors a weight vector of `len` entries covers, and the coordinate arrays.
+    /// [`AnchorCoords::weighted_sum`] built for the instruction set `S`.
     #[inline(always)]
-    pub(crate) fn dims(&self, len: usize) -> (usize, &[Vec<f64>; DIM]) {
-        (self.n.min(len), &self.dims)
-    }
-
-    /// The weighted sum as portable loops over [`LANES`]-wide partial sums (what
-    /// [`AnchorCoords::weighted_sum`] runs without AVX2, and computes bit for bit with it).
-    #[inline(always)]
-    pub(crate) fn weighted_sum_portable(&self, weights: &[f64], scale: f64) -> Vec8 {
+    fn weighted_sum_with<S: pulp::Simd>(&self, simd: S, weights: &[f64], scale: f64) -> Vec8 {
         let n = self.n.min(weights.len());
         let w = &weights[..n];
+        // A loop, not a closure: a closure is compiled without `S`'s instruction set, and
+        // `S`'s operations would not inline into it.
         let mut out = [0.0; DIM];
         for (o, dim) in out.iter_mut().zip(&self.dims) {
-            let y = &dim[..n];
-            let mut acc = [0.0; LANES];
-            let (wc, yc) = (w.chunks_exact(LANES), y.chunks_exact(LANES));
-            let (wr, yr) = (wc.remainder(), yc.remainder());
-            for (wc, yc) in wc.zip(yc) {
-                for l in 0..LANES {
-                    acc[l] += wc[l] * yc[l];
-                }
-            }
-            let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-            for (a, b) in wr.iter().zip(yr) {
-                s += a * b;
-            }
-            *o = s * scale;
+            *o = dot(simd, w, &dim[..n]) * scale;
         }
         Vec8::from(out)
+    }
+}
+
+/// [`AnchorCoords::weighted_sum`] as one SIMD operation.
+struct WeightedSum<'a> {
+    coords: &'a AnchorCoords,
+    weights: &'a [f64],
+    scale: f64,
+}
+
+impl pulp::WithSimd for WeightedSum<'_> {
+    type Output = Vec8;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> Vec8 {
+        self.coords
+            .weighted_sum_with(simd, self.weights, self.scale)
     }
 }
 
@@ -229,13 +230,18 @@ pub fn inverse_weights(
     scratch.a1.resize(padded, 0.0);
     scratch.d.resize(padded, 0.0);
     out.resize(padded, 0.0);
-    let r = crate::simd::inverse_kernel(&ctx, anchors, scratch, out);
+    let r = dispatch(InverseKernel {
+        ctx: &ctx,
+        ys: anchors,
+        sc: scratch,
+        out,
+    });
     out.truncate(if r.is_ok() { n } else { 0 });
     r
 }
 
 /// The per-query constants of the kernel.
-pub(crate) struct Ctx {
+struct Ctx {
     p0: [f64; DIM],
     p1: [f64; DIM],
     yh: [f64; DIM],
@@ -244,11 +250,31 @@ pub(crate) struct Ctx {
     n: usize,
 }
 
-/// The inverse problem's passes over the anchors, written as loops over contiguous arrays
-/// (or [`LANES`]-wide partial sums) so they vectorise. `sc` and `out` have the padded
-/// length; padded entries get `d = inf`, hence `s = 0` and no influence.
+/// [`kernel`] for one query as one SIMD operation.
+struct InverseKernel<'a> {
+    ctx: &'a Ctx,
+    ys: &'a AnchorCoords,
+    sc: &'a mut InverseScratch,
+    out: &'a mut [f64],
+}
+
+impl pulp::WithSimd for InverseKernel<'_> {
+    type Output = Result<(), SolveError>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> Self::Output {
+        kernel(simd, self.ctx, self.ys, self.sc, self.out)
+    }
+}
+
+/// The inverse problem's passes over the anchors, built for the instruction set `S`: loops
+/// over contiguous arrays with [`LANES`]-wide partial sums, which the compiler vectorises
+/// for `S` (the same operations in the same order whatever `S`, so the same bits). `sc` and
+/// `out` have the padded length; padded entries get `d = inf`, hence `s = 0` and no
+/// influence.
 #[inline(always)]
-pub(crate) fn kernel(
+fn kernel<S: pulp::Simd>(
+    _simd: S,
     ctx: &Ctx,
     ys: &AnchorCoords,
     sc: &mut InverseScratch,
@@ -341,7 +367,7 @@ pub(crate) fn kernel(
             ss[l] = s;
         }
     }
-    let [m00, m01, m02, m11, m12, m22] = acc.map(|a| (a[0] + a[1]) + (a[2] + a[3]));
+    let [m00, m01, m02, m11, m12, m22] = acc.map(sum_lanes);
     let b = [-am0, -am1, 1.0];
     let Some(z) = solve_scaled_3x3([[m00, m01, m02], [m01, m11, m12], [m02, m12, m22]], b) else {
         // Singular: either the other anchors' contributions underflowed because the point
@@ -365,7 +391,7 @@ pub(crate) fn kernel(
             sums[l] += w;
         }
     }
-    let sum = (sums[0] + sums[1]) + (sums[2] + sums[3]);
+    let sum = sum_lanes(sums);
     if !sum.is_finite() || (sum - 1.0).abs() > 1e-6 {
         return Err(SolveError::DegenerateAnchors);
     }
@@ -418,7 +444,7 @@ fn solve_scaled_3x3(m: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
 #[cfg(test)]
 mod tests {
 
-    /// The run-time dispatched weighted sum gives the portable loop's bits, for anchor
+    /// The run-time dispatched weighted sum gives the plain loops' bits, for anchor
     /// counts around the vector width.
     #[test]
     fn weighted_sum_paths_agree_bitwise() {
@@ -431,7 +457,7 @@ mod tests {
                 .map(|i| ((i as f64) * 1.37).cos() / n as f64)
                 .collect();
             let a = c.weighted_sum(&w, 1.25);
-            let b = c.weighted_sum_portable(&w, 1.25);
+            let b = c.weighted_sum_with(pulp::Scalar::new(), &w, 1.25);
             assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "{n}");
             let direct: Vec8 = pts.iter().zip(&w).map(|(p, w)| p * (*w * 1.25)).sum();
             assert!((a - direct).norm() < 1e-12, "{n}");
@@ -441,7 +467,7 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
 
-    /// The AVX2 build of the kernel gives the portable build's results bit for bit, so
+    /// The kernel built for this CPU gives the plain build's results bit for bit, so
     /// answers do not depend on the machine.
     #[test]
     fn simd_and_portable_kernels_agree_exactly() {
@@ -470,8 +496,15 @@ mod tests {
                 let mut out = vec![0.0; padded];
                 f(&mut sc, &mut out).map(|()| out)
             };
-            let a = run(&|sc, out| crate::simd::inverse_kernel(&ctx, &coords, sc, out));
-            let b = run(&|sc, out| kernel(&ctx, &coords, sc, out));
+            let a = run(&|sc, out| {
+                dispatch(InverseKernel {
+                    ctx: &ctx,
+                    ys: &coords,
+                    sc,
+                    out,
+                })
+            });
+            let b = run(&|sc, out| kernel(pulp::Scalar::new(), &ctx, &coords, sc, out));
             assert_eq!(a, b, "n = {n}");
         }
     }

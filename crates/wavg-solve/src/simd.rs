@@ -1,87 +1,96 @@
-//! Run-time SIMD dispatch. The inverse problem's kernel is written as portable loops over
-//! [`LANES`](crate::kernel::LANES)-wide partial sums, and `pulp` compiles it a second time
-//! for the widest instruction set the CPU has (AVX2 and up), chosen once at run time. The
-//! weighted sum is written with pulp's explicit 4-wide AVX2 operations. Either way the same
-//! operations run in the same order as the portable code, so all builds give the same bits
-//! (tested in `kernel`); only the registers are wider. No `unsafe`.
+//! Run-time SIMD dispatch and the vector building blocks of the inverse problem.
+//!
+//! The crate's convention: a hot loop is one function generic over `S: pulp::Simd`, wrapped
+//! in a [`pulp::WithSimd`] operation and run through [`dispatch`] once per call, which
+//! compiles it for the widest instruction set this CPU has (AVX2 and up) and picks that
+//! build at run time. Reductions keep [`LANES`] partial sums whatever the vector width, so
+//! every build runs the same operations in the same order and gives the same bits; only the
+//! registers are wider. No `unsafe`.
 
 use std::sync::LazyLock;
 
-use crate::Vec8;
-use crate::error::SolveError;
-use crate::kernel::{AnchorCoords, Ctx, InverseScratch, LANES, kernel};
+/// Lanes of the per-anchor reductions: partial sums are kept `LANES` apart, and anchor
+/// storage is padded to a multiple of this.
+pub(crate) const LANES: usize = 4;
 
 /// The instruction sets of this CPU, detected once.
 static ARCH: LazyLock<pulp::Arch> = LazyLock::new(pulp::Arch::new);
 
-/// [`kernel`] compiled for the CPU's widest SIMD instruction set.
-pub(crate) fn inverse_kernel(
-    ctx: &Ctx,
-    ys: &AnchorCoords,
-    sc: &mut InverseScratch,
-    out: &mut [f64],
-) -> Result<(), SolveError> {
-    ARCH.dispatch(Kernel { ctx, ys, sc, out })
-}
-
-/// AVX2 on this CPU, detected once.
-#[cfg(target_arch = "x86_64")]
-static V3: LazyLock<Option<pulp::x86::V3>> = LazyLock::new(pulp::x86::V3::try_new);
-
-/// [`AnchorCoords::weighted_sum_portable`] with its four partial sums in one AVX2 register
-/// where the CPU has one (the same multiplications and additions in the same order, so the
-/// same bits), else the portable loop. Written with explicit 4-wide operations: compiled
-/// from the portable loop, the compiler vectorised across chunks, with shuffles, at half
-/// the speed.
-pub(crate) fn weighted_sum(coords: &AnchorCoords, weights: &[f64], scale: f64) -> Vec8 {
-    #[cfg(target_arch = "x86_64")]
-    if let Some(simd) = *V3 {
-        return simd.vectorize(|| weighted_sum_v3(simd, coords, weights, scale));
-    }
-    coords.weighted_sum_portable(weights, scale)
-}
-
-struct Kernel<'a> {
-    ctx: &'a Ctx,
-    ys: &'a AnchorCoords,
-    sc: &'a mut InverseScratch,
-    out: &'a mut [f64],
-}
-
-impl pulp::WithSimd for Kernel<'_> {
-    type Output = Result<(), SolveError>;
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) -> Self::Output {
-        kernel(self.ctx, self.ys, self.sc, self.out)
-    }
-}
-
-/// The body of [`weighted_sum`] with AVX2 (inlined into pulp's AVX2 function).
-#[cfg(target_arch = "x86_64")]
+/// Runs `op` compiled for this CPU's widest SIMD instruction set.
 #[inline(always)]
-fn weighted_sum_v3(v3: pulp::x86::V3, coords: &AnchorCoords, weights: &[f64], scale: f64) -> Vec8 {
-    use pulp::{cast, f64x4};
-    const _: () = assert!(LANES == 4);
-    let (n, dims) = coords.dims(weights.len());
-    let w = &weights[..n];
-    let mut out = [0.0; 8];
-    for (o, dim) in out.iter_mut().zip(dims) {
-        let y = &dim[..n];
-        let (wc, yc) = (w.chunks_exact(LANES), y.chunks_exact(LANES));
-        let (wr, yr) = (wc.remainder(), yc.remainder());
-        let mut acc = v3.splat_f64x4(0.0);
-        for (wc, yc) in wc.zip(yc) {
-            let a: f64x4 = cast(<[f64; LANES]>::try_from(wc).unwrap_or_default());
-            let b: f64x4 = cast(<[f64; LANES]>::try_from(yc).unwrap_or_default());
-            acc = v3.add_f64x4(acc, v3.mul_f64x4(a, b));
+pub(crate) fn dispatch<Op: pulp::WithSimd>(op: Op) -> Op::Output {
+    ARCH.dispatch(op)
+}
+
+/// The [`LANES`] partial sums added pairwise, `(l0 + l1) + (l2 + l3)`.
+#[inline(always)]
+pub(crate) fn sum_lanes(l: [f64; LANES]) -> f64 {
+    (l[0] + l[1]) + (l[2] + l[3])
+}
+
+/// `sum_i a_i b_i` over the common length, as [`LANES`] partial sums added by
+/// [`sum_lanes`], then the remainder in order. With `S` exactly [`LANES`] wide the partial
+/// sums live in one register and use explicit vector operations (compiled from plain loops,
+/// the compiler vectorises across rows instead, with shuffles, at half the speed); any
+/// other `S` runs the same operations as plain loops. Both give the same bits.
+#[inline(always)]
+pub(crate) fn dot<S: pulp::Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (ac, bc) = (a[..n].chunks_exact(LANES), b[..n].chunks_exact(LANES));
+    let (ar, br) = (ac.remainder(), bc.remainder());
+    let lanes = if S::F64_LANES == LANES {
+        let mut acc = simd.splat_f64s(0.0);
+        for (x, y) in ac.zip(bc) {
+            let (x, y) = (S::as_simd_f64s(x).0[0], S::as_simd_f64s(y).0[0]);
+            acc = simd.add_f64s(acc, simd.mul_f64s(x, y));
         }
-        let l: [f64; LANES] = cast(acc);
-        let mut s = (l[0] + l[1]) + (l[2] + l[3]);
-        for (a, b) in wr.iter().zip(yr) {
-            s += a * b;
+        let mut l = [0.0; LANES];
+        S::as_mut_simd_f64s(&mut l).0[0] = acc;
+        l
+    } else {
+        let mut acc = [0.0; LANES];
+        for (x, y) in ac.zip(bc) {
+            for k in 0..LANES {
+                acc[k] += x[k] * y[k];
+            }
         }
-        *o = s * scale;
+        acc
+    };
+    let mut s = sum_lanes(lanes);
+    for (x, y) in ar.iter().zip(br) {
+        s += x * y;
     }
-    Vec8::from(out)
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The dot product for one pair of slices, run through [`dispatch`].
+    struct Dot<'a>(&'a [f64], &'a [f64]);
+
+    impl pulp::WithSimd for Dot<'_> {
+        type Output = f64;
+
+        #[inline(always)]
+        fn with_simd<S: pulp::Simd>(self, simd: S) -> f64 {
+            dot(simd, self.0, self.1)
+        }
+    }
+
+    /// The dispatched dot product gives the plain loops' bits, for lengths around the
+    /// vector width, and agrees with the direct sum to rounding.
+    #[test]
+    fn dispatched_dot_matches_the_plain_loops_bitwise() {
+        for n in [0usize, 1, 3, 4, 5, 27, 93, 100] {
+            let a: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7316).sin() * 3.0).collect();
+            let b: Vec<f64> = (0..n + 2).map(|i| (i as f64 * 1.37).cos()).collect();
+            let fast = dispatch(Dot(&a, &b));
+            let plain = dot(pulp::Scalar::new(), &a, &b);
+            assert_eq!(fast.to_bits(), plain.to_bits(), "{n}");
+            let direct: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
+            assert!((fast - direct).abs() < 1e-12, "{n}");
+        }
+    }
 }
