@@ -66,36 +66,102 @@ fn build(root: &Path) -> Result<PathBuf, String> {
     Ok(root.join("target/debug"))
 }
 
-/// Runs the built targets from `bin_dir`.
+/// How many targets run at once: libFuzzer keeps one core busy per target.
+fn parallel_runs() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Runs the built targets from `bin_dir`, as many at once as there are cores, each with its
+/// output in `target/fuzz-logs/TARGET.log` (its last lines printed when it fails).
 fn run_built(root: &Path, bin_dir: &Path, seconds: u64, only: Option<&str>) -> Result<(), String> {
     let fuzz_dir = root.join("fuzz");
     seed_corpora(root, &fuzz_dir)?;
-    for target in TARGETS.iter().filter(|t| only.is_none_or(|o| o == **t)) {
-        eprintln!("==> fuzz {target} for {seconds} s");
-        let corpus = fuzz_dir.join("corpus").join(target);
-        std::fs::create_dir_all(&corpus).map_err(|e| format!("{}: {e}", corpus.display()))?;
-        let artifacts = fuzz_dir.join("artifacts").join(target);
-        std::fs::create_dir_all(&artifacts).map_err(|e| format!("{}: {e}", artifacts.display()))?;
-        let status = Command::new(bin_dir.join(target))
-            .arg(&corpus)
-            .args([
-                format!("-artifact_prefix={}/", artifacts.display()),
-                format!("-max_total_time={seconds}"),
-                "-rss_limit_mb=4096".into(),
-                "-timeout=20".into(),
-                "-print_final_stats=1".into(),
-            ])
-            .args(max_len(target).map(|n| format!("-max_len={n}")))
-            .current_dir(&fuzz_dir)
-            .status()
-            .map_err(|e| format!("could not start {target}: {e}"))?;
-        if !status.success() {
-            return Err(format!(
-                "fuzz target {target} failed ({status}); the input is in fuzz/artifacts/{target}/: \
-                 add it as a regression test"
-            ));
-        }
+    let logs = root.join("target/fuzz-logs");
+    std::fs::create_dir_all(&logs).map_err(|e| format!("{}: {e}", logs.display()))?;
+    let targets: Vec<&str> = TARGETS
+        .iter()
+        .copied()
+        .filter(|t| only.is_none_or(|o| o == *t))
+        .collect();
+    for group in targets.chunks(parallel_runs()) {
+        let results: Vec<Result<(), String>> = std::thread::scope(|scope| {
+            let runs: Vec<_> = group
+                .iter()
+                .map(|target| {
+                    let (fuzz_dir, logs) = (&fuzz_dir, &logs);
+                    scope.spawn(move || run_one(bin_dir, fuzz_dir, logs, target, seconds))
+                })
+                .collect();
+            runs.into_iter()
+                .map(|h| {
+                    h.join()
+                        .unwrap_or_else(|_| Err("a fuzz runner panicked".into()))
+                })
+                .collect()
+        });
+        results.into_iter().collect::<Result<(), String>>()?;
     }
+    Ok(())
+}
+
+/// One target for `seconds`; `Ok` with a line of its final statistics printed.
+fn run_one(
+    bin_dir: &Path,
+    fuzz_dir: &Path,
+    logs: &Path,
+    target: &str,
+    seconds: u64,
+) -> Result<(), String> {
+    let corpus = fuzz_dir.join("corpus").join(target);
+    std::fs::create_dir_all(&corpus).map_err(|e| format!("{}: {e}", corpus.display()))?;
+    let artifacts = fuzz_dir.join("artifacts").join(target);
+    std::fs::create_dir_all(&artifacts).map_err(|e| format!("{}: {e}", artifacts.display()))?;
+    let log_path = logs.join(format!("{target}.log"));
+    let log =
+        std::fs::File::create(&log_path).map_err(|e| format!("{}: {e}", log_path.display()))?;
+    let log_err = log
+        .try_clone()
+        .map_err(|e| format!("{}: {e}", log_path.display()))?;
+    eprintln!(
+        "    fuzz {target} for {seconds} s (output in {})",
+        log_path.display()
+    );
+    let status = Command::new(bin_dir.join(target))
+        .arg(&corpus)
+        .args([
+            format!("-artifact_prefix={}/", artifacts.display()),
+            format!("-max_total_time={seconds}"),
+            "-rss_limit_mb=4096".into(),
+            "-timeout=20".into(),
+            "-print_final_stats=1".into(),
+        ])
+        .args(max_len(target).map(|n| format!("-max_len={n}")))
+        .current_dir(fuzz_dir)
+        .stdout(log)
+        .stderr(log_err)
+        .status()
+        .map_err(|e| format!("could not start {target}: {e}"))?;
+    let text = std::fs::read_to_string(&log_path).unwrap_or_default();
+    if !status.success() {
+        let lines: Vec<&str> = text.lines().collect();
+        let tail = lines[lines.len().saturating_sub(40)..].join("\n");
+        return Err(format!(
+            "fuzz target {target} failed ({status}):\n{tail}\nthe input is in \
+             fuzz/artifacts/{target}/: add it as a regression test"
+        ));
+    }
+    let stat = |key: &str| {
+        text.lines()
+            .find_map(|l| l.strip_prefix(key))
+            .map_or("?", str::trim)
+            .to_owned()
+    };
+    eprintln!(
+        "    fuzz {target}: {} runs, {} per second, {} new units",
+        stat("stat::number_of_executed_units:"),
+        stat("stat::average_exec_per_sec:"),
+        stat("stat::new_units_added:")
+    );
     Ok(())
 }
 
