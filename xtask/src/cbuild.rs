@@ -124,6 +124,10 @@ pub fn steps(root: &Path, data_dir: &Path) -> Vec<(&'static str, String, Vec<Str
                 "-B".into(),
                 build.clone(),
                 format!("-DWAVG_DATA_DIR={}", data_dir.display()),
+                format!(
+                    "-DWAVG_CARGO_TARGET_DIR={}",
+                    crate::steps::target_dir(root).display()
+                ),
                 // The library from the tests' optimised dev build: the same feature set,
                 // so cargo has only the C library itself left to link.
                 "-DWAVG_CARGO_PROFILE=dev".into(),

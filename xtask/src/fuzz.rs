@@ -63,7 +63,7 @@ fn build(root: &Path) -> Result<PathBuf, String> {
             (crate::sancov::ENV, "1"),
         ],
     )?;
-    Ok(root.join("target/debug"))
+    Ok(steps::target_dir(root).join("debug"))
 }
 
 /// How many targets run at once: libFuzzer keeps one core busy per target.
@@ -177,7 +177,7 @@ fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
     // The everyday build's feature set, so that after the tests nothing is rebuilt.
     steps::cargo_workspace(root, &["build", "--all-targets"], &[])
         .map_err(|e| format!("building wavg for the seed corpora: {e}"))?;
-    let wavg = root.join("target/debug/wavg");
+    let wavg = steps::target_dir(root).join("debug/wavg");
     let tmp = seeds.join("tmp");
     for d in [&mesh_dir, &file_dir, &tmp] {
         std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;

@@ -14,6 +14,6 @@ const DEFAULT_DIR: &str = "target/man";
 pub fn run(root: &Path, dir: Option<&str>) -> Result<(), String> {
     steps::cargo_workspace(root, &["build", "--all-targets"], &[])?;
     let dir = root.join(dir.unwrap_or(DEFAULT_DIR));
-    let exe = root.join("target/debug/examples/man");
+    let exe = steps::target_dir(root).join("debug/examples/man");
     steps::command(root, &exe.to_string_lossy(), &[&dir.to_string_lossy()])
 }

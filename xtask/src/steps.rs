@@ -1,6 +1,6 @@
 //! The checks of `cargo xtask test`, each timed, with a table of step times at the end.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
@@ -8,6 +8,14 @@ use std::time::Instant;
 /// them). Every step selects the same packages, so that cargo resolves one feature set and
 /// builds each dependency once.
 pub const EXCLUDED: &[&str] = &["--exclude", "wavg-lab"];
+
+/// cargo's target directory: `$CARGO_TARGET_DIR` when set (CI keeps one across runs),
+/// else `target/` in the repository.
+pub fn target_dir(root: &Path) -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .map_or_else(|| root.join("target"), |d| root.join(d))
+}
 
 /// Times and outcomes of the steps run so far.
 #[derive(Default)]
