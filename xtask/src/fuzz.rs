@@ -32,7 +32,8 @@ fn max_len(target: &str) -> Option<usize> {
 /// timed steps of `log`.
 pub fn smoke(root: &Path, seconds: u64, log: &mut steps::Log) -> bool {
     let mut bin_dir = PathBuf::new();
-    log.run("fuzz build", || {
+    log.run("fuzz build (seed corpora, instrumented targets)", || {
+        seed_corpora(root, &root.join("fuzz"))?;
         bin_dir = build(root)?;
         Ok(())
     }) && log.run(
@@ -44,13 +45,16 @@ pub fn smoke(root: &Path, seconds: u64, log: &mut steps::Log) -> bool {
 /// Builds and runs every target (or only `only`) for `seconds` each; `Err` names the first
 /// failure.
 pub fn run(root: &Path, seconds: u64, only: Option<&str>) -> Result<(), String> {
+    seed_corpora(root, &root.join("fuzz"))?;
     let bin_dir = build(root)?;
     run_built(root, &bin_dir, seconds, only)
 }
 
 /// Builds the targets with libFuzzer's instrumentation on the workspace's own crates (see
 /// [`crate::sancov`]), in the dev profile (optimised, debug assertions and overflow checks
-/// on, as cargo-fuzz builds); returns the folder of the binaries.
+/// on, as cargo-fuzz builds); returns the folder of the binaries. It must come after any
+/// plain build of the workspace (the seed corpora's), which puts uninstrumented targets in
+/// the same place.
 fn build(root: &Path) -> Result<PathBuf, String> {
     let xtask = std::env::current_exe().map_err(|e| format!("xtask's own path: {e}"))?;
     let xtask = xtask.to_string_lossy();
@@ -75,7 +79,6 @@ fn parallel_runs() -> usize {
 /// output in `target/fuzz-logs/TARGET.log` (its last lines printed when it fails).
 fn run_built(root: &Path, bin_dir: &Path, seconds: u64, only: Option<&str>) -> Result<(), String> {
     let fuzz_dir = root.join("fuzz");
-    seed_corpora(root, &fuzz_dir)?;
     let logs = root.join("target/fuzz-logs");
     std::fs::create_dir_all(&logs).map_err(|e| format!("{}: {e}", logs.display()))?;
     let targets: Vec<&str> = TARGETS
@@ -102,6 +105,22 @@ fn run_built(root: &Path, bin_dir: &Path, seconds: u64, only: Option<&str>) -> R
         results.into_iter().collect::<Result<(), String>>()?;
     }
     Ok(())
+}
+
+/// Whether libFuzzer's log says it found coverage counters ("Loaded 1 modules (6509 inline
+/// 8-bit counters)"); without them it fuzzes blind.
+fn instrumented(log: &str) -> bool {
+    log.lines()
+        .filter_map(|l| l.strip_prefix("INFO: Loaded "))
+        .filter_map(|l| {
+            l.split_once('(')?
+                .1
+                .split_whitespace()
+                .next()?
+                .parse::<u64>()
+                .ok()
+        })
+        .any(|counters| counters > 0)
 }
 
 /// One target for `seconds`; `Ok` with a line of its final statistics printed.
@@ -142,6 +161,13 @@ fn run_one(
         .status()
         .map_err(|e| format!("could not start {target}: {e}"))?;
     let text = std::fs::read_to_string(&log_path).unwrap_or_default();
+    if status.success() && !instrumented(&text) {
+        return Err(format!(
+            "fuzz target {target} ran without coverage counters (an uninstrumented build in \
+             its place?); see {}",
+            log_path.display()
+        ));
+    }
     if !status.success() {
         let lines: Vec<&str> = text.lines().collect();
         let tail = lines[lines.len().saturating_sub(40)..].join("\n");
@@ -267,4 +293,22 @@ fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
     ])?;
     let _ = std::fs::remove_dir_all(&tmp);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::instrumented;
+
+    #[test]
+    fn coverage_counters_are_read_from_the_log() {
+        let with = "INFO: Seed: 1\nINFO: Loaded 1 modules   (6509 inline 8-bit counters): 6509 \
+                    [0x55, 0x56),\nINFO: Loaded 1 PC tables (6509 PCs): 6509 [0x5,0x6),\n";
+        assert!(instrumented(with));
+        let without = "INFO: Seed: 1\nWARNING: no interesting inputs were found so far. Is the \
+                       code instrumented for coverage?\n";
+        assert!(!instrumented(without));
+        assert!(!instrumented(
+            "INFO: Loaded 1 modules   (0 inline 8-bit counters)\n"
+        ));
+    }
 }
