@@ -10,6 +10,7 @@ mod lab;
 mod lines;
 mod man;
 mod policy;
+mod python;
 mod sancov;
 mod steps;
 
@@ -38,6 +39,9 @@ fn main() -> ExitCode {
         Some("man") if args.len() <= 2 => {
             report(man::run(&workspace_root(), args.get(1).map(String::as_str)))
         }
+        Some("venv") if args.len() == 1 => {
+            report(python::ensure_venv(&workspace_root()).map(|py| println!("{}", py.display())))
+        }
         _ => usage(),
     }
 }
@@ -45,7 +49,7 @@ fn main() -> ExitCode {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
-         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR]\n\n  \
+         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask venv\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
          and wavg-ffi), cargo doc (-D warnings), the examples \
@@ -57,7 +61,8 @@ fn usage() -> ExitCode {
          lab    build the lab (lab/, not a default member), or run its program NAME \
          (lab/src/bin/NAME.rs, release mode) with ARGS\n  \
          lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])\n  \
-         man    man pages of wavg and every subcommand into DIR (default target/man)",
+         man    man pages of wavg and every subcommand into DIR (default target/man)\n  \
+         venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter",
         MAX = lines::MAX_LINES
     );
     ExitCode::from(2)
@@ -153,6 +158,9 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
             &[("RUSTDOCFLAGS", "-D warnings")],
         )
     }) && log.run("examples", || examples::run(root))
+        && log.run("python environment", || {
+            python::ensure_venv(root).map(|_| ())
+        })
         && log.run("C/C++ packages", cbuild::ensure_packages)
         && cbuild::steps(root, data_dir)
             .into_iter()
