@@ -36,6 +36,7 @@ __all__ = [
     "correspond",
     "decal",
     "read_mesh",
+    "read_png",
     "render",
     "save_png",
     "spline",
@@ -43,7 +44,10 @@ __all__ = [
     "weighted_average",
 ]
 
-_APPS = ("Remesher", "correspond", "decal", "render", "save_png", "spline", "transfer_texture")
+_APPS = (
+    "Remesher", "correspond", "decal", "read_png", "render", "save_png", "spline",
+    "transfer_texture",
+)
 for _name in _APPS:
     if hasattr(_wavg, _name):
         globals()[_name] = getattr(_wavg, _name)

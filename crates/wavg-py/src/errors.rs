@@ -13,7 +13,7 @@ use wavg::{Error, ErrorKind, MeshError};
 static ERRORS: PyOnceLock<Py<PyModule>> = PyOnceLock::new();
 
 /// An instance of the exception class `name` of `wavg._errors` with `message`.
-fn raise(py: Python<'_>, name: &str, message: String) -> PyErr {
+pub(crate) fn raise(py: Python<'_>, name: &str, message: String) -> PyErr {
     let make = || -> PyResult<PyErr> {
         let module = ERRORS.get_or_try_init(py, || py.import("wavg._errors").map(Into::into))?;
         let class = module.bind(py).getattr(name)?;
@@ -90,4 +90,21 @@ pub(crate) fn require_file(path: &Path) -> PyResult<()> {
             path.to_string_lossy().into_owned(),
         )))
     }
+}
+
+/// The Python exception for an application's error (the message with its causes).
+pub(crate) fn app(py: Python<'_>, e: &wavg::apps::AppError) -> PyErr {
+    raise(py, "InvalidArgumentError", one_line(e))
+}
+
+/// The Python exception for a remeshing error.
+pub(crate) fn remesh(py: Python<'_>, e: &wavg::apps::RemeshError) -> PyErr {
+    let class = if e.is_invalid_mesh() {
+        "InvalidMeshError"
+    } else if e.is_no_solution() {
+        "NoSolutionError"
+    } else {
+        "InvalidArgumentError"
+    };
+    raise(py, class, one_line(e))
 }

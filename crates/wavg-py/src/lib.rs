@@ -6,11 +6,16 @@
 //! thread pools; arguments are checked before any work, and a query without an answer is
 //! a row of the `ok`/`valid` mask, never an exception.
 
+#![forbid(unsafe_code)]
+
 mod apps;
 mod args;
 mod errors;
+mod image;
 mod json;
 mod progress;
+mod remesh;
+mod render;
 mod solver;
 mod surface;
 
