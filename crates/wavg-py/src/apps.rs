@@ -3,6 +3,8 @@
 
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
+
+use crate::args::DetachRun;
 use wavg::apps::{
     CorrespondOptions, Image, SplineKind, TransferOptions, ValidityTest, correspond_vertices,
     decal_vertices, evaluate_spline,
@@ -82,7 +84,7 @@ fn spline<'py>(
     };
     let par = par(threads)?;
     let curve = py
-        .detach(|| par.install(|| evaluate_spline(&solver, kind, samples as usize, 256)))
+        .detach_run(|| par.install(|| evaluate_spline(&solver, kind, samples as usize, 256)))
         .map_err(lib(py))?
         .map_err(lib(py))?;
     points_tuple(py, &curve.samples, false)
@@ -147,7 +149,7 @@ fn correspond<'py>(
     let par = par(threads)?;
     let t = std::time::Instant::now();
     let map = py
-        .detach(|| par.install(|| correspond_vertices(&ss, &ts, &opts)))
+        .detach_run(|| par.install(|| correspond_vertices(&ss, &ts, &opts)))
         .map_err(lib(py))?
         .map_err(lib(py))?;
     let seconds = t.elapsed().as_secs_f64();
@@ -255,7 +257,7 @@ fn decal<'py>(
     let pairs: Vec<[f64; 2]> = data(&ua).chunks_exact(2).map(|c| [c[0], c[1]]).collect();
     let par = par(threads)?;
     let d = py
-        .detach(|| par.install(|| decal_vertices(&solver, &pairs, max_negative)))
+        .detach_run(|| par.install(|| decal_vertices(&solver, &pairs, max_negative)))
         .map_err(lib(py))?
         .map_err(lib(py))?;
     let n = d.uv.uv.len();
@@ -314,7 +316,7 @@ fn transfer_texture<'py>(
     };
     let par = par(threads)?;
     let out = py
-        .detach(|| {
+        .detach_run(|| {
             par.install(|| wavg::apps::transfer_texture(&ss, &texture, &ts, &opts, &|_, _| {}))
         })
         .map_err(lib(py))?

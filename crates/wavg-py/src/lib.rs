@@ -23,6 +23,8 @@ use std::path::PathBuf;
 
 use pyo3::prelude::*;
 
+use crate::args::DetachRun;
+
 /// read_mesh(path) -> (V (n, 3) float64, F (m, 3) int64)
 ///
 /// Reads a mesh file (.obj, .off, .ply, optionally gzipped as .gz): vertex positions and
@@ -34,7 +36,7 @@ fn read_mesh<'py>(
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     errors::require_file(&path)?;
     let mesh = py
-        .detach(|| wavg::mesh::io::load(&path))
+        .detach_run(|| wavg::mesh::io::load(&path))
         .map_err(errors::lib(py))?;
     surface::mesh_arrays(py, &mesh)
 }
@@ -42,6 +44,7 @@ fn read_mesh<'py>(
 /// The module.
 #[pymodule]
 fn _wavg(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    args::remember_pid();
     m.add_class::<surface::Surface>()?;
     m.add_class::<solver::Solver>()?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;

@@ -69,7 +69,7 @@ pub(crate) fn watch<T: Send>(
     let mut last = None;
     let out = std::thread::scope(|scope| {
         let s = &shared;
-        let handle = scope.spawn(move || work(s));
+        let handle = scope.spawn(move || crate::args::run(|| work(s)));
         loop {
             let finished = py.detach(|| {
                 let t = Instant::now();

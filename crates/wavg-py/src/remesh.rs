@@ -3,6 +3,8 @@
 
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
+
+use crate::args::DetachRun;
 use wavg::Vector3;
 use wavg::apps::BaseMesh;
 
@@ -63,7 +65,7 @@ impl Remesher {
         let base = BaseMesh { positions, faces };
         let projector = S.inner.projector().clone();
         let inner = py
-            .detach(|| wavg::apps::Remesher::new(projector, &base))
+            .detach_run(|| wavg::apps::Remesher::new(projector, &base))
             .map_err(|e| remesh(py, &e))?;
         Ok(Self {
             inner,
@@ -78,7 +80,7 @@ impl Remesher {
         let (levels, smooth) = (self.levels, self.smooth);
         let inner = &mut self.inner;
         let r = py
-            .detach(|| inner.remesh(levels, smooth))
+            .detach_run(|| inner.remesh(levels, smooth))
             .map_err(|e| remesh(py, &e))?;
         self.result = Some(r);
         Ok((self.vertices(py)?, self.faces(py)?))

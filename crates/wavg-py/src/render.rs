@@ -2,6 +2,8 @@
 
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
+
+use crate::args::DetachRun;
 use wavg::Vector3;
 use wavg::apps::{Colouring, Overlays, RenderOptions, View};
 
@@ -115,7 +117,7 @@ pub(crate) fn render<'py>(
         ..Default::default()
     };
     let img = py
-        .detach(|| wavg::apps::render(mesh.mesh(), &colouring, &overlays, &opts))
+        .detach_run(|| wavg::apps::render(mesh.mesh(), &colouring, &overlays, &opts))
         .map_err(|e| app(py, &e))?;
     to_array(py, &img)
 }

@@ -3,6 +3,8 @@
 
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
+
+use crate::args::DetachRun;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyList, PyTuple};
 use wavg::{Anchor, ForwardOptions, ForwardResult, SolveError, SurfacePoint};
@@ -135,7 +137,7 @@ pub(crate) fn points_tuple<'py>(
     squeeze: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let q = out.len();
-    let (face, bary, xyz, ok) = py.detach(|| {
+    let (face, bary, xyz, ok) = py.detach_run(|| {
         let mut face = Vec::with_capacity(q);
         let mut bary = Vec::with_capacity(3 * q);
         let mut xyz = Vec::with_capacity(3 * q);
@@ -200,7 +202,7 @@ impl Solver {
         let rows: Vec<&[f64]> = flat.chunks_exact(k.max(1)).collect();
         let mut out = Vec::new();
         let mut scratch = wavg::ForwardScratch::default();
-        py.detach(|| {
+        py.detach_run(|| {
             self.inner.forward_batch_into(
                 &rows,
                 &ForwardOptions::default(),
@@ -285,7 +287,7 @@ impl Solver {
         let k = self.inner.n_anchors();
         let q = pts.len();
         let (w, ok) = py
-            .detach(|| -> Result<_, SolveError> {
+            .detach_run(|| -> Result<_, SolveError> {
                 let mut batch = wavg::BatchWeights::default();
                 let mut ok = vec![false; q];
                 if verified {

@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
+
+use crate::args::DetachRun;
 use pyo3::types::{PyBytes, PyTuple};
 use wavg::mesh::TexCoords;
 use wavg::{PrecomputeOptions, TriMesh, Vector3};
@@ -128,7 +130,7 @@ impl Surface {
     ) -> PyResult<Self> {
         let mesh = mesh_from(V, F, uv, "V", "F")?;
         let inner = py
-            .detach(|| wavg::Surface::from_mesh(mesh))
+            .detach_run(|| wavg::Surface::from_mesh(mesh))
             .map_err(|e| to_py(py, e))?;
         Ok(Self { inner })
     }
@@ -145,10 +147,10 @@ impl Surface {
             require_file(e)?;
         }
         let mut inner = py
-            .detach(|| wavg::Surface::open(&path))
+            .detach_run(|| wavg::Surface::open(&path))
             .map_err(|e| to_py(py, e))?;
         if let Some(e) = embedding {
-            py.detach(|| inner.load_embedding(&e))
+            py.detach_run(|| inner.load_embedding(&e))
                 .map_err(|e| to_py(py, e))?;
         }
         Ok(Self { inner })
@@ -237,7 +239,7 @@ impl Surface {
     fn load_embedding(&mut self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         require_file(&path)?;
         let mut s = self.inner.clone();
-        py.detach(|| s.load_embedding(&path))
+        py.detach_run(|| s.load_embedding(&path))
             .map_err(|e| to_py(py, e))?;
         self.inner = s;
         Ok(())
@@ -245,7 +247,7 @@ impl Surface {
 
     /// S.save_embedding(path): writes the embedding to a ``.wavg`` file (atomically).
     fn save_embedding(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        py.detach(|| self.inner.save_embedding(&path))
+        py.detach_run(|| self.inner.save_embedding(&path))
             .map_err(|e| to_py(py, e))
     }
 
