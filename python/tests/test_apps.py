@@ -103,7 +103,7 @@ def test_render_and_png_round_trip(tmp_path, surface, anchors):
     assert not np.array_equal(plain, img)
 
 
-EXAMPLES = sorted((ROOT / "crates" / "wavg-py" / "examples").glob("*.py"))
+EXAMPLES = sorted((ROOT / "crates" / "wavg-py" / "examples").glob("[a-z]*.py"))
 
 
 @pytest.mark.parametrize("example", EXAMPLES, ids=[e.name for e in EXAMPLES])

@@ -43,7 +43,10 @@ fn xyz_rows(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<Vector3<f64>>> {
 /// ``(H, W, 3|4)`` uint8 image through the surface's texture coordinates; ``scalar``: one
 /// float per vertex ``(n,)`` coloured with viridis. Save it with ``wavg.save_png``.
 #[pyfunction]
-#[pyo3(signature = (S, size=(800, 600), view=(35.0, 20.0), curves=None, points=None, texture=None, scalar=None, wireframe=false))]
+#[pyo3(
+    signature = (S, size=(800, 600), view=(35.0, 20.0), curves=None, points=None, texture=None, scalar=None, wireframe=false),
+    text_signature = "(S, size=(800, 600), view=(35, 20), curves=(), points=None, texture=None, scalar=None, wireframe=False)"
+)]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub(crate) fn render<'py>(
     py: Python<'py>,
