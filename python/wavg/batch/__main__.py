@@ -22,9 +22,10 @@ from . import correspond_all, precompute_all, transfer_all
 class Bar:
     """A one-line progress bar (redrawn in place on a terminal, a line per tenth otherwise)."""
 
-    def __init__(self, label: str, stream: TextIO = sys.stderr, width: int = 30):
-        self.label, self.stream, self.width = label, stream, width
-        self.tty = stream.isatty()
+    def __init__(self, label: str, stream: TextIO | None = None, width: int = 30):
+        self.label, self.width = label, width
+        self.stream = stream if stream is not None else sys.stderr
+        self.tty = self.stream.isatty()
         self.t0 = time.perf_counter()
         self.last_tenth = -1
 
@@ -120,7 +121,7 @@ def _parser() -> argparse.ArgumentParser:
         else:
             s.add_argument("--validity", default="local", choices=("local", "paper"), help="Which images to keep (default local)")
         s.add_argument("--target", nargs=2, action="append", default=[], metavar=("MESH", "ANCHORS"), help="A target mesh and its anchors (repeatable)")
-        s.add_argument("--targets", metavar="FILE", help="A file with 'MESH ANCHORS [EMBEDDING]' per line")
+        s.add_argument("--targets", metavar="FILE", help="A file with 'MESH ANCHORS [EMBEDDING]' per line (after the --target pairs)")
         s.add_argument("--embeddings", metavar="DIR", help="Folder of NAME.wavg embeddings (precompute's output)")
         common(s)
     return p
