@@ -70,20 +70,26 @@ class _Tracker:
             self.progress(self.done, self.total, self.failed)
 
 
-def _lost(error: BaseException, tries: int) -> dict[str, Any]:
-    """The result of a job whose worker died on each of its ``tries`` attempts."""
+def _lost(error: BaseException, tries: int, worker_died: bool = True) -> dict[str, Any]:
+    """The result of a job whose worker died on each of its ``tries`` attempts (or, with
+    ``worker_died=False``, that the executor could not run)."""
+    why = f"{type(error).__name__}: {error}"
     return {
         "status": "failed",
         "seconds": None,
         "worker": None,
-        "error": f"worker lost {tries} times; last: {type(error).__name__}: {error}",
+        "error": f"worker lost {tries} times; last: {why}" if worker_died else why,
         "figures": {},
         "attempts": tries,
     }
 
 
 def _run_dask(jobs: Sequence[Job], client: Any, tracker: _Tracker, attempts: int) -> list[dict[str, Any]]:
-    from distributed import as_completed
+    from distributed import KilledWorker, as_completed
+
+    # What a lost worker or connection raises; anything else (the job cannot even be
+    # unpickled on the worker, say) fails the job at once, with its message.
+    lost = (KilledWorker, OSError, cf.CancelledError)
 
     run = uuid.uuid4().hex[:8]
     results: list[dict[str, Any] | None] = [None] * len(jobs)
@@ -100,13 +106,16 @@ def _run_dask(jobs: Sequence[Job], client: Any, tracker: _Tracker, attempts: int
         i = pending.pop(fut)
         try:
             r = fut.result()
-        except Exception as e:  # the worker died or the connection broke mid-task
-            if tries[i] < attempts:
+        except Exception as e:
+            if not isinstance(e, lost):
+                r = _lost(e, tries[i], worker_died=False)
+            elif tries[i] < attempts:
                 again = submit(i)
                 pending[again] = i
                 finished.add(again)
                 continue
-            r = _lost(e, tries[i])
+            else:
+                r = _lost(e, tries[i])
         fut.release()
         r["attempts"] = tries[i]
         results[i] = r
@@ -146,8 +155,8 @@ def _run_executor(jobs: Sequence[Job], executor: cf.Executor, tracker: _Tracker,
                 except cf.BrokenExecutor as e:  # a worker process died: the pool is gone
                     broken.append((i, e))
                     continue
-                except Exception as e:  # an executor that lost the task in its own way
-                    r = _lost(e, tries[i])
+                except Exception as e:  # the executor could not run the task
+                    r = _lost(e, tries[i], worker_died=False)
                 r["attempts"] = tries[i]
                 results[i] = r
                 tracker.finished(r)
