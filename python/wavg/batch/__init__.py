@@ -6,8 +6,9 @@ with a fingerprint of its inputs beside it), skips inputs whose intact output wa
 the same inputs, and returns a :class:`Manifest` (also written as ``out_dir/manifest.json``)
 with one entry per input, in input order. ``executor`` is a ``dask.distributed.Client``, a
 ``concurrent.futures.Executor`` (a process pool, Ray's) or ``None`` for in-process. Jobs
-carry paths, never arrays; each uses ``threads`` threads (1 by default, so that a pool of
-N processes uses N cores). Dask is imported only when a Client is passed.
+carry paths, never arrays. ``threads`` is the threads per job: by default 1 on an executor
+(so that N worker processes use N cores) and all cores in-process. Dask is imported only
+when a Client is passed.
 """
 
 from __future__ import annotations
@@ -45,6 +46,15 @@ def _names(inputs: Sequence[PathLike], suffix: str) -> list[str]:
         seen.add(name)
         out.append(name)
     return out
+
+
+def _threads(threads: int | None, executor: Any) -> int | None:
+    """Threads per job: as given, else 1 on an executor and all cores (``None``) in-process."""
+    if threads is not None:
+        if int(threads) < 1:
+            raise ValueError(f"threads: expected a positive number or None, got {threads!r}")
+        return int(threads)
+    return None if executor is None else 1
 
 
 def _run(
@@ -89,7 +99,7 @@ def precompute_all(
     overwrite: bool = False,
     *,
     seed: int = 0,
-    threads: int | None = 1,
+    threads: int | None = None,
     progress: Progress | None = None,
 ) -> Manifest:
     """Precomputes the embedding of every mesh into ``out_dir/NAME.wavg`` (``NAME``: the
@@ -100,6 +110,7 @@ def precompute_all(
     missing) ends ``failed`` with its message; the others go on.
     """
     meshes = list(meshes)
+    threads = _threads(threads, executor)
     out = Path(out_dir)
     options = {"landmarks": int(landmarks), "seed": int(seed)}
     jobs = [
@@ -177,6 +188,7 @@ def _pair_jobs(
 ) -> Manifest:
     """Shared body of :func:`transfer_all` and :func:`correspond_all`."""
     out = Path(out_dir)
+    threads = _threads(threads, executor)
     tmesh, tgiven = _split_template(template)
     pairs = _split_targets(targets)
     out.mkdir(parents=True, exist_ok=True)
@@ -214,7 +226,7 @@ def transfer_all(
     embeddings: Any = None,
     landmarks: int = 1000,
     overwrite: bool = False,
-    threads: int | None = 1,
+    threads: int | None = None,
     progress: Progress | None = None,
 ) -> Manifest:
     """Carries ``template_texture`` (a PNG on the template's UVs) onto each target's UV
@@ -246,7 +258,7 @@ def correspond_all(
     embeddings: Any = None,
     landmarks: int = 1000,
     overwrite: bool = False,
-    threads: int | None = 1,
+    threads: int | None = None,
     progress: Progress | None = None,
 ) -> Manifest:
     """Maps every template vertex onto each target: one ``out_dir/NAME.npz`` per target

@@ -101,7 +101,7 @@ def _parser() -> argparse.ArgumentParser:
         where = s.add_mutually_exclusive_group()
         where.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler to run on (tcp://host:8786)")
         where.add_argument("--local", type=int, metavar="N", help="Run on a local Dask cluster of N worker processes")
-        s.add_argument("--threads", type=int, default=1, help="Threads per job (default 1)")
+        s.add_argument("--threads", type=int, help="Threads per job (default: 1 on Dask, all cores in-process)")
         s.add_argument("--landmarks", type=int, default=1000, help="Landmarks of embeddings precomputed here (default 1000)")
         s.add_argument("--overwrite", action="store_true", help="Redo outputs that are up to date")
 
