@@ -3,6 +3,7 @@ failures, the command line. The Dask and process-pool runs are in test_batch_das
 
 from __future__ import annotations
 
+import concurrent.futures as cf
 import json
 import os
 import struct
@@ -193,3 +194,34 @@ def test_command_line(tmp_path: Path, assets: dict, capsys: pytest.CaptureFixtur
     with pytest.raises(SystemExit):
         cli.main(["transfer", "--template", "t.obj", "--template-anchors", "a.txt", "--texture", "t.png", "-o", str(tmp_path), "--size", "0x3"])
     capsys.readouterr()
+
+
+class BreaksOnce(cf.Executor):
+    """Runs jobs in the calling thread, except that the job at ``index`` comes back as if
+    its worker process had died (``BrokenExecutor``), as a broken pool reports it."""
+
+    def __init__(self, index: int):
+        self.index = index
+
+    def submit(self, fn, /, *args, **kwargs):  # type: ignore[no-untyped-def, override]
+        fut: cf.Future = cf.Future()
+        if args[0].index == self.index:
+            fut.set_exception(cf.BrokenExecutor("a process of the pool died"))
+        else:
+            fut.set_result(fn(*args, **kwargs))
+        return fut
+
+
+def test_other_executors(tmp_path: Path, assets: dict) -> None:
+    meshes = assets["meshes"][:4]
+    ref = wb.precompute_all(meshes, tmp_path / "ref", landmarks=LANDMARKS)
+    with cf.ThreadPoolExecutor(2) as pool:
+        m = wb.precompute_all(meshes, tmp_path / "threads", pool, landmarks=LANDMARKS)
+    assert [j["status"] for j in m] == ["done"] * 4
+    for a, b in zip(m, ref):
+        assert Path(a["output"]).read_bytes() == Path(b["output"]).read_bytes()
+    # An executor that cannot be replaced: the lost job fails with why, the others finish.
+    m = wb.precompute_all(meshes, tmp_path / "flaky", BreaksOnce(1), landmarks=LANDMARKS)
+    assert [j["status"] for j in m] == ["done", "failed", "done", "done"]
+    assert m[1]["error"].startswith("worker lost 1 times") and "BrokenExecutor" in m[1]["error"]
+    assert not (tmp_path / "flaky" / Path(m[1]["output"]).name).exists()
