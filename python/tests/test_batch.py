@@ -225,3 +225,32 @@ def test_other_executors(tmp_path: Path, assets: dict) -> None:
     assert [j["status"] for j in m] == ["done", "failed", "done", "done"]
     assert m[1]["error"].startswith("worker lost 1 times") and "BrokenExecutor" in m[1]["error"]
     assert not (tmp_path / "flaky" / Path(m[1]["output"]).name).exists()
+
+
+def test_driver_killed_mid_run_then_rerun(tmp_path: Path, assets: dict) -> None:
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    meshes = [m for m in assets["meshes"] if m != assets["invalid"]]
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "wavg.batch", "precompute", *meshes, "-o", str(out), "--landmarks", str(LANDMARKS), "--threads", "1"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
+        if out.is_dir() and any(p.name.endswith(store.SIDECAR) for p in out.iterdir()):
+            break
+        time.sleep(0.005)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    finished = {p.name[: -len(store.SIDECAR)] for p in out.iterdir() if p.name.endswith(store.SIDECAR)}
+    assert finished, "the driver finished nothing before it was killed"
+    m = wb.precompute_all(meshes, out, landmarks=LANDMARKS)
+    statuses = {Path(j["output"]).name: j["status"] for j in m}
+    assert all(statuses[n] == "skipped" for n in finished)
+    assert set(statuses.values()) == {"skipped", "done"}  # killed mid-run: some left to do
+    assert not [p for p in out.iterdir() if store.TMP_MARK in p.name]
+    ref = wb.precompute_all(meshes, tmp_path / "ref", landmarks=LANDMARKS)
+    for a, b in zip(m, ref):
+        assert Path(a["output"]).read_bytes() == Path(b["output"]).read_bytes()
