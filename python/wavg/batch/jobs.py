@@ -218,7 +218,7 @@ def correspond(job: Job) -> dict[str, Any]:
         "bary": np.asarray(c.bary),
         "xyz": np.asarray(c.xyz),
         "valid": np.asarray(c.valid),
-        "reason": np.asarray(c.reason),
+        "reason": np.asarray(c.reason).astype(str),  # fixed-width text: loads without pickle
     }
     buf = io.BytesIO()
     np.savez(buf, **arrays)
