@@ -188,9 +188,7 @@ def costs(tmp: Path) -> None:
     targ = bf.write_obj(folder / "target.obj", d_v, d_f, d_uv)
     anchors = [bf.sheet_anchors(folder / f"{n}.txt", side, side) for n in ("ta", "da")]
     tex = folder / "tex.png"
-    from wavg.batch.pngio import encode_png
-
-    tex.write_bytes(encode_png(bf.checker(512, 16)))
+    wavg.save_png(str(tex), bf.checker(512, 16))
     emb = wb.precompute_all([tmpl, targ], folder / "emb")
     for j in emb:
         print(f"cost: precompute {j['vertices']} vertices, 1000 landmarks, 1 thread: {j['seconds']:.2f} s")

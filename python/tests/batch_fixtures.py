@@ -146,7 +146,7 @@ def make_assets(folder: Path) -> dict[str, object]:
     ``template``, ``template_anchors``, ``texture``, ``targets`` (list of (mesh, anchors),
     the invalid mesh last), ``meshes`` (every mesh for precompute, the invalid one among
     them) and ``invalid``."""
-    from wavg.batch.pngio import encode_png
+    import wavg
 
     folder.mkdir(parents=True, exist_ok=True)
     paths: dict[str, Path] = {}
@@ -166,7 +166,7 @@ def make_assets(folder: Path) -> dict[str, object]:
     invalid = invalid_mesh(folder / "nonmanifold.obj")
     (folder / "nonmanifold.anchors.txt").write_text("v 0\n" * len(ANCHOR_UV))
     texture = folder / "checker.png"
-    texture.write_bytes(encode_png(checker()))
+    wavg.save_png(str(texture), checker())
     targets = [(str(paths[n]), str(anchors[n])) for n in SHEETS if n != "template"]
     targets.append((str(invalid), str(folder / "nonmanifold.anchors.txt")))
     meshes = [str(p) for p in paths.values()] + [str(invalid)]

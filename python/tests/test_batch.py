@@ -6,8 +6,6 @@ from __future__ import annotations
 import concurrent.futures as cf
 import json
 import os
-import struct
-import zlib
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +16,6 @@ import wavg
 import wavg.batch as wb
 from wavg.batch import __main__ as cli
 from wavg.batch import jobs, store
-from wavg.batch.pngio import encode_png
 
 LANDMARKS = 40
 
@@ -26,37 +23,6 @@ LANDMARKS = 40
 @pytest.fixture(scope="module")
 def assets(tmp_path_factory: pytest.TempPathFactory) -> dict:
     return bf.make_assets(tmp_path_factory.mktemp("assets"))
-
-
-def decode_png(data: bytes) -> np.ndarray:
-    """Decodes the PNGs encode_png writes (8-bit, filter 0), to check the encoder."""
-    assert data[:8] == b"\x89PNG\r\n\x1a\n"
-    pos, idat, w = 8, b"", 0
-    while pos < len(data):
-        (n,) = struct.unpack(">I", data[pos : pos + 4])
-        kind, body = data[pos + 4 : pos + 8], data[pos + 8 : pos + 8 + n]
-        assert struct.unpack(">I", data[pos + 8 + n : pos + 12 + n])[0] == zlib.crc32(kind + body)
-        if kind == b"IHDR":
-            w, h, depth, ctype = struct.unpack(">IIBB", body[:10])
-            c = {0: 1, 2: 3, 6: 4}[ctype]
-        elif kind == b"IDAT":
-            idat += body
-        pos += 12 + n
-    rows = np.frombuffer(zlib.decompress(idat), np.uint8).reshape(h, 1 + w * c)
-    assert (rows[:, 0] == 0).all()
-    return rows[:, 1:].reshape(h, w, c)
-
-
-def test_png_encoder_round_trips() -> None:
-    rng = np.random.default_rng(1)
-    for shape in [(5, 7, 4), (3, 2, 3), (4, 9)]:
-        img = rng.integers(0, 256, shape, dtype=np.uint8)
-        back = decode_png(encode_png(img))
-        assert np.array_equal(back.reshape(img.shape), img)
-    with pytest.raises(TypeError, match="uint8"):
-        encode_png(np.zeros((2, 2, 4)))
-    with pytest.raises(ValueError, match="shape"):
-        encode_png(np.zeros((2, 2, 2), np.uint8))
 
 
 def test_atomic_write_leaves_nothing_on_error(tmp_path: Path) -> None:

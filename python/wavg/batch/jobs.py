@@ -24,7 +24,6 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from . import store
-from .pngio import write_png
 
 #: Suffixes stripped from a mesh file name to name its outputs.
 MESH_SUFFIXES = (".gz", ".obj", ".off", ".ply")
@@ -241,11 +240,19 @@ def transfer(job: Job) -> dict[str, Any]:
     src, dst, a_src, a_dst = _pair(job)
     o = job.options
     t0 = time.perf_counter()
+    size = o.get("size")
+    if size is not None:
+        size = (int(size), int(size)) if np.ndim(size) == 0 else (int(size[0]), int(size[1]))
     kw = _threads_kw(wavg.transfer_texture, job.threads)
-    image = wavg.transfer_texture(src, job.files["template_texture"], dst, a_src, a_dst, size=o.get("size"), **kw)
+    image = np.asarray(wavg.transfer_texture(src, job.files["template_texture"], dst, a_src, a_dst, size=size, **kw))
     seconds = time.perf_counter() - t0
-    image = np.asarray(image)
-    store.atomic_write(job.output, lambda f: write_png(f, image))
+    tmp = store.temporary_path(job.output)
+    try:
+        wavg.save_png(str(tmp), image)
+        store.commit(tmp, job.output)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
     h, w = image.shape[:2]
     opaque = int(np.count_nonzero(image[..., 3])) if image.ndim == 3 and image.shape[2] == 4 else h * w
     return {
