@@ -169,8 +169,8 @@ def precompute(job: Job) -> dict[str, Any]:
     import wavg
 
     o = job.options
-    t0 = time.perf_counter()
     s = wavg.Surface.open(job.files["mesh"])
+    t0 = time.perf_counter()
     s.precompute(landmarks=int(o["landmarks"]), seed=int(o.get("seed", 0)), threads=job.threads, progress=False)
     seconds = time.perf_counter() - t0
     tmp = store.temporary_path(job.output)
