@@ -78,16 +78,20 @@ def engine(tmp: Path, rounds: int) -> None:
     ratios = []
     try:
         for r in range(rounds):
-            times = {}
+            times, busy = {}, {}
             for name, ex in (("dask", client), ("pool", pool)) if r % 2 == 0 else (("pool", pool), ("dask", client)):
                 out = tmp / f"engine-{name}-{r}"
                 t0 = time.perf_counter()
                 m = wb.precompute_all(meshes, out, ex)
                 times[name] = time.perf_counter() - t0
+                busy[name] = sum(j["seconds"] for j in m)
                 assert m.counts["done"] == 16, m.failed
                 shutil.rmtree(out)
             ratios.append(times["dask"] / times["pool"])
-            print(f"  round {r}: LocalCluster {times['dask']:.1f} s, ProcessPool {times['pool']:.1f} s, ratio {ratios[-1]:.3f}")
+            print(
+                f"  round {r}: LocalCluster {times['dask']:.1f} s, ProcessPool {times['pool']:.1f} s, ratio {ratios[-1]:.3f}; "
+                f"job seconds summed {busy['dask']:.1f} / {busy['pool']:.1f}"
+            )
         print(f"engine ratio (Dask / pool): median {np.median(ratios):.3f}, range {min(ratios):.3f}-{max(ratios):.3f}")
     finally:
         pool.shutdown()
