@@ -195,13 +195,13 @@ def costs(tmp: Path) -> None:
     wavg.save_png(str(tex), bf.checker(512, 16))
     emb = wb.precompute_all([tmpl, targ], folder / "emb")
     for j in emb:
-        print(f"cost: precompute {j['vertices']} vertices, 1000 landmarks, 1 thread: {j['seconds']:.2f} s")
+        print(f"cost: precompute {j['vertices']} vertices, 1000 landmarks, 1 thread: {j['seconds']:.2f} s wall, {j['cpu_seconds']:.2f} s CPU")
     co = wb.correspond_all((tmpl, emb[0]["output"]), anchors[0], [(targ, anchors[1], emb[1]["output"])], folder / "co")
     j = co[0]
-    print(f"cost: correspond {j['vertices']} onto {len(d_v)} vertices, 1 thread: {j['seconds']:.2f} s job ({j['map_seconds']:.2f} s map), valid {j['valid_fraction']:.3f}")
+    print(f"cost: correspond {j['vertices']} onto {len(d_v)} vertices, 1 thread: {j['seconds']:.2f} s wall, {j['cpu_seconds']:.2f} s CPU ({j['map_seconds']:.2f} s map), valid {j['valid_fraction']:.3f}")
     tr = wb.transfer_all((tmpl, emb[0]["output"]), tex, anchors[0], [(targ, anchors[1], emb[1]["output"])], folder / "tr", size=2048)
     j = tr[0]
-    print(f"cost: transfer 2048^2, 1 thread: {j['seconds']:.2f} s job ({j['transfer_seconds']:.2f} s transfer), {j['texels_per_s']:.0f} texels/s, valid {j['valid_fraction']:.3f}")
+    print(f"cost: transfer 2048^2, 1 thread: {j['seconds']:.2f} s wall, {j['cpu_seconds']:.2f} s CPU ({j['transfer_seconds']:.2f} s transfer), {j['texels_per_s']:.0f} texels/s, valid {j['valid_fraction']:.3f}")
 
 
 def main() -> None:

@@ -79,6 +79,7 @@ def _run(
             "output": job.output,
             "status": r["status"],
             "seconds": r["seconds"],
+            "cpu_seconds": r.get("cpu_seconds"),
             "worker": r["worker"],
             "error": r["error"],
             "attempts": r.get("attempts", 1),

@@ -74,26 +74,29 @@ def worker_name() -> str:
 def run_job(job: Job) -> dict[str, Any]:
     """Runs ``job`` (or skips it) and returns ``status``, ``seconds``, ``worker``,
     ``error`` and the job's figures."""
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     worker = worker_name()
     try:
         inputs = store.fingerprint(job.files, job.options)
         if not job.overwrite:
             figures = store.check(job.output, inputs)
             if figures is not None:
-                return _result("skipped", t0, worker, None, figures)
+                return _result("skipped", t0, c0, worker, None, figures)
         figures = RUNNERS[job.kind](job)
         store.record(job.output, inputs, figures)
-        return _result("done", t0, worker, None, figures)
+        return _result("done", t0, c0, worker, None, figures)
     except Exception as e:  # a job's failure is data for the manifest, not a crash
         message = str(e) or repr(e)
-        return _result("failed", t0, worker, f"{type(e).__name__}: {message}", {})
+        return _result("failed", t0, c0, worker, f"{type(e).__name__}: {message}", {})
 
 
-def _result(status: str, t0: float, worker: str, error: str | None, figures: Mapping[str, Any]) -> dict[str, Any]:
+def _result(status: str, t0: float, c0: float, worker: str, error: str | None, figures: Mapping[str, Any]) -> dict[str, Any]:
+    """A job's result; ``cpu_seconds`` is the worker process's CPU time over the job (all
+    its threads), a figure that does not depend on how busy the machine is."""
     return {
         "status": status,
         "seconds": round(time.perf_counter() - t0, 6),
+        "cpu_seconds": round(time.process_time() - c0, 6),
         "worker": worker,
         "error": error,
         "figures": dict(figures),
