@@ -68,8 +68,8 @@ def local_cluster(n: int):
     return cluster, Client(cluster)
 
 
-def engine(tmp: Path, rounds: int) -> None:
-    meshes = make_meshes(tmp / "m20k", 16, 20000)
+def engine(tmp: Path, rounds: int, vertices: int) -> None:
+    meshes = make_meshes(tmp / "m20k", 16, vertices)
     verts = [wavg.read_mesh(m)[0].shape[0] for m in meshes]
     print(f"engine: 16 meshes, {min(verts)}-{max(verts)} vertices, 1000 landmarks, 1 thread per job")
     cluster, client = local_cluster(2)
@@ -78,19 +78,21 @@ def engine(tmp: Path, rounds: int) -> None:
     ratios = []
     try:
         for r in range(rounds):
-            times, busy = {}, {}
+            times, busy, cpu = {}, {}, {}
             for name, ex in (("dask", client), ("pool", pool)) if r % 2 == 0 else (("pool", pool), ("dask", client)):
                 out = tmp / f"engine-{name}-{r}"
                 t0 = time.perf_counter()
                 m = wb.precompute_all(meshes, out, ex)
                 times[name] = time.perf_counter() - t0
                 busy[name] = sum(j["seconds"] for j in m)
+                cpu[name] = sum(j["cpu_seconds"] for j in m)
                 assert m.counts["done"] == 16, m.failed
                 shutil.rmtree(out)
             ratios.append(times["dask"] / times["pool"])
             print(
                 f"  round {r}: LocalCluster {times['dask']:.1f} s, ProcessPool {times['pool']:.1f} s, ratio {ratios[-1]:.3f}; "
-                f"job seconds summed {busy['dask']:.1f} / {busy['pool']:.1f}"
+                f"job seconds summed {busy['dask']:.1f} / {busy['pool']:.1f}, CPU {cpu['dask']:.1f} / {cpu['pool']:.1f}; "
+                f"engine overhead (wall - job seconds / 2) {times['dask'] - busy['dask'] / 2:.1f} / {times['pool'] - busy['pool'] / 2:.1f} s"
             )
         print(f"engine ratio (Dask / pool): median {np.median(ratios):.3f}, range {min(ratios):.3f}-{max(ratios):.3f}")
     finally:
@@ -209,6 +211,7 @@ def main() -> None:
     p.add_argument("--only", choices=("engine", "kills", "overhead", "costs"))
     p.add_argument("--rounds", type=int, default=2, help="Alternated Dask/pool rounds of the engine part (default 2)")
     p.add_argument("--kill-runs", type=int, default=20)
+    p.add_argument("--engine-vertices", type=int, default=20000, help="Vertices per mesh of the engine part (default 20000)")
     p.add_argument("--seed", type=int, default=0)
     args = p.parse_args()
     print(f"wavg {store.package_version()}, {os.cpu_count()} CPUs, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
@@ -216,7 +219,7 @@ def main() -> None:
         tmp = Path(d)
         for part in ("costs", "overhead", "engine", "kills"):
             if args.only in (None, part):
-                {"costs": lambda: costs(tmp), "overhead": lambda: overhead(tmp), "engine": lambda: engine(tmp, args.rounds),
+                {"costs": lambda: costs(tmp), "overhead": lambda: overhead(tmp), "engine": lambda: engine(tmp, args.rounds, args.engine_vertices),
                  "kills": lambda: kills(tmp, args.kill_runs, args.seed)}[part]()  # fmt: skip
                 sys.stdout.flush()
 
