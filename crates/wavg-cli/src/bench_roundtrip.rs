@@ -40,9 +40,8 @@ verified_penalized_fraction and verified_not_reached_fraction.
 
 Without --embedding or --precompute the 3-D positions are the embedding.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// Embedding (.wavg from `wavg precompute`).
     #[arg(long, conflicts_with = "precompute")]
     pub embedding: Option<PathBuf>,

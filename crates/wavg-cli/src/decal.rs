@@ -28,9 +28,8 @@ the surface-to-plane map over faces with three unmarked corners; null when there
 flipped_faces (against the
 decal's own orientation), seconds, marked (the marked vertex ids), plus mesh and anchors.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// A .wavg embedding of the mesh (default: precompute one in memory).
     #[arg(long)]
     pub embedding: Option<PathBuf>,

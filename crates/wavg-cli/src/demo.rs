@@ -45,9 +45,9 @@ roundtrip_queries, inverse_us, forward_us, roundtrip_ok_fraction,
 verified_roundtrip_ok_fraction; with --out also pictures (paths written) and
 skipped_pictures (\"NAME: REASON\" each).")]
 pub struct Args {
-    /// Mesh file or builtin:NAME.
-    #[arg(long, default_value = "builtin:bump")]
-    pub mesh: String,
+    /// The mesh (default: builtin:bump).
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::OptionalMeshArg,
     /// Landmarks of the embedding (default: a tenth of the vertices, 50 to 1000).
     #[arg(long)]
     pub landmarks: Option<usize>,
@@ -141,14 +141,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
             eprintln!("{s}");
         }
     };
-    let mesh = load_valid(&args.mesh)?;
+    let mesh_name = args.mesh.0.as_deref().unwrap_or("builtin:bump");
+    let mesh = load_valid(mesh_name)?;
     let landmarks = args
         .landmarks
         .unwrap_or((mesh.n_vertices() / 10).clamp(50, 1000))
         .min(mesh.n_vertices());
     say(&format!(
         "mesh {}: {} vertices, {} faces; precomputing the embedding ({landmarks} landmarks)...",
-        args.mesh,
+        mesh_name,
         mesh.n_vertices(),
         mesh.n_faces()
     ));
@@ -238,7 +239,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     if args.json {
         let j = serde_json::to_value(JsonReport {
-            mesh: &args.mesh,
+            mesh: mesh_name,
             vertices: mesh.n_vertices(),
             faces: mesh.n_faces(),
             landmarks,

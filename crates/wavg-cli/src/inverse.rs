@@ -25,9 +25,11 @@ bad barycentrics) are input errors: exit status 2 naming the line, and nothing i
 guess): where the paper's weights do not lead back to the point (within 1e-3 mean edge
 lengths; it happens on thin parts covered by few anchors), the smallest offset penalty
 lambda in 10, 100, 1000, 10000 whose weights do is used instead (the objective gains
-lambda d_ref |ybar - yhat|^2, d_ref the fourth smallest D_ii). The output format is
-unchanged; a summary on standard error counts the penalised points and lists the points
-(counted from 1) that no weights reach (those get the paper's weights). About 3-5x slower.";
+lambda d_ref |ybar - yhat|^2, d_ref the fourth smallest D_ii). A point that no weights
+reach is written as 'none not-reached' (a NaN row in .npy), as the C call
+wavg_inverse_verified returns NO_SOLUTION for it: add anchors near it (wavg anchors
+--count). A summary on standard error counts the penalised and the unreached points and
+lists the latter (counted from 1). About 3-5x slower.";
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -71,11 +73,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
             sink.write(
                 &batch,
                 |r, out| match r {
+                    Ok(v) if v.round_trip == RoundTrip::NotReached => {
+                        out.extend_from_slice(NOT_REACHED.as_bytes())
+                    }
                     Ok(v) => text::push_numbers(out, v.weights.iter().copied()),
                     Err(e) => none(out, e),
                 },
                 |r, row| {
-                    if let Ok(v) = r {
+                    if let Ok(v) = r
+                        && v.round_trip != RoundTrip::NotReached
+                    {
                         row.copy_from_slice(&v.weights);
                     }
                 },
@@ -136,6 +143,9 @@ fn npy_point(line: usize, row: NpyRow) -> Result<PointSpec, wavg::text::LineErro
         bary: [*b0, *b1, *b2],
     })
 }
+
+/// The line of a point that `--verified` finds no weights for (the C ABI's `NO_SOLUTION`).
+const NOT_REACHED: &str = "none not-reached";
 
 /// `none REASON` for a point without weights.
 fn none(out: &mut Vec<u8>, e: &wavg::SolveError) {

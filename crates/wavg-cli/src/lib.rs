@@ -21,6 +21,7 @@ mod forward;
 mod info;
 mod inverse;
 pub mod man;
+mod mesh_arg;
 mod morph;
 mod precompute;
 mod remesh;

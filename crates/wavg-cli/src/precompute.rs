@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -25,8 +25,8 @@ use crate::common::{load_mesh, one_line};
 /// Arguments.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Mesh file (.obj, .off, .ply, optionally .gz) or builtin:NAME.
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// Output .wavg file (written atomically).
     #[arg(short, long, value_name = "OUT.wavg")]
     pub output: PathBuf,
@@ -73,7 +73,7 @@ fn check_args(args: &Args) -> Result<(), CliError> {
         )));
     }
     let out = &args.output;
-    if crate::common::same_file(Path::new(&args.mesh), out) {
+    if crate::common::same_file(args.mesh.as_ref(), out) {
         return Err(CliError::input(format!(
             "the output {} is the input mesh; write the embedding to a .wavg file",
             out.display()

@@ -38,9 +38,8 @@ time of all threads per frame), frames, max_offsurface
 roughness (mean umbrella length over mean edge length), problems, fallbacks, threads,
 precompute_seconds, plus mesh and base.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// The coarse base mesh (OBJ with polygons).
     #[arg(long)]
     pub base: PathBuf,

@@ -26,9 +26,8 @@ no projection. --json prints one object: samples, ok_samples, seconds, us_per_sa
 length (3-D length of the polyline through the samples), plus mesh, controls, degree,
 closed, bezier.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// A .wavg embedding of the mesh (default: precompute one in memory).
     #[arg(long)]
     pub embedding: Option<PathBuf>,

@@ -598,3 +598,83 @@ fn npy_files_match_the_text_formats() {
         "cut.npy",
     );
 }
+
+/// `wavg inverse --verified` writes `none not-reached` for the points no weights reach
+/// (three anchors far apart on the torus leave many), as many as its summary counts; every
+/// other line's weights lead back to its point.
+#[test]
+fn verified_inverse_marks_unreached_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = write(dir.path(), "a.txt", "v 0\nv 500\nv 1000\n");
+    let points: String = (0..120)
+        .map(|i| format!("f {} 0.2 0.3 0.5\n", i * 25))
+        .collect();
+    let points = write(dir.path(), "p.txt", &points);
+    let (w, back) = (dir.path().join("w.txt"), dir.path().join("back.txt"));
+    let torus = ["--mesh", "builtin:torus", "--embedding", "none"];
+    let out = wavg_ok(
+        &[
+            &["inverse"][..],
+            &torus,
+            &[
+                "--anchors",
+                s(&anchors),
+                "--points",
+                s(&points),
+                "-o",
+                s(&w),
+                "--verified",
+            ],
+        ]
+        .concat(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<String> = std::fs::read_to_string(&w)
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect();
+    let missed = lines.iter().filter(|l| *l == "none not-reached").count();
+    assert!(
+        missed > 0 && missed < lines.len(),
+        "{missed} of {}",
+        lines.len()
+    );
+    assert!(err.contains(&format!("{missed} not reached")), "{err}");
+    // The reached lines go back to their points through the forward problem.
+    let reached: Vec<(usize, &String)> = lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| !l.starts_with("none"))
+        .collect();
+    let wr = write(
+        dir.path(),
+        "wr.txt",
+        &reached
+            .iter()
+            .map(|(_, l)| format!("{l}\n"))
+            .collect::<String>(),
+    );
+    wavg_ok(
+        &[
+            &["forward"][..],
+            &torus,
+            &[
+                "--anchors",
+                s(&anchors),
+                "--weights",
+                s(&wr),
+                "-o",
+                s(&back),
+            ],
+        ]
+        .concat(),
+    );
+    let mesh = wavg::mesh::procedural::builtin("torus").unwrap();
+    let edge = (mesh.positions[0] - mesh.positions[1]).norm();
+    for ((i, _), b) in reached.iter().zip(read_rows(&back)) {
+        let o = wavg::mesh::SurfacePoint::new(*i as u32 * 25, [0.2, 0.3, 0.5]).position(&mesh);
+        let d = ((b[4] - o.x).powi(2) + (b[5] - o.y).powi(2) + (b[6] - o.z).powi(2)).sqrt();
+        assert!(d < 1e-2 * edge, "point {i}: {d}");
+    }
+}

@@ -16,9 +16,8 @@ use super::{PointSpec, located, read_points};
 /// anchors, the output and the thread count.
 #[derive(clap::Args)]
 pub struct ProblemArgs {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// Embedding (.wavg from `wavg precompute`); default: the mesh's 3-D positions.
     #[arg(long)]
     pub embedding: Option<PathBuf>,
@@ -33,12 +32,15 @@ pub struct ProblemArgs {
     pub threads: Option<usize>,
 }
 
+/// The `--embedding` value that asks for the mesh's 3-D positions as the embedding.
+pub const NO_EMBEDDING: &str = "none";
+
 /// The embedded mesh: the `.wavg` embedding when given, else the 3-D positions.
 pub fn load_embedded(
     mesh: Arc<ValidMesh>,
     embedding: Option<&Path>,
 ) -> Result<Arc<EmbeddedMesh>, CliError> {
-    let Some(path) = embedding else {
+    let Some(path) = embedding.filter(|p| *p != Path::new(NO_EMBEDDING)) else {
         return Ok(Arc::new(EmbeddedMesh::from_positions(mesh)));
     };
     let e = wavg::embed::file::load(path, &mesh).map_err(|e| CliError::input(one_line(&e)))?;
