@@ -2,16 +2,13 @@
 //! the anchors format, on a mesh with a loaded or freshly precomputed embedding (with a
 //! progress bar on a terminal).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 
-use wavg::{Anchor, PrecomputeOptions, Solver, Surface};
+use wavg::{Anchor, Solver, Surface};
 
 use crate::CliError;
+use crate::cache::CacheArg;
 use crate::common::{load_valid, one_line};
-use crate::precompute::Bars;
 use crate::textio::{located, read_points, spec_anchor};
 
 /// Flags of the commands that relate two surfaces through anchors paired line by line
@@ -30,26 +27,30 @@ pub struct PairArgs {
     /// Anchors on the target, paired line by line with the source's (same count).
     #[arg(long)]
     pub target_anchors: PathBuf,
-    /// A .wavg embedding of the source (default: precompute one in memory).
+    /// A .wavg embedding of the source (default: the embedding cache's, computed on first
+    /// use).
     #[arg(long)]
     pub source_embedding: Option<PathBuf>,
-    /// A .wavg embedding of the target (default: precompute one in memory).
+    /// A .wavg embedding of the target (default: the embedding cache's).
     #[arg(long)]
     pub target_embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: CacheArg,
     /// Worker threads (default: all cores; at most 4 per CPU, or 64).
     #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
 }
 
-/// Loads the mesh, the embedding (`.wavg`, or precomputed in memory with a tenth of the
-/// vertices as landmarks, 50 to 1000) and the anchors, each error naming its file and line.
+/// Loads the mesh, the embedding (`.wavg`, or the cache's) and the anchors, each error
+/// naming its file and line.
 pub fn solver_for(
     mesh: &str,
     embedding: Option<&Path>,
     anchors: &Path,
+    cache: CacheArg,
 ) -> Result<Solver, CliError> {
     let (mut surface, list) = surface_and_anchors(mesh, anchors)?;
-    embed(&mut surface, embedding)?;
+    embed(&mut surface, embedding, mesh, cache)?;
     surface
         .solver(list)
         .map_err(|e| CliError::input(one_line(&e)))
@@ -74,27 +75,23 @@ pub fn surface_and_anchors(mesh: &str, anchors: &Path) -> Result<(Surface, Vec<A
     Ok((surface, list))
 }
 
-/// Loads `embedding` into the surface or precomputes one in memory (a tenth of the
-/// vertices as landmarks, 50 to 1000), with progress bars on stderr when it is a terminal.
-pub fn embed(surface: &mut Surface, embedding: Option<&Path>) -> Result<(), CliError> {
+/// Loads `embedding` into the surface (named `name` in messages), or takes the embedding
+/// cache's (see [`crate::cache::embedding`]: computed on first use).
+pub fn embed(
+    surface: &mut Surface,
+    embedding: Option<&Path>,
+    name: &str,
+    cache: CacheArg,
+) -> Result<(), CliError> {
     match embedding {
         Some(path) => surface
             .load_embedding(path)
             .map_err(|e| CliError::input(one_line(&e))),
         None => {
-            let landmarks = (surface.n_vertices() / 10).clamp(50, 1000);
-            let opts = PrecomputeOptions {
-                landmarks,
-                quality_pairs: 0,
-                ..Default::default()
-            };
-            let bars = Bars::new(
-                std::io::stderr().is_terminal(),
-                Arc::new(AtomicBool::new(false)),
-            );
-            let r = surface.precompute(&opts, &bars).map(|_| ());
-            bars.clear();
-            r.map_err(|e| CliError::failure(one_line(&e)))
+            let e = crate::cache::embedding(surface.mesh(), name, cache.no_cache)?;
+            surface
+                .set_embedding(e)
+                .map_err(|e| CliError::failure(one_line(&e)))
         }
     }
 }

@@ -133,8 +133,18 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
             "--max-stretch must be a finite number above 1",
         ));
     }
-    embed(&mut source, a.pair.source_embedding.as_deref())?;
-    embed(&mut target, a.pair.target_embedding.as_deref())?;
+    embed(
+        &mut source,
+        a.pair.source_embedding.as_deref(),
+        &a.pair.source,
+        a.pair.cache,
+    )?;
+    embed(
+        &mut target,
+        a.pair.target_embedding.as_deref(),
+        &a.pair.target,
+        a.pair.cache,
+    )?;
     let solver = |s: &Surface, l: Vec<Anchor>| -> Result<Solver, CliError> {
         s.solver(l).map_err(|e| CliError::input(one_line(&e)))
     };

@@ -30,9 +30,12 @@ decal's own orientation), seconds, marked (the marked vertex ids), plus mesh and
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
-    /// A .wavg embedding of the mesh (default: precompute one in memory).
+    /// A .wavg embedding of the mesh (default: the embedding cache's, computed on first
+    /// use).
     #[arg(long)]
     pub embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: crate::cache::CacheArg,
     /// Anchors, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub anchors: PathBuf,
@@ -93,7 +96,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             anchors.len()
         )));
     }
-    embed(&mut surface, args.embedding.as_deref())?;
+    embed(
+        &mut surface,
+        args.embedding.as_deref(),
+        &args.mesh,
+        args.cache,
+    )?;
     let solver = surface
         .solver(anchors)
         .map_err(|e| CliError::input(one_line(&e)))?;

@@ -54,11 +54,7 @@ pub struct Args {
 /// Runs the command: the weights stream through in chunks (parsed, checked, solved and
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let solver = textio::load_solver(
-        &args.problem.mesh,
-        args.problem.embedding.as_deref(),
-        &args.problem.anchors,
-    )?;
+    let solver = textio::load_solver(&args.problem)?;
     let normalization = if args.normalize {
         Normalization::Normalize
     } else {

@@ -52,11 +52,7 @@ pub struct Args {
 /// Runs the command: the points stream through in chunks (parsed, resolved, solved and
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let mut solver = textio::load_solver(
-        &args.problem.mesh,
-        args.problem.embedding.as_deref(),
-        &args.problem.anchors,
-    )?;
+    let mut solver = textio::load_solver(&args.problem)?;
     solver
         .set_gamma(args.gamma)
         .map_err(|e| CliError::input(format!("--gamma: {e}")))?;

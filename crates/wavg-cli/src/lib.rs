@@ -9,6 +9,8 @@ mod apps_common;
 mod bench_load;
 mod bench_project;
 mod bench_roundtrip;
+mod cache;
+mod cache_cmd;
 mod common;
 mod completions;
 mod correspond;
@@ -80,6 +82,9 @@ enum Command {
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// The embedding cache: list or clear the embeddings computed for meshes.
+    #[command(subcommand)]
+    Cache(cache_cmd::Command),
     /// Print a shell completion script (bash, zsh or fish) to standard output.
     Completions(completions::Args),
 }
@@ -121,6 +126,7 @@ pub fn main() -> ExitCode {
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),
+        Command::Cache(c) => cache_cmd::run(c),
         Command::Completions(a) => completions::run(a),
     };
     match result {

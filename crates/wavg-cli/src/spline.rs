@@ -28,9 +28,12 @@ closed, bezier.")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
-    /// A .wavg embedding of the mesh (default: precompute one in memory).
+    /// A .wavg embedding of the mesh (default: the embedding cache's, computed on first
+    /// use).
     #[arg(long)]
     pub embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: crate::cache::CacheArg,
     /// Control points, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub control: PathBuf,
@@ -85,8 +88,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             closed: args.closed,
         }
     };
-    let solver =
-        crate::apps_common::solver_for(&args.mesh, args.embedding.as_deref(), &args.control)?;
+    let solver = crate::apps_common::solver_for(
+        &args.mesh,
+        args.embedding.as_deref(),
+        &args.control,
+        args.cache,
+    )?;
     let t = Instant::now();
     let curve = evaluate_spline(&solver, kind, args.samples, CHUNK)
         .map_err(|e| CliError::input(format!("{}: {}", args.control.display(), one_line(&e))))?;

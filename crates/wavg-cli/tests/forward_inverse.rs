@@ -217,6 +217,8 @@ fn no_weighted_average_is_a_per_line_marker() {
         "forward",
         "--mesh",
         "builtin:grid",
+        "--embedding",
+        "none",
         "--anchors",
         s(&anchors),
         "--weights",

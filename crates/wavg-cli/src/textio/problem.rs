@@ -18,9 +18,12 @@ use super::{PointSpec, located, read_points};
 pub struct ProblemArgs {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
-    /// Embedding (.wavg from `wavg precompute`); default: the mesh's 3-D positions.
+    /// Embedding (.wavg from `wavg precompute`); default: the embedding cache's (computed
+    /// on first use); `none`: the mesh's 3-D positions.
     #[arg(long)]
     pub embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: crate::cache::CacheArg,
     /// Anchors file ('v VERTEX' or 'f FACE B0 B1 B2' per line).
     #[arg(long)]
     pub anchors: PathBuf,
@@ -84,12 +87,10 @@ pub fn spec_anchor(spec: PointSpec) -> Result<Anchor, String> {
     })
 }
 
-/// Loads mesh, embedding and anchors, and makes the solver (shared by forward/inverse).
-pub fn load_solver(
-    mesh: &str,
-    embedding: Option<&Path>,
-    anchors: &Path,
-) -> Result<Solver, CliError> {
+/// Loads mesh, embedding (the file, `none` for the 3-D positions, or by default the
+/// cache's) and anchors, and makes the solver (shared by forward/inverse).
+pub fn load_solver(args: &ProblemArgs) -> Result<Solver, CliError> {
+    let (mesh, embedding, anchors) = (&*args.mesh, args.embedding.as_deref(), &*args.anchors);
     let specs = read_points(anchors)?;
     if specs.is_empty() {
         return Err(CliError::input(format!(
@@ -106,7 +107,16 @@ pub fn load_solver(
     for (&(line, _), a) in specs.iter().zip(&anchor_list) {
         wavg::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
-    let emb = load_embedded(mesh, embedding)?;
+    let emb = match embedding {
+        Some(path) => load_embedded(mesh, Some(path))?,
+        None => {
+            let e = crate::cache::embedding(&mesh, &args.mesh, args.cache.no_cache)?;
+            let coords: Vec<Vec8> = e.coords.iter().map(|c| Vec8::from(*c)).collect();
+            let emb =
+                EmbeddedMesh::new(mesh, coords).map_err(|e| CliError::failure(one_line(&e)))?;
+            Arc::new(emb)
+        }
+    };
     let proj = build_projector(emb)?;
     Solver::new(proj, anchor_list).map_err(|e| CliError::input(one_line(&e)))
 }
