@@ -148,6 +148,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             SolveError::InvalidParameter(_) => CliError::input(one_line(&e)),
             e => CliError::failure(one_line(&e)),
         })?;
+    crate::anchors::warn_if_low(
+        report.roundtrip_ok_fraction,
+        "round trips that lead back to their point",
+        report.anchors,
+        &args.mesh,
+    );
     if args.json {
         let json = JsonReport {
             report: &report,

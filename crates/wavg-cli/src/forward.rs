@@ -85,6 +85,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     // The batch's buffers live across chunks (no fresh memory to fault in per chunk).
     let (mut scratch, mut results) = (ForwardScratch::default(), Vec::new());
+    // Lines answered and lines without a weighted average, for the warning at the end.
+    let (mut answered, mut missing) = (0usize, 0usize);
     let solve = |rows: Vec<(usize, WeightRow)>, sink: &mut Sink| -> Result<(), CliError> {
         let weights: Vec<&[f64]> = rows.iter().map(|(_, w)| w.as_ref()).collect();
         // `Par::Rayon` always starts.
@@ -107,6 +109,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 )));
             }
         }
+        answered += results.len();
+        missing += results.iter().filter(|r| r.is_err()).count();
         sink.write(
             &results,
             |r, out| match r {
@@ -142,7 +146,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
             npy: |_, row| Ok(WeightRow::Npy(row)),
         };
         stream_queries(&args.weights, &args.problem.output, format, 7, check, solve)
-    })?
+    })??;
+    if answered > 0 {
+        crate::anchors::warn_if_low(
+            1.0 - missing as f64 / answered as f64,
+            "weight lines with a weighted average on the surface",
+            solver.n_anchors(),
+            &args.problem.mesh,
+        );
+    }
+    Ok(())
 }
 
 /// One query's weights as read: a parsed text line, or a row of a `.npy` block.

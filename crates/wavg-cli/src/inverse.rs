@@ -87,6 +87,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             // `Par::Rayon` always starts.
             let _ = solver.inverse_batch_into(&points, &mut weights, wavg::Par::Rayon);
             let rows: Vec<usize> = (0..weights.len()).collect();
+            summary.points += rows.len();
+            summary.none += rows.iter().filter(|&&i| weights.get(i).is_err()).count();
             sink.write(
                 &rows,
                 |&i, out| match weights.get(i) {
@@ -113,6 +115,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
     })??;
     if args.verified {
         summary.report();
+    }
+    if summary.points > 0 {
+        let what = if args.verified {
+            "points that weights lead back to"
+        } else {
+            "points with weights"
+        };
+        crate::anchors::warn_if_low(
+            1.0 - (summary.missed.len() + summary.none) as f64 / summary.points as f64,
+            what,
+            solver.n_anchors(),
+            &args.problem.mesh,
+        );
     }
     Ok(())
 }
@@ -149,18 +164,21 @@ fn none(out: &mut Vec<u8>, e: &wavg::SolveError) {
 }
 
 /// What `--verified` reports on standard error: penalised points and points no weights
-/// reach (counted from 1 over the whole file).
+/// reach (counted from 1 over the whole file); and, for the warning, points without weights.
 #[derive(Default)]
 struct VerifiedSummary {
     points: usize,
     penalised: usize,
     missed: Vec<usize>,
+    /// Points without weights at all (`none REASON`).
+    none: usize,
 }
 
 impl VerifiedSummary {
     fn add(&mut self, batch: &[Result<Verified, wavg::SolveError>]) {
         for (i, r) in batch.iter().enumerate() {
             match r {
+                Err(_) => self.none += 1,
                 Ok(v) if matches!(v.round_trip, RoundTrip::Penalized(_)) => self.penalised += 1,
                 Ok(v) if v.round_trip == RoundTrip::NotReached => {
                     self.missed.push(self.points + i + 1);

@@ -5,6 +5,7 @@
 
 #![forbid(unsafe_code)]
 
+mod anchors;
 mod apps_common;
 mod bench_load;
 mod bench_project;
@@ -59,6 +60,8 @@ enum Command {
     Repair(repair::Args),
     /// Compute the 8-D embedding of a mesh and write it as a .wavg file.
     Precompute(precompute::Args),
+    /// Choose K well-spread anchors on a mesh and write them as an anchors file.
+    Anchors(anchors::Args),
     /// Forward problem: anchors + weights -> points on the surface.
     Forward(forward::Args),
     /// Inverse problem: anchors + surface points -> weights.
@@ -113,6 +116,7 @@ pub fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Repair(a) => repair::run(a),
         Command::Precompute(a) => precompute::run(a),
+        Command::Anchors(a) => anchors::run(a),
         Command::Forward(a) => forward::run(a),
         Command::Inverse(a) => inverse::run(a),
         Command::Spline(a) => spline::run(a),

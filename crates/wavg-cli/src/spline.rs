@@ -115,6 +115,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Ok(())
     })?;
     let ok = curve.ok_samples();
+    crate::anchors::warn_if_low(
+        ok as f64 / args.samples as f64,
+        "samples of the curve on the surface",
+        solver.n_anchors(),
+        &args.mesh,
+    );
     let us = seconds / args.samples as f64 * 1e6;
     if args.json {
         let j = serde_json::to_value(JsonReport {

@@ -529,6 +529,8 @@ fn demo_json_keys() {
         "geodesic_rel_err_p50",
         "geodesic_rel_err_p90",
         "anchors",
+        "anchor_gap",
+        "spline_controls",
         "curve_points",
         "curve_ok",
         "curve_us",
