@@ -73,7 +73,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let validate = |line: usize, w: &[f64]| {
         wavg::validate_weights(w, solver.n_anchors(), normalization)
             .map(|_| ())
-            .map_err(|e| located(&args.weights, line, &e))
+            .map_err(|e| match e {
+                SolveError::WeightSum { .. } => located(
+                    &args.weights,
+                    line,
+                    &format!("{e}; pass --normalize to divide each line by its sum"),
+                ),
+                e => located(&args.weights, line, &e),
+            })
     };
     // The first pass for outputs that cannot be written atomically (in parallel; the
     // error reported is the first bad line's).

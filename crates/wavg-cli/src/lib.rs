@@ -136,7 +136,9 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("wavg: {}", e.message);
+            if !e.message.is_empty() {
+                eprintln!("wavg: {}", e.message);
+            }
             ExitCode::from(e.code)
         }
     }

@@ -223,13 +223,19 @@ struct Removed {
 
 /// Validates with a message naming the problems and the repair options.
 fn validate(name: &str, mesh: wavg::TriMesh) -> Result<ValidMesh, CliError> {
-    let components = wavg::mesh::analyze(&mesh).stats.components;
+    let analysis = wavg::mesh::analyze(&mesh);
+    let components = analysis.stats.components;
+    // What the default repairs would do, for the hint (only for an invalid mesh).
+    let preview = (!analysis.report.is_valid()).then(|| wavg::mesh::RepairPreview::of(&mesh));
     match ValidMesh::new(mesh) {
         Ok(m) => {
             if m.topology().n_components() != 1 {
                 return Err(CliError::input(format!(
-                    "{name}: the mesh has {} connected components; the embedding needs one \
-                     (rerun with --largest-component to keep the largest)",
+                    "{name}: the mesh has {} connected components; the embedding needs one. \
+                     Keep the largest with `wavg repair {name} -o FIXED.obj \
+                     --largest-component` and use FIXED.obj from then on (or here: \
+                     --largest-component --repaired-mesh FIXED.obj, which saves the mesh the \
+                     embedding belongs to)",
                     m.topology().n_components()
                 )));
             }
@@ -237,6 +243,16 @@ fn validate(name: &str, mesh: wavg::TriMesh) -> Result<ValidMesh, CliError> {
         }
         Err(MeshError::Invalid(report)) => {
             let mut hint = String::from("run `wavg info` for details");
+            if let Some(preview) = preview.filter(|p| p.fixes_all) {
+                let one = if preview.components > 1 {
+                    " --largest-component"
+                } else {
+                    ""
+                };
+                hint.push_str(&format!(
+                    "; `wavg repair {name} -o FIXED.obj{one}` fixes it (then use FIXED.obj)"
+                ));
+            }
             if components > 1 {
                 hint.push_str(&format!(
                     "; the mesh has {components} components: --largest-component keeps the \

@@ -33,7 +33,8 @@ vertices, faces, levels, smooth_steps, seconds (the first, cold remeshing), warm
 the previous frame; null with --frames 0), warm_seconds_max, warm_cpu_seconds (mean CPU
 time of all threads per frame), frames, max_offsurface
 (largest 3-D distance of an output vertex from the mesh over its bounding-box diagonal),
-roughness (mean umbrella length over mean edge length), problems, fallbacks, threads,
+roughness (mean umbrella length over mean edge length), problems (forward problems
+solved; also as forward_problems_solved), fallbacks, threads,
 precompute_seconds, plus mesh and base.")]
 pub struct Args {
     #[command(flatten)]
@@ -120,10 +121,12 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
         w.write_all(obj.as_bytes())
     })?;
     if args.json {
+        let remesh = r.report(&out);
         let j = serde_json::to_value(JsonReport {
             mesh: &args.mesh,
             base: &args.base,
-            remesh: r.report(&out),
+            forward_problems_solved: remesh.problems,
+            remesh,
             seconds,
             warm_seconds: warm,
             warm_seconds_max: drag.max,
@@ -160,6 +163,8 @@ struct JsonReport<'a> {
     base: &'a Path,
     #[serde(flatten)]
     remesh: RemeshReport,
+    /// The report's `problems` under a name that says what they are.
+    forward_problems_solved: usize,
     seconds: f64,
     warm_seconds: Option<f64>,
     warm_seconds_max: Option<f64>,

@@ -114,6 +114,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
             }
         }
     }
+    if after.report.is_valid() && after.stats.components > 1 {
+        eprintln!(
+            "note: {} has {} connected components; `wavg precompute` and every command that \
+             needs an embedding take one: add --largest-component to keep the largest",
+            args.output.display(),
+            after.stats.components
+        );
+    }
     if after.report.is_valid() {
         Ok(())
     } else {

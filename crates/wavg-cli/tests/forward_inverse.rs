@@ -144,7 +144,7 @@ fn malformed_weights_are_reported_with_their_line() {
             "w.txt:4: expected 3 weights",
         ),
         ("0.2 0.3 0.5\n0.2 NaN 0.8\n", "w.txt:2:"),
-        ("0.2 0.3 0.5\n0.2 0.3 0.6\n", "w.txt:2: weights sum to"),
+        ("0.2 0.3 0.5\n0.2 0.3 0.6\n", "; pass --normalize to divide"),
         ("0.2 0.3 0.5\n0.2 inf 0.5\n", "not finite"),
     ] {
         let w = write(dir.path(), "w.txt", text);

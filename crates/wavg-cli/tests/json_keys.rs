@@ -306,6 +306,7 @@ fn remesh_json_keys() {
         "max_offsurface",
         "roughness",
         "problems",
+        "forward_problems_solved",
         "fallbacks",
         "threads",
         "precompute_seconds",
