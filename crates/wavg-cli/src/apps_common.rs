@@ -3,8 +3,9 @@
 //! progress bar on a terminal).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-use wavg::{Anchor, Solver, Surface};
+use wavg::{Anchor, Solver, Surface, ValidMesh};
 
 use crate::CliError;
 use crate::cache::CacheArg;
@@ -49,16 +50,19 @@ pub fn solver_for(
     anchors: &Path,
     cache: CacheArg,
 ) -> Result<Solver, CliError> {
-    let (mut surface, list) = surface_and_anchors(mesh, anchors)?;
-    embed(&mut surface, embedding, mesh, cache)?;
+    let (valid, list) = mesh_and_anchors(mesh, anchors)?;
+    let surface = embed(valid, embedding, mesh, cache)?;
     surface
         .solver(list)
         .map_err(|e| CliError::input(one_line(&e)))
 }
 
-/// The surface (no embedding yet: see [`embed`]) and the anchors of `anchors`, checked
-/// against the mesh, so bad input fails before any precomputation.
-pub fn surface_and_anchors(mesh: &str, anchors: &Path) -> Result<(Surface, Vec<Anchor>), CliError> {
+/// The mesh (no embedding yet: see [`embed`]) and the anchors of `anchors`, checked
+/// against it, so bad input fails before any precomputation.
+pub fn mesh_and_anchors(
+    mesh: &str,
+    anchors: &Path,
+) -> Result<(Arc<ValidMesh>, Vec<Anchor>), CliError> {
     let specs = read_points(anchors)?;
     if specs.is_empty() {
         return Err(CliError::input(format!("{}: no points", anchors.display())));
@@ -71,27 +75,23 @@ pub fn surface_and_anchors(mesh: &str, anchors: &Path) -> Result<(Surface, Vec<A
     for (&(line, _), a) in specs.iter().zip(&list) {
         wavg::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
-    let surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
-    Ok((surface, list))
+    Ok((mesh, list))
 }
 
-/// Loads `embedding` into the surface (named `name` in messages), or takes the embedding
-/// cache's (see [`crate::cache::embedding`]: computed on first use).
+/// The surface on `mesh` (named `name` in messages) with the embedding of the file
+/// `embedding`, or else the embedding cache's (see [`crate::cache::embedding`]: computed on
+/// first use).
 pub fn embed(
-    surface: &mut Surface,
+    mesh: Arc<ValidMesh>,
     embedding: Option<&Path>,
     name: &str,
     cache: CacheArg,
-) -> Result<(), CliError> {
-    match embedding {
-        Some(path) => surface
-            .load_embedding(path)
-            .map_err(|e| CliError::input(one_line(&e))),
-        None => {
-            let e = crate::cache::embedding(surface.mesh(), name, cache.no_cache)?;
-            surface
-                .set_embedding(e)
-                .map_err(|e| CliError::failure(one_line(&e)))
+) -> Result<Surface, CliError> {
+    let e = match embedding {
+        Some(path) => {
+            wavg::embed::file::load(path, &mesh).map_err(|e| CliError::input(one_line(&e)))?
         }
-    }
+        None => crate::cache::embedding(&mesh, name, cache.no_cache)?,
+    };
+    Surface::from_valid_with_embedding(mesh, e).map_err(|e| CliError::failure(one_line(&e)))
 }

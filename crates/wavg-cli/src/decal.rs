@@ -8,7 +8,7 @@ use std::time::Instant;
 use wavg::apps::{DecalReport, decal_vertices};
 
 use crate::CliError;
-use crate::apps_common::{embed, surface_and_anchors};
+use crate::apps_common::{embed, mesh_and_anchors};
 use crate::common::one_line;
 use crate::textio::{self, located, write_numbers};
 
@@ -86,7 +86,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if !args.max_negative.is_finite() {
         return Err(CliError::input("--max-negative must be a finite number"));
     }
-    let (mut surface, anchors) = surface_and_anchors(&args.mesh, &args.anchors)?;
+    let (mesh, anchors) = mesh_and_anchors(&args.mesh, &args.anchors)?;
     if uv.len() != anchors.len() {
         return Err(CliError::input(format!(
             "{} has {} (u, v) lines but {} has {} anchors; give one per anchor",
@@ -96,12 +96,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             anchors.len()
         )));
     }
-    embed(
-        &mut surface,
-        args.embedding.as_deref(),
-        &args.mesh,
-        args.cache,
-    )?;
+    let surface = embed(mesh, args.embedding.as_deref(), &args.mesh, args.cache)?;
     let solver = surface
         .solver(anchors)
         .map_err(|e| CliError::input(one_line(&e)))?;

@@ -219,13 +219,10 @@ struct Drag {
 
 /// The surface with its embedding: loaded, or the embedding cache's.
 fn surface_for(args: &Args) -> Result<Surface, CliError> {
-    let mesh = load_valid(&args.mesh)?;
-    let mut surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
     crate::apps_common::embed(
-        &mut surface,
+        load_valid(&args.mesh)?,
         args.embedding.as_deref(),
         &args.mesh,
         args.cache,
-    )?;
-    Ok(surface)
+    )
 }
