@@ -25,8 +25,21 @@ set(ENV{PKG_CONFIG_PATH} ${pcdir})
 run(pkg-config --cflags --libs wavg)
 separate_arguments(flags UNIX_COMMAND "${out}")
 string(REGEX MATCH "-L([^ ]+)" _ "${out}")
-run(${CC} ${SOURCE_DIR}/ffi_tests/consumer/hello.c ${flags} -Wl,-rpath,${CMAKE_MATCH_1}
-    -o ${WORK}/hello_pc)
+# No -Wl,-rpath here and no LD_LIBRARY_PATH below: the .pc file's flags must suffice.
+run(${CC} ${SOURCE_DIR}/ffi_tests/consumer/hello.c ${flags} -o ${WORK}/hello_pc)
+unset(ENV{LD_LIBRARY_PATH})
+
+# The installed library has no debug info; it is in libwavg.so.0.debug beside it.
+file(GLOB_RECURSE lib ${prefix}/*/libwavg.so.0)
+if(NOT EXISTS "${lib}.debug")
+  message(FATAL_ERROR "${lib}.debug (the separate debug info) was not installed")
+endif()
+file(SIZE ${lib} lib_size)
+file(SIZE ${lib}.debug debug_size)
+if(NOT lib_size LESS debug_size)
+  message(FATAL_ERROR "${lib}: ${lib_size} bytes, debug info not stripped (${debug_size})")
+endif()
+message(STATUS "installed libwavg.so.0: ${lib_size} bytes (+ ${debug_size} bytes of debug info)")
 
 if(EXISTS "${MESH}")
   foreach(exe ${WORK}/cmake/hello ${WORK}/hello_pc)

@@ -2,16 +2,14 @@
 //! the anchors format, on a mesh with a loaded or freshly precomputed embedding (with a
 //! progress bar on a terminal).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 
-use wavg::{Anchor, PrecomputeOptions, Solver, Surface};
+use wavg::{Anchor, Solver, Surface, ValidMesh};
 
 use crate::CliError;
+use crate::cache::CacheArg;
 use crate::common::{load_valid, one_line};
-use crate::precompute::Bars;
 use crate::textio::{located, read_points, spec_anchor};
 
 /// Flags of the commands that relate two surfaces through anchors paired line by line
@@ -30,34 +28,41 @@ pub struct PairArgs {
     /// Anchors on the target, paired line by line with the source's (same count).
     #[arg(long)]
     pub target_anchors: PathBuf,
-    /// A .wavg embedding of the source (default: precompute one in memory).
+    /// A .wavg embedding of the source (default: the embedding cache's, computed on first
+    /// use).
     #[arg(long)]
     pub source_embedding: Option<PathBuf>,
-    /// A .wavg embedding of the target (default: precompute one in memory).
+    /// A .wavg embedding of the target (default: the embedding cache's).
     #[arg(long)]
     pub target_embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: CacheArg,
     /// Worker threads (default: all cores; at most 4 per CPU, or 64).
     #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
 }
 
-/// Loads the mesh, the embedding (`.wavg`, or precomputed in memory with a tenth of the
-/// vertices as landmarks, 50 to 1000) and the anchors, each error naming its file and line.
+/// Loads the mesh, the embedding (`.wavg`, or the cache's) and the anchors, each error
+/// naming its file and line.
 pub fn solver_for(
     mesh: &str,
     embedding: Option<&Path>,
     anchors: &Path,
+    cache: CacheArg,
 ) -> Result<Solver, CliError> {
-    let (mut surface, list) = surface_and_anchors(mesh, anchors)?;
-    embed(&mut surface, embedding)?;
+    let (valid, list) = mesh_and_anchors(mesh, anchors)?;
+    let surface = embed(valid, embedding, mesh, cache)?;
     surface
         .solver(list)
         .map_err(|e| CliError::input(one_line(&e)))
 }
 
-/// The surface (no embedding yet: see [`embed`]) and the anchors of `anchors`, checked
-/// against the mesh, so bad input fails before any precomputation.
-pub fn surface_and_anchors(mesh: &str, anchors: &Path) -> Result<(Surface, Vec<Anchor>), CliError> {
+/// The mesh (no embedding yet: see [`embed`]) and the anchors of `anchors`, checked
+/// against it, so bad input fails before any precomputation.
+pub fn mesh_and_anchors(
+    mesh: &str,
+    anchors: &Path,
+) -> Result<(Arc<ValidMesh>, Vec<Anchor>), CliError> {
     let specs = read_points(anchors)?;
     if specs.is_empty() {
         return Err(CliError::input(format!("{}: no points", anchors.display())));
@@ -70,31 +75,23 @@ pub fn surface_and_anchors(mesh: &str, anchors: &Path) -> Result<(Surface, Vec<A
     for (&(line, _), a) in specs.iter().zip(&list) {
         wavg::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
-    let surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
-    Ok((surface, list))
+    Ok((mesh, list))
 }
 
-/// Loads `embedding` into the surface or precomputes one in memory (a tenth of the
-/// vertices as landmarks, 50 to 1000), with progress bars on stderr when it is a terminal.
-pub fn embed(surface: &mut Surface, embedding: Option<&Path>) -> Result<(), CliError> {
-    match embedding {
-        Some(path) => surface
-            .load_embedding(path)
-            .map_err(|e| CliError::input(one_line(&e))),
-        None => {
-            let landmarks = (surface.n_vertices() / 10).clamp(50, 1000);
-            let opts = PrecomputeOptions {
-                landmarks,
-                quality_pairs: 0,
-                ..Default::default()
-            };
-            let bars = Bars::new(
-                std::io::stderr().is_terminal(),
-                Arc::new(AtomicBool::new(false)),
-            );
-            let r = surface.precompute(&opts, &bars).map(|_| ());
-            bars.clear();
-            r.map_err(|e| CliError::failure(one_line(&e)))
+/// The surface on `mesh` (named `name` in messages) with the embedding of the file
+/// `embedding`, or else the embedding cache's (see [`crate::cache::embedding`]: computed on
+/// first use).
+pub fn embed(
+    mesh: Arc<ValidMesh>,
+    embedding: Option<&Path>,
+    name: &str,
+    cache: CacheArg,
+) -> Result<Surface, CliError> {
+    let e = match embedding {
+        Some(path) => {
+            wavg::embed::file::load(path, &mesh).map_err(|e| CliError::input(one_line(&e)))?
         }
-    }
+        None => crate::cache::embedding(&mesh, name, cache.no_cache)?,
+    };
+    Surface::from_valid_with_embedding(mesh, e).map_err(|e| CliError::failure(one_line(&e)))
 }

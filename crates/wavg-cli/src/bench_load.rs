@@ -1,7 +1,6 @@
 //! `wavg bench load`: how long reading, parsing, and validating + building the topology
 //! of a mesh take (best of N runs each), in release builds.
 
-use std::path::PathBuf;
 use std::time::Instant;
 
 use wavg::mesh::{analyze, io};
@@ -12,9 +11,8 @@ use crate::common::one_line;
 /// Arguments.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Mesh file (.obj, .off, .ply, optionally .gz).
-    #[arg(long)]
-    pub mesh: PathBuf,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// Number of runs; each stage reports its best time.
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     pub repeat: u32,
@@ -60,9 +58,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     for _ in 0..args.repeat {
         let t0 = Instant::now();
         let (format, bytes) =
-            io::read_file(&args.mesh).map_err(|e| CliError::input(one_line(&e)))?;
+            io::read_file(args.mesh.as_ref()).map_err(|e| CliError::input(one_line(&e)))?;
         let t1 = Instant::now();
-        let (mesh, _) = io::parse_bytes(&bytes, format, &args.mesh)
+        let (mesh, _) = io::parse_bytes(&bytes, format, args.mesh.as_ref())
             .map_err(|e| CliError::input(one_line(&e)))?;
         let t2 = Instant::now();
         let a = analyze(&mesh);
@@ -83,7 +81,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (nv, nf, nbytes, valid, topo) = facts.expect("repeat >= 1");
     if args.json {
         let j = serde_json::to_value(JsonReport {
-            mesh: args.mesh.display().to_string(),
+            mesh: args.mesh.to_string(),
             vertices: nv,
             faces: nf,
             bytes: nbytes,
@@ -100,7 +98,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else {
         println!(
             "{}: {nv} vertices, {nf} faces, {:.1} MB uncompressed, valid: {}",
-            args.mesh.display(),
+            args.mesh,
             nbytes as f64 / 1e6,
             if valid { "yes" } else { "no" }
         );

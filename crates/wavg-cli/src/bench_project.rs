@@ -27,9 +27,8 @@ through Projector::project_batch (queries visited in spatial order, the greedy w
 queries interleaved; the answers equal one Projector::project call per query, which is
 checked). The table also shows the time of one project call at a time.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    mesh: PathBuf,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// A .wavg embedding of the mesh (default: the 3-D positions, zero-padded).
     #[arg(long)]
     embedding: Option<PathBuf>,
@@ -49,7 +48,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.queries == 0 {
         return Err(CliError::input("--queries must be at least 1"));
     }
-    let mesh = load_valid(&args.mesh.to_string_lossy())?;
+    let mesh = load_valid(&args.mesh)?;
     let emb = textio::load_embedded(mesh, args.embedding.as_deref())?;
     let opts = ProjectionBenchOptions {
         queries: args.queries,
@@ -67,7 +66,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "project_batch and project disagree (a bug: please report it)",
         ));
     }
-    let name = args.mesh.display().to_string();
+    let name = args.mesh.to_string();
     if args.json {
         let j = serde_json::to_value(JsonReport {
             mesh: &name,

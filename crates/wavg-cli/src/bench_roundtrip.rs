@@ -40,9 +40,8 @@ verified_penalized_fraction and verified_not_reached_fraction.
 
 Without --embedding or --precompute the 3-D positions are the embedding.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// Embedding (.wavg from `wavg precompute`).
     #[arg(long, conflicts_with = "precompute")]
     pub embedding: Option<PathBuf>,
@@ -149,6 +148,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             SolveError::InvalidParameter(_) => CliError::input(one_line(&e)),
             e => CliError::failure(one_line(&e)),
         })?;
+    crate::anchors::warn_if_low(
+        report.roundtrip_ok_fraction,
+        "round trips that lead back to their point",
+        report.anchors,
+        &args.mesh,
+    );
     if args.json {
         let json = JsonReport {
             report: &report,

@@ -13,7 +13,7 @@ use wavg::apps::{
 use wavg::{Anchor, Solver, Surface};
 
 use crate::CliError;
-use crate::apps_common::{PairArgs, embed, surface_and_anchors};
+use crate::apps_common::{PairArgs, embed, mesh_and_anchors};
 use crate::common::one_line;
 use crate::textio::{self, write_numbers};
 
@@ -114,8 +114,8 @@ pub struct Computed {
 /// both surfaces and maps every source vertex.
 pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
     let t0 = Instant::now();
-    let (mut source, sa) = surface_and_anchors(&a.pair.source, &a.pair.source_anchors)?;
-    let (mut target, ta) = surface_and_anchors(&a.pair.target, &a.pair.target_anchors)?;
+    let (source, sa) = mesh_and_anchors(&a.pair.source, &a.pair.source_anchors)?;
+    let (target, ta) = mesh_and_anchors(&a.pair.target, &a.pair.target_anchors)?;
     if sa.len() != ta.len() {
         return Err(CliError::input(format!(
             "{} has {} anchors and {} has {}; they are paired line by line and must agree",
@@ -133,8 +133,18 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
             "--max-stretch must be a finite number above 1",
         ));
     }
-    embed(&mut source, a.pair.source_embedding.as_deref())?;
-    embed(&mut target, a.pair.target_embedding.as_deref())?;
+    let source = embed(
+        source,
+        a.pair.source_embedding.as_deref(),
+        &a.pair.source,
+        a.pair.cache,
+    )?;
+    let target = embed(
+        target,
+        a.pair.target_embedding.as_deref(),
+        &a.pair.target,
+        a.pair.cache,
+    )?;
     let solver = |s: &Surface, l: Vec<Anchor>| -> Result<Solver, CliError> {
         s.solver(l).map_err(|e| CliError::input(one_line(&e)))
     };

@@ -8,7 +8,7 @@ use std::time::Instant;
 use wavg::apps::{DecalReport, decal_vertices};
 
 use crate::CliError;
-use crate::apps_common::{embed, surface_and_anchors};
+use crate::apps_common::{embed, mesh_and_anchors};
 use crate::common::one_line;
 use crate::textio::{self, located, write_numbers};
 
@@ -28,12 +28,14 @@ the surface-to-plane map over faces with three unmarked corners; null when there
 flipped_faces (against the
 decal's own orientation), seconds, marked (the marked vertex ids), plus mesh and anchors.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
-    /// A .wavg embedding of the mesh (default: precompute one in memory).
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
+    /// A .wavg embedding of the mesh (default: the embedding cache's, computed on first
+    /// use).
     #[arg(long)]
     pub embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: crate::cache::CacheArg,
     /// Anchors, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub anchors: PathBuf,
@@ -84,7 +86,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if !args.max_negative.is_finite() {
         return Err(CliError::input("--max-negative must be a finite number"));
     }
-    let (mut surface, anchors) = surface_and_anchors(&args.mesh, &args.anchors)?;
+    let (mesh, anchors) = mesh_and_anchors(&args.mesh, &args.anchors)?;
     if uv.len() != anchors.len() {
         return Err(CliError::input(format!(
             "{} has {} (u, v) lines but {} has {} anchors; give one per anchor",
@@ -94,7 +96,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             anchors.len()
         )));
     }
-    embed(&mut surface, args.embedding.as_deref())?;
+    let surface = embed(mesh, args.embedding.as_deref(), &args.mesh, args.cache)?;
     let solver = surface
         .solver(anchors)
         .map_err(|e| CliError::input(one_line(&e)))?;

@@ -16,6 +16,7 @@ use wavg::{Anchor, EmbeddedMesh, ForwardOptions, Solver, Vec8};
 use wavg::{SurfacePoint, ValidMesh};
 
 use crate::CliError;
+use crate::anchors::{GOOD_GAP, closed_tour, largest_gap, spread_to_good_gap};
 use crate::common::{load_valid, one_line};
 use crate::textio::{self, write_numbers};
 
@@ -24,9 +25,12 @@ use crate::textio::{self, write_numbers};
 #[command(after_long_help = "\
 Runs the method end to end on a mesh the project generates itself (default builtin:bump,
 an icosphere with a bump) or on your own: precomputes the 8-D embedding, places anchors
-by farthest-point sampling, evaluates a closed cubic B-spline on the surface whose control
-points are the anchors (ordered around the z axis), and runs inverse-then-forward round
-trips on random surface points with the paper's and the verified inverse.
+by farthest-point sampling in the embedding (as many as bring the largest gap between them
+to 0.08 of the diagonal, reported; --anchors K for K), evaluates a closed cubic B-spline on
+the surface through the first 8 of them (or all K) in the order of a short closed tour, and
+runs inverse-then-forward round trips on random surface points with the paper's and the
+verified inverse. Fewer than 90% of round trips leading back is a warning on stderr that
+names the remedy.
 
 With --out DIR it writes DIR/mesh.obj, DIR/mesh.wavg, DIR/anchors.txt, DIR/curve.txt
 (FACE B0 B1 B2 X Y Z per sample, as `wavg forward` writes) and DIR/curve.obj (the curve
@@ -40,20 +44,23 @@ example remeshing a cube onto a torus) is not drawn; the reason is printed and t
 goes on.
 
 --json prints one object: mesh, vertices, faces, landmarks, precompute_s, stress,
-geodesic_rel_err_p50, geodesic_rel_err_p90, anchors, curve_points, curve_ok, curve_us,
+geodesic_rel_err_p50, geodesic_rel_err_p90, anchors, anchor_gap, spline_controls,
+curve_points, curve_ok, curve_us,
 roundtrip_queries, inverse_us, forward_us, roundtrip_ok_fraction,
 verified_roundtrip_ok_fraction; with --out also pictures (paths written) and
 skipped_pictures (\"NAME: REASON\" each).")]
 pub struct Args {
-    /// Mesh file or builtin:NAME.
-    #[arg(long, default_value = "builtin:bump")]
-    pub mesh: String,
+    /// The mesh (default: builtin:bump).
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::OptionalMeshArg,
     /// Landmarks of the embedding (default: a tenth of the vertices, 50 to 1000).
     #[arg(long)]
     pub landmarks: Option<usize>,
-    /// Anchors (spline control points).
-    #[arg(long, default_value_t = 8)]
-    pub anchors: usize,
+    /// Anchors, all of them the spline's control points (default: as many as bring the
+    /// largest gap between anchors to 0.08 of the diagonal, at least 8; the spline then goes
+    /// through the first 8).
+    #[arg(long)]
+    pub anchors: Option<usize>,
     /// Samples along the spline.
     #[arg(long, default_value_t = 400)]
     pub samples: usize,
@@ -87,6 +94,8 @@ struct JsonReport<'a> {
     geodesic_rel_err_p50: f64,
     geodesic_rel_err_p90: f64,
     anchors: usize,
+    anchor_gap: f64,
+    spline_controls: usize,
     curve_points: usize,
     curve_ok: usize,
     curve_us: f64,
@@ -102,6 +111,11 @@ struct JsonReport<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     skipped_pictures: Option<Vec<String>>,
 }
+
+/// Control points of the demo's spline when `--anchors` is not given.
+const DEFAULT_CONTROLS: usize = 8;
+/// The most anchors the demo chooses by itself.
+const MAX_ANCHORS: usize = 400;
 
 /// Weights (one per anchor) of `samples` points along the closed cubic B-spline whose
 /// control points are the anchors in the order `order`.
@@ -126,7 +140,7 @@ fn spline_weights(order: &[usize], samples: usize) -> Result<Vec<Vec<f64>>, CliE
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    if args.anchors < 4 {
+    if args.anchors.is_some_and(|k| k < 4) {
         return Err(CliError::input(
             "--anchors must be at least 4 (a cubic spline)",
         ));
@@ -141,14 +155,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
             eprintln!("{s}");
         }
     };
-    let mesh = load_valid(&args.mesh)?;
+    let mesh_name = args.mesh.0.as_deref().unwrap_or("builtin:bump");
+    let mesh = load_valid(mesh_name)?;
     let landmarks = args
         .landmarks
         .unwrap_or((mesh.n_vertices() / 10).clamp(50, 1000))
         .min(mesh.n_vertices());
     say(&format!(
         "mesh {}: {} vertices, {} faces; precomputing the embedding ({landmarks} landmarks)...",
-        args.mesh,
+        mesh_name,
         mesh.n_vertices(),
         mesh.n_faces()
     ));
@@ -170,21 +185,45 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map(Arc::new)
         .map_err(|e| CliError::failure(one_line(&e)))?;
     let proj = textio::build_projector(embedded)?;
-    let anchor_ids = farthest_point_vertices(&mesh, args.anchors, args.seed, FpsMetric::EdgeGraph)
-        .map_err(|e| CliError::input(one_line(&e)))?;
-    let solver = Solver::new(proj, anchor_ids.iter().map(|&v| Anchor::Vertex(v)))
-        .map_err(|e| CliError::failure(one_line(&e)))?;
-
-    // The spline: control points ordered by their angle around the z axis.
-    let mut order: Vec<usize> = (0..anchor_ids.len()).collect();
-    let angle = |i: usize| {
-        let p = mesh.positions[anchor_ids[i] as usize];
-        p.y.atan2(p.x)
+    let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
+    // The anchors: as many as asked, else enough for a small gap between them; the spline's
+    // control points are all of them when asked for, else the first (most spread) 8.
+    let (anchor_ids, gap) = match args.anchors {
+        Some(k) => {
+            let ids = farthest_point_vertices(&mesh, k, args.seed, FpsMetric::Embedding(&coords))
+                .map_err(|e| CliError::input(one_line(&e)))?;
+            let gap = largest_gap(&coords, &ids) / mesh.bounding_box_diagonal();
+            (ids, gap)
+        }
+        None => spread_to_good_gap(&mesh, &coords, args.seed, DEFAULT_CONTROLS, MAX_ANCHORS)?,
     };
-    order.sort_by(|&a, &b| angle(a).total_cmp(&angle(b)));
+    let controls = match args.anchors {
+        Some(_) => anchor_ids.clone(),
+        None => anchor_ids[..DEFAULT_CONTROLS.min(anchor_ids.len())].to_vec(),
+    };
+    let solver_for = |ids: &[u32]| {
+        Solver::new(proj.clone(), ids.iter().map(|&v| Anchor::Vertex(v)))
+            .map_err(|e| CliError::failure(one_line(&e)))
+    };
+    let (solver, spline_solver) = (solver_for(&anchor_ids)?, solver_for(&controls)?);
+    say(&format!(
+        "anchors        {} (largest gap {gap:.3} of the diagonal{}); the spline through {}",
+        anchor_ids.len(),
+        if args.anchors.is_some() {
+            String::new()
+        } else {
+            format!(", chosen to bring it to {GOOD_GAP} or less")
+        },
+        controls.len()
+    ));
+
+    // The spline: control points in the order of a short closed tour (any up axis).
+    let tour_points: Vec<Vec8> = controls.iter().map(|&v| coords[v as usize]).collect();
+    let order = closed_tour(&tour_points);
     let weights = spline_weights(&order, args.samples)?;
     let t0 = Instant::now();
-    let curve = solver.forward_batch_warm(&weights, &ForwardOptions::default(), args.samples);
+    let curve =
+        spline_solver.forward_batch_warm(&weights, &ForwardOptions::default(), args.samples);
     let curve_us = t0.elapsed().as_secs_f64() / args.samples as f64 * 1e6;
     let curve_ok = curve.iter().filter(|r| r.is_ok()).count();
 
@@ -212,19 +251,32 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let vfwd = solver.forward_batch(&vrows, &ForwardOptions::default());
     let vok = points.iter().zip(&vfwd).filter(|(p, r)| back(p, r)).count();
     let n = points.len() as f64;
+    let warned = crate::anchors::warn_if_low(
+        ok as f64 / n,
+        "round trips that lead back to their point",
+        anchor_ids.len(),
+        mesh_name,
+    );
+    if !warned {
+        crate::anchors::warn_if_low(
+            curve_ok as f64 / args.samples as f64,
+            "spline samples on the surface",
+            controls.len(),
+            mesh_name,
+        );
+    }
 
     let mut pictures = None;
     if let Some(dir) = &args.out {
         write_outputs(dir, &mesh, &emb, &anchor_ids, &curve)?;
         let t0 = Instant::now();
-        let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
         let drawn = crate::demo_pictures::write_pictures(
             dir,
             &mesh,
             &coords,
-            &anchor_ids,
+            &controls,
             &curve,
-            &solver,
+            &spline_solver,
             args.seed,
         )?;
         for (name, why) in &drawn.skipped {
@@ -238,7 +290,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     if args.json {
         let j = serde_json::to_value(JsonReport {
-            mesh: &args.mesh,
+            mesh: mesh_name,
             vertices: mesh.n_vertices(),
             faces: mesh.n_faces(),
             landmarks,
@@ -247,6 +299,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             geodesic_rel_err_p50: emb.geodesic_rel_err_p50,
             geodesic_rel_err_p90: emb.geodesic_rel_err_p90,
             anchors: anchor_ids.len(),
+            anchor_gap: gap,
+            spline_controls: controls.len(),
             curve_points: args.samples,
             curve_ok,
             curve_us,
@@ -275,9 +329,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         emb.stress, emb.geodesic_rel_err_p50, emb.geodesic_rel_err_p90
     );
     println!(
-        "spline         {} anchors, {curve_ok} of {} samples on the surface, {curve_us:.2} us \
-         each (warm-started)",
-        anchor_ids.len(),
+        "spline         {} control points, {curve_ok} of {} samples on the surface, {curve_us:.2} \
+         us each (warm-started)",
+        controls.len(),
         args.samples
     );
     println!(

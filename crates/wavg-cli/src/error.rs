@@ -5,7 +5,8 @@ use std::fmt::Display;
 /// A failure reported to the user as `wavg: MESSAGE` with exit status `code`.
 #[derive(Debug)]
 pub struct CliError {
-    /// Exit status: 2 for unreadable or malformed input, 1 for other failures.
+    /// Exit status: 2 for unreadable or malformed input, 1 for other failures, 0 for a
+    /// [`CliError::quiet`] stop.
     pub code: u8,
     /// One-line message.
     pub message: String,
@@ -17,6 +18,15 @@ impl CliError {
         Self {
             code: 2,
             message: msg.to_string(),
+        }
+    }
+
+    /// A stop that is no failure (standard output closed by its reader): exit status 0,
+    /// nothing printed.
+    pub fn quiet() -> Self {
+        Self {
+            code: 0,
+            message: String::new(),
         }
     }
 

@@ -54,11 +54,7 @@ pub struct Args {
 /// Runs the command: the weights stream through in chunks (parsed, checked, solved and
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let solver = textio::load_solver(
-        &args.problem.mesh,
-        args.problem.embedding.as_deref(),
-        &args.problem.anchors,
-    )?;
+    let solver = textio::load_solver(&args.problem)?;
     let normalization = if args.normalize {
         Normalization::Normalize
     } else {
@@ -77,7 +73,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let validate = |line: usize, w: &[f64]| {
         wavg::validate_weights(w, solver.n_anchors(), normalization)
             .map(|_| ())
-            .map_err(|e| located(&args.weights, line, &e))
+            .map_err(|e| match e {
+                SolveError::WeightSum { .. } => located(
+                    &args.weights,
+                    line,
+                    &format!("{e}; pass --normalize to divide each line by its sum"),
+                ),
+                e => located(&args.weights, line, &e),
+            })
     };
     // The first pass for outputs that cannot be written atomically (in parallel; the
     // error reported is the first bad line's).
@@ -89,6 +92,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     // The batch's buffers live across chunks (no fresh memory to fault in per chunk).
     let (mut scratch, mut results) = (ForwardScratch::default(), Vec::new());
+    // Lines answered and lines without a weighted average, for the warning at the end.
+    let (mut answered, mut missing) = (0usize, 0usize);
     let solve = |rows: Vec<(usize, WeightRow)>, sink: &mut Sink| -> Result<(), CliError> {
         let weights: Vec<&[f64]> = rows.iter().map(|(_, w)| w.as_ref()).collect();
         // `Par::Rayon` always starts.
@@ -111,6 +116,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 )));
             }
         }
+        answered += results.len();
+        missing += results.iter().filter(|r| r.is_err()).count();
         sink.write(
             &results,
             |r, out| match r {
@@ -146,7 +153,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
             npy: |_, row| Ok(WeightRow::Npy(row)),
         };
         stream_queries(&args.weights, &args.problem.output, format, 7, check, solve)
-    })?
+    })??;
+    if answered > 0 {
+        crate::anchors::warn_if_low(
+            1.0 - missing as f64 / answered as f64,
+            "weight lines with a weighted average on the surface",
+            solver.n_anchors(),
+            &args.problem.mesh,
+        );
+    }
+    Ok(())
 }
 
 /// One query's weights as read: a parsed text line, or a row of a `.npy` block.

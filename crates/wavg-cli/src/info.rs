@@ -13,11 +13,14 @@ use crate::common::one_line;
 
 /// Arguments.
 #[derive(clap::Args)]
-#[command(group(clap::ArgGroup::new("source").required(true).args(["mesh", "builtin"])))]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["mesh", "mesh_flag", "builtin"])))]
 pub struct Args {
     /// Mesh file: .obj, .off or .ply, optionally gzip-compressed (.gz), or builtin:NAME
     /// (as the other commands take it).
     pub mesh: Option<String>,
+    /// The same as the positional MESH.
+    #[arg(long = "mesh", value_name = "MESH")]
+    pub mesh_flag: Option<String>,
     /// Describe a procedural mesh instead of a file (icosphere, sphere-small, torus, grid,
     /// bump, noisy-sphere).
     #[arg(long, value_name = "NAME")]
@@ -28,7 +31,8 @@ pub struct Args {
 }
 
 /// Runs the command.
-pub fn run(args: Args) -> Result<(), CliError> {
+pub fn run(mut args: Args) -> Result<(), CliError> {
+    args.mesh = args.mesh.or(args.mesh_flag.take());
     let builtin = args.builtin.as_deref().or_else(|| {
         args.mesh
             .as_deref()

@@ -25,9 +25,11 @@ bad barycentrics) are input errors: exit status 2 naming the line, and nothing i
 guess): where the paper's weights do not lead back to the point (within 1e-3 mean edge
 lengths; it happens on thin parts covered by few anchors), the smallest offset penalty
 lambda in 10, 100, 1000, 10000 whose weights do is used instead (the objective gains
-lambda d_ref |ybar - yhat|^2, d_ref the fourth smallest D_ii). The output format is
-unchanged; a summary on standard error counts the penalised points and lists the points
-(counted from 1) that no weights reach (those get the paper's weights). About 3-5x slower.";
+lambda d_ref |ybar - yhat|^2, d_ref the fourth smallest D_ii). A point that no weights
+reach is written as 'none not-reached' (a NaN row in .npy), as the C call
+wavg_inverse_verified returns NO_SOLUTION for it: add anchors near it (wavg anchors
+--count). A summary on standard error counts the penalised and the unreached points and
+lists the latter (counted from 1). About 3-5x slower.";
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -50,11 +52,7 @@ pub struct Args {
 /// Runs the command: the points stream through in chunks (parsed, resolved, solved and
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let mut solver = textio::load_solver(
-        &args.problem.mesh,
-        args.problem.embedding.as_deref(),
-        &args.problem.anchors,
-    )?;
+    let mut solver = textio::load_solver(&args.problem)?;
     solver
         .set_gamma(args.gamma)
         .map_err(|e| CliError::input(format!("--gamma: {e}")))?;
@@ -71,11 +69,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
             sink.write(
                 &batch,
                 |r, out| match r {
+                    Ok(v) if v.round_trip == RoundTrip::NotReached => {
+                        out.extend_from_slice(NOT_REACHED.as_bytes())
+                    }
                     Ok(v) => text::push_numbers(out, v.weights.iter().copied()),
                     Err(e) => none(out, e),
                 },
                 |r, row| {
-                    if let Ok(v) = r {
+                    if let Ok(v) = r
+                        && v.round_trip != RoundTrip::NotReached
+                    {
                         row.copy_from_slice(&v.weights);
                     }
                 },
@@ -84,6 +87,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             // `Par::Rayon` always starts.
             let _ = solver.inverse_batch_into(&points, &mut weights, wavg::Par::Rayon);
             let rows: Vec<usize> = (0..weights.len()).collect();
+            summary.points += rows.len();
+            summary.none += rows.iter().filter(|&&i| weights.get(i).is_err()).count();
             sink.write(
                 &rows,
                 |&i, out| match weights.get(i) {
@@ -111,6 +116,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.verified {
         summary.report();
     }
+    if summary.points > 0 {
+        let what = if args.verified {
+            "points that weights lead back to"
+        } else {
+            "points with weights"
+        };
+        crate::anchors::warn_if_low(
+            1.0 - (summary.missed.len() + summary.none) as f64 / summary.points as f64,
+            what,
+            solver.n_anchors(),
+            &args.problem.mesh,
+        );
+    }
     Ok(())
 }
 
@@ -137,24 +155,30 @@ fn npy_point(line: usize, row: NpyRow) -> Result<PointSpec, wavg::text::LineErro
     })
 }
 
+/// The line of a point that `--verified` finds no weights for (the C ABI's `NO_SOLUTION`).
+const NOT_REACHED: &str = "none not-reached";
+
 /// `none REASON` for a point without weights.
 fn none(out: &mut Vec<u8>, e: &wavg::SolveError) {
     out.extend_from_slice(format!("none {}", crate::common::one_line(e)).as_bytes());
 }
 
 /// What `--verified` reports on standard error: penalised points and points no weights
-/// reach (counted from 1 over the whole file).
+/// reach (counted from 1 over the whole file); and, for the warning, points without weights.
 #[derive(Default)]
 struct VerifiedSummary {
     points: usize,
     penalised: usize,
     missed: Vec<usize>,
+    /// Points without weights at all (`none REASON`).
+    none: usize,
 }
 
 impl VerifiedSummary {
     fn add(&mut self, batch: &[Result<Verified, wavg::SolveError>]) {
         for (i, r) in batch.iter().enumerate() {
             match r {
+                Err(_) => self.none += 1,
                 Ok(v) if matches!(v.round_trip, RoundTrip::Penalized(_)) => self.penalised += 1,
                 Ok(v) if v.round_trip == RoundTrip::NotReached => {
                     self.missed.push(self.points + i + 1);

@@ -5,10 +5,13 @@
 
 #![forbid(unsafe_code)]
 
+mod anchors;
 mod apps_common;
 mod bench_load;
 mod bench_project;
 mod bench_roundtrip;
+mod cache;
+mod cache_cmd;
 mod common;
 mod completions;
 mod correspond;
@@ -21,6 +24,7 @@ mod forward;
 mod info;
 mod inverse;
 pub mod man;
+mod mesh_arg;
 mod morph;
 mod precompute;
 mod remesh;
@@ -56,6 +60,8 @@ enum Command {
     Repair(repair::Args),
     /// Compute the 8-D embedding of a mesh and write it as a .wavg file.
     Precompute(precompute::Args),
+    /// Choose K well-spread anchors on a mesh and write them as an anchors file.
+    Anchors(anchors::Args),
     /// Forward problem: anchors + weights -> points on the surface.
     Forward(forward::Args),
     /// Inverse problem: anchors + surface points -> weights.
@@ -79,6 +85,9 @@ enum Command {
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// The embedding cache: list or clear the embeddings computed for meshes.
+    #[command(subcommand)]
+    Cache(cache_cmd::Command),
     /// Print a shell completion script (bash, zsh or fish) to standard output.
     Completions(completions::Args),
 }
@@ -107,6 +116,7 @@ pub fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Repair(a) => repair::run(a),
         Command::Precompute(a) => precompute::run(a),
+        Command::Anchors(a) => anchors::run(a),
         Command::Forward(a) => forward::run(a),
         Command::Inverse(a) => inverse::run(a),
         Command::Spline(a) => spline::run(a),
@@ -120,12 +130,15 @@ pub fn main() -> ExitCode {
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),
+        Command::Cache(c) => cache_cmd::run(c),
         Command::Completions(a) => completions::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("wavg: {}", e.message);
+            if !e.message.is_empty() {
+                eprintln!("wavg: {}", e.message);
+            }
             ExitCode::from(e.code)
         }
     }

@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -25,8 +25,8 @@ use crate::common::{load_mesh, one_line};
 /// Arguments.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Mesh file (.obj, .off, .ply, optionally .gz) or builtin:NAME.
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// Output .wavg file (written atomically).
     #[arg(short, long, value_name = "OUT.wavg")]
     pub output: PathBuf,
@@ -73,7 +73,7 @@ fn check_args(args: &Args) -> Result<(), CliError> {
         )));
     }
     let out = &args.output;
-    if crate::common::same_file(Path::new(&args.mesh), out) {
+    if crate::common::same_file(args.mesh.as_ref(), out) {
         return Err(CliError::input(format!(
             "the output {} is the input mesh; write the embedding to a .wavg file",
             out.display()
@@ -223,13 +223,19 @@ struct Removed {
 
 /// Validates with a message naming the problems and the repair options.
 fn validate(name: &str, mesh: wavg::TriMesh) -> Result<ValidMesh, CliError> {
-    let components = wavg::mesh::analyze(&mesh).stats.components;
+    let analysis = wavg::mesh::analyze(&mesh);
+    let components = analysis.stats.components;
+    // What the default repairs would do, for the hint (only for an invalid mesh).
+    let preview = (!analysis.report.is_valid()).then(|| wavg::mesh::RepairPreview::of(&mesh));
     match ValidMesh::new(mesh) {
         Ok(m) => {
             if m.topology().n_components() != 1 {
                 return Err(CliError::input(format!(
-                    "{name}: the mesh has {} connected components; the embedding needs one \
-                     (rerun with --largest-component to keep the largest)",
+                    "{name}: the mesh has {} connected components; the embedding needs one. \
+                     Keep the largest with `wavg repair {name} -o FIXED.obj \
+                     --largest-component` and use FIXED.obj from then on (or here: \
+                     --largest-component --repaired-mesh FIXED.obj, which saves the mesh the \
+                     embedding belongs to)",
                     m.topology().n_components()
                 )));
             }
@@ -237,6 +243,16 @@ fn validate(name: &str, mesh: wavg::TriMesh) -> Result<ValidMesh, CliError> {
         }
         Err(MeshError::Invalid(report)) => {
             let mut hint = String::from("run `wavg info` for details");
+            if let Some(preview) = preview.filter(|p| p.fixes_all) {
+                let one = if preview.components > 1 {
+                    " --largest-component"
+                } else {
+                    ""
+                };
+                hint.push_str(&format!(
+                    "; `wavg repair {name} -o FIXED.obj{one}` fixes it (then use FIXED.obj)"
+                ));
+            }
             if components > 1 {
                 hint.push_str(&format!(
                     "; the mesh has {components} components: --largest-component keeps the \

@@ -2,14 +2,12 @@
 //! Laplacian smoothing on the surface; optionally times interactive recomputation while a
 //! base vertex is dragged.
 
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use wavg::apps::{BaseMesh, RemeshReport, Remesher, polygons_to_obj};
-use wavg::{NoProgress, PrecomputeOptions, Surface, Vector3};
+use wavg::{Surface, Vector3};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
@@ -35,18 +33,21 @@ vertices, faces, levels, smooth_steps, seconds (the first, cold remeshing), warm
 the previous frame; null with --frames 0), warm_seconds_max, warm_cpu_seconds (mean CPU
 time of all threads per frame), frames, max_offsurface
 (largest 3-D distance of an output vertex from the mesh over its bounding-box diagonal),
-roughness (mean umbrella length over mean edge length), problems, fallbacks, threads,
+roughness (mean umbrella length over mean edge length), problems (forward problems
+solved; also as forward_problems_solved), fallbacks, threads,
 precompute_seconds, plus mesh and base.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// The coarse base mesh (OBJ with polygons).
     #[arg(long)]
     pub base: PathBuf,
-    /// A .wavg embedding of the mesh (default: precompute one in memory).
+    /// A .wavg embedding of the mesh (default: the embedding cache's, computed on first
+    /// use).
     #[arg(long)]
     pub embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: crate::cache::CacheArg,
     /// Levels of splitting (each multiplies the face count by about four).
     #[arg(long, default_value_t = 2)]
     pub levels: usize,
@@ -120,10 +121,12 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
         w.write_all(obj.as_bytes())
     })?;
     if args.json {
+        let remesh = r.report(&out);
         let j = serde_json::to_value(JsonReport {
             mesh: &args.mesh,
             base: &args.base,
-            remesh: r.report(&out),
+            forward_problems_solved: remesh.problems,
+            remesh,
             seconds,
             warm_seconds: warm,
             warm_seconds_max: drag.max,
@@ -160,6 +163,8 @@ struct JsonReport<'a> {
     base: &'a Path,
     #[serde(flatten)]
     remesh: RemeshReport,
+    /// The report's `problems` under a name that says what they are.
+    forward_problems_solved: usize,
     seconds: f64,
     warm_seconds: Option<f64>,
     warm_seconds_max: Option<f64>,
@@ -212,32 +217,12 @@ struct Drag {
     cpu: Option<f64>,
 }
 
-/// The surface with its embedding: loaded, or precomputed in memory (a tenth of the
-/// vertices as landmarks, 50 to 1000) with a progress bar when stderr is a terminal.
+/// The surface with its embedding: loaded, or the embedding cache's.
 fn surface_for(args: &Args) -> Result<Surface, CliError> {
-    let mesh = load_valid(&args.mesh)?;
-    let mut surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
-    match &args.embedding {
-        Some(path) => surface
-            .load_embedding(path)
-            .map_err(|e| CliError::input(one_line(&e)))?,
-        None => {
-            let landmarks = (surface.n_vertices() / 10).clamp(50, 1000);
-            let opts = PrecomputeOptions {
-                landmarks,
-                quality_pairs: 0,
-                ..Default::default()
-            };
-            let result = if std::io::stderr().is_terminal() {
-                let bars = crate::precompute::Bars::new(true, Arc::new(AtomicBool::new(false)));
-                let r = surface.precompute(&opts, &bars);
-                bars.clear();
-                r
-            } else {
-                surface.precompute(&opts, &NoProgress)
-            };
-            result.map_err(|e| CliError::failure(one_line(&e)))?;
-        }
-    }
-    Ok(surface)
+    crate::apps_common::embed(
+        load_valid(&args.mesh)?,
+        args.embedding.as_deref(),
+        &args.mesh,
+        args.cache,
+    )
 }

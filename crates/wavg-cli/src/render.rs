@@ -34,8 +34,8 @@ from the vertex count) is an error and nothing is written. --json prints one obj
 output, width, height, vertices, faces, covered_fraction (of pixels showing the mesh),
 seconds, plus scalar_min and scalar_max with --scalar.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    pub mesh: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// Output PNG.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,

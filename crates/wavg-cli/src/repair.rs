@@ -28,8 +28,8 @@ use crate::common::{load_mesh, one_line};
     still written, and the remaining problems are listed), 2 for unreadable input."
 )]
 pub struct Args {
-    /// Input mesh (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    pub input: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// Output mesh; the format follows the extension.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
@@ -66,7 +66,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     // The output's format, from its extension, before any work.
     wavg::mesh::Format::from_path(&args.output).map_err(|e| CliError::input(one_line(&e)))?;
-    let mesh = load_mesh(&args.input)?;
+    let mesh = load_mesh(&args.mesh)?;
     let options = RepairOptions {
         weld: (!args.no_weld).then_some(args.weld),
         keep_largest_component: args.largest_component,
@@ -88,7 +88,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let report = RepairReport::new(&mesh, &r, &after);
     if args.json {
         let j = serde_json::to_value(JsonReport {
-            input: &args.input,
+            input: &args.mesh,
             output: &args.output,
             report: &report,
         })
@@ -97,7 +97,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else {
         println!(
             "{} -> {}: {} -> {} vertices, {} -> {} faces, {} component(s)",
-            args.input,
+            args.mesh,
             args.output.display(),
             report.vertices_before,
             report.vertices,
@@ -113,6 +113,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 println!("  - {p}");
             }
         }
+    }
+    if after.report.is_valid() && after.stats.components > 1 {
+        eprintln!(
+            "note: {} has {} connected components; `wavg precompute` and every command that \
+             needs an embedding take one: add --largest-component to keep the largest",
+            args.output.display(),
+            after.stats.components
+        );
     }
     if after.report.is_valid() {
         Ok(())

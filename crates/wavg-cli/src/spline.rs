@@ -26,12 +26,14 @@ no projection. --json prints one object: samples, ok_samples, seconds, us_per_sa
 length (3-D length of the polyline through the samples), plus mesh, controls, degree,
 closed, bezier.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
-    /// A .wavg embedding of the mesh (default: precompute one in memory).
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
+    /// A .wavg embedding of the mesh (default: the embedding cache's, computed on first
+    /// use).
     #[arg(long)]
     pub embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: crate::cache::CacheArg,
     /// Control points, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub control: PathBuf,
@@ -86,8 +88,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             closed: args.closed,
         }
     };
-    let solver =
-        crate::apps_common::solver_for(&args.mesh, args.embedding.as_deref(), &args.control)?;
+    let solver = crate::apps_common::solver_for(
+        &args.mesh,
+        args.embedding.as_deref(),
+        &args.control,
+        args.cache,
+    )?;
     let t = Instant::now();
     let curve = evaluate_spline(&solver, kind, args.samples, CHUNK)
         .map_err(|e| CliError::input(format!("{}: {}", args.control.display(), one_line(&e))))?;
@@ -109,6 +115,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Ok(())
     })?;
     let ok = curve.ok_samples();
+    crate::anchors::warn_if_low(
+        ok as f64 / args.samples as f64,
+        "samples of the curve on the surface",
+        solver.n_anchors(),
+        &args.mesh,
+    );
     let us = seconds / args.samples as f64 * 1e6;
     if args.json {
         let j = serde_json::to_value(JsonReport {

@@ -20,8 +20,8 @@ use crate::common::{load_valid, one_line};
     --json prints one object: input_vertices, input_faces, vertices, faces, levels, seconds."
 )]
 pub struct Args {
-    /// Input mesh (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    pub input: String,
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
     /// Output mesh; the format follows the extension (binary .ply is the fastest to read).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
@@ -35,7 +35,7 @@ pub struct Args {
 
 /// Runs `wavg subdivide`.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let input = load_valid(&args.input)?;
+    let input = load_valid(&args.mesh)?;
     let t = Instant::now();
     let (nv0, nf0) = (input.n_vertices(), input.n_faces());
     let mut mesh = std::sync::Arc::unwrap_or_clone(input);
@@ -59,7 +59,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else {
         println!(
             "{} -> {}: {nv0} -> {} vertices, {nf0} -> {} faces, {} level(s) in {seconds:.2} s",
-            args.input,
+            args.mesh,
             args.output.display(),
             report.vertices,
             report.faces,

@@ -121,11 +121,13 @@ fn run_inner(args: Args) -> Result<(), CliError> {
         &args.pair.source,
         args.pair.source_embedding.as_deref(),
         &args.pair.source_anchors,
+        args.pair.cache,
     )?;
     let target = solver_for(
         &args.pair.target,
         args.pair.target_embedding.as_deref(),
         &args.pair.target_anchors,
+        args.pair.cache,
     )?;
     let precompute_s = t0.elapsed().as_secs_f64();
     let opts = TransferOptions {

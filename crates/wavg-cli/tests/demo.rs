@@ -20,6 +20,7 @@ fn demo_reports_and_writes_its_outputs() {
     assert_eq!(
         keys,
         [
+            "anchor_gap",
             "anchors",
             "curve_ok",
             "curve_points",
@@ -36,12 +37,18 @@ fn demo_reports_and_writes_its_outputs() {
             "roundtrip_ok_fraction",
             "roundtrip_queries",
             "skipped_pictures",
+            "spline_controls",
             "stress",
             "verified_roundtrip_ok_fraction",
             "vertices",
         ]
     );
     assert_eq!(o["vertices"], 2562);
+    // The anchor count follows from the gap between anchors; the spline uses the first 8.
+    let anchors = o["anchors"].as_u64().unwrap() as usize;
+    assert!(anchors > 8, "{anchors}");
+    assert!(o["anchor_gap"].as_f64().unwrap() <= 0.08);
+    assert_eq!(o["spline_controls"], 8);
     assert_eq!(o["pictures"].as_array().unwrap().len(), 6);
     assert_eq!(o["skipped_pictures"], serde_json::json!([]));
     assert_eq!(o["curve_ok"], o["curve_points"]);
@@ -70,7 +77,7 @@ fn demo_reports_and_writes_its_outputs() {
             .unwrap()
             .lines()
             .count(),
-        8
+        anchors
     );
     for png in [
         "spline.png",
@@ -144,4 +151,24 @@ fn demo_pictures_that_do_not_apply_are_skipped_with_a_reason() {
         assert!(name.ends_with(".png") && !why.is_empty(), "{s}");
         assert!(!out_dir.join(name).exists());
     }
+}
+
+/// Too few anchors for the mesh: the demo says so on stderr and names the remedy.
+#[test]
+fn demo_warns_when_round_trips_fail() {
+    let out = wavg_ok(&[
+        "demo",
+        "--mesh",
+        "builtin:torus",
+        "--anchors",
+        "4",
+        "--queries",
+        "300",
+        "--json",
+    ]);
+    let (o, _) = json_object(&out);
+    let ok = o["roundtrip_ok_fraction"].as_f64().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(ok < 0.9, "{ok}");
+    assert!(err.contains("warning") && err.contains("--count"), "{err}");
 }

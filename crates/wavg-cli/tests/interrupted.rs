@@ -21,6 +21,7 @@ fn timed_run(args: &[&str]) -> Duration {
 fn kill_after(args: &[&str], delay: Duration) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_wavg"))
         .args(args)
+        .env("WAVG_CACHE_DIR", common::cache_dir())
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()

@@ -62,3 +62,37 @@ fn a_named_pipe_gets_nothing_when_a_later_chunk_is_bad() {
     let kind = std::fs::symlink_metadata(&fifo).unwrap().file_type();
     assert!(kind.is_fifo(), "the pipe was replaced by a file");
 }
+
+/// `wavg ... -o - | head`: the reader stops early; wavg stops quietly with status 0.
+#[test]
+fn a_reader_that_stops_early_is_no_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = dir.path().join("a.txt");
+    std::fs::write(
+        &anchors,
+        "v 0\nv 300\nv 600\nv 900\nv 1200\nv 1500\nv 1800\n",
+    )
+    .unwrap();
+    let points = dir.path().join("p.txt");
+    let text: String = (0..200_000)
+        .map(|i| format!("f {} 0.2 0.3 0.5\n", i % 5000))
+        .collect();
+    std::fs::write(&points, text).unwrap();
+    let cmd = format!(
+        "'{}' inverse builtin:icosphere --embedding none --anchors '{}' --points '{}' -o - \
+         | head -n 2 >/dev/null; echo \"status ${{PIPESTATUS[0]}}\"",
+        env!("CARGO_BIN_EXE_wavg"),
+        anchors.display(),
+        points.display()
+    );
+    let out = std::process::Command::new("bash")
+        .args(["-c", &cmd])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(stdout.trim(), "status 0", "{stderr}");
+    assert!(!stderr.contains("Broken pipe"), "{stderr}");
+}

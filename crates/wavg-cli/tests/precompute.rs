@@ -121,6 +121,10 @@ fn two_components_need_largest_component() {
         err.contains("2 connected components") && err.contains("--largest-component"),
         "{err}"
     );
+    assert!(
+        err.contains("wavg repair") && err.contains("--repaired-mesh"),
+        "{err}"
+    );
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(!out_path.exists());
 

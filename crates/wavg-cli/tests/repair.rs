@@ -161,3 +161,49 @@ fn an_output_without_a_mesh_extension_is_refused_by_name() {
     );
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
+
+/// A repair whose result is valid but in several pieces says that the embedding needs one
+/// (stderr), and `precompute` on a mesh that `wavg repair` fixes names that command.
+#[test]
+fn several_components_and_fixable_meshes_point_to_the_next_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = wavg::mesh::procedural::icosphere(1);
+    let mut two = a.clone();
+    let n = a.n_vertices() as u32;
+    two.positions
+        .extend(a.positions.iter().map(|p| p.add_scalar(5.0)));
+    two.triangles
+        .extend(a.triangles.iter().map(|t| t.map(|v| v + n)));
+    let input = dir.path().join("two.obj");
+    io::save(&input, &two).unwrap();
+    let output = dir.path().join("two-out.obj");
+    let out = wavg_ok(&[
+        "repair",
+        input.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("2 connected components") && err.contains("--largest-component"),
+        "{err}"
+    );
+    // A duplicated face: invalid, and the default repair fixes it.
+    let mut dup = a.clone();
+    dup.triangles.push(dup.triangles[0]);
+    let input = dir.path().join("dup.obj");
+    io::save(&input, &dup).unwrap();
+    let wavg_file = dir.path().join("dup.wavg");
+    let out = wavg(&[
+        "precompute",
+        input.to_str().unwrap(),
+        "-o",
+        wavg_file.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("`wavg repair") && err.contains("fixes it"),
+        "{err}"
+    );
+}

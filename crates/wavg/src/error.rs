@@ -7,7 +7,16 @@ use wavg_project::ProjectError;
 use wavg_solve::SolveError;
 
 /// Anything [`crate::Surface`] and the one-off functions can fail with.
-#[derive(Debug, thiserror::Error)]
+///
+/// Its `Debug` form is the message and the kind, so a `main` that returns
+/// `Result<(), wavg::Error>` and fails through `?` prints a readable line:
+///
+/// ```
+/// let e = wavg::Surface::open("missing.obj").unwrap_err();
+/// let shown = format!("{e:?}");
+/// assert!(shown.contains("missing.obj") && shown.ends_with("(Io)"), "{shown}");
+/// ```
+#[derive(thiserror::Error)]
 pub enum Error {
     /// Loading, validating or repairing a mesh failed.
     #[error(transparent)]
@@ -25,6 +34,12 @@ pub enum Error {
     /// the embedding); the message says how to fix it.
     #[error("{0}")]
     Unsuitable(String),
+}
+
+impl std::fmt::Debug for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{self} ({:?})", self.kind())
+    }
 }
 
 /// Coarse classes of [`Error`], stable enough to map to exit codes or C status codes.

@@ -71,6 +71,29 @@ impl Surface {
         })
     }
 
+    /// A surface on an already validated mesh with an embedding computed for it (one
+    /// projector build, where [`Surface::from_valid`] then [`Surface::set_embedding`]
+    /// build two: the start-up time of a run that reads a cached embedding).
+    pub fn from_valid_with_embedding(
+        mesh: impl Into<Arc<ValidMesh>>,
+        embedding: Embedding,
+    ) -> Result<Self> {
+        let mesh = mesh.into();
+        embedding
+            .validate(mesh.n_vertices())
+            .map_err(wavg_embed::EmbedError::InvalidArgument)?;
+        let coords = embedding.coords.iter().map(|c| Vec8::from(*c)).collect();
+        let emb = EmbeddedMesh::new(mesh.clone(), coords)?;
+        let projector = Projector::new(Arc::new(emb))?;
+        Ok(Self {
+            inner: Arc::new(Inner {
+                mesh,
+                embedding: Some(embedding),
+                projector: Arc::new(projector),
+            }),
+        })
+    }
+
     /// A surface from flat arrays: vertex positions and counter-clockwise triangles
     /// (0-based vertex indices). Out-of-range indices and non-finite coordinates are
     /// reported as an invalid mesh.

@@ -71,6 +71,35 @@ impl Camera {
         }
     }
 
+    /// The camera moved across its image plane and zoomed in (1 to 4 times) so that
+    /// `points` fill the image with a small margin: a long or flat mesh, whose bounding ball
+    /// [`Camera::fit`] sees whole, then no longer covers only a fraction of the picture.
+    pub fn framed(mut self, points: &[Vector3<f64>]) -> Self {
+        if points.is_empty() {
+            return self;
+        }
+        let (w, h) = (self.size.0 as f64, self.size.1 as f64);
+        for _ in 0..3 {
+            let (mut lo, mut hi, mut depth) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2], 0.0);
+            for p in points {
+                let s = self.project(p);
+                for k in 0..2 {
+                    lo[k] = lo[k].min(s[k]);
+                    hi[k] = hi[k].max(s[k]);
+                }
+                depth += s[2];
+            }
+            let depth = depth / points.len() as f64;
+            let (cx, cy) = ((lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0);
+            // Moving the eye by d across the view moves a point at depth z by focal d / z.
+            self.eye += self.right * ((cx - w / 2.0) * depth / self.focal)
+                - self.up * ((cy - h / 2.0) * depth / self.focal);
+            let span = ((hi[0] - lo[0]) / w).max((hi[1] - lo[1]) / h).max(1e-12);
+            self.focal *= (0.9 / span).clamp(1.0, 4.0);
+        }
+        self
+    }
+
     /// Screen position (x right, y down, pixels, pixel centres at +0.5) and depth along
     /// the viewing direction of a world point.
     pub fn project(&self, p: &Vector3<f64>) -> [f64; 3] {
@@ -109,5 +138,41 @@ mod tests {
             );
             assert!(c.right.iter().all(|x| x.is_finite()));
         }
+    }
+
+    #[test]
+    fn a_long_flat_mesh_is_framed_to_fill_the_picture() {
+        // A 10 x 1 x 0.1 slab off the origin: its bounding ball leaves most of the frame empty.
+        let pts: Vec<Vector3<f64>> = (0..8)
+            .map(|i| {
+                let b = |k: usize, v: f64| if i >> k & 1 == 1 { v } else { 0.0 };
+                Vector3::new(5.0 + b(0, 10.0), b(1, 1.0), b(2, 0.1))
+            })
+            .collect();
+        let span = |c: &Camera| {
+            let s: Vec<[f64; 3]> = pts.iter().map(|p| c.project(p)).collect();
+            let (x0, x1) = s
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p[0]), b.max(p[0])));
+            let (y0, y1) = s
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p[1]), b.max(p[1])));
+            assert!(
+                x0 >= 0.0 && x1 <= 800.0 && y0 >= 0.0 && y1 <= 600.0,
+                "{x0} {x1} {y0} {y1}"
+            );
+            ((x1 - x0) / 800.0).max((y1 - y0) / 600.0)
+        };
+        let ball = Camera::fit(
+            Vector3::new(10.0, 0.5, 0.05),
+            5.03,
+            View::default(),
+            800,
+            600,
+        );
+        let before = span(&ball);
+        let after = span(&ball.framed(&pts));
+        assert!(after > 0.85 && after <= 0.95, "{before} -> {after}");
+        assert!(after > before * 1.2, "{before} -> {after}");
     }
 }

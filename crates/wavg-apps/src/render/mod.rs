@@ -199,7 +199,8 @@ pub fn render(
     let ss = opts.supersample;
     let (w, h) = ((opts.width * ss) as usize, (opts.height * ss) as usize);
     let (center, radius) = bounds(&mesh.positions);
-    let cam = Camera::fit(center, radius, opts.view, w as u32, h as u32);
+    // The whole bounding ball in view, then the mesh itself framed to fill the picture.
+    let cam = Camera::fit(center, radius, opts.view, w as u32, h as u32).framed(&mesh.positions);
     let screen: Vec<[f64; 3]> = mesh.positions.iter().map(|p| cam.project(p)).collect();
     let mut vis = VisBuffer::new(w, h);
     for (f, t) in mesh.triangles.iter().enumerate() {

@@ -25,9 +25,13 @@ pub fn write_atomic(
     if path == Path::new("-") {
         let stdout = std::io::stdout();
         let mut w = std::io::BufWriter::new(stdout.lock());
+        // A reader that stopped early (`wavg ... -o - | head`) is not a failure.
         body(&mut w)
             .and_then(|()| w.flush())
-            .map_err(|e| fail(&e))?;
+            .map_err(|e| match e.kind() {
+                std::io::ErrorKind::BrokenPipe => CliError::quiet(),
+                _ => fail(&e),
+            })?;
         return Ok(());
     }
     wavg::mesh::io::write_atomic(path, body).map_err(|e| fail(&e))

@@ -16,12 +16,14 @@ use super::{PointSpec, located, read_points};
 /// anchors, the output and the thread count.
 #[derive(clap::Args)]
 pub struct ProblemArgs {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(long)]
-    pub mesh: String,
-    /// Embedding (.wavg from `wavg precompute`); default: the mesh's 3-D positions.
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
+    /// Embedding (.wavg from `wavg precompute`); default: the embedding cache's (computed
+    /// on first use); `none`: the mesh's 3-D positions.
     #[arg(long)]
     pub embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: crate::cache::CacheArg,
     /// Anchors file ('v VERTEX' or 'f FACE B0 B1 B2' per line).
     #[arg(long)]
     pub anchors: PathBuf,
@@ -33,12 +35,15 @@ pub struct ProblemArgs {
     pub threads: Option<usize>,
 }
 
+/// The `--embedding` value that asks for the mesh's 3-D positions as the embedding.
+pub const NO_EMBEDDING: &str = "none";
+
 /// The embedded mesh: the `.wavg` embedding when given, else the 3-D positions.
 pub fn load_embedded(
     mesh: Arc<ValidMesh>,
     embedding: Option<&Path>,
 ) -> Result<Arc<EmbeddedMesh>, CliError> {
-    let Some(path) = embedding else {
+    let Some(path) = embedding.filter(|p| *p != Path::new(NO_EMBEDDING)) else {
         return Ok(Arc::new(EmbeddedMesh::from_positions(mesh)));
     };
     let e = wavg::embed::file::load(path, &mesh).map_err(|e| CliError::input(one_line(&e)))?;
@@ -82,12 +87,10 @@ pub fn spec_anchor(spec: PointSpec) -> Result<Anchor, String> {
     })
 }
 
-/// Loads mesh, embedding and anchors, and makes the solver (shared by forward/inverse).
-pub fn load_solver(
-    mesh: &str,
-    embedding: Option<&Path>,
-    anchors: &Path,
-) -> Result<Solver, CliError> {
+/// Loads mesh, embedding (the file, `none` for the 3-D positions, or by default the
+/// cache's) and anchors, and makes the solver (shared by forward/inverse).
+pub fn load_solver(args: &ProblemArgs) -> Result<Solver, CliError> {
+    let (mesh, embedding, anchors) = (&*args.mesh, args.embedding.as_deref(), &*args.anchors);
     let specs = read_points(anchors)?;
     if specs.is_empty() {
         return Err(CliError::input(format!(
@@ -104,7 +107,16 @@ pub fn load_solver(
     for (&(line, _), a) in specs.iter().zip(&anchor_list) {
         wavg::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
-    let emb = load_embedded(mesh, embedding)?;
+    let emb = match embedding {
+        Some(path) => load_embedded(mesh, Some(path))?,
+        None => {
+            let e = crate::cache::embedding(&mesh, &args.mesh, args.cache.no_cache)?;
+            let coords: Vec<Vec8> = e.coords.iter().map(|c| Vec8::from(*c)).collect();
+            let emb =
+                EmbeddedMesh::new(mesh, coords).map_err(|e| CliError::failure(one_line(&e)))?;
+            Arc::new(emb)
+        }
+    };
     let proj = build_projector(emb)?;
     Solver::new(proj, anchor_list).map_err(|e| CliError::input(one_line(&e)))
 }

@@ -3,10 +3,17 @@
 
 use std::process::{Command, Output};
 
+/// The embedding cache folder the tests' `wavg` runs use.
+pub fn cache_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("wavg-cache")
+}
+
 /// Runs `wavg ARGS`.
 pub fn wavg(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_wavg"))
         .args(args)
+        // The embedding cache of the tests: shared by them, never the user's.
+        .env("WAVG_CACHE_DIR", cache_dir())
         .output()
         .expect("run wavg")
 }

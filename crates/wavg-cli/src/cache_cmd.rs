@@ -1,0 +1,93 @@
+//! `wavg cache list|clear`: what the embedding cache holds, and emptying it.
+
+use crate::CliError;
+use crate::cache;
+
+/// `wavg cache` subcommands.
+#[derive(clap::Subcommand)]
+pub enum Command {
+    /// List the cached embeddings: key, size, mesh, vertices, landmarks, age.
+    List(ListArgs),
+    /// Remove every cached embedding.
+    Clear,
+}
+
+/// Arguments of `wavg cache list`.
+#[derive(clap::Args)]
+pub struct ListArgs {
+    /// Print one JSON object: dir, entries (key, bytes, mesh, vertices, faces, landmarks,
+    /// seconds, created).
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `wavg cache list` or `wavg cache clear`.
+pub fn run(cmd: Command) -> Result<(), CliError> {
+    let dir = cache::dir().ok_or_else(|| {
+        CliError::input("no cache folder: set WAVG_CACHE_DIR, XDG_CACHE_HOME or HOME")
+    })?;
+    let entries =
+        cache::entries(&dir).map_err(|e| CliError::failure(format!("{}: {e}", dir.display())))?;
+    match cmd {
+        Command::List(a) if a.json => {
+            let list: Vec<serde_json::Value> = entries
+                .iter()
+                .map(|(key, bytes, meta)| {
+                    let mut v = meta
+                        .as_ref()
+                        .and_then(|m| serde_json::to_value(m).ok())
+                        .unwrap_or_else(|| serde_json::json!({}));
+                    v["key"] = key.clone().into();
+                    v["bytes"] = (*bytes).into();
+                    v
+                })
+                .collect();
+            let j = serde_json::json!({ "dir": dir.display().to_string(), "entries": list });
+            println!("{j}");
+        }
+        Command::List(_) => {
+            println!("{} ({} entries)", dir.display(), entries.len());
+            let now = std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs());
+            for (key, bytes, meta) in &entries {
+                let size = format!("{:.1} MB", *bytes as f64 / 1e6);
+                match meta {
+                    Some(m) => println!(
+                        "{key}  {size:>9}  {} vertices, {} landmarks, {:.1} s to compute, \
+                         {} h old  {}",
+                        m.vertices,
+                        m.landmarks,
+                        m.seconds,
+                        now.saturating_sub(m.created) / 3600,
+                        m.mesh
+                    ),
+                    None => println!("{key}  {size:>9}"),
+                }
+            }
+        }
+        Command::Clear => {
+            let mut freed = 0u64;
+            for (key, bytes, _) in &entries {
+                for ext in ["wavg", "json"] {
+                    let p = dir.join(format!("{key}.{ext}"));
+                    match std::fs::remove_file(&p) {
+                        Ok(()) => {}
+                        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                        Err(e) => {
+                            return Err(CliError::failure(format!("{}: {e}", p.display())));
+                        }
+                    }
+                }
+                freed += bytes;
+            }
+            println!(
+                "removed {} cached embeddings ({:.1} MB) from {}",
+                entries.len(),
+                freed as f64 / 1e6,
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}
