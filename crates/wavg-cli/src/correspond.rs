@@ -69,7 +69,8 @@ source_vertices, valid_fraction, flipped_faces, flipped_area_fraction, stretch (
 L2 stretch over the valid part; null when no face is measured), stretch_best95, seconds, vertices_per_s, plus cpu_seconds and
 vertices_per_cpu_s (CPU time of the map, all threads), counts per reason and, with
 --ground-truth, the error of the images against vertex i of the target as fractions of the
-target's bounding-box diagonal.
+target's bounding-box diagonal, with rejected_correct (images within 2% rejected) and
+accepted_wrong (valid vertices farther than 2%).
 
 Timings: `seconds` is the wall time of the map alone, from starting its worker threads to the
 last validity decision; `vertices_per_s` is source_vertices / seconds. Neither includes
