@@ -510,7 +510,8 @@ fn smooth_normals(
             for &v in t {
                 let p = mapped.get(v as usize)?.target.as_ref().ok()?.point;
                 let c = p.interpolate(target, &vn).normalize();
-                if !(c.dot(&sum) >= min_cos) {
+                let cos = c.dot(&sum);
+                if cos.is_nan() || cos < min_cos {
                     return None;
                 }
             }
