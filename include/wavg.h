@@ -222,10 +222,9 @@ enum wavg_status wavg_correspond(const struct wavg_solver *source,
 
 // Maps every vertex of the source surface onto the target (as `wavg_correspond`) and
 // judges each vertex: with `local`, by local consistency (its weights return to it and
-// most triangles around it land neither flipped against the target's normals nor
-// stretched beyond 4 times the map's overall symmetrised L2 stretch); otherwise by the
-// paper's test (round trip, no weight below `max_negative`). Writes `out[v]`, and unless
-// NULL `out_xyz[3*v..3*v+3]` and `out_statuses[v]`, for each of the source's
+// most of its edges land stretched by at most 4 times the map's median edge stretch);
+// otherwise by the paper's test (round trip, no weight below `max_negative`). Writes
+// `out[v]`, and unless NULL `out_xyz[3*v..3*v+3]` and `out_statuses[v]`, for each of the source's
 // `n_vertices` vertices (the arrays must hold that many): `WAVG_STATUS_OK` for a kept
 // vertex, `WAVG_STATUS_NO_SOLUTION` for a rejected one (the image is still written when
 // it exists; `face = UINT32_MAX` and NaN otherwise). Returns the first non-OK vertex's

@@ -40,8 +40,14 @@ impl ErrorStats {
     }
 }
 
+/// An image farther than this from the truth, in bounding-box diagonals of the target,
+/// is wrong (for [`GroundTruthErrors::accepted_wrong`] and
+/// [`GroundTruthErrors::rejected_correct`]).
+pub const WRONG_ERROR: f64 = 0.02;
+
 /// Errors of a map's images against the ground truth, in bounding-box diagonals of the
-/// target; with the `serde` feature, keyed by the field names.
+/// target, and how well the validity test separates right images from wrong ones; with
+/// the `serde` feature, keyed by the field names.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct GroundTruthErrors {
@@ -49,6 +55,10 @@ pub struct GroundTruthErrors {
     pub valid: ErrorStats,
     /// Over every vertex with an image, valid or not.
     pub answered: ErrorStats,
+    /// Vertices with an image within [`WRONG_ERROR`] of the truth that the test rejected.
+    pub rejected_correct: usize,
+    /// Valid vertices whose image is farther than [`WRONG_ERROR`] from the truth.
+    pub accepted_wrong: usize,
 }
 
 impl Correspondence {
@@ -76,18 +86,26 @@ impl Correspondence {
         }
         let diag = target.bounding_box_diagonal();
         let (mut valid, mut answered) = (Vec::new(), Vec::new());
+        let (mut rejected_correct, mut accepted_wrong) = (0, 0);
         for (v, (m, ok)) in self.mapped.iter().zip(&self.validity).enumerate() {
             if let Ok(img) = &m.target {
                 let e = (img.position - target.positions[v]).norm() / diag;
                 answered.push(e);
+                // NaN errors count as wrong.
+                let right = e <= WRONG_ERROR;
                 if *ok == Validity::Valid {
                     valid.push(e);
+                    accepted_wrong += usize::from(!right);
+                } else {
+                    rejected_correct += usize::from(right);
                 }
             }
         }
         Ok(GroundTruthErrors {
             valid: ErrorStats::of(valid),
             answered: ErrorStats::of(answered),
+            rejected_correct,
+            accepted_wrong,
         })
     }
 }

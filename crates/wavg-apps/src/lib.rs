@@ -27,7 +27,7 @@ pub use correspond::{
     CorrespondOptions, CorrespondTimings, Correspondence, Mapped, ROUND_TRIP_TOLERANCE,
     ReasonCounts, Validity, ValidityTest, correspond_vertices, map_points, vertex_points,
 };
-pub use ground_truth::{ErrorStats, GroundTruthErrors};
+pub use ground_truth::{ErrorStats, GroundTruthErrors, WRONG_ERROR};
 pub use metrics::{Distortion, distortion};
 
 /// Internals for the benchmarks and experiments of this workspace.

@@ -20,8 +20,8 @@ use crate::textio::{self, write_numbers};
 /// The validity test, on the command line.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum Test {
-    /// Local consistency: rejects vertices whose surrounding triangles mostly land flipped
-    /// or over-stretched on the target, or whose weights do not round-trip.
+    /// Local consistency: rejects vertices whose edges mostly land over-stretched on the
+    /// target, or whose weights do not round-trip.
     Local,
     /// The paper's: the weights round-trip and none is below --max-negative.
     Paper,
@@ -42,8 +42,8 @@ pub struct MapArgs {
     /// Validity test.
     #[arg(long, value_enum, default_value_t = Test::Local)]
     pub validity: Test,
-    /// Local test: a triangle is over-stretched above this many times the map's overall
-    /// symmetrised stretch.
+    /// Local test: an edge is over-stretched above this many times the map's median edge
+    /// stretch.
     #[arg(long, default_value_t = 4.0)]
     pub max_stretch: f64,
 }
@@ -57,9 +57,9 @@ anchor i of --target-anchors. A vertex's weights come from the inverse problem o
 forward problem on the target with the same weights.
 
 Validity (--validity): `local` (default) keeps a vertex when its weights round-trip on the
-source and most triangles around it land neither flipped (orientation against the target's
-normal) nor stretched beyond --max-stretch times the map's overall stretch: it judges the
-image, so correct images with negative weights are kept and wrong images with harmless
+source and most of its edges land stretched by at most --max-stretch times the map's median
+edge stretch (image length over source length) and two thirds of its triangles do not land
+flipped where the target is smooth: it judges the image, so correct images with negative weights are kept and wrong images with harmless
 weights are not. `paper` is the paper's test: the weights round-trip and none is below
 --max-negative.
 
@@ -69,7 +69,8 @@ source_vertices, valid_fraction, flipped_faces, flipped_area_fraction, stretch (
 L2 stretch over the valid part; null when no face is measured), stretch_best95, seconds, vertices_per_s, plus cpu_seconds and
 vertices_per_cpu_s (CPU time of the map, all threads), counts per reason and, with
 --ground-truth, the error of the images against vertex i of the target as fractions of the
-target's bounding-box diagonal.
+target's bounding-box diagonal, with rejected_correct (images within 2% rejected) and
+accepted_wrong (valid vertices farther than 2%).
 
 Timings: `seconds` is the wall time of the map alone, from starting its worker threads to the
 last validity decision; `vertices_per_s` is source_vertices / seconds. Neither includes

@@ -125,6 +125,7 @@ fn correspond_json_keys() {
         .flat_map(|g| {
             std::iter::once(g.to_string()).chain(stats.iter().map(move |k| format!("{g}.{k}")))
         })
+        .chain(["accepted_wrong".to_string(), "rejected_correct".to_string()])
         .collect();
     want.sort();
     assert_eq!(truth, want);

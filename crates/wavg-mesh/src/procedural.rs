@@ -8,7 +8,12 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::error::MeshError;
+
+mod figure;
+mod tubes;
+
 use crate::mesh::TriMesh;
+pub use figure::{FigureShape, figure};
 
 /// Unit sphere: an icosahedron subdivided `level` times (10 * 4^level + 2 vertices).
 ///

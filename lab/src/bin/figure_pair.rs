@@ -1,0 +1,36 @@
+//! Writes the procedural figure pair (`procedural::figure`, slim and heavy: the same
+//! connectivity, so vertex i corresponds to vertex i) and K farthest-point anchors of the
+//! slim one, for `wavg correspond --ground-truth`.
+//!
+//! `cargo xtask lab figure_pair OUT_DIR [K]` writes OUT_DIR/slim.obj, heavy.obj,
+//! anchors.txt (K = 93 by default).
+
+use std::fmt::Write;
+
+use wavg_mesh::ValidMesh;
+use wavg_mesh::procedural::{FigureShape, figure};
+use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let dir = std::path::PathBuf::from(args.first().expect("OUT_DIR"));
+    let k: usize = args.get(1).map_or(93, |s| s.parse().expect("K"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let slim = figure(&FigureShape::SLIM);
+    let heavy = figure(&FigureShape::HEAVY);
+    wavg_mesh::io::save(&dir.join("slim.obj"), &slim).unwrap();
+    wavg_mesh::io::save(&dir.join("heavy.obj"), &heavy).unwrap();
+    let mesh = ValidMesh::new(slim).unwrap();
+    let ids = farthest_point_vertices(&mesh, k, 1, FpsMetric::EdgeGraph).unwrap();
+    let text = ids.iter().fold(String::new(), |mut s, v| {
+        let _ = writeln!(s, "v {v}");
+        s
+    });
+    std::fs::write(dir.join("anchors.txt"), text).unwrap();
+    println!(
+        "{} vertices, {} anchors in {}",
+        mesh.n_vertices(),
+        ids.len(),
+        dir.display()
+    );
+}
