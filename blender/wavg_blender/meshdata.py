@@ -32,16 +32,17 @@ class MeshInput:
         m = len(me.loop_triangles)
         if n == 0 or m == 0:
             raise AddonError(f"'{obj.name}' has no faces: wavg needs a triangle mesh surface")
-        tris = np.empty(m * 3, dtype=np.int32)
+        # uint32 buffers: Blender's index type, read without a per-item conversion.
+        tris = np.empty(m * 3, dtype=np.uint32)
         me.loop_triangles.foreach_get("vertices", tris)
-        loops = np.empty(m * 3, dtype=np.int32)
+        loops = np.empty(m * 3, dtype=np.uint32)
         me.loop_triangles.foreach_get("loops", loops)
         self.obj = obj
         self.name = obj.name
+        self.key = fingerprint(co, tris)
         self.V = co.reshape(n, 3).astype(np.float64)
         self.F = tris.reshape(m, 3).astype(np.int64)
         self.tri_loops = loops.reshape(m, 3).astype(np.int64)
-        self.key = fingerprint(self.V, self.F)
 
     @property
     def diagonal(self):
@@ -49,14 +50,15 @@ class MeshInput:
         return float(np.linalg.norm(self.V.max(axis=0) - self.V.min(axis=0)))
 
 
-def fingerprint(V, F):
-    """A 16-hex-digit key of the exact positions and triangles (BLAKE2b over the counts, the
-    float64 positions and the uint32 vertex ids, little-endian), naming the cached
-    ``.wavg`` file; the file itself carries wavg's own fingerprint, checked on load."""
+def fingerprint(co, tris):
+    """A 16-hex-digit key of the exact positions and triangles (BLAKE2b over the counts,
+    Blender's float32 positions and the uint32 vertex ids of the triangles, little-endian),
+    naming the cached ``.wavg`` file; the file itself carries wavg's own fingerprint of the
+    mesh, checked when it is loaded."""
     h = hashlib.blake2b(digest_size=8)
-    h.update(np.array([len(V), len(F)], dtype="<u8").tobytes())
-    h.update(np.ascontiguousarray(V, dtype="<f8").tobytes())
-    h.update(np.ascontiguousarray(F, dtype="<u4").tobytes())
+    h.update(np.array([len(co) // 3, len(tris) // 3], dtype="<u8").tobytes())
+    h.update(np.ascontiguousarray(co, dtype="<f4").tobytes())
+    h.update(np.ascontiguousarray(tris, dtype="<u4").tobytes())
     return h.hexdigest()
 
 

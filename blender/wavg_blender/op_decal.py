@@ -22,7 +22,7 @@ def set_uv_layer(obj, name, per_vertex_uv):
     layer = me.uv_layers.get(name) or me.uv_layers.new(name=name, do_init=False)
     if active >= 0:
         me.uv_layers.active_index = active
-    loop_vertex = np.empty(len(me.loops), dtype=np.int32)
+    loop_vertex = np.empty(len(me.loops), dtype=np.uint32)
     me.loops.foreach_get("vertex_index", loop_vertex)
     uv = np.ascontiguousarray(per_vertex_uv[loop_vertex], dtype=np.float32).ravel()
     layer.data.foreach_set("uv", uv)
