@@ -30,7 +30,9 @@ def row(name, ms, ref=None):
 def test_bench(ctx):
     w = wavg()
     from wavg_blender import surfaces
-    from wavg_blender.op_spline import follow_controls
+    from wavg_blender import op_spline
+
+    follow_controls = op_spline.follow_controls
 
     big = scene.uv_sphere("big", u=256, v=100)
     faces = len(big.data.polygons)

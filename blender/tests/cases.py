@@ -74,7 +74,7 @@ def check_undo(label, run):
     after = scene.snapshot()
     changed = scene.diff(before, after)
     assert not changed, f"undo of {label} left changes: " + "; ".join(
-        f"{k}: {str(before.get(k))[:200]} -> {str(after.get(k))[:200]}" for k in changed)
+        f"{k}: {scene.describe_change(before.get(k), after.get(k))}" for k in changed)
 
 
 # --- tests -------------------------------------------------------------------------------
@@ -88,7 +88,7 @@ def test_registered(ctx):
     assert hasattr(bpy.types, "VIEW3D_PT_wavg") and hasattr(bpy.types, "VIEW3D_MT_wavg")
     for menu in ("VIEW3D_MT_object", "VIEW3D_MT_edit_mesh"):
         funcs = getattr(getattr(bpy.types, menu).draw, "_draw_funcs", [])
-        assert any(getattr(f, "__module__", "").startswith("wavg_blender") for f in funcs), menu
+        assert any("wavg_blender" in getattr(f, "__module__", "") for f in funcs), menu
 
 
 def test_precompute_cache(ctx):

@@ -116,9 +116,9 @@ def test_transfer(ctx):
     t_dst.load_embedding(surfaces.find_embedding(dst["wavg_key"]))
     ref = np.asarray(w.transfer_texture(t_src, tex, t_dst, a_src, a_dst, size=(64, 64)))
     img = bpy.data.images["wavg_transfer"]
-    from wavg_blender.transfer_data import image_array
+    from wavg_blender import transfer_data
 
-    baked = image_array(img)
+    baked = transfer_data.image_array(img)
     assert baked.shape == ref.shape, (baked.shape, ref.shape)
     assert np.array_equal(baked, ref), f"{int((baked != ref).any(axis=2).sum())} texels differ"
     assert (ref[..., 3] > 0).mean() > 0.2, "almost nothing was transferred"

@@ -31,21 +31,35 @@ def parse_args():
     p.add_argument("--zip", required=True, help="the add-on zip (cargo xtask blender-addon)")
     p.add_argument("--wavg-cli", help="the wavg command line, to compare the decal with")
     p.add_argument("--bench", action="store_true", help="also measure (50k-face mesh)")
+    p.add_argument(
+        "--extension", action="store_true",
+        help="install as a Blender 4.2+ extension (Install from Disk) instead of a legacy add-on",
+    )
     return p.parse_args(argv)
 
 
-def install(zip_path, tmp):
-    """Installs and enables the add-on from the zip into a temporary script folder."""
-    scripts = os.path.join(tmp, "scripts")
-    os.makedirs(os.path.join(scripts, "addons"), exist_ok=True)
-    bpy.context.preferences.filepaths.script_directory = scripts
-    bpy.utils.refresh_script_paths()
-    bpy.ops.preferences.addon_install(filepath=os.path.abspath(zip_path), target='PREFS')
-    bpy.ops.preferences.addon_enable(module="wavg_blender")
-    import wavg_blender  # noqa: F401
-
-    path = os.path.dirname(wavg_blender.__file__)
-    assert path.startswith(scripts), f"the add-on was loaded from {path}, not the zip"
+def install(zip_path, tmp, extension):
+    """Installs and enables the add-on from the zip: as a legacy add-on into a temporary
+    script folder, or as a 4.2+ extension into the user repository."""
+    zip_path = os.path.abspath(zip_path)
+    if extension:
+        bpy.ops.extensions.package_install_files(
+            filepath=zip_path, repo="user_default", enable_on_install=True
+        )
+        name = "bl_ext.user_default.wavg_blender"
+        root = bpy.utils.user_resource('EXTENSIONS')
+    else:
+        root = os.path.join(tmp, "scripts")
+        os.makedirs(os.path.join(root, "addons"), exist_ok=True)
+        bpy.context.preferences.filepaths.script_directory = root
+        bpy.utils.refresh_script_paths()
+        bpy.ops.preferences.addon_install(filepath=zip_path, target='PREFS')
+        bpy.ops.preferences.addon_enable(module="wavg_blender")
+        name = "wavg_blender"
+    addon = sys.modules[name]
+    sys.modules["wavg_blender"] = addon  # the tests import it by this name
+    path = os.path.dirname(addon.__file__)
+    assert path.startswith(root), f"the add-on was loaded from {path}, not from the zip"
     import wavg
 
     assert os.path.dirname(wavg.__file__).startswith(path), (
@@ -58,7 +72,7 @@ def main():
     args = parse_args()
     tmp = tempfile.mkdtemp(prefix="wavg-blender-tests-")
     os.environ["WAVG_BLENDER_CACHE"] = os.path.join(tmp, "cache")
-    install(args.zip, tmp)
+    install(args.zip, tmp, args.extension)
     ctx = cases.Context(tmp=tmp, cli=args.wavg_cli)
     tests = cases.TESTS + cases_more.TESTS
     if args.bench:

@@ -129,6 +129,14 @@ def group_ids(obj, name):
     return sorted(v.index for v in obj.data.vertices for x in v.groups if x.group == g.index)
 
 
+# Attributes Blender itself adds or drops when a mesh goes in and out of Edit mode (4.x).
+BUILTIN_ATTRIBUTES = {"position", "sharp_face", "sharp_edge", "material_index"}
+
+
+def internal_attribute(name):
+    return name.startswith(".") or name in BUILTIN_ATTRIBUTES
+
+
 def snapshot():
     """Everything the operators may change, as comparable values."""
     snap = {}
@@ -149,7 +157,7 @@ def snapshot():
             len(m.vertices),
             co.tobytes(),
             [u.name for u in m.uv_layers],
-            sorted(a.name for a in m.attributes if not a.name.startswith(".")),
+            sorted(a.name for a in m.attributes if not internal_attribute(a.name)),
             keys,
         )
     for c in bpy.data.curves:
@@ -162,3 +170,11 @@ def snapshot():
 def diff(a, b):
     """The keys whose values differ between two snapshots."""
     return sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
+
+
+def describe_change(a, b):
+    """Which parts of a snapshot value differ."""
+    if isinstance(a, tuple) and isinstance(b, tuple) and len(a) == len(b):
+        return ", ".join(f"[{i}] {x!r:.120} -> {y!r:.120}" for i, (x, y) in enumerate(zip(a, b))
+                         if x != y)
+    return f"{a!r:.120} -> {b!r:.120}"
