@@ -30,10 +30,11 @@ def wavg():
 
 
 def describe(e):
-    """A one-line message for an exception raised by ``wavg``."""
-    problems = getattr(e, "problems", None)
-    if problems:
-        shown = "; ".join(str(p) for p in list(problems)[:3])
-        more = f" (and {len(problems) - 3} more)" if len(problems) > 3 else ""
-        return f"{e}: {shown}{more}" if shown not in str(e) else str(e)
-    return str(e) or type(e).__name__
+    """A one-line message for an exception raised by ``wavg`` (with the first problems of
+    an invalid mesh when the message does not already list them)."""
+    text = str(e) or type(e).__name__
+    problems = [str(p) for p in (getattr(e, "problems", None) or [])]
+    if not problems or any(p in text for p in problems):
+        return text
+    more = f" (and {len(problems) - 3} more)" if len(problems) > 3 else ""
+    return f"{text}: {'; '.join(problems[:3])}{more}"
