@@ -42,6 +42,9 @@ fn main() -> ExitCode {
         Some("venv") if args.len() == 1 => {
             report(python::ensure_venv(&workspace_root()).map(|py| println!("{}", py.display())))
         }
+        Some("wheel") if args.len() == 1 => {
+            report(python::build_wheel(&workspace_root()).map(|w| println!("{}", w.display())))
+        }
         _ => usage(),
     }
 }
@@ -49,7 +52,7 @@ fn main() -> ExitCode {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
-         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask venv\n\n  \
+         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask venv | cargo xtask wheel\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
          and wavg-ffi), cargo doc (-D warnings), the examples \
@@ -62,7 +65,8 @@ fn usage() -> ExitCode {
          (lab/src/bin/NAME.rs, release mode) with ARGS\n  \
          lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])\n  \
          man    man pages of wavg and every subcommand into DIR (default target/man)\n  \
-         venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter",
+         venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
+         wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path",
         MAX = lines::MAX_LINES
     );
     ExitCode::from(2)
@@ -160,6 +164,9 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
     }) && log.run("examples", || examples::run(root))
         && log.run("python environment", || {
             python::ensure_venv(root).map(|_| ())
+        })
+        && log.run("python package (wheel, pytest python/tests)", || {
+            python::test_package(root, data_dir)
         })
         && log.run("C/C++ packages", cbuild::ensure_packages)
         && cbuild::steps(root, data_dir)

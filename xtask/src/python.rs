@@ -54,3 +54,81 @@ pub fn ensure_venv(root: &Path) -> Result<PathBuf, String> {
     }
     Ok(py)
 }
+
+/// Builds the `wavg` wheel (abi3, CPython >= 3.10) with the environment's maturin from
+/// `pyproject.toml`, in cargo's dev profile and target directory, so the dependencies the
+/// workspace build already compiled are reused (only PyO3 and the binding crate compile);
+/// returns the wheel's path (in `target/wheels`, older `wavg-*.whl` there removed first).
+pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
+    let py = ensure_venv(root)?;
+    let out = steps::target_dir(root).join("wheels");
+    if let Ok(entries) = std::fs::read_dir(&out) {
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if name.starts_with("wavg-") && name.ends_with(".whl") {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+    let maturin = venv_dir(root).join("bin").join("maturin");
+    let (maturin_s, py_s, out_s) = (
+        maturin.to_string_lossy(),
+        py.to_string_lossy(),
+        out.to_string_lossy(),
+    );
+    steps::command(
+        root,
+        &maturin_s,
+        &[
+            "build",
+            "--profile",
+            "dev",
+            "--interpreter",
+            &py_s,
+            "--out",
+            &out_s,
+        ],
+    )?;
+    std::fs::read_dir(&out)
+        .map_err(|e| format!("{}: {e}", out.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| {
+            p.file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with("wavg-"))
+                && p.extension().is_some_and(|x| x == "whl")
+        })
+        .ok_or_else(|| format!("maturin built no wavg wheel in {}", out.display()))
+}
+
+/// Builds the wheel, installs it into the environment (replacing any earlier build) and
+/// runs `pytest python/tests` there; pytest's "no tests ran" (exit 5) fails too.
+pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
+    let wheel = build_wheel(root)?;
+    let py = python(root);
+    let (py_s, wheel_s) = (py.to_string_lossy(), wheel.to_string_lossy());
+    steps::command(
+        root,
+        &py_s,
+        &[
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            "--force-reinstall",
+            "--no-deps",
+            &wheel_s,
+        ],
+    )?;
+    let data = data_dir.to_string_lossy();
+    let wavg_bin = steps::target_dir(root).join("debug").join("wavg");
+    let wavg_bin = wavg_bin.to_string_lossy();
+    steps::command_env(
+        root,
+        &py_s,
+        &["-m", "pytest", "-q", "python/tests"],
+        &[("WAVG_DATA_DIR", &data), ("WAVG_CLI", &wavg_bin)],
+    )
+    .map_err(|e| format!("{e} (pytest exit 5 means no tests ran)"))
+}

@@ -1,0 +1,179 @@
+//! Arguments from Python: any array-like of a suitable dtype becomes a C-contiguous NumPy
+//! array of `float64` or `int64` (a copy only when the dtype or the layout differ), checked
+//! for shape; errors name the argument and the expected shape and dtype.
+
+use numpy::{PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::PyDict;
+
+use crate::errors::{type_error, value};
+
+static NUMPY: PyOnceLock<Py<PyModule>> = PyOnceLock::new();
+
+/// The `numpy` module.
+pub(crate) fn numpy(py: Python<'_>) -> PyResult<&Bound<'_, PyModule>> {
+    Ok(NUMPY
+        .get_or_try_init(py, || py.import("numpy").map(Into::into))?
+        .bind(py))
+}
+
+/// Element kinds an argument accepts.
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    /// Floating point or integer (converted to float64).
+    Real,
+    /// Integer (converted to int64).
+    Int,
+}
+
+/// `obj` as a C-contiguous array, after checking its dtype kind.
+fn coerce<'py, T: numpy::Element>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    kind: Kind,
+    expected: &str,
+) -> PyResult<PyReadonlyArrayDyn<'py, T>> {
+    let py = obj.py();
+    let np = numpy(py)?;
+    let arr = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| type_error(format!("{name} must be {expected}: {e}")))?;
+    let dtype = arr.getattr("dtype")?;
+    let k: String = dtype.getattr("kind")?.extract()?;
+    let ok = match kind {
+        Kind::Real => matches!(k.as_str(), "f" | "i" | "u"),
+        Kind::Int => matches!(k.as_str(), "i" | "u"),
+    };
+    if !ok {
+        return Err(type_error(format!(
+            "{name} must be {expected}; got an array of dtype {dtype}"
+        )));
+    }
+    if k == "u"
+        && kind == Kind::Int
+        && arr
+            .call_method0("max")
+            .is_ok_and(|m| m.extract::<u64>().is_ok_and(|m| m > i64::MAX as u64))
+    {
+        return Err(value(format!("{name} holds an index too large for int64")));
+    }
+    let kwargs = PyDict::new(py);
+    kwargs.set_item(
+        "dtype",
+        if kind == Kind::Real {
+            "float64"
+        } else {
+            "int64"
+        },
+    )?;
+    let c = np.call_method("ascontiguousarray", (arr,), Some(&kwargs))?;
+    let c = c.cast_into::<PyArrayDyn<T>>().map_err(PyErr::from)?;
+    Ok(c.readonly())
+}
+
+/// A float64 array of `ndim` dimensions whose trailing dimensions are `tail` (`None`: any).
+pub(crate) fn reals<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    ndim: usize,
+    tail: &[Option<usize>],
+    expected: &str,
+) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    let a = coerce::<f64>(obj, name, Kind::Real, expected)?;
+    check_shape(&a, name, ndim, tail, expected)?;
+    Ok(a)
+}
+
+/// An int64 array, as [`reals`].
+pub(crate) fn ints<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    ndim: usize,
+    tail: &[Option<usize>],
+    expected: &str,
+) -> PyResult<PyReadonlyArrayDyn<'py, i64>> {
+    let a = coerce::<i64>(obj, name, Kind::Int, expected)?;
+    check_shape(&a, name, ndim, tail, expected)?;
+    Ok(a)
+}
+
+fn check_shape<T: numpy::Element>(
+    a: &PyReadonlyArrayDyn<'_, T>,
+    name: &str,
+    ndim: usize,
+    tail: &[Option<usize>],
+    expected: &str,
+) -> PyResult<()> {
+    let shape = a.shape();
+    let tail_ok = shape.len() == ndim
+        && shape[1..]
+            .iter()
+            .zip(tail)
+            .all(|(s, t)| t.is_none_or(|t| *s == t));
+    if tail_ok {
+        Ok(())
+    } else {
+        Err(value(format!(
+            "{name} must be {expected}; got an array of shape {shape:?}"
+        )))
+    }
+}
+
+/// The contiguous data of a coerced array.
+pub(crate) fn data<'a, T: numpy::Element>(a: &'a PyReadonlyArrayDyn<'_, T>) -> &'a [T] {
+    // Coerced arrays are C-contiguous.
+    a.as_slice().unwrap_or(&[])
+}
+
+/// `values` as indices below `bound` (`what` names them in errors).
+pub(crate) fn indices(values: &[i64], bound: usize, what: &str) -> PyResult<Vec<u32>> {
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| {
+            if x >= 0 && (x as u64) < bound as u64 {
+                Ok(x as u32)
+            } else {
+                Err(value(format!(
+                    "{what}[{i}] = {x} is out of range: must be in 0..{bound}"
+                )))
+            }
+        })
+        .collect()
+}
+
+/// Rejects NaN and infinite values (`what` names them).
+pub(crate) fn finite(values: &[f64], what: &str) -> PyResult<()> {
+    match values.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(value(format!(
+            "{what} must be finite; element {i} (flat) is {}",
+            values[i]
+        ))),
+    }
+}
+
+/// A thread count: `None` is all cores (rayon's global pool), 1 the calling thread.
+pub(crate) fn par(threads: Option<i64>) -> PyResult<wavg::Par> {
+    match threads {
+        None => Ok(wavg::Par::Rayon),
+        Some(n) if n >= 1 => wavg::Par::from_threads(Some(n.min(1024) as usize))
+            .map_err(|e| value(format!("threads: {e}"))),
+        Some(n) => Err(value(format!(
+            "threads must be None (all cores) or a positive integer, got {n}"
+        ))),
+    }
+}
+
+/// A new read-only NumPy array of `shape` holding `v`.
+pub(crate) fn array<'py, T: numpy::Element>(
+    py: Python<'py>,
+    v: Vec<T>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
+    let a = numpy::ndarray::ArrayD::from_shape_vec(shape.to_vec(), v)
+        .map_err(|e| value(format!("internal shape error: {e}")))?;
+    let a = numpy::PyArray::from_owned_array(py, a).into_any();
+    Ok(a)
+}

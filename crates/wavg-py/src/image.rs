@@ -1,0 +1,112 @@
+//! Images between NumPy `(H, W, 4)` uint8 arrays and the library's RGBA images, and PNG
+//! files.
+
+use std::path::PathBuf;
+
+use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use wavg::apps::{Image, MAX_SIDE};
+
+use crate::args::array;
+use crate::errors::{app, require_file, type_error, value};
+
+/// An image argument: an `(H, W, 3)` or `(H, W, 4)` uint8 array (or a PNG path).
+pub(crate) fn image_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Image> {
+    let py = obj.py();
+    if let Ok(path) = obj.extract::<PathBuf>() {
+        require_file(&path)?;
+        return Image::read_png(&path).map_err(|e| app(py, &e));
+    }
+    let expected = "an (H, W, 3) or (H, W, 4) uint8 image array (or a PNG path)";
+    let np = crate::args::numpy(py)?;
+    let arr = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| type_error(format!("{name} must be {expected}: {e}")))?;
+    let dtype: String = arr.getattr("dtype")?.str()?.extract()?;
+    if dtype != "uint8" {
+        return Err(type_error(format!(
+            "{name} must be {expected}; got dtype {dtype}"
+        )));
+    }
+    let arr = np.call_method1("ascontiguousarray", (arr,))?;
+    let arr = arr.cast_into::<PyArrayDyn<u8>>().map_err(PyErr::from)?;
+    let ro = arr.readonly();
+    let shape = ro.shape().to_vec();
+    if shape.len() != 3 || !(shape[2] == 3 || shape[2] == 4) {
+        return Err(value(format!(
+            "{name} must be {expected}; got shape {shape:?}"
+        )));
+    }
+    let (h, w, c) = (shape[0], shape[1], shape[2]);
+    if !(1..=MAX_SIDE as usize).contains(&h) || !(1..=MAX_SIDE as usize).contains(&w) {
+        return Err(value(format!(
+            "{name} must be 1 to {MAX_SIDE} pixels on each side; got {w} x {h}"
+        )));
+    }
+    let px = ro.as_slice().unwrap_or(&[]);
+    let pixels = px
+        .chunks_exact(c)
+        .map(|p| {
+            if c == 4 {
+                [p[0], p[1], p[2], p[3]]
+            } else {
+                [p[0], p[1], p[2], 255]
+            }
+        })
+        .collect();
+    Ok(Image {
+        width: w as u32,
+        height: h as u32,
+        pixels,
+    })
+}
+
+/// `(W, H)` of a picture.
+pub(crate) fn size_arg(s: (i64, i64), name: &str) -> PyResult<(u32, u32)> {
+    let ok = |x: i64| (1..=i64::from(MAX_SIDE)).contains(&x);
+    if ok(s.0) && ok(s.1) {
+        Ok((s.0 as u32, s.1 as u32))
+    } else {
+        Err(value(format!(
+            "{name} must be (width, height), each 1 to {MAX_SIDE}; got {s:?}"
+        )))
+    }
+}
+
+/// An image as an `(H, W, 4)` uint8 array.
+pub(crate) fn to_array<'py>(py: Python<'py>, img: &Image) -> PyResult<Bound<'py, PyAny>> {
+    let v: Vec<u8> = img.pixels.iter().flatten().copied().collect();
+    array(py, v, &[img.height as usize, img.width as usize, 4])
+}
+
+/// save_png(path, image): writes an ``(H, W, 3|4)`` uint8 image as a PNG file
+/// (atomically: a temporary file renamed into place).
+#[pyfunction]
+pub(crate) fn save_png(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>) -> PyResult<()> {
+    let img = image_arg(image, "image")?;
+    let mut bytes = Vec::new();
+    img.encode_png(&mut bytes).map_err(|e| app(py, &e))?;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    std::fs::write(&tmp, &bytes)
+        .and_then(|_| std::fs::rename(&tmp, &path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            PyErr::from(e)
+        })
+}
+
+/// read_png(path) -> (H, W, 4) uint8: reads a PNG file as RGBA.
+#[pyfunction]
+pub(crate) fn read_png<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    require_file(&path)?;
+    let img = Image::read_png(&path).map_err(|e| app(py, &e))?;
+    to_array(py, &img)
+}

@@ -1,0 +1,52 @@
+//! The `wavg._wavg` Python extension module: the facade `wavg` for NumPy arrays. The
+//! Python package `wavg` (in `python/wavg`) re-exports it with the pure-Python parts
+//! (exceptions, named tuples, the progress bar).
+//!
+//! Every call that loops over arrays releases the GIL and runs on the library's own
+//! thread pools; arguments are checked before any work, and a query without an answer is
+//! a row of the `ok`/`valid` mask, never an exception.
+
+#![forbid(unsafe_code)]
+
+mod apps;
+mod args;
+mod errors;
+mod image;
+mod json;
+mod progress;
+mod remesh;
+mod render;
+mod solver;
+mod surface;
+
+use std::path::PathBuf;
+
+use pyo3::prelude::*;
+
+/// read_mesh(path) -> (V (n, 3) float64, F (m, 3) int64)
+///
+/// Reads a mesh file (.obj, .off, .ply, optionally gzipped as .gz): vertex positions and
+/// 0-based triangles (polygons are triangulated). The mesh is not validated.
+#[pyfunction]
+fn read_mesh<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    errors::require_file(&path)?;
+    let mesh = py
+        .detach(|| wavg::mesh::io::load(&path))
+        .map_err(errors::lib(py))?;
+    surface::mesh_arrays(py, &mesh)
+}
+
+/// The module.
+#[pymodule]
+fn _wavg(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<surface::Surface>()?;
+    m.add_class::<solver::Solver>()?;
+    m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(surface::_restore_surface, m)?)?;
+    m.add_function(wrap_pyfunction!(solver::_restore_solver, m)?)?;
+    apps::register(m)?;
+    Ok(())
+}

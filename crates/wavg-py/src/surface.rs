@@ -1,0 +1,444 @@
+//! `wavg.Surface`: a validated mesh with its 8-D embedding, from arrays or a file.
+
+use std::path::PathBuf;
+
+use numpy::PyUntypedArrayMethods;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyTuple};
+use wavg::mesh::TexCoords;
+use wavg::{PrecomputeOptions, TriMesh, Vector3};
+
+use crate::args::{self, array, data, finite, indices, ints, reals};
+use crate::errors::{lib, require_file, to_py, value};
+use crate::progress;
+
+/// A triangle mesh with its embedding in R^8, the object every question starts from.
+///
+/// ``Surface(V, F, uv=None)``: ``V`` vertex positions ``(n, 3)`` (any float or integer
+/// dtype), ``F`` counter-clockwise triangles ``(m, 3)`` of 0-based vertex ids (any integer
+/// dtype), ``uv`` optional per-corner texture coordinates ``(m, 3, 2)``. The mesh must be
+/// an oriented manifold (``InvalidMeshError`` lists its problems otherwise). Until
+/// ``precompute`` or ``load_embedding``, the 3-D positions serve as the embedding.
+#[pyclass(module = "wavg", name = "Surface")]
+pub(crate) struct Surface {
+    pub(crate) inner: wavg::Surface,
+}
+
+/// `(V, F)` of a mesh as NumPy arrays.
+pub(crate) fn mesh_arrays<'py>(
+    py: Python<'py>,
+    mesh: &TriMesh,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let v: Vec<f64> = mesh
+        .positions
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.z])
+        .collect();
+    let f: Vec<i64> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| t.map(i64::from))
+        .collect();
+    Ok((
+        array(py, v, &[mesh.positions.len(), 3])?,
+        array(py, f, &[mesh.triangles.len(), 3])?,
+    ))
+}
+
+/// A mesh from `V (n, 3)`, `F (m, 3)` and optional per-corner `uv (m, 3, 2)`.
+pub(crate) fn mesh_from(
+    v: &Bound<'_, PyAny>,
+    f: &Bound<'_, PyAny>,
+    uv: Option<&Bound<'_, PyAny>>,
+    vname: &str,
+    fname: &str,
+) -> PyResult<TriMesh> {
+    let va = reals(
+        v,
+        vname,
+        2,
+        &[Some(3)],
+        "an (n, 3) array of float vertex positions",
+    )?;
+    let fa = ints(
+        f,
+        fname,
+        2,
+        &[Some(3)],
+        "an (m, 3) array of integer vertex ids",
+    )?;
+    let vs = data(&va);
+    finite(vs, vname)?;
+    let n = va.shape()[0];
+    let ids = indices(data(&fa), n, fname)?;
+    let positions = vs
+        .chunks_exact(3)
+        .map(|p| Vector3::new(p[0], p[1], p[2]))
+        .collect();
+    let triangles = ids.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let mut mesh = TriMesh::new(positions, triangles);
+    if let Some(uv) = uv.filter(|u| !u.is_none()) {
+        let m = fa.shape()[0];
+        let ua = reals(
+            uv,
+            "uv",
+            3,
+            &[Some(3), Some(2)],
+            "an (m, 3, 2) array of per-corner texture coordinates",
+        )?;
+        if ua.shape()[0] != m {
+            return Err(value(format!(
+                "uv must have one row per face: shape ({m}, 3, 2); got {:?}",
+                ua.shape()
+            )));
+        }
+        finite(data(&ua), "uv")?;
+        mesh.uv = Some(TexCoords {
+            coords: data(&ua)
+                .chunks_exact(2)
+                .map(|c| [c[0], c[1]].into())
+                .collect(),
+            faces: (0..m as u32)
+                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .collect(),
+        });
+    }
+    Ok(mesh)
+}
+
+/// Embedding bytes (the `.wavg` format) of a surface, when it has one.
+fn embedding_bytes(s: &wavg::Surface) -> PyResult<Option<Vec<u8>>> {
+    Python::attach(|py| {
+        s.embedding()
+            .map(|e| wavg::embed::file::encode(e, s.mesh().mesh()).map_err(lib(py)))
+            .transpose()
+    })
+}
+
+#[pymethods]
+impl Surface {
+    #[new]
+    #[pyo3(signature = (V, F, uv=None))]
+    #[allow(non_snake_case)]
+    fn new(
+        py: Python<'_>,
+        V: &Bound<'_, PyAny>,
+        F: &Bound<'_, PyAny>,
+        uv: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let mesh = mesh_from(V, F, uv, "V", "F")?;
+        let inner = py
+            .detach(|| wavg::Surface::from_mesh(mesh))
+            .map_err(|e| to_py(py, e))?;
+        Ok(Self { inner })
+    }
+
+    /// Surface.open(path, embedding=None) -> Surface
+    ///
+    /// Reads a mesh file (.obj, .off, .ply, optionally .gz; texture coordinates of .obj
+    /// are kept) and, when ``embedding`` names a ``.wavg`` file, its embedding.
+    #[staticmethod]
+    #[pyo3(signature = (path, embedding=None))]
+    fn open(py: Python<'_>, path: PathBuf, embedding: Option<PathBuf>) -> PyResult<Self> {
+        require_file(&path)?;
+        if let Some(e) = &embedding {
+            require_file(e)?;
+        }
+        let mut inner = py
+            .detach(|| wavg::Surface::open(&path))
+            .map_err(|e| to_py(py, e))?;
+        if let Some(e) = embedding {
+            py.detach(|| inner.load_embedding(&e))
+                .map_err(|e| to_py(py, e))?;
+        }
+        Ok(Self { inner })
+    }
+
+    /// Surface.from_trimesh(mesh) -> Surface
+    ///
+    /// A surface from a ``trimesh.Trimesh`` (its ``vertices`` and ``faces``; trimesh itself
+    /// is not needed by wavg).
+    #[staticmethod]
+    fn from_trimesh(py: Python<'_>, mesh: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let v = mesh.getattr("vertices").map_err(|_| {
+            crate::errors::type_error("mesh must have .vertices and .faces (a trimesh.Trimesh)")
+        })?;
+        let f = mesh.getattr("faces").map_err(|_| {
+            crate::errors::type_error("mesh must have .vertices and .faces (a trimesh.Trimesh)")
+        })?;
+        Self::new(py, &v, &f, None)
+    }
+
+    /// S.precompute(landmarks=1000, seed=0, threads=None, progress=True) -> dict
+    ///
+    /// Computes the 8-D embedding (landmarks, geodesic distances, MDS, least-squares mesh)
+    /// and uses it from now on; returns the report (the keys of ``wavg precompute --json``).
+    /// ``threads``: None for all cores. ``progress``: True draws a text bar on a terminal,
+    /// False nothing, a callable ``(stage: str, done: int, total: int)`` is called about ten
+    /// times a second and cancels (``CancelledError``) by returning ``False``. Ctrl-C stops
+    /// it within a second (``KeyboardInterrupt``); on any error the surface is unchanged.
+    #[pyo3(
+        signature = (landmarks=1000, seed=0, threads=None, progress=None),
+        text_signature = "($self, landmarks=1000, seed=0, threads=None, progress=True)"
+    )]
+    fn precompute(
+        slf: &Bound<'_, Self>,
+        py: Python<'_>,
+        landmarks: i64,
+        seed: u64,
+        threads: Option<i64>,
+        progress: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Py<PyAny>> {
+        if landmarks < 1 {
+            return Err(value(format!(
+                "landmarks must be a positive integer, got {landmarks}"
+            )));
+        }
+        let par = args::par(threads)?;
+        let bar = match &progress {
+            None => true,
+            Some(p) => !p.is_callable() && p.is_truthy()?,
+        };
+        let callback: Option<Bound<'_, PyAny>> =
+            if let Some(p) = progress.filter(|p| p.is_callable()) {
+                Some(p)
+            } else if bar {
+                let bar = py
+                    .import("wavg._progress")?
+                    .getattr("terminal_bar")?
+                    .call0()?;
+                (!bar.is_none()).then_some(bar)
+            } else {
+                None
+            };
+        let mut s = slf.borrow().inner.clone();
+        let opts = PrecomputeOptions {
+            landmarks: landmarks as usize,
+            seed,
+            ..Default::default()
+        };
+        let result = progress::watch(py, callback.as_ref(), |p| {
+            par.install(|| s.precompute(&opts, p).map(|r| (r, s)))
+        });
+        if let Some(bar) = &callback {
+            if bar.hasattr("close")? {
+                bar.call_method0("close")?;
+            }
+        }
+        let (report, s) = result?
+            .map_err(|e| value(format!("threads: {e}")))?
+            .map_err(|e| to_py(py, e))?;
+        slf.borrow_mut().inner = s;
+        crate::json::to_py(py, &report)
+    }
+
+    /// S.load_embedding(path): reads a ``.wavg`` embedding computed for this mesh (its
+    /// fingerprint is checked) and uses it from now on.
+    fn load_embedding(&mut self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        require_file(&path)?;
+        let mut s = self.inner.clone();
+        py.detach(|| s.load_embedding(&path))
+            .map_err(|e| to_py(py, e))?;
+        self.inner = s;
+        Ok(())
+    }
+
+    /// S.save_embedding(path): writes the embedding to a ``.wavg`` file (atomically).
+    fn save_embedding(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        py.detach(|| self.inner.save_embedding(&path))
+            .map_err(|e| to_py(py, e))
+    }
+
+    /// Vertex positions, ``(n, 3)`` float64 (a copy).
+    #[getter]
+    fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Ok(mesh_arrays(py, self.inner.mesh().mesh())?.0)
+    }
+
+    /// Triangles, ``(m, 3)`` int64 (a copy).
+    #[getter]
+    fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Ok(mesh_arrays(py, self.inner.mesh().mesh())?.1)
+    }
+
+    /// Per-corner texture coordinates ``(m, 3, 2)`` float64, or None.
+    #[getter]
+    fn uv<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let mesh = self.inner.mesh().mesh();
+        mesh.uv
+            .as_ref()
+            .map(|uv| {
+                let v: Vec<f64> = uv
+                    .faces
+                    .iter()
+                    .flat_map(|t| {
+                        t.iter().flat_map(|&i| {
+                            let c = uv.coords[i as usize];
+                            [c.x, c.y]
+                        })
+                    })
+                    .collect();
+                array(py, v, &[uv.faces.len(), 3, 2])
+            })
+            .transpose()
+    }
+
+    /// The embedding, ``(n, 8)`` float64, or None before ``precompute``/``load_embedding``.
+    #[getter]
+    fn embedding<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.inner
+            .embedding()
+            .map(|e| {
+                let v: Vec<f64> = e.coords.iter().flat_map(|c| c.iter().copied()).collect();
+                array(py, v, &[e.coords.len(), 8])
+            })
+            .transpose()
+    }
+
+    /// Landmark vertex ids of the embedding, ``(L,)`` int64 (empty without one).
+    #[getter]
+    fn landmarks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let l: Vec<i64> = self
+            .inner
+            .landmarks()
+            .iter()
+            .map(|&v| i64::from(v))
+            .collect();
+        let n = l.len();
+        array(py, l, &[n])
+    }
+
+    /// Number of vertices.
+    #[getter]
+    fn vertex_count(&self) -> usize {
+        self.inner.n_vertices()
+    }
+
+    /// Number of triangles.
+    #[getter]
+    fn face_count(&self) -> usize {
+        self.inner.n_faces()
+    }
+
+    /// True once an embedding was computed or loaded.
+    #[getter]
+    fn has_embedding(&self) -> bool {
+        self.inner.embedding().is_some()
+    }
+
+    /// S.vertex_points(ids) -> (faces (q,) int64, bary (q, 3) float64)
+    ///
+    /// Vertices as surface points: a face of each vertex and the barycentrics of its corner.
+    fn vertex_points<'py>(
+        &self,
+        py: Python<'py>,
+        ids: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let a = ints(ids, "ids", 1, &[], "a (q,) array of integer vertex ids")?;
+        let ids = indices(data(&a), self.inner.n_vertices(), "ids")?;
+        let mut faces = Vec::with_capacity(ids.len());
+        let mut bary = Vec::with_capacity(3 * ids.len());
+        for v in ids {
+            let p = self.inner.vertex_point(v).map_err(|e| to_py(py, e))?;
+            faces.push(i64::from(p.face));
+            bary.extend(p.bary);
+        }
+        let q = faces.len();
+        Ok((array(py, faces, &[q])?, array(py, bary, &[q, 3])?))
+    }
+
+    /// S.spread_anchors(k, seed=0) -> (k,) int64: ``k`` vertices spread over the surface by
+    /// farthest-point sampling (a good default anchor set).
+    #[pyo3(signature = (k, seed=0))]
+    fn spread_anchors<'py>(
+        &self,
+        py: Python<'py>,
+        k: usize,
+        seed: u64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let a = self
+            .inner
+            .spread_anchors(k, seed)
+            .map_err(|e| to_py(py, e))?;
+        let v: Vec<i64> = a
+            .iter()
+            .map(|a| match a {
+                wavg::Anchor::Vertex(v) => i64::from(*v),
+                wavg::Anchor::Point(_) => -1,
+            })
+            .collect();
+        array(py, v, &[k])
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "wavg.Surface({} vertices, {} faces, {})",
+            self.inner.n_vertices(),
+            self.inner.n_faces(),
+            if self.inner.embedding().is_some() {
+                "embedded"
+            } else {
+                "no embedding"
+            }
+        )
+    }
+
+    /// Pickling: the mesh arrays and the embedding's `.wavg` bytes.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let (v, f) = mesh_arrays(py, self.inner.mesh().mesh())?;
+        let uv = self.uv(py)?;
+        let emb = embedding_bytes(&self.inner)?.map(|b| PyBytes::new(py, &b));
+        let restore = py.import("wavg._wavg")?.getattr("_restore_surface")?;
+        Ok((
+            restore,
+            PyTuple::new(
+                py,
+                [
+                    v,
+                    f,
+                    uv.into_pyobject(py)?.into_any(),
+                    emb.into_pyobject(py)?.into_any(),
+                ],
+            )?,
+        ))
+    }
+
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+        // Immutable mesh and embedding are shared; later changes replace them.
+        Self {
+            inner: self.inner.clone(),
+        }
+    }
+
+    fn __copy__(&self) -> Self {
+        Self {
+            inner: self.inner.clone(),
+        }
+    }
+}
+
+/// Rebuilds a pickled surface.
+#[pyfunction]
+#[pyo3(signature = (v, f, uv, embedding))]
+pub(crate) fn _restore_surface(
+    py: Python<'_>,
+    v: &Bound<'_, PyAny>,
+    f: &Bound<'_, PyAny>,
+    uv: &Bound<'_, PyAny>,
+    embedding: Option<&[u8]>,
+) -> PyResult<Surface> {
+    let mut s = Surface::new(py, v, f, Some(uv))?;
+    if let Some(bytes) = embedding {
+        let e = wavg::embed::file::decode(
+            bytes,
+            s.inner.mesh().mesh(),
+            std::path::Path::new("<pickle>"),
+        )
+        .map_err(lib(py))?;
+        s.inner.set_embedding(e).map_err(|e| to_py(py, e))?;
+    }
+    Ok(s)
+}
