@@ -74,7 +74,7 @@ def marker(at, parent, radius, color):
     return obj
 
 
-def stage(out_path):
+def stage(out_path, color_type='MATERIAL'):
     """Camera, light and Workbench settings; renders to ``out_path``."""
     sc = bpy.context.scene
     cam = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
@@ -90,7 +90,7 @@ def stage(out_path):
     sc.camera = cam
     sc.render.engine = 'BLENDER_WORKBENCH'
     sc.display.shading.light = 'STUDIO'
-    sc.display.shading.color_type = 'MATERIAL'
+    sc.display.shading.color_type = color_type
     sc.display.shading.show_cavity = False
     sc.render.resolution_x, sc.render.resolution_y = 640, 400
     sc.render.resolution_percentage = 100
@@ -142,23 +142,25 @@ def surface_spline_picture(out):
     stage(os.path.join(out, "blender_surface_spline.png"))
 
 
-def checker_material(name, size=256, cells=8):
-    y, x = np.mgrid[0:size, 0:size] * cells // size
-    rgba = np.ones((size, size, 4), dtype=np.float32)
-    light = (x + y) % 2 == 0
-    rgba[..., 0] = np.where(light, 0.95, 0.2)
-    rgba[..., 1] = np.where(light, 0.85, 0.3)
-    rgba[..., 2] = np.where(light, 0.3, 0.6)
-    img = bpy.data.images.new(name, size, size)
-    img.pixels.foreach_set(rgba.ravel())
-    img.pack()
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    node = mat.node_tree.nodes.new('ShaderNodeTexImage')
-    node.image = img
-    node.interpolation = 'Closest'
-    mat.node_tree.nodes.active = node
-    return mat
+def checker_colors(obj, layer, invalid, cells=4):
+    """A per-corner colour attribute "decal": a checkerboard in the UV layer's coordinates,
+    clay where a corner's vertex is in ``invalid`` (Workbench shows it as "Attribute")."""
+    me = obj.data
+    uv = np.empty(len(me.loops) * 2, dtype=np.float32)
+    me.uv_layers[layer].data.foreach_get("uv", uv)
+    uv = uv.reshape(-1, 2)
+    lv = np.empty(len(me.loops), dtype=np.uint32)
+    me.loops.foreach_get("vertex_index", lv)
+    light = (np.floor(uv[:, 0] * cells) + np.floor(uv[:, 1] * cells)) % 2 == 0
+    rgba = np.where(light[:, None], (0.95, 0.85, 0.3, 1.0), (0.2, 0.3, 0.6, 1.0))
+    bad = np.isin(lv, np.array(sorted(invalid), dtype=np.int64))
+    rgba[bad] = (0.75, 0.72, 0.68, 1.0)
+    attr = me.color_attributes.new("decal", 'FLOAT_COLOR', 'CORNER')
+    attr.data.foreach_set("color", rgba.astype(np.float32).ravel())
+    me.color_attributes.active_color = attr
+    index = list(me.color_attributes).index(attr)
+    me.color_attributes.render_color_index = index
+    me.color_attributes.active_color_index = index
 
 
 def decal_uv_picture(out):
@@ -181,16 +183,8 @@ def decal_uv_picture(out):
         uv[i] = (0.5 + 0.5 * math.cos(t), 0.5 + 0.5 * math.sin(t))
     attr.data.foreach_set("vector", uv.ravel())
     bpy.ops.wavg.decal_uv()
-    obj.data.uv_layers.active = obj.data.uv_layers["wavg_decal"]
-    obj.data.materials.clear()
-    obj.data.materials.append(checker_material("decal"))
-    obj.data.materials.append(material("clay", (0.75, 0.72, 0.68, 1.0)))
-    # Faces with a corner in wavg_invalid keep the plain material.
-    invalid = set(scene.group_ids(obj, "wavg_invalid"))
-    for poly in obj.data.polygons:
-        poly.material_index = 1 if invalid.intersection(poly.vertices) else 0
-    bpy.context.scene.display.shading.color_type = 'TEXTURE'
-    stage(os.path.join(out, "blender_decal_uv.png"))
+    checker_colors(obj, "wavg_decal", set(scene.group_ids(obj, "wavg_invalid")))
+    stage(os.path.join(out, "blender_decal_uv.png"), color_type='VERTEX')
 
 
 def main():
@@ -198,7 +192,10 @@ def main():
     install(args.zip)
     os.makedirs(args.out, exist_ok=True)
     out = os.path.abspath(args.out)
+    only = os.environ.get("WAVG_DOCS_ONLY")
     for picture in (place_point_picture, surface_spline_picture, decal_uv_picture):
+        if only and only not in picture.__name__:
+            continue
         scene.clear()
         for cam in list(bpy.data.cameras):
             bpy.data.cameras.remove(cam)
