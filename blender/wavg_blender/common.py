@@ -6,6 +6,8 @@ from contextlib import contextmanager
 
 import bpy
 import numpy as np
+from mathutils import Vector
+from mathutils.interpolate import poly_3d_calc
 
 from .errors import AddonError, describe
 
@@ -53,32 +55,17 @@ def closest_points(tree, V, F, points):
     surface given by ``tree`` (a BVH of the triangles ``F`` over ``V``)."""
     k = len(points)
     faces = np.empty(k, dtype=np.int64)
+    bary = np.empty((k, 3))
     xyz = np.empty((k, 3))
     dist = np.empty(k)
     for i, p in enumerate(points):
         loc, _normal, index, d = tree.find_nearest(p)
         if index is None:
             raise AddonError("no surface point found near a control point")
+        corners = [Vector(V[j]) for j in F[index]]
         faces[i], xyz[i], dist[i] = index, loc, d
-    return faces, barycentric(V[F[faces]], xyz), xyz, dist
-
-
-def barycentric(tri, p):
-    """Barycentric coordinates ``(k, 3)`` of points ``p`` ``(k, 3)`` in triangles ``tri``
-    ``(k, 3, 3)``, clamped to the triangle and summing to 1."""
-    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
-    v0, v1, v2 = b - a, c - a, p - a
-    d00 = np.einsum("ij,ij->i", v0, v0)
-    d01 = np.einsum("ij,ij->i", v0, v1)
-    d11 = np.einsum("ij,ij->i", v1, v1)
-    d20 = np.einsum("ij,ij->i", v2, v0)
-    d21 = np.einsum("ij,ij->i", v2, v1)
-    den = d00 * d11 - d01 * d01
-    den = np.where(den == 0.0, 1.0, den)
-    v = (d11 * d20 - d01 * d21) / den
-    w = (d00 * d21 - d01 * d20) / den
-    bary = np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, 1.0)
-    return bary / bary.sum(axis=1, keepdims=True)
+        bary[i] = poly_3d_calc(corners, loc)
+    return faces, bary, xyz, dist
 
 
 def as_float_rows(xyz):

@@ -35,14 +35,21 @@ class MeshInput:
         # uint32 buffers: Blender's index type, read without a per-item conversion.
         tris = np.empty(m * 3, dtype=np.uint32)
         me.loop_triangles.foreach_get("vertices", tris)
-        loops = np.empty(m * 3, dtype=np.uint32)
-        me.loop_triangles.foreach_get("loops", loops)
         self.obj = obj
         self.name = obj.name
         self.key = fingerprint(co, tris)
         self.V = co.reshape(n, 3).astype(np.float64)
         self.F = tris.reshape(m, 3).astype(np.int64)
-        self.tri_loops = loops.reshape(m, 3).astype(np.int64)
+        self._tri_loops = None
+
+    @property
+    def tri_loops(self):
+        """``(m, 3)`` loop ids of the triangles (read on first use: only UVs need them)."""
+        if self._tri_loops is None:
+            loops = np.empty(len(self.F) * 3, dtype=np.uint32)
+            self.obj.data.loop_triangles.foreach_get("loops", loops)
+            self._tri_loops = loops.reshape(-1, 3).astype(np.int64)
+        return self._tri_loops
 
     @property
     def diagonal(self):
@@ -56,9 +63,9 @@ def fingerprint(co, tris):
     naming the cached ``.wavg`` file; the file itself carries wavg's own fingerprint of the
     mesh, checked when it is loaded."""
     h = hashlib.blake2b(digest_size=8)
-    h.update(np.array([len(co) // 3, len(tris) // 3], dtype="<u8").tobytes())
-    h.update(np.ascontiguousarray(co, dtype="<f4").tobytes())
-    h.update(np.ascontiguousarray(tris, dtype="<u4").tobytes())
+    h.update(np.array([len(co) // 3, len(tris) // 3], dtype="<u8"))
+    h.update(np.ascontiguousarray(co, dtype="<f4"))
+    h.update(np.ascontiguousarray(tris, dtype="<u4"))
     return h.hexdigest()
 
 

@@ -156,7 +156,7 @@ def follow_controls(curve_obj, force=False):
     surface = surfaces.cached(key)
     if mesh_obj is None or surface is None:
         return False
-    V, F, tree = surfaces.geometry(key, surface)
+    V, F, tree, diagonal = surfaces.geometry(key, surface)
     cvs = control_objects(curve_obj)
     if len(cvs) < 2:
         return False
@@ -167,7 +167,7 @@ def follow_controls(curve_obj, force=False):
     faces, bary, xyz, dist = closest_points(tree, V, F, points)
     old_faces = np.array(curve_obj["wavg_faces"], dtype=np.int64)
     old_bary = np.array(curve_obj["wavg_bary"], dtype=np.float64).reshape(-1, 3)
-    if not force and np.array_equal(faces, old_faces) and np.allclose(bary, old_bary, 0, 1e-12):
+    if not force and np.array_equal(faces, old_faces) and np.array_equal(bary, old_bary):
         return False
     try:
         pts = evaluate(surface, faces, bary, settings_of(curve_obj))
@@ -175,7 +175,7 @@ def follow_controls(curve_obj, force=False):
         return False
     write_curve(curve_obj.data, pts.xyz, np.asarray(pts.ok, dtype=bool), curve_obj["wavg_closed"])
     store_control(curve_obj, faces, bary)
-    tol = 1e-9 * max(float(np.ptp(V, axis=0).max()), 1e-300)
+    tol = 1e-9 * diagonal
     for c, p, d in zip(cvs, xyz, dist):
         if d > tol and c.parent == mesh_obj:
             c.location = p

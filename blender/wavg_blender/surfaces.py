@@ -116,14 +116,16 @@ def surface_of(obj):
 
 
 def geometry(key, surface):
-    """``(V, F, tree)`` of ``surface``: its positions and triangles as arrays and a BVH tree
-    over the triangles (closest-point queries), cached by ``key``."""
+    """``(V, F, tree, diagonal)`` of ``surface``: its positions and triangles as arrays, a
+    BVH tree over the triangles (closest-point queries) and the bounding-box diagonal,
+    cached by ``key``."""
     g = _TREES.get(key)
     if g is None:
         V = np.asarray(surface.vertices, dtype=np.float64)
         F = np.asarray(surface.faces, dtype=np.int64)
         t = BVHTree.FromPolygons(V.tolist(), F.tolist(), all_triangles=True, epsilon=0.0)
-        g = _TREES[key] = (V, F, t)
+        diagonal = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+        g = _TREES[key] = (V, F, t, diagonal)
     return g
 
 
