@@ -6,6 +6,7 @@
 
 writes `blender_place_point.png`, `blender_surface_spline.png` and `blender_decal_uv.png`
 (640 x 400). Each scene is built in code and the operators run as a script runs them.
+`WAVG_DOCS_ONLY=decal` (any part of a picture's name) renders only that picture.
 """
 
 import argparse
