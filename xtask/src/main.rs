@@ -3,6 +3,7 @@
 
 #![forbid(unsafe_code)]
 
+mod blender;
 mod cbuild;
 mod examples;
 mod fuzz;
@@ -39,6 +40,9 @@ fn main() -> ExitCode {
         Some("man") if args.len() <= 2 => {
             report(man::run(&workspace_root(), args.get(1).map(String::as_str)))
         }
+        Some("blender-addon") if args.len() == 1 => {
+            report(blender::build_addon(&workspace_root()).map(|zip| println!("{}", zip.display())))
+        }
         Some("venv") if args.len() == 1 => {
             report(python::ensure_venv(&workspace_root()).map(|py| println!("{}", py.display())))
         }
@@ -52,7 +56,8 @@ fn main() -> ExitCode {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
-         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask venv | cargo xtask wheel\n\n  \
+         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask venv | cargo xtask wheel | \
+         cargo xtask blender-addon\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
          and wavg-ffi), cargo doc (-D warnings), the examples \
@@ -66,7 +71,8 @@ fn usage() -> ExitCode {
          lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])\n  \
          man    man pages of wavg and every subcommand into DIR (default target/man)\n  \
          venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
-         wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path",
+         wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path\n  \
+         blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)",
         MAX = lines::MAX_LINES
     );
     ExitCode::from(2)
@@ -168,6 +174,7 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         && log.run("python package (wheel, pytest python/tests)", || {
             python::test_package(root, data_dir)
         })
+        && log.run("blender", || blender::test(root))
         && log.run("C/C++ packages", cbuild::ensure_packages)
         && cbuild::steps(root, data_dir)
             .into_iter()

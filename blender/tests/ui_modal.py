@@ -1,0 +1,121 @@
+"""The interactive precompute in a real Blender window (not background mode): its modal
+operator runs wavg in a worker thread, shows progress in the status bar, and Esc cancels.
+Needs a display (Xvfb is enough) and Blender's event simulation:
+
+    xvfb-run -a blender --factory-startup --enable-event-simulate \\
+        --python blender/tests/ui_modal.py -- --zip target/wavg_blender.zip
+
+Prints `ok`/`FAILED` lines and exits 0 when every check passed, 1 otherwise.
+"""
+
+import os
+import sys
+import tempfile
+import threading
+import time
+import traceback
+
+import bmesh
+import bpy
+
+ARGS = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+ZIP = os.path.abspath(ARGS[ARGS.index("--zip") + 1])
+TMP = tempfile.mkdtemp(prefix="wavg-blender-ui-")
+os.environ["WAVG_BLENDER_CACHE"] = os.path.join(TMP, "cache")
+FAILURES = []
+STATE = {}
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name} {detail}", flush=True)
+    if not ok:
+        FAILURES.append(name)
+
+
+def finish():
+    print(f"{'all passed' if not FAILURES else 'failed: ' + ', '.join(FAILURES)}", flush=True)
+    os._exit(1 if FAILURES else 0)
+
+
+def setup():
+    scripts = os.path.join(TMP, "scripts")
+    os.makedirs(os.path.join(scripts, "addons"))
+    bpy.context.preferences.filepaths.script_directory = scripts
+    bpy.utils.refresh_script_paths()
+    bpy.ops.preferences.addon_install(filepath=ZIP, target='PREFS')
+    bpy.ops.preferences.addon_enable(module="wavg_blender")
+    bm = bmesh.new()
+    bmesh.ops.create_icosphere(bm, subdivisions=5, radius=1.0)
+    me = bpy.data.meshes.new("big")
+    bm.to_mesh(me)
+    bm.free()
+    obj = bpy.data.objects.new("big", me)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    return obj
+
+
+def start_precompute():
+    win = bpy.context.window_manager.windows[0]
+    area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
+    with bpy.context.temp_override(window=win, area=area):
+        result = bpy.ops.wavg.precompute('INVOKE_DEFAULT')
+    return win, result
+
+
+def cache_files():
+    d = os.environ["WAVG_BLENDER_CACHE"]
+    return sorted(os.listdir(d)) if os.path.isdir(d) else []
+
+
+def step():
+    """A state machine driven by a timer: start, press Esc, check, start again, wait."""
+    try:
+        phase = STATE.setdefault("phase", "start")
+        obj = bpy.data.objects["big"]
+        if phase == "start":
+            STATE["threads"] = threading.active_count()
+            win, result = start_precompute()
+            check("the worker thread runs", threading.active_count() == STATE["threads"] + 1)
+            check("invoke starts a modal precompute", result == {'RUNNING_MODAL'}, str(result))
+            STATE.update(phase="esc", win=win, t=time.time())
+            return 0.3
+        if phase == "esc":
+            STATE["win"].event_simulate(type='ESC', value='PRESS')
+            STATE["win"].event_simulate(type='ESC', value='RELEASE')
+            STATE.update(phase="cancelled", t=time.time())
+            return 0.2
+        if phase == "cancelled":
+            # A worker gone well before a whole precompute takes (printed below) was
+            # stopped by Esc.
+            stopped = threading.active_count() == STATE["threads"]
+            if not stopped and time.time() - STATE["t"] < 10.0:
+                return 0.1
+            check("Esc stops the worker within 10 s", stopped,
+                  f"(after {time.time() - STATE['t']:.1f} s)")
+            check("Esc cancels: nothing written", "wavg_key" not in obj and not cache_files(),
+                  str(cache_files()))
+            win, result = start_precompute()
+            STATE.update(phase="wait", t=time.time())
+            return 0.5
+        if phase == "wait":
+            if "wavg_key" not in obj:
+                if time.time() - STATE["t"] > 240:
+                    check("precompute finishes", False, "timed out")
+                    finish()
+                return 0.5
+            print(f"       a whole precompute took {time.time() - STATE['t']:.1f} s")
+            files = cache_files()
+            check("precompute finishes and writes the cache", files == [f"wavg-{obj['wavg_key']}.wavg"],
+                  str(files))
+            finish()
+    except Exception:
+        traceback.print_exc()
+        check("no exception", False)
+        finish()
+    return None
+
+
+setup()
+bpy.app.timers.register(step, first_interval=1.0)

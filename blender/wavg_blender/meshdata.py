@@ -1,0 +1,163 @@
+"""Reading a Blender mesh as wavg sees it: vertex positions (object space), the loop
+triangles as faces, the fingerprint that keys the embedding cache, the selection (in
+selection order), vertex groups, point attributes and UV layers. Nothing here changes the
+scene."""
+
+import hashlib
+
+import bmesh
+import numpy as np
+
+from .errors import AddonError
+
+
+class MeshInput:
+    """A mesh object's geometry as arrays.
+
+    ``V`` ``(n, 3)`` float64 object-space positions, ``F`` ``(m, 3)`` int64 vertex ids of
+    the loop triangles (Blender's triangulation of the polygons, so vertex ids are the
+    mesh's own), ``tri_loops`` ``(m, 3)`` their loop ids (for UVs), ``key`` the fingerprint.
+    """
+
+    def __init__(self, obj):
+        if obj is None or obj.type != 'MESH':
+            raise AddonError("the active object must be a mesh")
+        if obj.mode == 'EDIT':
+            obj.update_from_editmode()
+        me = obj.data
+        n = len(me.vertices)
+        co = np.empty(n * 3, dtype=np.float32)
+        me.vertices.foreach_get("co", co)
+        me.calc_loop_triangles()
+        m = len(me.loop_triangles)
+        if n == 0 or m == 0:
+            raise AddonError(f"'{obj.name}' has no faces: wavg needs a triangle mesh surface")
+        # uint32 buffers: Blender's index type, read without a per-item conversion.
+        tris = np.empty(m * 3, dtype=np.uint32)
+        me.loop_triangles.foreach_get("vertices", tris)
+        self.obj = obj
+        self.name = obj.name
+        self.key = fingerprint(co, tris)
+        self.V = co.reshape(n, 3).astype(np.float64)
+        self.F = tris.reshape(m, 3).astype(np.int64)
+        self._tri_loops = None
+
+    @property
+    def tri_loops(self):
+        """``(m, 3)`` loop ids of the triangles (read on first use: only UVs need them)."""
+        if self._tri_loops is None:
+            loops = np.empty(len(self.F) * 3, dtype=np.uint32)
+            self.obj.data.loop_triangles.foreach_get("loops", loops)
+            self._tri_loops = loops.reshape(-1, 3).astype(np.int64)
+        return self._tri_loops
+
+    @property
+    def diagonal(self):
+        """Length of the bounding-box diagonal (object space)."""
+        return float(np.linalg.norm(self.V.max(axis=0) - self.V.min(axis=0)))
+
+
+def fingerprint(co, tris):
+    """A 16-hex-digit key of the exact positions and triangles (BLAKE2b over the counts,
+    Blender's float32 positions and the uint32 vertex ids of the triangles, little-endian),
+    naming the cached ``.wavg`` file; the file itself carries wavg's own fingerprint of the
+    mesh, checked when it is loaded."""
+    h = hashlib.blake2b(digest_size=8)
+    h.update(np.array([len(co) // 3, len(tris) // 3], dtype="<u8"))
+    h.update(np.ascontiguousarray(co, dtype="<f4"))
+    h.update(np.ascontiguousarray(tris, dtype="<u4"))
+    return h.hexdigest()
+
+
+def selected_vertices(obj, ordered=True):
+    """``(ordered, selected)``: the selected vertices in selection order (the select
+    history: ``bmesh`` in Edit mode, the order stored in the mesh in Object mode; empty when
+    ``ordered`` is false, which skips reading it) and all selected vertex ids by id."""
+    me = obj.data
+    if obj.mode != 'EDIT' and not ordered:
+        flags = np.zeros(len(me.vertices), dtype=bool)
+        me.vertices.foreach_get("select", flags)
+        return [], np.flatnonzero(flags).tolist()
+    if obj.mode == 'EDIT':
+        bm = bmesh.from_edit_mesh(me)
+        owned = False
+    else:
+        bm = bmesh.new()
+        bm.from_mesh(me)
+        owned = True
+    try:
+        bm.verts.index_update()
+        selected = [v.index for v in bm.verts if v.select]
+        history = []
+        seen = set()
+        for elem in bm.select_history if ordered else ():
+            if isinstance(elem, bmesh.types.BMVert) and elem.select and elem.index not in seen:
+                seen.add(elem.index)
+                history.append(elem.index)
+    finally:
+        if owned:
+            bm.free()
+    return history, selected
+
+
+def vertex_group(obj, name):
+    """The vertex group ``name`` of ``obj``, or an :class:`AddonError` listing the groups."""
+    group = obj.vertex_groups.get(name)
+    if group is None:
+        have = ", ".join(g.name for g in obj.vertex_groups) or "none"
+        raise AddonError(f"'{obj.name}' has no vertex group '{name}' (its groups: {have})")
+    return group
+
+
+def group_members(obj, group):
+    """``(ids, weights)`` of the vertices in ``group`` with a weight above zero, by id."""
+    index = group.index
+    ids, weights = [], []
+    for v in obj.data.vertices:
+        for g in v.groups:
+            if g.group == index and g.weight > 0.0:
+                ids.append(v.index)
+                weights.append(g.weight)
+    return np.array(ids, dtype=np.int64), np.array(weights, dtype=np.float64)
+
+
+def weights_of(group, ids):
+    """The weight of each vertex of ``ids`` in ``group`` (0 where it is not a member)."""
+    out = np.zeros(len(ids), dtype=np.float64)
+    for i, v in enumerate(ids):
+        try:
+            out[i] = group.weight(int(v))
+        except RuntimeError:
+            out[i] = 0.0
+    return out
+
+
+def point_attribute_2d(obj, name):
+    """The per-vertex 2-vector attribute ``name`` as ``(n, 2)`` float64 (a FLOAT2 attribute,
+    or the first two components of a FLOAT_VECTOR one)."""
+    me = obj.data
+    attr = me.attributes.get(name)
+    if attr is None:
+        raise AddonError(f"'{obj.name}' has no attribute '{name}' (a 2-D vector on points)")
+    if attr.domain != 'POINT' or attr.data_type not in ('FLOAT2', 'FLOAT_VECTOR'):
+        raise AddonError(
+            f"attribute '{name}' of '{obj.name}' is {attr.data_type} on {attr.domain}; "
+            "it must be a 2-D vector (FLOAT2) on points"
+        )
+    width = 2 if attr.data_type == 'FLOAT2' else 3
+    flat = np.empty(len(me.vertices) * width, dtype=np.float32)
+    attr.data.foreach_get("vector", flat)
+    return flat.reshape(-1, width)[:, :2].astype(np.float64)
+
+
+def uv_corners(obj, tri_loops, layer=None):
+    """``(uv, uv_faces)``: the UV layer's coordinates per loop ``(loops, 2)`` and the loop
+    ids of each triangle ``(m, 3)`` (a wavg texture-coordinate pair), or ``None`` when the
+    mesh has no UV layer."""
+    me = obj.data
+    uv_layer = me.uv_layers.get(layer) if layer else me.uv_layers.active
+    if uv_layer is None:
+        return None
+    flat = np.empty(len(me.loops) * 2, dtype=np.float32)
+    uv_layer.data.foreach_get("uv", flat)
+    return flat.reshape(-1, 2).astype(np.float64), tri_loops

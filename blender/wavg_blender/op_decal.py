@@ -1,0 +1,106 @@
+"""``wavg.decal_uv``: a UV layer from anchors (the vertices of a vertex group) and their
+(u, v) (a 2-D point attribute); vertices whose weights are not meaningful go into the
+vertex group ``wavg_invalid``."""
+
+import bpy
+import numpy as np
+
+from . import surfaces
+from .common import active_mesh, guarded, object_mode
+from .errors import AddonError, describe, wavg
+from .meshdata import group_members, point_attribute_2d, vertex_group
+
+INVALID_GROUP = "wavg_invalid"
+MAX_UV_LAYERS = 8
+
+
+def set_uv_layer(obj, name, per_vertex_uv):
+    """Writes ``per_vertex_uv`` ``(n, 2)`` to UV layer ``name`` (created when missing) of
+    ``obj`` in Object mode: every loop gets its vertex's coordinates."""
+    me = obj.data
+    active = me.uv_layers.active_index
+    layer = me.uv_layers.get(name) or me.uv_layers.new(name=name, do_init=False)
+    if active >= 0:
+        me.uv_layers.active_index = active
+    loop_vertex = np.empty(len(me.loops), dtype=np.uint32)
+    me.loops.foreach_get("vertex_index", loop_vertex)
+    uv = np.ascontiguousarray(per_vertex_uv[loop_vertex], dtype=np.float32).ravel()
+    layer.data.foreach_set("uv", uv)
+    me.update()
+
+
+def check_uv_layer_room(obj, name):
+    if obj.data.uv_layers.get(name) is None and len(obj.data.uv_layers) >= MAX_UV_LAYERS:
+        raise AddonError(
+            f"'{obj.name}' already has {MAX_UV_LAYERS} UV layers, Blender's limit; remove one"
+        )
+
+
+def set_invalid_group(obj, ids):
+    """Vertex group ``wavg_invalid`` of ``obj`` holds exactly ``ids`` (weight 1)."""
+    old = obj.vertex_groups.get(INVALID_GROUP)
+    if old is not None:
+        obj.vertex_groups.remove(old)
+    group = obj.vertex_groups.new(name=INVALID_GROUP)
+    if len(ids):
+        group.add([int(i) for i in ids], 1.0, 'REPLACE')
+
+
+class WAVG_OT_decal_uv(bpy.types.Operator):
+    """Make a UV layer from anchor vertices (a vertex group) and their (u, v) (a 2-D point
+    attribute); vertices without meaningful coordinates go into vertex group wavg_invalid"""
+
+    bl_idname = "wavg.decal_uv"
+    bl_label = "Decal UV"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    group: bpy.props.StringProperty(
+        name="Anchors", default="wavg_anchors", description="Vertex group of the anchors"
+    )
+    attribute: bpy.props.StringProperty(
+        name="UV attribute", default="wavg_uv", description="2-D point attribute with their (u, v)"
+    )
+    uv_layer: bpy.props.StringProperty(
+        name="UV layer", default="wavg_decal", description="UV layer written"
+    )
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.view_layer.objects.active
+        return obj is not None and obj.type == 'MESH'
+
+    def execute(self, context):
+        return guarded(self, lambda: self._run(context))
+
+    def _run(self, context):
+        obj = active_mesh(context)
+        if not self.uv_layer:
+            raise AddonError("give the name of the UV layer to write")
+        surface, _mesh = surfaces.surface_of(obj)
+        anchors, _ = group_members(obj, vertex_group(obj, self.group))
+        if len(anchors) < 3:
+            raise AddonError(
+                f"too few anchors: vertex group '{self.group}' holds {len(anchors)} "
+                "vertices; a decal needs at least 3"
+            )
+        anchor_uv = point_attribute_2d(obj, self.attribute)[anchors]
+        if not np.all(np.isfinite(anchor_uv)):
+            raise AddonError(f"attribute '{self.attribute}' is not finite at every anchor")
+        check_uv_layer_room(obj, self.uv_layer)
+        w = wavg()
+        try:
+            uv, valid = w.decal(surface, anchors, anchor_uv)
+        except (w.WavgError, ValueError, TypeError) as e:
+            raise AddonError(f"wavg cannot make this decal: {describe(e)}") from e
+        uv = np.asarray(uv, dtype=np.float64)
+        valid = np.asarray(valid, dtype=bool)
+        with object_mode(context):
+            set_uv_layer(obj, self.uv_layer, np.where(np.isfinite(uv), uv, 0.0))
+            set_invalid_group(obj, np.flatnonzero(~valid))
+        fraction = float(valid.mean())
+        self.report(
+            {'INFO'},
+            f"UV layer '{self.uv_layer}': {fraction:.1%} of the vertices valid, "
+            f"{int((~valid).sum())} in '{INVALID_GROUP}'",
+        )
+        return {'FINISHED'}
