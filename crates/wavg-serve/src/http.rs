@@ -83,7 +83,9 @@ fn answer(app: &App, mut request: Request) {
         let body = serde_json::json!({ "error": e.message }).to_string();
         Reply::json(body.into_bytes()).with_status(e.status)
     });
-    let mut response = Response::from_data(reply.body).with_status_code(reply.status);
+    let mut response = Response::from_data(reply.body)
+        .with_status_code(reply.status)
+        .with_chunked_threshold(usize::MAX);
     for (k, v) in [
         ("Content-Type", reply.content_type),
         ("Cache-Control", "no-store"),
