@@ -2,13 +2,13 @@
 //! read its body within [`crate::MAX_BODY`], route it and answer; a panic in a handler is
 //! caught and answered with 500, so nothing a client sends stops the server.
 
-use std::io::Read;
+use std::io::{Cursor, Read, Write};
 use std::net::SocketAddr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use tiny_http::{Header, Method, Request, Response, Server};
+use tiny_http::{Header, Method, Request, Response, Server, StatusCode};
 
 use crate::routes::{Reply, route};
 use crate::{ApiError, App, MAX_BODY, WORKERS};
@@ -83,23 +83,58 @@ fn answer(app: &App, mut request: Request) {
         let body = serde_json::json!({ "error": e.message }).to_string();
         Reply::json(body.into_bytes()).with_status(e.status)
     });
-    let mut response = Response::from_data(reply.body)
-        .with_status_code(reply.status)
-        .with_chunked_threshold(usize::MAX);
-    for (k, v) in [
-        ("Content-Type", reply.content_type),
-        ("Cache-Control", "no-store"),
-    ] {
-        if let Ok(h) = Header::from_bytes(k.as_bytes(), v.as_bytes()) {
+    if reply.status == 413 {
+        // The body was not read: `into_writer` would first drain it (up to its declared
+        // length), so answer through tiny_http, which writes before it drains.
+        let body = Cursor::new(reply.body);
+        let ty = Header::from_bytes(&b"Content-Type"[..], reply.content_type.as_bytes());
+        let mut response = Response::new(
+            StatusCode(413),
+            Vec::new(),
+            body.clone(),
+            Some(body.get_ref().len()),
+            None,
+        );
+        if let Ok(h) = ty {
             response.add_header(h);
         }
+        let _ = request.respond(response);
+        return;
     }
-    if let Some(ms) = reply.compute_ms
-        && let Ok(h) = Header::from_bytes(&b"Server-Timing"[..], format!("compute;dur={ms:.3}"))
-    {
-        response.add_header(h);
+    let head = *request.method() == Method::Head;
+    let _ = write_response(request.into_writer(), &reply, head);
+}
+
+/// Writes the whole response and closes the connection (`Connection: close`): tiny_http
+/// runs each open connection on a thread of a small pool and may leave a new connection
+/// queued while the pool's threads wait on idle keep-alive connections (a browser opens
+/// several), so no connection is kept open after its response.
+fn write_response(mut w: Box<dyn Write + Send>, reply: &Reply, head: bool) -> std::io::Result<()> {
+    let reason = match reply.status {
+        200 => "OK",
+        400 => "Bad Request",
+        404 => "Not Found",
+        405 => "Method Not Allowed",
+        413 => "Payload Too Large",
+        503 => "Service Unavailable",
+        _ => "Internal Server Error",
+    };
+    let mut out = format!(
+        "HTTP/1.1 {} {reason}\r\nContent-Type: {}\r\nContent-Length: {}\r\n\
+         Cache-Control: no-store\r\nConnection: close\r\n",
+        reply.status,
+        reply.content_type,
+        reply.body.len()
+    );
+    if let Some(ms) = reply.compute_ms {
+        out.push_str(&format!("Server-Timing: compute;dur={ms:.3}\r\n"));
     }
-    let _ = request.respond(response);
+    out.push_str("\r\n");
+    w.write_all(out.as_bytes())?;
+    if !head {
+        w.write_all(&reply.body)?;
+    }
+    w.flush()
 }
 
 /// The body of a POST (empty for other methods), refusing more than [`MAX_BODY`] bytes:

@@ -64,15 +64,30 @@ impl Answer {
     }
 }
 
-/// Sends raw bytes and reads the whole answer (the connection is closed by the request).
+/// Sends raw bytes and reads one answer (its head, then `Content-Length` bytes).
 pub fn raw(addr: SocketAddr, bytes: &[u8]) -> Answer {
     let mut s = TcpStream::connect(addr).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
     // A server that answers before reading everything may close early: ignore that.
     let _ = s.write_all(bytes);
     let mut out = Vec::new();
-    s.read_to_end(&mut out).unwrap();
-    parse(&out)
+    let mut buf = [0u8; 65536];
+    loop {
+        if let Some(end) = out.windows(4).position(|w| w == b"\r\n\r\n") {
+            let a = parse(&out);
+            let len: usize = a.header("content-length").unwrap().parse().unwrap();
+            if out.len() >= end + 4 + len {
+                return a;
+            }
+        }
+        let n = s.read(&mut buf).unwrap();
+        assert!(
+            n > 0,
+            "connection closed early: {:?}",
+            String::from_utf8_lossy(&out)
+        );
+        out.extend_from_slice(&buf[..n]);
+    }
 }
 
 /// `method path` with `body`.

@@ -397,3 +397,27 @@ fn computing_routes_wait_for_the_embedding() {
     );
     running.stop();
 }
+
+/// Browsers open several keep-alive connections at once (some never used); every
+/// response closes its connection, so a burst of them never leaves a request unanswered.
+#[test]
+fn a_burst_of_keep_alive_connections_is_answered() {
+    let addr = server();
+    let idle: Vec<TcpStream> = (0..6).map(|_| TcpStream::connect(addr).unwrap()).collect();
+    let handles: Vec<_> = (0..12)
+        .map(|_| {
+            std::thread::spawn(move || {
+                let a = raw(
+                    addr,
+                    b"GET /app.js HTTP/1.1\r\nHost: x\r\nConnection: keep-alive\r\n\r\n",
+                );
+                assert_eq!(a.status, 200);
+                assert_eq!(a.header("connection"), Some("close"));
+            })
+        })
+        .collect();
+    for h in handles {
+        h.join().unwrap();
+    }
+    drop(idle);
+}
