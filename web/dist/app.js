@@ -17,26 +17,51 @@ export function status(text, error = false) {
   statusLine.classList.toggle('error', error);
 }
 
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+const renderer = new THREE.WebGLRenderer({ antialias: false });
 renderer.setPixelRatio(1);
 view.appendChild(renderer.domElement);
-const scene = new THREE.Scene();
-scene.background = new THREE.Color(0xf4f4f2);
+// Two scenes: the mesh, drawn into an off-screen colour + depth target only when the view
+// or its colours change, and the overlay (anchors, curves, cages), drawn every frame over
+// a copy of that target with its depth, so a frame during a drag costs a full-screen copy
+// and the overlay rather than the whole mesh.
 const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 1000);
 const controls = new OrbitControls(camera, renderer.domElement);
-scene.add(new THREE.HemisphereLight(0xffffff, 0x444450, 1.6));
-const sun = new THREE.DirectionalLight(0xffffff, 1.6);
-camera.add(sun);
-sun.position.set(0.5, 1, 1);
-scene.add(camera);
+function lit(scene) {
+  scene.add(new THREE.HemisphereLight(0xffffff, 0x444450, 1.6));
+  const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+  sun.position.set(0.5, 1, 1).multiplyScalar(1000);
+  scene.add(sun);
+  return scene;
+}
+const meshScene = lit(new THREE.Scene());
+meshScene.background = new THREE.Color(0xf4f4f2);
+const scene = lit(new THREE.Scene());
+const target = new THREE.WebGLRenderTarget(1, 1, { depthTexture: new THREE.DepthTexture(1, 1) });
+target.texture.colorSpace = THREE.SRGBColorSpace;
+const copy = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), new THREE.ShaderMaterial({
+  uniforms: { tColor: { value: target.texture }, tDepth: { value: target.depthTexture } },
+  vertexShader: 'varying vec2 vUv; void main() { vUv = uv; gl_Position = vec4(position.xy, 0.0, 1.0); }',
+  fragmentShader: `uniform sampler2D tColor; uniform sampler2D tDepth; varying vec2 vUv;
+    void main() {
+      gl_FragColor = texture2D(tColor, vUv);
+      gl_FragDepth = texture2D(tDepth, vUv).r;
+      #include <colorspace_fragment>
+    }`,
+  depthTest: true, depthWrite: true, depthFunc: THREE.AlwaysDepth,
+}));
+copy.frustumCulled = false;
+const copyScene = new THREE.Scene();
+copyScene.add(copy);
+const copyCamera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1);
+let meshDirty = true;
 
 // Everything the test suite reads (measurements, state) hangs off window.wavg.
 const stats = { readyMs: null, latencies: [], serverMs: [], requests: 0 };
 const app = {
-  THREE, scene, camera, renderer, stats, status, measure: false,
+  THREE, scene, meshScene, camera, renderer, stats, status, measure: false,
   anchors: [], // {point: [face, b0, b1, b2], pos: THREE.Vector3, weight, sphere}
   mesh: null, info: null, picker: null, radius: 1, ready: false,
-  render, addAnchor, setAnchor, anchorScreen, surfaceScreen, refreshAnchorList,
+  render, invalidate: () => { meshDirty = true; }, addAnchor, setAnchor, anchorScreen, surfaceScreen, refreshAnchorList,
 };
 window.wavg = app;
 
@@ -44,6 +69,8 @@ function resize() {
   const w = view.clientWidth;
   const h = view.clientHeight;
   renderer.setSize(w, h);
+  target.setSize(w, h);
+  meshDirty = true;
   camera.aspect = w / Math.max(1, h);
   camera.updateProjectionMatrix();
   render();
@@ -51,7 +78,17 @@ function resize() {
 
 /** Draws one frame (on demand: after a change, not continuously). */
 function render() {
+  if (meshDirty) {
+    renderer.setRenderTarget(target);
+    renderer.render(meshScene, camera);
+    renderer.setRenderTarget(null);
+    meshDirty = false;
+  }
+  renderer.autoClear = true;
+  renderer.render(copyScene, copyCamera);
+  renderer.autoClear = false;
   renderer.render(scene, camera);
+  renderer.autoClear = true;
   if (app.measure) {
     // Wait for the frame to be drawn, so measured times include the drawing.
     const gl = renderer.getContext();
@@ -59,7 +96,7 @@ function render() {
   }
 }
 
-controls.addEventListener('change', render);
+controls.addEventListener('change', () => { meshDirty = true; render(); });
 window.addEventListener('resize', resize);
 
 /** Screen (page) coordinates of a 3-D point, and whether it faces the camera. */
@@ -76,6 +113,8 @@ function surfaceScreen(v) {
   const P = app.mesh.positions;
   const p = new THREE.Vector3(P[3 * v], P[3 * v + 1], P[3 * v + 2]);
   const s = screenOf(p);
+  const r = renderer.domElement.getBoundingClientRect();
+  if (!(s.x > r.left + 4 && s.x < r.right - 4 && s.y > r.top + 4 && s.y < r.bottom - 4)) return null;
   const hit = hitAt(s.x, s.y);
   if (!hit || hit.pos.distanceTo(p) > 0.02 * app.radius) return null;
   return s;
@@ -204,14 +243,14 @@ async function main() {
     vertexColors: true, side: THREE.DoubleSide,
     polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
   }));
-  scene.add(surface);
+  meshScene.add(surface);
   app.surface = surface;
   const [lo, hi] = info.bounding_box;
   const center = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
   app.radius = Math.max(1e-9, Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) / 2);
   sphereGeometry = new THREE.SphereGeometry(0.025 * app.radius, 16, 12);
   controls.target.copy(center);
-  camera.position.copy(center).add(new THREE.Vector3(0, 0, 2.8 * app.radius));
+  camera.position.copy(center).add(new THREE.Vector3(0.3, 0.4, 1).normalize().multiplyScalar(3.4 * app.radius));
   camera.near = app.radius / 100;
   camera.far = app.radius * 100;
   app.picker = buildPicker(mesh.positions, mesh.triangles);

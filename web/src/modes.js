@@ -97,10 +97,13 @@ export class Modes {
   }
 
   setColors(colors) {
+    if (!colors && !this.colored) return;
+    this.colored = Boolean(colors);
     const attr = this.app.surface.geometry.getAttribute('color');
     if (colors) attr.array.set(colors);
     else attr.array.fill(0.78);
     attr.needsUpdate = true;
+    this.app.invalidate();
   }
 
   anchorPoints() { return this.app.anchors.map((a) => a.point); }

@@ -13,6 +13,7 @@ mod policy;
 mod python;
 mod sancov;
 mod steps;
+mod web;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -39,6 +40,11 @@ fn main() -> ExitCode {
         Some("man") if args.len() <= 2 => {
             report(man::run(&workspace_root(), args.get(1).map(String::as_str)))
         }
+        Some("web") => match args.get(1).map(String::as_str) {
+            None => report(web::build(&workspace_root())),
+            Some("--check") => report(web::check_assets(&workspace_root())),
+            Some(_) => usage(),
+        },
         Some("venv") if args.len() == 1 => {
             report(python::ensure_venv(&workspace_root()).map(|py| println!("{}", py.display())))
         }
@@ -49,7 +55,7 @@ fn main() -> ExitCode {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
-         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask venv\n\n  \
+         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask venv | cargo xtask web [--check]\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
          and wavg-ffi), cargo doc (-D warnings), the examples \
@@ -62,7 +68,8 @@ fn usage() -> ExitCode {
          (lab/src/bin/NAME.rs, release mode) with ARGS\n  \
          lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])\n  \
          man    man pages of wavg and every subcommand into DIR (default target/man)\n  \
-         venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter",
+         venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
+         web    rebuild web/dist (the page of `wavg serve`) from web/src and npm ci of web/package-lock.json (--check: verify the checked-in copy)",
         MAX = lines::MAX_LINES
     );
     ExitCode::from(2)
@@ -161,6 +168,8 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         && log.run("python environment", || {
             python::ensure_venv(root).map(|_| ())
         })
+        && log.run("web assets", || web::check_assets(root))
+        && log.run("browser tests", || web::browser_tests(root, data_dir))
         && log.run("C/C++ packages", cbuild::ensure_packages)
         && cbuild::steps(root, data_dir)
             .into_iter()
