@@ -36,8 +36,13 @@ function lit(scene) {
 const meshScene = lit(new THREE.Scene());
 meshScene.background = new THREE.Color(0xf4f4f2);
 const scene = lit(new THREE.Scene());
-const target = new THREE.WebGLRenderTarget(1, 1, { depthTexture: new THREE.DepthTexture(1, 1) });
-target.texture.colorSpace = THREE.SRGBColorSpace;
+/** The off-screen colour + depth target of the mesh, at the canvas's size. */
+function makeTarget(w, h) {
+  const t = new THREE.WebGLRenderTarget(w, h, { depthTexture: new THREE.DepthTexture(w, h) });
+  t.texture.colorSpace = THREE.SRGBColorSpace;
+  return t;
+}
+let target = makeTarget(1, 1);
 const copy = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), new THREE.ShaderMaterial({
   uniforms: { tColor: { value: target.texture }, tDepth: { value: target.depthTexture } },
   vertexShader: 'varying vec2 vUv; void main() { vUv = uv; gl_Position = vec4(position.xy, 0.0, 1.0); }',
@@ -69,7 +74,11 @@ function resize() {
   const w = view.clientWidth;
   const h = view.clientHeight;
   renderer.setSize(w, h);
-  target.setSize(w, h);
+  target.dispose();
+  target.depthTexture.dispose();
+  target = makeTarget(w, h);
+  copy.material.uniforms.tColor.value = target.texture;
+  copy.material.uniforms.tDepth.value = target.depthTexture;
   meshDirty = true;
   camera.aspect = w / Math.max(1, h);
   camera.updateProjectionMatrix();
@@ -97,7 +106,7 @@ function render() {
 }
 
 controls.addEventListener('change', () => { meshDirty = true; render(); });
-window.addEventListener('resize', resize);
+new ResizeObserver(() => { if (app.mesh) resize(); }).observe(view);
 
 /** Screen (page) coordinates of a 3-D point, and whether it faces the camera. */
 function screenOf(p) {
@@ -253,6 +262,7 @@ async function main() {
   camera.position.copy(center).add(new THREE.Vector3(0.3, 0.4, 1).normalize().multiplyScalar(3.4 * app.radius));
   camera.near = app.radius / 100;
   camera.far = app.radius * 100;
+  controls.update();
   app.picker = buildPicker(mesh.positions, mesh.triangles);
   resize();
   stats.readyMs = performance.now();

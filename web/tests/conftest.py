@@ -105,8 +105,8 @@ def browser():
 class Page:
     """A page of the server with its console errors collected."""
 
-    def __init__(self, browser, server):
-        self.context = browser.new_context(viewport={"width": 1100, "height": 760}, accept_downloads=True)
+    def __init__(self, browser, server, width=1100, height=760):
+        self.context = browser.new_context(viewport={"width": width, "height": height}, accept_downloads=True)
         self.page = self.context.new_page()
         self.errors = []
         self.page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))

@@ -230,10 +230,8 @@ def test_readme_screenshot(browser, server):
     WAVG_UPDATE_SCREENSHOT=1, else under target/)."""
     from conftest import Page
 
-    p = Page(browser, server)
+    p = Page(browser, server, 820, 460)
     try:
-        p.page.set_viewport_size({"width": 820, "height": 460})
-        p.js("window.dispatchEvent(new Event('resize'))")
         add_anchors(p, 5)
         p.page.check("#closed")
         p.idle()
