@@ -1,5 +1,5 @@
 //! The local HTTP server of `wavg serve`: one interactive page (three.js, embedded at
-//! compile time from `web/dist/`) and a JSON/binary API over a [`Surface`], with the same
+//! compile time from `web/dist/`) and a JSON/binary API over a [`wavg::Surface`], with the same
 //! semantics and row formats as the command line (routes and bodies: `docs/serve.md`).
 //!
 //! [`App::new`] takes the surface; without an embedding, [`App::precompute_in_background`]
