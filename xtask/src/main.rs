@@ -14,6 +14,7 @@ mod policy;
 mod python;
 mod sancov;
 mod steps;
+mod web;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -43,6 +44,11 @@ fn main() -> ExitCode {
         Some("blender-addon") if args.len() == 1 => {
             report(blender::build_addon(&workspace_root()).map(|zip| println!("{}", zip.display())))
         }
+        Some("web") => match args.get(1).map(String::as_str) {
+            None => report(web::build(&workspace_root())),
+            Some("--check") => report(web::check_assets(&workspace_root())),
+            Some(_) => usage(),
+        },
         Some("venv") if args.len() == 1 => {
             report(python::ensure_venv(&workspace_root()).map(|py| println!("{}", py.display())))
         }
@@ -57,7 +63,7 @@ fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
          cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask venv | cargo xtask wheel | \
-         cargo xtask blender-addon\n\n  \
+         cargo xtask blender-addon | cargo xtask web [--check]\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
          and wavg-ffi), cargo doc (-D warnings), the examples \
@@ -72,7 +78,8 @@ fn usage() -> ExitCode {
          man    man pages of wavg and every subcommand into DIR (default target/man)\n  \
          venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
          wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path\n  \
-         blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)",
+         blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)\n  \
+         web    rebuild web/dist (the page of `wavg serve`) from web/src and npm ci of web/package-lock.json (--check: verify the checked-in copy)",
         MAX = lines::MAX_LINES
     );
     ExitCode::from(2)
@@ -175,6 +182,8 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
             python::test_package(root, data_dir)
         })
         && log.run("blender", || blender::test(root))
+        && log.run("web assets", || web::check_assets(root))
+        && log.run("browser tests", || web::browser_tests(root, data_dir))
         && log.run("C/C++ packages", cbuild::ensure_packages)
         && cbuild::steps(root, data_dir)
             .into_iter()

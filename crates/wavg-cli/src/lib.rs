@@ -30,6 +30,7 @@ mod precompute;
 mod remesh;
 mod render;
 mod repair;
+mod serve;
 mod spline;
 mod stream;
 mod subdivide;
@@ -82,6 +83,8 @@ enum Command {
     Render(render::Args),
     /// Carry a texture from one mesh to another through corresponding anchors.
     TransferTexture(transfer_texture::Args),
+    /// Serve an interactive page (anchors, splines, decals, remeshing) and its HTTP API.
+    Serve(serve::Args),
     /// Benchmarks (report timings and quality figures).
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -127,6 +130,7 @@ pub fn main() -> ExitCode {
         Command::Remesh(a) => remesh::run(a),
         Command::Render(a) => render::run(a),
         Command::TransferTexture(a) => transfer_texture::run(a),
+        Command::Serve(a) => serve::run(a),
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),

@@ -1,0 +1,117 @@
+//! `wavg serve`: the interactive page and its API on a local HTTP server (the
+//! `wavg-serve` crate), over a mesh whose embedding is loaded or precomputed in the
+//! background while the page already shows the mesh.
+
+use std::io::IsTerminal;
+use std::net::IpAddr;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use wavg::Surface;
+
+use crate::CliError;
+use crate::common::{load_valid, one_line};
+use crate::precompute::Bars;
+
+/// Arguments.
+#[derive(clap::Args)]
+#[command(after_long_help = "\
+Serves one page (three.js, embedded in the binary) and a JSON/binary API on
+http://HOST:PORT/: the shaded mesh with orbit controls; click to add anchors, drag them on
+the surface, weight sliders with the weighted average moving live; modes spline, average,
+decal, distance and remesh; downloads of the curve, the decal's UVs and the remeshed OBJ in
+the formats of `wavg spline`, `wavg decal` and `wavg remesh`. Routes and bodies:
+docs/serve.md.
+
+Without --embedding the embedding is precomputed in memory (a tenth of the vertices as
+landmarks, 50 to 1000) while the server already answers: the page shows the mesh and the
+progress, and the computing routes answer 503 until it is ready.
+
+Only this machine can connect unless --host names another interface (a warning is
+printed: anyone who can reach it can use the server). Ctrl-C stops the server.")]
+pub struct Args {
+    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    #[arg(value_name = "MESH", required_unless_present = "mesh_flag")]
+    pub mesh: Option<String>,
+    /// The mesh, as a flag (instead of the positional MESH).
+    #[arg(
+        long = "mesh",
+        id = "mesh_flag",
+        value_name = "MESH",
+        conflicts_with = "mesh"
+    )]
+    pub mesh_flag: Option<String>,
+    /// A .wavg embedding of the mesh (default: precompute one in memory).
+    #[arg(long)]
+    pub embedding: Option<PathBuf>,
+    /// TCP port (0: any free port).
+    #[arg(long, default_value_t = 8080)]
+    pub port: u16,
+    /// Interface address to listen on.
+    #[arg(long, default_value = "127.0.0.1")]
+    pub host: IpAddr,
+    /// Open the page in the default browser.
+    #[arg(long)]
+    pub open: bool,
+}
+
+/// Runs the command (until the process is stopped).
+pub fn run(args: Args) -> Result<(), CliError> {
+    let mesh_name = args.mesh.or(args.mesh_flag).unwrap_or_default();
+    let mesh = load_valid(&mesh_name)?;
+    let mut surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    if let Some(path) = &args.embedding {
+        surface
+            .load_embedding(path)
+            .map_err(|e| CliError::input(one_line(&e)))?;
+    }
+    let (n, m) = (surface.n_vertices(), surface.n_faces());
+    let app = wavg_serve::App::new(surface);
+    let addr = std::net::SocketAddr::new(args.host, args.port);
+    let server = wavg_serve::start(app.clone(), &addr.to_string())
+        .map_err(|e| CliError::input(format!("cannot listen on {addr}: {e}")))?;
+    let addr = server.addr();
+    if !args.host.is_loopback() {
+        eprintln!(
+            "wavg: warning: listening on {} : other machines that can reach it can use this \
+             server (it has no authentication)",
+            args.host
+        );
+    }
+    let url = format!("http://{addr}/");
+    println!("{mesh_name}: {n} vertices, {m} faces; serving {url} (Ctrl-C to stop)");
+    if args.embedding.is_none() {
+        eprintln!("precomputing the embedding (the page shows the mesh meanwhile)...");
+        let bars: Box<dyn wavg::Progress + Send> = Box::new(Bars::new(
+            std::io::stderr().is_terminal(),
+            Arc::new(AtomicBool::new(false)),
+        ));
+        let t = Instant::now();
+        let handle = app.precompute_in_background(Some(bars));
+        let app2 = app.clone();
+        std::thread::spawn(move || {
+            let _ = handle.join();
+            match app2.status() {
+                wavg_serve::Status::Ready => eprintln!(
+                    "embedding ready in {:.1} s; every route answers",
+                    t.elapsed().as_secs_f64()
+                ),
+                s => eprintln!("wavg: the embedding could not be computed: {s:?}"),
+            }
+        });
+    }
+    if args.open {
+        let opener = if cfg!(target_os = "macos") {
+            "open"
+        } else {
+            "xdg-open"
+        };
+        if let Err(e) = std::process::Command::new(opener).arg(&url).spawn() {
+            eprintln!("wavg: could not open a browser ({opener}: {e}); open {url} yourself");
+        }
+    }
+    server.join();
+    Ok(())
+}

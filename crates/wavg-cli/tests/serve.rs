@@ -1,0 +1,86 @@
+//! `wavg serve` as a process: it prints where it listens, answers there, precomputes in
+//! the background, takes the mesh positionally or as `--mesh`, and warns for non-loopback
+//! hosts.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Starts `wavg serve ARGS --port 0`; returns the child and its address.
+fn serve(args: &[&str]) -> (Child, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .arg("serve")
+        .args(args)
+        .args(["--port", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let addr = line
+        .split("serving http://")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no address in {line:?}"))
+        .split('/')
+        .next()
+        .unwrap()
+        .to_string();
+    (child, addr)
+}
+
+fn get(addr: &str, path: &str) -> String {
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
+    write!(
+        s,
+        "GET {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut out = String::new();
+    s.read_to_string(&mut out).unwrap();
+    out
+}
+
+#[test]
+fn serve_answers_and_becomes_ready() {
+    for args in [
+        &["builtin:sphere-small"][..],
+        &["--mesh", "builtin:sphere-small"],
+    ] {
+        let (mut child, addr) = serve(args);
+        let info = get(&addr, "/api/info");
+        assert!(info.starts_with("HTTP/1.1 200"), "{info}");
+        assert!(info.contains("\"faces\":320"), "{info}");
+        let t = Instant::now();
+        while !get(&addr, "/api/status").contains("\"ready\"") {
+            assert!(t.elapsed() < Duration::from_secs(120), "never ready");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        assert!(get(&addr, "/").contains("importmap"));
+        child.kill().unwrap();
+        child.wait().unwrap();
+    }
+}
+
+#[test]
+fn other_hosts_get_a_warning_and_bad_meshes_fail() {
+    let (mut child, _) = serve(&["builtin:sphere-small", "--host", "0.0.0.0"]);
+    child.kill().unwrap();
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    assert!(err.contains("warning") && err.contains("0.0.0.0"), "{err}");
+    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(["serve", "no-such-mesh.obj", "--port", "0"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}

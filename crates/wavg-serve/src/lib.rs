@@ -1,0 +1,80 @@
+//! The local HTTP server of `wavg serve`: one interactive page (three.js, embedded at
+//! compile time from `web/dist/`) and a JSON/binary API over a [`wavg::Surface`], with the same
+//! semantics and row formats as the command line (routes and bodies: `docs/serve.md`).
+//!
+//! [`App::new`] takes the surface; without an embedding, [`App::precompute_in_background`]
+//! computes one while the server already answers (`GET /api/status` reports the stage;
+//! the computing routes answer 503 until it is done). [`start`] binds and serves on worker
+//! threads, so a slow request never blocks the others; bad requests get a 4xx status with
+//! a message and never stop the server.
+//!
+//! ```no_run
+//! use wavg::Surface;
+//! let surface = Surface::from_mesh(wavg::mesh::procedural::torus(48, 16, 1.0, 0.35))?;
+//! let app = wavg_serve::App::new(surface);
+//! app.precompute_in_background(None);
+//! let server = wavg_serve::start(app, "127.0.0.1:0")?;
+//! println!("http://{}", server.addr());
+//! server.join();
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+#![deny(unreachable_pub)]
+#![forbid(unsafe_code)]
+
+mod apps;
+mod assets;
+mod http;
+mod meshbin;
+mod parse;
+mod problems;
+mod routes;
+mod state;
+
+pub use http::{Running, start};
+pub use meshbin::encode_mesh;
+pub use state::{App, Status};
+
+/// Largest request body accepted (bytes); larger ones get 413.
+pub const MAX_BODY: usize = 16 << 20;
+/// Most anchors or control points in one request.
+pub const MAX_ANCHORS: usize = 4096;
+/// Most query rows (weights, points) in one request.
+pub const MAX_ROWS: usize = 200_000;
+/// Most samples of one spline.
+pub const MAX_SAMPLES: usize = 100_000;
+/// Worker threads answering requests.
+pub const WORKERS: usize = 8;
+
+/// A request the server refuses: its HTTP status and a one-line message (sent as
+/// `{"error": MESSAGE}`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ApiError {
+    /// HTTP status (400, 404, 405, 413, 503, 500).
+    pub status: u16,
+    /// What is wrong, on one line.
+    pub message: String,
+}
+
+impl ApiError {
+    /// 400 Bad Request.
+    pub(crate) fn bad(message: impl Into<String>) -> Self {
+        Self {
+            status: 400,
+            message: message.into(),
+        }
+    }
+
+    /// Any status.
+    pub(crate) fn status(status: u16, message: impl Into<String>) -> Self {
+        Self {
+            status,
+            message: message.into(),
+        }
+    }
+
+    /// A library error: 400 for input errors, 500 otherwise.
+    pub(crate) fn from_lib(e: &dyn std::fmt::Display) -> Self {
+        Self::bad(e.to_string().replace('\n', " "))
+    }
+}

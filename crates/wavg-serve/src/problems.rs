@@ -1,0 +1,159 @@
+//! The routes of the method itself: forward and inverse problems, splines, and the
+//! embedding distance.
+
+use serde_json::{Value, json};
+use wavg::apps::{SplineKind, evaluate_spline};
+use wavg::{DEFAULT_TOLERANCE, ForwardOptions, ForwardResult, Normalization, SolveError, Solver};
+
+use crate::parse::{self, Body};
+use crate::routes::Reply;
+use crate::{ApiError, App, MAX_ROWS, MAX_SAMPLES};
+
+/// Samples evaluated in sequence, warm-started, per parallel chunk (as `wavg spline`).
+const CHUNK: usize = 256;
+
+/// A forward result as `[face, b0, b1, b2, x, y, z]`, `null` where there is no average.
+pub(crate) fn point_json(r: &Result<ForwardResult, SolveError>) -> Value {
+    match r {
+        Ok(r) => {
+            let (p, x) = (r.point, r.position);
+            json!([p.face, p.bary[0], p.bary[1], p.bary[2], x.x, x.y, x.z])
+        }
+        Err(_) => Value::Null,
+    }
+}
+
+/// A solver for the field `key`'s anchors (at least `min`).
+fn solver(app: &App, body: &Body, key: &str, min: usize) -> Result<Solver, ApiError> {
+    let surface = app.surface()?;
+    let anchors = parse::anchors(body.required(key)?, key, surface.mesh(), min)?;
+    surface.solver(anchors).map_err(|e| ApiError::from_lib(&e))
+}
+
+/// `POST /api/forward` `{"anchors": [...], "weights": [[...], ...], "normalize": false}` ->
+/// `{"points": [...]}`. Weight rows must have one finite weight per anchor summing to 1
+/// (or any non-zero sum with `"normalize": true`), as `wavg forward` checks them.
+pub(crate) fn forward(app: &App, body: &Body) -> Result<Reply, ApiError> {
+    let solver = solver(app, body, "anchors", 1)?;
+    let norm = if body.bool_or("normalize", false)? {
+        Normalization::Normalize
+    } else {
+        Normalization::Reject
+    };
+    let rows = parse::array(body.required("weights")?, "weights", MAX_ROWS)?;
+    let k = solver.n_anchors();
+    let weights = rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let what = format!("weights[{i}]");
+            let w = parse::numbers(r, &what, k)?;
+            wavg::validate_weights(&w, k, norm)
+                .map_err(|e| ApiError::bad(format!("{what}: {e}")))?;
+            Ok(w)
+        })
+        .collect::<Result<Vec<_>, ApiError>>()?;
+    let opts = ForwardOptions {
+        normalization: norm,
+        ..Default::default()
+    };
+    let results = solver.forward_batch(&weights, &opts);
+    let points: Vec<Value> = results.iter().map(point_json).collect();
+    Ok(Reply::value(&json!({ "points": points })))
+}
+
+/// `POST /api/inverse` `{"anchors": [...], "points": [...], "verified": false}` ->
+/// `{"weights": [[...] or null, ...]}` (with `verified`, checked by the forward problem as
+/// `wavg inverse --verified`).
+pub(crate) fn inverse(app: &App, body: &Body) -> Result<Reply, ApiError> {
+    let solver = solver(app, body, "anchors", 1)?;
+    let list = parse::array(body.required("points")?, "points", MAX_ROWS)?;
+    let points = list
+        .iter()
+        .enumerate()
+        .map(|(i, p)| parse::point(p, &format!("points[{i}]"), solver.mesh()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let weights: Vec<Value> = if body.bool_or("verified", false)? {
+        solver
+            .inverse_verified_batch(&points, DEFAULT_TOLERANCE)
+            .into_iter()
+            .map(|r| r.map_or(Value::Null, |v| json!(v.weights)))
+            .collect()
+    } else {
+        let batch = solver.inverse_batch(&points);
+        batch
+            .iter()
+            .map(|r| r.map_or(Value::Null, |w| json!(w)))
+            .collect()
+    };
+    Ok(Reply::value(&json!({ "weights": weights })))
+}
+
+/// `POST /api/spline` `{"control": [...], "degree": 3, "closed": false, "bezier": false,
+/// "samples": 500, "format": "json"}` -> `{"points": [...]}`: the samples of `wavg
+/// spline`; `"format": "text"` answers with its output file instead.
+pub(crate) fn spline(app: &App, body: &Body) -> Result<Reply, ApiError> {
+    let solver = solver(app, body, "control", 2)?;
+    let kind = if body.bool_or("bezier", false)? {
+        SplineKind::Bezier
+    } else {
+        SplineKind::BSpline {
+            degree: body.usize_or("degree", 3, 1, 64)?,
+            closed: body.bool_or("closed", false)?,
+        }
+    };
+    let samples = body.usize_or("samples", 500, 1, MAX_SAMPLES)?;
+    let text = text_format(body, "text")?;
+    let curve =
+        evaluate_spline(&solver, kind, samples, CHUNK).map_err(|e| ApiError::from_lib(&e))?;
+    if text {
+        let mut out = Vec::new();
+        for r in &curve.samples {
+            match r {
+                Ok(r) => {
+                    out.extend_from_slice(format!("{} ", r.point.face).as_bytes());
+                    wavg::text::push_numbers(
+                        &mut out,
+                        r.point.bary.into_iter().chain(r.position.iter().copied()),
+                    );
+                }
+                Err(e) => out.extend_from_slice(
+                    format!("none {}", e.to_string().replace('\n', " ")).as_bytes(),
+                ),
+            }
+            out.push(b'\n');
+        }
+        return Ok(Reply::text(out));
+    }
+    let points: Vec<Value> = curve.samples.iter().map(point_json).collect();
+    Ok(Reply::value(
+        &json!({ "points": points, "length": curve.length() }),
+    ))
+}
+
+/// Whether `"format"` asks for the command line's file format `name` (else JSON).
+pub(crate) fn text_format(body: &Body, name: &str) -> Result<bool, ApiError> {
+    match body.str("format")? {
+        None | Some("json") => Ok(false),
+        Some(f) if f == name => Ok(true),
+        Some(f) => Err(ApiError::bad(format!(
+            "\"format\" is \"json\" or \"{name}\", not \"{f}\""
+        ))),
+    }
+}
+
+/// `POST /api/distance` `{"source": POINT}` -> `{"distances": [per vertex], "max": D}`: the
+/// Euclidean distance in the 8-D embedding from the source point to every vertex (an
+/// approximation of the geodesic distance).
+pub(crate) fn distance(app: &App, body: &Body) -> Result<Reply, ApiError> {
+    let surface = app.surface()?;
+    let p = parse::point(body.required("source")?, "source", surface.mesh())?;
+    let coords = surface.embedded_coords();
+    let tri = surface.mesh().triangles[p.face as usize];
+    let at = (0..3).fold(wavg::Vec8::zeros(), |acc, k| {
+        acc + coords[tri[k] as usize] * p.bary[k]
+    });
+    let d: Vec<f64> = coords.iter().map(|c| (c - at).norm()).collect();
+    let max = d.iter().copied().fold(0.0, f64::max);
+    Ok(Reply::value(&json!({ "distances": d, "max": max })))
+}
