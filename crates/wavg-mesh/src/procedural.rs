@@ -10,10 +10,12 @@ use rand_chacha::ChaCha8Rng;
 use crate::error::MeshError;
 
 mod figure;
+mod plate;
 mod tubes;
 
 use crate::mesh::TriMesh;
 pub use figure::{FigureShape, figure};
+pub use plate::holed_plate;
 
 /// Unit sphere: an icosahedron subdivided `level` times (10 * 4^level + 2 vertices).
 ///

@@ -1,14 +1,16 @@
-//! Writes the procedural figure pair (`procedural::figure`, slim and heavy: the same
-//! connectivity, so vertex i corresponds to vertex i) and K farthest-point anchors of the
-//! slim one, for `wavg correspond --ground-truth`.
+//! Writes the procedural meshes of the hard-input figures: the figure pair
+//! (`procedural::figure`, slim and heavy: the same connectivity, so vertex i corresponds
+//! to vertex i) with K farthest-point anchors of the slim one, for `wavg correspond
+//! --ground-truth`, and a genus-12 plate with thin straps (`procedural::holed_plate(4, 3,
+//! 8, 0.05)`), for `wavg bench project`.
 //!
-//! `cargo xtask lab figure_pair OUT_DIR [K]` writes OUT_DIR/slim.obj, heavy.obj,
-//! anchors.txt (K = 93 by default).
+//! `cargo xtask lab procedural_meshes OUT_DIR [K]` writes OUT_DIR/slim.obj, heavy.obj,
+//! anchors.txt (K = 93 by default), plate12.obj.
 
 use std::fmt::Write;
 
 use wavg_mesh::ValidMesh;
-use wavg_mesh::procedural::{FigureShape, figure};
+use wavg_mesh::procedural::{FigureShape, figure, holed_plate};
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
 
 fn main() {
@@ -27,6 +29,7 @@ fn main() {
         s
     });
     std::fs::write(dir.join("anchors.txt"), text).unwrap();
+    wavg_mesh::io::save(&dir.join("plate12.obj"), &holed_plate(4, 3, 8, 0.05)).unwrap();
     println!(
         "{} vertices, {} anchors in {}",
         mesh.n_vertices(),
