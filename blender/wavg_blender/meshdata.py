@@ -115,9 +115,12 @@ def group_members(obj, group):
     ids, weights = [], []
     for v in obj.data.vertices:
         for g in v.groups:
-            if g.group == index and g.weight > 0.0:
-                ids.append(v.index)
-                weights.append(g.weight)
+            if g.group == index:
+                w = g.weight
+                if w > 0.0:
+                    ids.append(v.index)
+                    weights.append(w)
+                break
     return np.array(ids, dtype=np.int64), np.array(weights, dtype=np.float64)
 
 

@@ -43,7 +43,7 @@ def set_invalid_group(obj, ids):
         obj.vertex_groups.remove(old)
     group = obj.vertex_groups.new(name=INVALID_GROUP)
     if len(ids):
-        group.add([int(i) for i in ids], 1.0, 'REPLACE')
+        group.add(np.asarray(ids, dtype=np.int64).tolist(), 1.0, 'REPLACE')
 
 
 class WAVG_OT_decal_uv(bpy.types.Operator):
