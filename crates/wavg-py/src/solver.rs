@@ -174,6 +174,45 @@ pub(crate) fn points_tuple<'py>(
     ))
 }
 
+/// The paper's weights of each point straight into its row of `out` (NaN rows where there
+/// are none), in parallel on the current pool: the loop of `Solver::inverse_batch_into`
+/// without its buffer and the copy out of it (a visible share of a batch this fast).
+fn paper_rows(solver: &wavg::Solver, points: &[SurfacePoint], out: &mut [f64]) -> Vec<bool> {
+    use rayon::prelude::*;
+    const CHUNK: usize = 64;
+    let n = solver.n_anchors().max(1);
+    let proj = solver.projector();
+    let hint = wavg::internal::prefetch_point_data;
+    out.par_chunks_mut(n * CHUNK)
+        .zip(points.par_chunks(CHUNK))
+        .flat_map_iter(|(rows, pts)| {
+            let mut scratch = Default::default();
+            let mut buf = Vec::with_capacity(n);
+            // Random points read random face records, then their corners' records: request
+            // both a few points ahead so the waits overlap.
+            for p in pts.iter().take(4) {
+                hint(proj, p.face, false);
+            }
+            let mut ok = Vec::with_capacity(pts.len());
+            for (i, (row, p)) in rows.chunks_exact_mut(n).zip(pts).enumerate() {
+                if let Some(q) = pts.get(i + 4) {
+                    hint(proj, q.face, false);
+                }
+                if let Some(q) = pts.get(i + 2) {
+                    hint(proj, q.face, true);
+                }
+                let r = solver.inverse_into(p, &mut scratch, &mut buf);
+                match r {
+                    Ok(()) => row.copy_from_slice(&buf),
+                    Err(_) => row.fill(f64::NAN),
+                }
+                ok.push(r.is_ok());
+            }
+            ok
+        })
+        .collect()
+}
+
 impl Solver {
     /// Forward problems for the rows of `w` (`(q, k)`, or `(k,)` for one).
     pub(crate) fn forward_rows<'py>(
@@ -288,29 +327,18 @@ impl Solver {
         let q = pts.len();
         let (w, ok) = py
             .detach_run(|| -> Result<_, SolveError> {
-                let mut batch = wavg::BatchWeights::default();
-                let mut ok = vec![false; q];
-                if verified {
-                    let mut trips = Vec::new();
-                    self.inner.inverse_verified_batch_into(
-                        &pts,
-                        wavg::DEFAULT_TOLERANCE,
-                        &mut batch,
-                        &mut trips,
-                        par,
-                    )?;
-                    for (o, t) in ok.iter_mut().zip(&trips) {
-                        *o = matches!(
-                            t,
-                            Ok(wavg::RoundTrip::Paper | wavg::RoundTrip::Penalized(_))
-                        );
-                    }
-                } else {
-                    self.inner.inverse_batch_into(&pts, &mut batch, par)?;
-                    for (i, o) in ok.iter_mut().enumerate() {
-                        *o = batch.get(i).is_ok();
-                    }
+                if !verified {
+                    let mut w = vec![0.0; q * k];
+                    let ok = par.install(|| paper_rows(&self.inner, &pts, &mut w))?;
+                    return Ok((w, ok));
                 }
+                let mut batch = wavg::BatchWeights::default();
+                let mut trips = Vec::new();
+                self.inner.inverse_verified_batch_into(&pts, wavg::DEFAULT_TOLERANCE, &mut batch, &mut trips, par)?;
+                let ok: Vec<bool> = trips
+                    .iter()
+                    .map(|t| matches!(t, Ok(wavg::RoundTrip::Paper | wavg::RoundTrip::Penalized(_))))
+                    .collect();
                 let mut w = vec![f64::NAN; q * k];
                 for (i, row) in w.chunks_exact_mut(k.max(1)).enumerate().take(q) {
                     if let Ok(r) = batch.get(i) {

@@ -1,0 +1,107 @@
+"""Targets of the Python package, measured against the CLI in the same run.
+
+    python python/bench.py [--mesh meshes/armadillo.obj.gz] [--anchors 93] [--queries 100000]
+                           [--threads 2] [--wheel target/wheels-release/wavg-*.whl]
+
+Solver.forward / Solver.inverse (paper weights) on N random surface points (uniform by
+area) of the mesh with K farthest-point anchors on T threads, best of 3, against
+`wavg bench roundtrip --json` (forward_us / inverse_us) on the same embedding; the time of
+`import wavg` (best of 5 fresh interpreters); the wheel's size. Needs the `wavg` CLI
+($WAVG_CLI or target/release/wavg or target/debug/wavg) and $WAVG_DATA_DIR.
+"""
+
+import argparse
+import glob
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+# The installed package, not its sources beside this script.
+sys.path = [p for p in sys.path if pathlib.Path(p or ".").resolve() != pathlib.Path(__file__).resolve().parent]
+import wavg  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+def cli_path():
+    for c in (os.environ.get("WAVG_CLI"), ROOT / "target/release/wavg", ROOT / "target/debug/wavg"):
+        if c and pathlib.Path(c).is_file():
+            return str(c)
+    sys.exit("the wavg CLI is not built (cargo build --release -p wavg-cli), or set WAVG_CLI")
+
+
+def random_points(S, n, seed):
+    V, F = S.vertices, S.faces
+    area = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    rng = np.random.default_rng(seed)
+    faces = rng.choice(len(F), size=n, p=area / area.sum())
+    r1, r2 = np.sqrt(rng.random(n)), rng.random(n)
+    bary = np.stack([1 - r1, r1 * (1 - r2), r1 * r2], axis=1)
+    return faces, bary
+
+
+def best(f, repeat=3):
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        f()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--mesh", default="meshes/armadillo.obj.gz")
+    ap.add_argument("--anchors", type=int, default=93)
+    ap.add_argument("--queries", type=int, default=100_000)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--landmarks", type=int, default=1000)
+    ap.add_argument("--wheel", default=None)
+    a = ap.parse_args()
+    data = pathlib.Path(os.environ.get("WAVG_DATA_DIR", ROOT.parent / "shared" / "data"))
+    mesh = data / a.mesh
+    cli = cli_path()
+    with tempfile.TemporaryDirectory() as tmp:
+        emb = pathlib.Path(tmp) / "m.wavg"
+        S = wavg.Surface.open(mesh)
+        t = time.perf_counter()
+        S.precompute(landmarks=a.landmarks, progress=False)
+        pre = time.perf_counter() - t
+        S.save_embedding(emb)
+        sol = wavg.Solver(S, S.spread_anchors(a.anchors, seed=0))
+        faces, bary = random_points(S, a.queries, seed=1)
+        W, ok = sol.inverse(faces, bary, verified=False, threads=a.threads)
+        t_inv = best(lambda: sol.inverse(faces, bary, verified=False, threads=a.threads))
+        t_fwd = best(lambda: sol.forward(W[ok], threads=a.threads))
+        r = subprocess.run([cli, "bench", "roundtrip", "--mesh", str(mesh), "--embedding", str(emb),
+                            "--anchors", str(a.anchors), "--queries", str(a.queries),
+                            "--threads", str(a.threads), "--json"],
+                           check=True, capture_output=True, text=True)
+        ref = json.loads(r.stdout)
+    py_inv, py_fwd = t_inv / a.queries * 1e6, t_fwd / ok.sum() * 1e6
+    imports = []
+    for _ in range(5):
+        out = subprocess.run([sys.executable, "-c", "import time; t = time.perf_counter(); import wavg; "
+                              "print(time.perf_counter() - t)"], capture_output=True, text=True, check=True)
+        imports.append(float(out.stdout))
+    wheels = glob.glob(a.wheel) if a.wheel else sorted(glob.glob(str(ROOT / "target/wheels*/wavg-*.whl")))
+    print(f"mesh {a.mesh}: {S.vertex_count} vertices, precompute {pre:.1f} s; "
+          f"{a.anchors} anchors, {a.queries} queries, {a.threads} threads")
+    print(f"{'':28}{'python us':>10}{'cli us':>10}{'ratio':>8}  target")
+    for name, p, c in (("Solver.inverse (paper)", py_inv, ref["inverse_us"]),
+                       ("Solver.forward", py_fwd, ref["forward_us"])):
+        print(f"{name:28}{p:10.3f}{c:10.3f}{p / c:8.3f}  <= 1.15")
+    print(f"{'import wavg (best of 5)':28}{min(imports):10.3f} s{'':8}  <= 0.3 s")
+    for w in wheels:
+        print(f"wheel {pathlib.Path(w).parent.name}/{pathlib.Path(w).name}: "
+              f"{os.path.getsize(w) / 2**20:.1f} MB  (<= 15 MB)")
+
+
+if __name__ == "__main__":
+    main()
