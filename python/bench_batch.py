@@ -61,18 +61,20 @@ def make_meshes(folder: Path, count: int, n: int) -> list[str]:
     return out
 
 
-def local_cluster(n: int):
+def local_cluster(n: int, profile: bool = True):
+    import dask
     from distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
+    with dask.config.set({"distributed.worker.profile.enabled": profile}):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
     return cluster, Client(cluster)
 
 
-def engine(tmp: Path, rounds: int, vertices: int) -> None:
+def engine(tmp: Path, rounds: int, vertices: int, profile: bool) -> None:
     meshes = make_meshes(tmp / "m20k", 16, vertices)
     verts = [wavg.read_mesh(m)[0].shape[0] for m in meshes]
-    print(f"engine: 16 meshes, {min(verts)}-{max(verts)} vertices, 1000 landmarks, 1 thread per job")
-    cluster, client = local_cluster(2)
+    print(f"engine: 16 meshes, {min(verts)}-{max(verts)} vertices, 1000 landmarks, 1 thread per job, Dask profiler {'on' if profile else 'off'}")
+    cluster, client = local_cluster(2, profile)
     pool = cf.ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn"))
     pool.submit(int).result()  # start the pool's processes outside the timing
     ratios = []
@@ -211,6 +213,7 @@ def main() -> None:
     p.add_argument("--only", choices=("engine", "kills", "overhead", "costs"))
     p.add_argument("--rounds", type=int, default=2, help="Alternated Dask/pool rounds of the engine part (default 2)")
     p.add_argument("--kill-runs", type=int, default=20)
+    p.add_argument("--no-profile", action="store_true", help="Turn off the Dask workers' statistical profiler")
     p.add_argument("--engine-vertices", type=int, default=20000, help="Vertices per mesh of the engine part (default 20000)")
     p.add_argument("--seed", type=int, default=0)
     args = p.parse_args()
@@ -219,7 +222,7 @@ def main() -> None:
         tmp = Path(d)
         for part in ("costs", "overhead", "engine", "kills"):
             if args.only in (None, part):
-                {"costs": lambda: costs(tmp), "overhead": lambda: overhead(tmp), "engine": lambda: engine(tmp, args.rounds, args.engine_vertices),
+                {"costs": lambda: costs(tmp), "overhead": lambda: overhead(tmp), "engine": lambda: engine(tmp, args.rounds, args.engine_vertices, not args.no_profile),
                  "kills": lambda: kills(tmp, args.kill_runs, args.seed)}[part]()  # fmt: skip
                 sys.stdout.flush()
 

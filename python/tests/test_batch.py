@@ -220,3 +220,11 @@ def test_driver_killed_mid_run_then_rerun(tmp_path: Path, assets: dict) -> None:
     ref = wb.precompute_all(meshes, tmp_path / "ref", landmarks=LANDMARKS)
     for a, b in zip(m, ref):
         assert Path(a["output"]).read_bytes() == Path(b["output"]).read_bytes()
+
+
+def test_outputs_have_ordinary_permissions(tmp_path: Path) -> None:
+    out = tmp_path / "o.bin"
+    store.atomic_write_bytes(out, b"x")
+    old = os.umask(0o022)
+    os.umask(old)
+    assert out.stat().st_mode & 0o777 == 0o666 & ~old

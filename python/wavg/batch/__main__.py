@@ -80,15 +80,17 @@ def _executor(args: argparse.Namespace) -> Iterator[Any]:
     if args.scheduler is None and args.local is None:
         yield None
         return
+    import dask
     from distributed import Client, LocalCluster
 
     if args.scheduler is not None:
         with Client(args.scheduler) as client:
             yield client
         return
-    with LocalCluster(
-        n_workers=args.local, threads_per_worker=1, processes=True, dashboard_address=None
-    ) as cluster, Client(cluster) as client:
+    # No dashboard, so the workers' statistical profiler would sample stacks for nobody.
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        cluster = LocalCluster(n_workers=args.local, threads_per_worker=1, processes=True, dashboard_address=None)
+    with cluster, Client(cluster) as client:
         yield client
 
 

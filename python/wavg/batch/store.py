@@ -69,13 +69,32 @@ def sidecar_path(output: str | os.PathLike[str]) -> Path:
     return output.with_name(output.name + SIDECAR)
 
 
+def _umask() -> int:
+    """The process's umask, read without changing it (``os.umask`` would, racing threads)."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    return 0o022
+
+
+def _make_temporary(path: Path, suffix: str = "") -> tuple[int, str]:
+    """A new temporary file beside ``path`` with the permissions of a normally created file
+    (``mkstemp`` makes it private, which would hide outputs from other cluster users)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix="." + path.name + TMP_MARK, suffix=suffix, dir=path.parent)
+    os.fchmod(fd, 0o666 & ~_umask())
+    return fd, tmp
+
+
 def atomic_write(path: str | os.PathLike[str], write: Callable[[Any], None]) -> None:
     """Calls ``write(file)`` on a temporary binary file in ``path``'s folder, flushes it to
     disk and renames it to ``path``. On any error the temporary file is removed and
     ``path`` is untouched."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix="." + path.name + TMP_MARK, dir=path.parent)
+    fd, tmp = _make_temporary(Path(path))
     try:
         with os.fdopen(fd, "wb") as f:
             write(f)
@@ -99,8 +118,7 @@ def temporary_path(path: str | os.PathLike[str]) -> Path:
     """A fresh temporary name in ``path``'s folder (for writers that take a file name);
     the caller renames it with :func:`commit` or removes it."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix="." + path.name + TMP_MARK, suffix=path.suffix, dir=path.parent)
+    fd, tmp = _make_temporary(path, path.suffix)
     os.close(fd)
     return Path(tmp)
 
