@@ -181,6 +181,9 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         && log.run("python package (wheel, pytest python/tests)", || {
             python::test_package(root, data_dir)
         })
+        && log.run("python blocks of README.md and docs/", || {
+            python::docs_blocks(root, data_dir)
+        })
         && log.run("blender", || blender::test(root))
         && log.run("web assets", || web::check_assets(root))
         && log.run("browser tests", || web::browser_tests(root, data_dir))

@@ -132,3 +132,26 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     )
     .map_err(|e| format!("{e} (pytest exit 5 means no tests ran)"))
 }
+
+/// The `python` code blocks of `README.md` and `docs/`, run by the CLI's `docs_blocks` test
+/// with the environment's interpreter (the package just installed): there a block that
+/// cannot import what it needs fails instead of being skipped.
+pub fn docs_blocks(root: &Path, data_dir: &Path) -> Result<(), String> {
+    let py = python(root);
+    let (py_s, data) = (py.to_string_lossy(), data_dir.to_string_lossy());
+    steps::command_env(
+        root,
+        "cargo",
+        &[
+            &["test", "--workspace"],
+            steps::EXCLUDED,
+            &["--test", "docs_blocks", "--", "every_code_block"],
+        ]
+        .concat(),
+        &[
+            ("WAVG_DOCS_PYTHON", &py_s),
+            ("WAVG_DOCS_LANGS", "python,py"),
+            ("WAVG_DATA_DIR", &data),
+        ],
+    )
+}

@@ -117,6 +117,17 @@ pub fn embedding(mesh: &ValidMesh, name: &str, no_cache: bool) -> Result<Embeddi
     Ok(emb)
 }
 
+/// The cache entry of `mesh` under [`default_options`] when it exists (and `no_cache` is
+/// false), for commands that load it themselves.
+pub fn existing(mesh: &ValidMesh, no_cache: bool) -> Option<PathBuf> {
+    let folder = if no_cache { None } else { dir() }?;
+    let path = folder.join(format!(
+        "{}.wavg",
+        key(mesh, &default_options(mesh.n_vertices()))
+    ));
+    path.exists().then_some(path)
+}
+
 /// Precomputes with progress bars on stderr when it is a terminal; returns the seconds.
 fn compute(
     mesh: &ValidMesh,

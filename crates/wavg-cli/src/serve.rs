@@ -25,27 +25,22 @@ decal, distance and remesh; downloads of the curve, the decal's UVs and the reme
 the formats of `wavg spline`, `wavg decal` and `wavg remesh`. Routes and bodies:
 docs/serve.md.
 
-Without --embedding the embedding is precomputed in memory (a tenth of the vertices as
+Without --embedding the embedding cache's entry for the mesh is used when there is one
+(the one `wavg spline` and the other commands compute); else the embedding is precomputed in memory (a tenth of the vertices as
 landmarks, 50 to 1000) while the server already answers: the page shows the mesh and the
 progress, and the computing routes answer 503 until it is ready.
 
 Only this machine can connect unless --host names another interface (a warning is
 printed: anyone who can reach it can use the server). Ctrl-C stops the server.")]
 pub struct Args {
-    /// Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME.
-    #[arg(value_name = "MESH", required_unless_present = "mesh_flag")]
-    pub mesh: Option<String>,
-    /// The mesh, as a flag (instead of the positional MESH).
-    #[arg(
-        long = "mesh",
-        id = "mesh_flag",
-        value_name = "MESH",
-        conflicts_with = "mesh"
-    )]
-    pub mesh_flag: Option<String>,
-    /// A .wavg embedding of the mesh (default: precompute one in memory).
+    #[command(flatten)]
+    pub mesh: crate::mesh_arg::MeshArg,
+    /// A .wavg embedding of the mesh (default: the embedding cache's when it has one, else
+    /// precomputed in memory while the page already shows the mesh).
     #[arg(long)]
     pub embedding: Option<PathBuf>,
+    #[command(flatten)]
+    pub cache: crate::cache::CacheArg,
     /// TCP port (0: any free port).
     #[arg(long, default_value_t = 8080)]
     pub port: u16,
@@ -59,10 +54,14 @@ pub struct Args {
 
 /// Runs the command (until the process is stopped).
 pub fn run(args: Args) -> Result<(), CliError> {
-    let mesh_name = args.mesh.or(args.mesh_flag).unwrap_or_default();
+    let mesh_name = args.mesh.to_string();
     let mesh = load_valid(&mesh_name)?;
+    let embedding = args
+        .embedding
+        .clone()
+        .or_else(|| crate::cache::existing(&mesh, args.cache.no_cache));
     let mut surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
-    if let Some(path) = &args.embedding {
+    if let Some(path) = &embedding {
         surface
             .load_embedding(path)
             .map_err(|e| CliError::input(one_line(&e)))?;
@@ -82,7 +81,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let url = format!("http://{addr}/");
     println!("{mesh_name}: {n} vertices, {m} faces; serving {url} (Ctrl-C to stop)");
-    if args.embedding.is_none() {
+    if embedding.is_none() {
         eprintln!("precomputing the embedding (the page shows the mesh meanwhile)...");
         let bars: Box<dyn wavg::Progress + Send> = Box::new(Bars::new(
             std::io::stderr().is_terminal(),

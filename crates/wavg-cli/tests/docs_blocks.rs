@@ -7,8 +7,11 @@
 //!   pointing at the data folder, and a private `HOME` and embedding cache. A block that
 //!   fails, or that changes one of those input files (an example must never overwrite
 //!   its input), fails the test.
-//! * `python` blocks run with `$WAVG_DOCS_PYTHON`, else `target/py-venv/bin/python`, else
-//!   `python3`; one that stops on a module this machine does not have prints `SKIPPED`.
+//! * `python` blocks run the same way (as a script in such a folder) with
+//!   `$WAVG_DOCS_PYTHON`, else `target/py-venv/bin/python`, else `python3`; one that stops
+//!   on a module this machine does not have prints `SKIPPED`, unless `$WAVG_DOCS_PYTHON`
+//!   is set: `cargo xtask test` sets it (and `WAVG_DOCS_LANGS=python`, which checks only
+//!   those blocks) after it installs the package, so there they must run.
 //! * `text`, `json`, `console` and `output` blocks are not code.
 //! * Any other block (Rust, C, C++, CMake, TOML, JavaScript, ...) must be marked by an HTML
 //!   comment on the line before it: `<!-- docs-test: excerpt PATH -->` for an excerpt of
@@ -247,37 +250,11 @@ fn snapshot(dir: &Path) -> BTreeMap<String, Vec<u8>> {
 /// Runs an `sh` block in a fresh copy of the fixtures; `Err` says why it failed.
 fn run_sh(block: &Block, fixtures: &Path, data: Option<&Path>) -> Result<(), String> {
     let outputs = outputs(&block.body)?;
-    let root = tempfile::tempdir().unwrap();
-    let work = root.path().join("work");
-    std::fs::create_dir_all(&work).unwrap();
-    for (name, bytes) in snapshot(fixtures) {
-        std::fs::write(work.join(name), bytes).unwrap();
-    }
-    if let Some(d) = data {
-        std::fs::create_dir_all(root.path().join("shared")).unwrap();
-        std::os::unix::fs::symlink(d, root.path().join("shared/data")).unwrap();
-    }
-    let home = root.path().join("home");
-    for d in [
-        ".local/share/bash-completion/completions",
-        ".zfunc",
-        ".config/fish/completions",
-    ] {
-        std::fs::create_dir_all(home.join(d)).unwrap();
-    }
-    let before = snapshot(&work);
-    let bin = Path::new(env!("CARGO_BIN_EXE_wavg")).parent().unwrap();
-    let path = format!(
-        "{}:{}",
-        bin.display(),
-        std::env::var("PATH").unwrap_or_default()
-    );
-    let out = Command::new("bash")
+    let sandbox = Sandbox::new(fixtures, data);
+    let before = snapshot(&sandbox.work);
+    let out = sandbox
+        .command("bash")
         .args(["-e", "-o", "pipefail", "-c", &block.body])
-        .current_dir(&work)
-        .env("PATH", path)
-        .env("HOME", &home)
-        .env("WAVG_CACHE_DIR", common::cache_dir())
         .output()
         .unwrap();
     if !out.status.success() {
@@ -287,13 +264,60 @@ fn run_sh(block: &Block, fixtures: &Path, data: Option<&Path>) -> Result<(), Str
             String::from_utf8_lossy(&out.stderr)
         ));
     }
-    let after = snapshot(&work);
+    let after = snapshot(&sandbox.work);
     for (name, bytes) in &before {
         if after.get(name) != Some(bytes) && !outputs.contains(name) {
             return Err(format!("it overwrites (or removes) its input {name}"));
         }
     }
     Ok(())
+}
+
+/// A fresh folder for one block: `work/` (the current folder) holding the fixtures,
+/// `shared/data` beside it pointing at the data folder (so `../shared/data` works as in a
+/// clone), a private `HOME` and the tests' embedding cache.
+struct Sandbox {
+    root: tempfile::TempDir,
+    work: PathBuf,
+}
+
+impl Sandbox {
+    fn new(fixtures: &Path, data: Option<&Path>) -> Sandbox {
+        let root = tempfile::tempdir().unwrap();
+        let work = root.path().join("work");
+        std::fs::create_dir_all(&work).unwrap();
+        for (name, bytes) in snapshot(fixtures) {
+            std::fs::write(work.join(name), bytes).unwrap();
+        }
+        if let Some(d) = data {
+            std::fs::create_dir_all(root.path().join("shared")).unwrap();
+            std::os::unix::fs::symlink(d, root.path().join("shared/data")).unwrap();
+        }
+        for d in [
+            ".local/share/bash-completion/completions",
+            ".zfunc",
+            ".config/fish/completions",
+        ] {
+            std::fs::create_dir_all(root.path().join("home").join(d)).unwrap();
+        }
+        Sandbox { root, work }
+    }
+
+    /// `program` in `work/` with the dev-built `wavg` first on `PATH`.
+    fn command(&self, program: impl AsRef<std::ffi::OsStr>) -> Command {
+        let bin = Path::new(env!("CARGO_BIN_EXE_wavg")).parent().unwrap();
+        let path = format!(
+            "{}:{}",
+            bin.display(),
+            std::env::var("PATH").unwrap_or_default()
+        );
+        let mut c = Command::new(program);
+        c.current_dir(&self.work)
+            .env("PATH", path)
+            .env("HOME", self.root.path().join("home"))
+            .env("WAVG_CACHE_DIR", common::cache_dir());
+        c
+    }
 }
 
 /// The files the commands of `body` write (`-o F`, `--output F`, `> F`); an error names a
@@ -317,42 +341,48 @@ fn outputs(body: &str) -> Result<Vec<String>, String> {
     Ok(out)
 }
 
-/// The interpreter for `python` blocks, when one exists.
-fn python() -> Option<PathBuf> {
+/// The interpreter for `python` blocks, when one exists, and whether it is required
+/// (`$WAVG_DOCS_PYTHON`, set by `cargo xtask test` after it installs the package: then a
+/// missing module fails the block instead of skipping it).
+fn python() -> Option<(PathBuf, bool)> {
     if let Some(p) = std::env::var_os("WAVG_DOCS_PYTHON") {
-        return Some(PathBuf::from(p));
+        return Some((PathBuf::from(p), true));
     }
     let venv = repo().join("target/py-venv/bin/python");
     if venv.exists() {
-        return Some(venv);
+        return Some((venv, false));
     }
     Command::new("python3")
         .arg("--version")
         .output()
         .ok()
         .filter(|o| o.status.success())
-        .map(|_| PathBuf::from("python3"))
+        .map(|_| (PathBuf::from("python3"), false))
 }
 
 /// Runs a `python` block; `Ok(Some(reason))` when it cannot run here.
-fn run_python(block: &Block) -> Result<Option<String>, String> {
-    let Some(py) = python() else {
+fn run_python(
+    block: &Block,
+    fixtures: &Path,
+    data: Option<&Path>,
+) -> Result<Option<String>, String> {
+    let Some((py, required)) = python() else {
         return Ok(Some("no Python interpreter".into()));
     };
-    let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(&py)
-        .args(["-c", &block.body])
-        .current_dir(dir.path())
-        .env("WAVG_CACHE_DIR", common::cache_dir())
-        .output()
-        .unwrap();
+    if block.body.contains("../shared/data") && data.is_none() {
+        return Ok(Some("needs the data folder ($WAVG_DATA_DIR)".into()));
+    }
+    let sandbox = Sandbox::new(fixtures, data);
+    let script = sandbox.work.join("block.py");
+    std::fs::write(&script, &block.body).unwrap();
+    let out = sandbox.command(&py).arg(&script).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     if out.status.success() {
         return Ok(None);
     }
     match err.lines().find(|l| l.starts_with("ModuleNotFoundError")) {
-        Some(l) => Ok(Some(l.to_string())),
-        None => Err(format!("exit {:?}: {err}", out.status.code())),
+        Some(l) if !required => Ok(Some(l.to_string())),
+        _ => Err(format!("exit {:?}: {err}", out.status.code())),
     }
 }
 
@@ -415,7 +445,7 @@ fn check(block: &Block, fixtures: &Path, data: Option<&Path>) -> Result<Option<S
             }
             run_sh(block, fixtures, data).map(|()| None)
         }
-        "python" | "py" => run_python(block),
+        "python" | "py" => run_python(block, fixtures, data),
         other => Err(format!(
             "no runner for `{other}` blocks: mark it `<!-- docs-test: excerpt PATH -->` or \
              `<!-- docs-test: skip REASON -->`, or make it `text`"
@@ -430,8 +460,16 @@ fn every_code_block_in_the_docs_runs_or_says_why_not() {
     make_fixtures(fixtures.path(), data.as_deref());
     let mut failures = Vec::new();
     let (mut ran, mut skipped) = (0, 0);
+    // `WAVG_DOCS_LANGS=python` checks only those languages (`cargo xtask test` runs the
+    // Python blocks again once the package is installed).
+    let langs: Option<Vec<String>> = std::env::var("WAVG_DOCS_LANGS")
+        .ok()
+        .map(|v| v.split(',').map(str::to_string).collect());
     for (name, text) in documents() {
         for b in blocks(&name, &text) {
+            if langs.as_ref().is_some_and(|l| !l.contains(&b.lang)) {
+                continue;
+            }
             match check(&b, fixtures.path(), data.as_deref()) {
                 Ok(None) => ran += 1,
                 Ok(Some(why)) => {
