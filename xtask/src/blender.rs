@@ -11,6 +11,9 @@ use crate::{python, steps};
 
 /// The add-on's folder in the repository.
 const SOURCE: &str = "blender/wavg_blender";
+/// The README's headless example.
+const EXAMPLE: &str = "blender/examples/headless.py";
+
 /// The headless test script.
 const TESTS: &str = "blender/tests/run.py";
 /// The test of the interactive (modal) precompute in a window on a virtual display.
@@ -99,6 +102,22 @@ pub fn test(root: &Path) -> Result<(), String> {
     let scripts_s = scripts.to_string_lossy();
     let env = [("BLENDER_USER_SCRIPTS", scripts_s.as_ref())];
     steps::command_env(root, "blender", &args, &env)?;
+    // The README's example, as written there.
+    steps::command_env(
+        root,
+        "blender",
+        &[
+            "-b",
+            "--factory-startup",
+            "--python-exit-code",
+            "1",
+            "--python",
+            EXAMPLE,
+            "--",
+            &zip_s,
+        ],
+        &env,
+    )?;
     if !runs("xvfb-run", &["--help"]) {
         eprintln!("SKIPPED blender window test (xvfb-run not installed)");
         return Ok(());

@@ -253,8 +253,9 @@ fn run_sh(block: &Block, fixtures: &Path, data: Option<&Path>) -> Result<(), Str
     let sandbox = Sandbox::new(fixtures, data);
     let before = snapshot(&sandbox.work);
     let out = sandbox
-        .command("bash")
-        .args(["-e", "-o", "pipefail", "-c", &block.body])
+        .command("timeout")
+        .args(TIMEOUT)
+        .args(["bash", "-e", "-o", "pipefail", "-c", &block.body])
         .output()
         .unwrap();
     if !out.status.success() {
@@ -272,6 +273,10 @@ fn run_sh(block: &Block, fixtures: &Path, data: Option<&Path>) -> Result<(), Str
     }
     Ok(())
 }
+
+/// coreutils `timeout` arguments for one block: a block that hangs (waiting for a window,
+/// a server that never answers) fails after five minutes instead of stopping the tests.
+const TIMEOUT: [&str; 2] = ["--kill-after=10", "300"];
 
 /// A fresh folder for one block: `work/` (the current folder) holding the fixtures,
 /// `shared/data` beside it pointing at the data folder (so `../shared/data` works as in a
@@ -375,7 +380,13 @@ fn run_python(
     let sandbox = Sandbox::new(fixtures, data);
     let script = sandbox.work.join("block.py");
     std::fs::write(&script, &block.body).unwrap();
-    let out = sandbox.command(&py).arg(&script).output().unwrap();
+    let out = sandbox
+        .command("timeout")
+        .args(TIMEOUT)
+        .arg(&py)
+        .arg(&script)
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     if out.status.success() {
         return Ok(None);
