@@ -334,10 +334,21 @@ impl Solver {
                 }
                 let mut batch = wavg::BatchWeights::default();
                 let mut trips = Vec::new();
-                self.inner.inverse_verified_batch_into(&pts, wavg::DEFAULT_TOLERANCE, &mut batch, &mut trips, par)?;
+                self.inner.inverse_verified_batch_into(
+                    &pts,
+                    wavg::DEFAULT_TOLERANCE,
+                    &mut batch,
+                    &mut trips,
+                    par,
+                )?;
                 let ok: Vec<bool> = trips
                     .iter()
-                    .map(|t| matches!(t, Ok(wavg::RoundTrip::Paper | wavg::RoundTrip::Penalized(_))))
+                    .map(|t| {
+                        matches!(
+                            t,
+                            Ok(wavg::RoundTrip::Paper | wavg::RoundTrip::Penalized(_))
+                        )
+                    })
                     .collect();
                 let mut w = vec![f64::NAN; q * k];
                 for (i, row) in w.chunks_exact_mut(k.max(1)).enumerate().take(q) {
