@@ -1,8 +1,9 @@
 """The named tuples wavg returns."""
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
-import numpy as np
+if TYPE_CHECKING:  # NumPy loads on the first call that needs it, not on `import wavg`.
+    import numpy as np
 
 
 class Points(NamedTuple):
@@ -13,10 +14,10 @@ class Points(NamedTuple):
     answer), ``ok (q,) bool``.
     """
 
-    face: np.ndarray
-    bary: np.ndarray
-    xyz: np.ndarray
-    ok: np.ndarray
+    face: "np.ndarray"
+    bary: "np.ndarray"
+    xyz: "np.ndarray"
+    ok: "np.ndarray"
 
 
 class Correspondence(NamedTuple):
@@ -29,9 +30,9 @@ class Correspondence(NamedTuple):
     ``wavg correspond --json``.
     """
 
-    face: np.ndarray
-    bary: np.ndarray
-    xyz: np.ndarray
-    valid: np.ndarray
-    reason: np.ndarray
+    face: "np.ndarray"
+    bary: "np.ndarray"
+    xyz: "np.ndarray"
+    valid: "np.ndarray"
+    reason: "np.ndarray"
     report: dict
