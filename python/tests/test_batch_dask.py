@@ -170,3 +170,15 @@ def test_process_pool_equals_serial_and_survives_a_kill(serial: dict, assets: di
     assert max(j["attempts"] for j in tr) >= 2  # the broken pool was replaced and jobs resubmitted
     for d in ("emb", "co", "tr"):
         no_partial_files(tmp_path / d)
+
+
+def test_command_line_local_cluster(assets: dict, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from wavg.batch import __main__ as cli
+
+    meshes = assets["meshes"][:3]
+    status = cli.main(["precompute", *meshes, "-o", str(tmp_path), "--local", "2", "--landmarks", str(LANDMARKS)])
+    out = capsys.readouterr().out.strip()
+    assert status == 0 and out == str(tmp_path / "manifest.json")
+    m = wb.Manifest.load(out)
+    assert [j["status"] for j in m] == ["done"] * 3
+    assert all(j["worker"].startswith("tcp://") for j in m)
