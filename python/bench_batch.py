@@ -33,7 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).parent / "tests"))
+# The installed package, not the sources beside this script (they lack the compiled module).
+_HERE = Path(__file__).resolve().parent
+sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != _HERE]
+sys.path.insert(0, str(_HERE / "tests"))
 import batch_fixtures as bf  # noqa: E402
 
 import wavg  # noqa: E402
