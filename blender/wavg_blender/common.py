@@ -27,6 +27,20 @@ def guarded(op, step):
     return {'CANCELLED'}
 
 
+class ActiveMeshOperator:
+    """Mix-in of the operators that work on the active mesh object: available when the
+    active object is a mesh; ``execute`` runs the operator's ``_run(context)`` under
+    :func:`guarded`."""
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.view_layer.objects.active
+        return obj is not None and obj.type == 'MESH'
+
+    def execute(self, context):
+        return guarded(self, lambda: self._run(context))
+
+
 @contextmanager
 def object_mode(context):
     """Object mode for the block (mesh data such as UV layers, vertex groups and shape keys

@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 
 from . import surfaces
-from .common import active_mesh, guarded, object_mode
+from .common import ActiveMeshOperator, active_mesh, object_mode
 from .errors import AddonError, describe, wavg
 from .meshdata import group_members, point_attribute_2d, vertex_group
 
@@ -46,7 +46,7 @@ def set_invalid_group(obj, ids):
         group.add(np.asarray(ids, dtype=np.int64).tolist(), 1.0, 'REPLACE')
 
 
-class WAVG_OT_decal_uv(bpy.types.Operator):
+class WAVG_OT_decal_uv(ActiveMeshOperator, bpy.types.Operator):
     """Make a UV layer from anchor vertices (a vertex group) and their (u, v) (a 2-D point
     attribute); vertices without meaningful coordinates go into vertex group wavg_invalid"""
 
@@ -63,14 +63,6 @@ class WAVG_OT_decal_uv(bpy.types.Operator):
     uv_layer: bpy.props.StringProperty(
         name="UV layer", default="wavg_decal", description="UV layer written"
     )
-
-    @classmethod
-    def poll(cls, context):
-        obj = context.view_layer.objects.active
-        return obj is not None and obj.type == 'MESH'
-
-    def execute(self, context):
-        return guarded(self, lambda: self._run(context))
 
     def _run(self, context):
         obj = active_mesh(context)

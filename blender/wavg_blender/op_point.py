@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 
 from . import surfaces
-from .common import active_mesh, guarded
+from .common import ActiveMeshOperator, active_mesh
 from .errors import AddonError, describe, wavg
 from .meshdata import selected_vertices, vertex_group, weights_of
 
@@ -37,7 +37,7 @@ def anchor_weights(obj, anchors, group):
     return weights_of(vertex_group(obj, group), anchors)
 
 
-class WAVG_OT_place_point(bpy.types.Operator):
+class WAVG_OT_place_point(ActiveMeshOperator, bpy.types.Operator):
     """Add an Empty at the weighted average of the selected vertices on the surface (weights
     from a vertex group, uniform without one); it follows when the weights change"""
 
@@ -48,14 +48,6 @@ class WAVG_OT_place_point(bpy.types.Operator):
     group: bpy.props.StringProperty(
         name="Weights", default="", description="Vertex group with the weights (empty: uniform)"
     )
-
-    @classmethod
-    def poll(cls, context):
-        obj = context.view_layer.objects.active
-        return obj is not None and obj.type == 'MESH'
-
-    def execute(self, context):
-        return guarded(self, lambda: self._run(context))
 
     def _run(self, context):
         obj = active_mesh(context)

@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 
 from . import surfaces
-from .common import active_mesh, as_float_rows, closest_points, guarded
+from .common import ActiveMeshOperator, active_mesh, as_float_rows, closest_points
 from .errors import AddonError, describe, wavg
 from .meshdata import selected_vertices
 
@@ -60,7 +60,7 @@ def settings_of(curve_obj):
     )
 
 
-class WAVG_OT_surface_spline(bpy.types.Operator):
+class WAVG_OT_surface_spline(ActiveMeshOperator, bpy.types.Operator):
     """Add a curve on the surface through the selected vertices in selection order, with
     control points that slide on the surface and update the curve live"""
 
@@ -74,14 +74,6 @@ class WAVG_OT_surface_spline(bpy.types.Operator):
         name="Bézier", default=False, description="Control points form Bézier segments"
     )
     samples: bpy.props.IntProperty(name="Samples", default=200, min=2, max=100000)
-
-    @classmethod
-    def poll(cls, context):
-        obj = context.view_layer.objects.active
-        return obj is not None and obj.type == 'MESH'
-
-    def execute(self, context):
-        return guarded(self, lambda: self._run(context))
 
     def _run(self, context):
         obj = active_mesh(context)

@@ -8,7 +8,7 @@ import bpy
 import numpy as np
 
 from . import surfaces
-from .common import active_mesh, guarded, object_mode
+from .common import ActiveMeshOperator, active_mesh, object_mode
 from .errors import AddonError, describe, wavg
 from .meshdata import uv_corners
 from .op_decal import check_uv_layer_room, set_invalid_group, set_uv_layer
@@ -37,7 +37,7 @@ def paired_anchors(src, dst, prefix):
     return np.array([a[n] for n in names]), np.array([b[n] for n in names])
 
 
-class WAVG_OT_transfer(bpy.types.Operator):
+class WAVG_OT_transfer(ActiveMeshOperator, bpy.types.Operator):
     """Transfer from the active mesh to the selected one through corresponding anchor
     vertex groups: a shape key on the active mesh, a UV layer and a baked image on the
     selected one"""
@@ -55,14 +55,6 @@ class WAVG_OT_transfer(bpy.types.Operator):
         name="Image size", default=0, min=0, max=8192,
         description="Width and height of the baked image (0: the source image's size)",
     )
-
-    @classmethod
-    def poll(cls, context):
-        obj = context.view_layer.objects.active
-        return obj is not None and obj.type == 'MESH'
-
-    def execute(self, context):
-        return guarded(self, lambda: self._run(context))
 
     def _run(self, context):
         src = active_mesh(context)
