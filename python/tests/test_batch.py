@@ -4,6 +4,7 @@ failures, the command line. The Dask and process-pool runs are in test_batch_das
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 import json
 import os
 from pathlib import Path
@@ -45,8 +46,8 @@ def test_check_detects_changed_inputs_and_corruption(tmp_path: Path) -> None:
     out = tmp_path / "out.bin"
     fp = store.fingerprint({"mesh": src}, {"landmarks": 10})
     store.atomic_write_bytes(out, b"result")
-    store.record(out, fp, {"valid_fraction": 0.5})
-    assert store.check(out, fp) == {"valid_fraction": 0.5}
+    store.record(out, fp, {"valid_fraction": 0.5}, "run-1")
+    assert store.check(out, fp) == ({"valid_fraction": 0.5}, "run-1")
     assert store.fingerprint({"mesh": src}, {"landmarks": 11}) != fp
     src.write_text("b")
     assert store.fingerprint({"mesh": src}, {"landmarks": 10}) != fp
@@ -119,6 +120,14 @@ def test_precompute_in_process_skip_redo_and_failure(tmp_path: Path, assets: dic
     assert fourth[0]["status"] == "done"  # another option: another fingerprint
     assert wb.precompute_all(meshes[:1], out, landmarks=LANDMARKS + 1, overwrite=True)[0]["status"] == "done"
     assert not [p for p in out.iterdir() if store.TMP_MARK in p.name]
+
+
+def test_an_attempt_lost_with_its_worker_counts_as_done(tmp_path: Path, assets: dict) -> None:
+    job = jobs.Job("precompute", 0, assets["meshes"][0], str(tmp_path / "a.wavg"), {"mesh": assets["meshes"][0]}, {"landmarks": LANDMARKS, "seed": 0}, run="run-1")
+    assert jobs.run_job(job)["status"] == "done"
+    again = jobs.run_job(job)  # the same run resubmits a job whose result was lost
+    assert again["status"] == "done" and again["figures"]["vertices"] > 0
+    assert jobs.run_job(dataclasses.replace(job, run="run-2"))["status"] == "skipped"
 
 
 def test_pair_arguments_are_checked(tmp_path: Path, assets: dict) -> None:

@@ -12,6 +12,7 @@ same size (the caller's pool stays broken). Dask is imported only when a Client 
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 import uuid
 from typing import Any, Callable, Sequence
 
@@ -37,6 +38,8 @@ def run_all(
     attempts: int = ATTEMPTS,
 ) -> list[dict[str, Any]]:
     """Runs every job once; returns their results in job order, each with ``attempts``."""
+    run = uuid.uuid4().hex
+    jobs = [dataclasses.replace(j, run=run) for j in jobs]
     tracker = _Tracker(len(jobs), progress)
     if executor is None:
         results = []

@@ -34,7 +34,9 @@ class Job:
     """One unit of work: ``kind`` (``precompute``, ``correspond`` or ``transfer``), the
     input it is listed under in the manifest, the output file, the input files (by role)
     and the options that make its fingerprint, and the threads it may use (not part of the
-    fingerprint: results do not depend on it)."""
+    fingerprint: results do not depend on it). ``run`` names the batch call that dispatched
+    the job: an output recorded by the same run was made by an earlier attempt whose result
+    was lost with its worker, so it counts as ``done``, not ``skipped``."""
 
     kind: str
     index: int
@@ -44,6 +46,7 @@ class Job:
     options: Mapping[str, Any] = field(default_factory=dict)
     overwrite: bool = False
     threads: int | None = 1
+    run: str = ""
 
 
 def stem(path: str | os.PathLike[str]) -> str:
@@ -79,11 +82,13 @@ def run_job(job: Job) -> dict[str, Any]:
     try:
         inputs = store.fingerprint(job.files, job.options)
         if not job.overwrite:
-            figures = store.check(job.output, inputs)
-            if figures is not None:
-                return _result("skipped", t0, c0, worker, None, figures)
+            found = store.check(job.output, inputs)
+            if found is not None:
+                figures, run = found
+                status = "done" if job.run and run == job.run else "skipped"
+                return _result(status, t0, c0, worker, None, figures)
         figures = RUNNERS[job.kind](job)
-        store.record(job.output, inputs, figures)
+        store.record(job.output, inputs, figures, job.run)
         return _result("done", t0, c0, worker, None, figures)
     except Exception as e:  # a job's failure is data for the manifest, not a crash
         message = str(e) or repr(e)

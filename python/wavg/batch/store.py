@@ -133,10 +133,12 @@ def commit(tmp: str | os.PathLike[str], path: str | os.PathLike[str]) -> None:
     os.replace(tmp, path)
 
 
-def record(output: str | os.PathLike[str], inputs: str, figures: Mapping[str, Any]) -> None:
-    """Writes ``output``'s sidecar: the input fingerprint, the output's digest and the
-    figures the job reported (repeated in the manifest when a rerun skips the job)."""
+def record(output: str | os.PathLike[str], inputs: str, figures: Mapping[str, Any], run: str = "") -> None:
+    """Writes ``output``'s sidecar: the input fingerprint, the output's digest, the
+    figures the job reported (repeated in the manifest when a rerun skips the job) and the
+    id of the batch run that made it."""
     side = {
+        "run": run,
         "inputs": inputs,
         "output_sha256": file_digest(output),
         "output_bytes": os.path.getsize(output),
@@ -145,9 +147,10 @@ def record(output: str | os.PathLike[str], inputs: str, figures: Mapping[str, An
     atomic_write_bytes(sidecar_path(output), json.dumps(side, sort_keys=True).encode())
 
 
-def check(output: str | os.PathLike[str], inputs: str) -> dict[str, Any] | None:
-    """The figures recorded for ``output`` when it exists, was made from inputs with
-    fingerprint ``inputs`` and its bytes are intact; ``None`` when it must be (re)made."""
+def check(output: str | os.PathLike[str], inputs: str) -> tuple[dict[str, Any], str] | None:
+    """The figures recorded for ``output`` and the id of the run that made it, when it
+    exists, was made from inputs with fingerprint ``inputs`` and its bytes are intact;
+    ``None`` when it must be (re)made."""
     output = Path(output)
     try:
         side = json.loads(sidecar_path(output).read_text())
@@ -156,7 +159,8 @@ def check(output: str | os.PathLike[str], inputs: str) -> dict[str, Any] | None:
         if file_digest(output) != side.get("output_sha256"):
             return None
         figures = side.get("figures")
-        return dict(figures) if isinstance(figures, dict) else {}
+        run = side.get("run")
+        return (dict(figures) if isinstance(figures, dict) else {}), (run if isinstance(run, str) else "")
     except (OSError, ValueError, AttributeError):
         return None
 
