@@ -1,7 +1,7 @@
 //! `wavg.Solver`: forward and inverse problems for one anchor set, in parallel batches
 //! without the GIL.
 
-use numpy::PyUntypedArrayMethods;
+use numpy::{PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
 use crate::args::DetachRun;
@@ -213,6 +213,22 @@ fn paper_rows(solver: &wavg::Solver, points: &[SurfacePoint], out: &mut [f64]) -
         .collect()
 }
 
+/// The caller's `out` array for `q` rows of `k` weights: float64, C-contiguous, writable.
+fn out_rows<'py>(o: &Bound<'py, PyAny>, q: usize, k: usize) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let expected = format!("a writable C-contiguous ({q}, {k}) float64 array");
+    let a = o
+        .cast::<numpy::PyArray2<f64>>()
+        .map_err(|_| type_error(format!("out must be {expected}")))?;
+    if a.shape() != [q, k] || !a.is_c_contiguous() {
+        return Err(value(format!(
+            "out must be {expected}; got shape {:?}{}",
+            a.shape(),
+            if a.is_c_contiguous() { "" } else { ", not C-contiguous" }
+        )));
+    }
+    Ok(a.clone())
+}
+
 impl Solver {
     /// Forward problems for the rows of `w` (`(q, k)`, or `(k,)` for one).
     pub(crate) fn forward_rows<'py>(
@@ -303,7 +319,7 @@ impl Solver {
         self.forward_rows(py, W, threads, "W")
     }
 
-    /// sol.inverse(faces, bary, verified=True, threads=None) -> (W (q, k) float64, ok (q,) bool)
+    /// sol.inverse(faces, bary, verified=True, threads=None, out=None) -> (W (q, k) float64, ok (q,) bool)
     ///
     /// Generalised barycentric weights of surface points ``faces (q,) int``, ``bary (q, 3)
     /// float``. With ``verified`` (default) the weights are checked by the forward problem
@@ -311,8 +327,9 @@ impl Solver {
     /// does); ``ok`` is False where none returns (the paper's weights are then given) or
     /// where there are no weights (a NaN row). Without ``verified``, the paper's weights;
     /// ``ok`` False only for NaN rows. Parallel without the GIL (``threads``: None = all
-    /// cores).
-    #[pyo3(signature = (faces, bary, verified=true, threads=None))]
+    /// cores). ``out``: a writable C-contiguous ``(q, k) float64`` array to fill and return
+    /// as ``W`` (saves allocating and first touching a new one in repeated calls).
+    #[pyo3(signature = (faces, bary, verified=true, threads=None, out=None))]
     fn inverse<'py>(
         &self,
         py: Python<'py>,
@@ -320,17 +337,26 @@ impl Solver {
         bary: &Bound<'py, PyAny>,
         verified: bool,
         threads: Option<i64>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let pts = points(faces, bary, self.inner.mesh().n_faces(), "faces", "bary")?;
         let par = par(threads)?;
         let k = self.inner.n_anchors();
         let q = pts.len();
-        let (w, ok) = py
+        let w = match out {
+            Some(o) => out_rows(o, q, k)?,
+            None => numpy::PyArray2::<f64>::zeros(py, [q, k], false),
+        };
+        let mut rw = w
+            .try_readwrite()
+            .map_err(|e| value(format!("out: {e}")))?;
+        let rows = rw
+            .as_slice_mut()
+            .map_err(|e| value(format!("out: {e}")))?;
+        let ok = py
             .detach_run(|| -> Result<_, SolveError> {
                 if !verified {
-                    let mut w = vec![0.0; q * k];
-                    let ok = par.install(|| paper_rows(&self.inner, &pts, &mut w))?;
-                    return Ok((w, ok));
+                    return Ok(par.install(|| paper_rows(&self.inner, &pts, rows))?);
                 }
                 let mut batch = wavg::BatchWeights::default();
                 let mut trips = Vec::new();
@@ -341,7 +367,13 @@ impl Solver {
                     &mut trips,
                     par,
                 )?;
-                let ok: Vec<bool> = trips
+                for (i, row) in rows.chunks_exact_mut(k.max(1)).enumerate().take(q) {
+                    match batch.get(i) {
+                        Ok(r) => row.copy_from_slice(r),
+                        Err(_) => row.fill(f64::NAN),
+                    }
+                }
+                Ok(trips
                     .iter()
                     .map(|t| {
                         matches!(
@@ -349,17 +381,11 @@ impl Solver {
                             Ok(wavg::RoundTrip::Paper | wavg::RoundTrip::Penalized(_))
                         )
                     })
-                    .collect();
-                let mut w = vec![f64::NAN; q * k];
-                for (i, row) in w.chunks_exact_mut(k.max(1)).enumerate().take(q) {
-                    if let Ok(r) = batch.get(i) {
-                        row.copy_from_slice(r);
-                    }
-                }
-                Ok((w, ok))
+                    .collect())
             })
             .map_err(lib(py))?;
-        Ok((array(py, w, &[q, k])?, array(py, ok, &[q])?))
+        drop(rw);
+        Ok((w.into_any(), array(py, ok, &[q])?))
     }
 
     /// sol.set_anchor(i, vertex_or_point): replaces anchor ``i`` by a vertex id or a pair
