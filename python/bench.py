@@ -82,18 +82,21 @@ def main():
         W_ok = np.ascontiguousarray(W[ok])  # selected once, outside the timed calls
         # Interleaved rounds: each round times Python once (best of 3) and the CLI once, so
         # both sides see the same machine; the medians are compared.
+        out = np.empty_like(W)
         rounds = []
         for _ in range(a.rounds):
             t_inv = best(lambda: sol.inverse(faces, bary, verified=False, threads=a.threads))
+            t_out = best(lambda: sol.inverse(faces, bary, verified=False, threads=a.threads, out=out))
             t_fwd = best(lambda: sol.forward(W_ok, threads=a.threads))
             r = subprocess.run([cli, "bench", "roundtrip", "--mesh", str(mesh), "--embedding", str(emb),
                                 "--anchors", str(a.anchors), "--queries", str(a.queries),
                                 "--threads", str(a.threads), "--json"],
                                check=True, capture_output=True, text=True)
             ref = json.loads(r.stdout)
-            rounds.append((t_inv / a.queries * 1e6, ref["inverse_us"], t_fwd / ok.sum() * 1e6, ref["forward_us"]))
+            q_us = a.queries / 1e6
+            rounds.append((t_inv / q_us, ref["inverse_us"], t_fwd / ok.sum() * 1e6, ref["forward_us"], t_out / q_us, ref["inverse_us"]))
     med = np.median(np.array(rounds), axis=0)
-    py_inv, cli_inv, py_fwd, cli_fwd = med
+    py_inv, cli_inv, py_fwd, cli_fwd, py_out, _ = med
     imports = []
     for _ in range(5):
         out = subprocess.run([sys.executable, "-c", "import time; t = time.perf_counter(); import wavg; "
@@ -104,7 +107,8 @@ def main():
           f"{a.anchors} anchors, {a.queries} queries, {a.threads} threads")
     print(f"medians of {a.rounds} interleaved rounds (ratio range over the rounds in brackets)")
     print(f"{'':28}{'python us':>10}{'cli us':>10}{'ratio':>8}  target")
-    for name, p, c, i in (("Solver.inverse (paper)", py_inv, cli_inv, 0), ("Solver.forward", py_fwd, cli_fwd, 2)):
+    for name, p, c, i in (("Solver.inverse (paper)", py_inv, cli_inv, 0), ("Solver.inverse (paper, out=)", py_out, cli_inv, 4),
+                          ("Solver.forward", py_fwd, cli_fwd, 2)):
         per = [r[i] / r[i + 1] for r in rounds]
         print(f"{name:28}{p:10.3f}{c:10.3f}{p / c:8.3f}  <= 1.15  ({min(per):.2f}-{max(per):.2f})")
     print(f"{'import wavg (best of 5)':28}{min(imports):10.3f} s{'':8}  <= 0.3 s")

@@ -87,6 +87,28 @@ def test_inverse_paper_weights(solver, surface):
     assert np.allclose(W[ok].sum(axis=1), 1.0)
 
 
+def test_inverse_into_out(solver, surface):
+    faces, bary = surface.vertex_points(np.arange(0, surface.vertex_count, 5))
+    k, q = solver.anchor_count, len(faces)
+    for verified in (False, True):
+        want, want_ok = solver.inverse(faces, bary, verified=verified)
+        out = np.full((q, k), 7.0)
+        W, ok = solver.inverse(faces, bary, verified=verified, out=out)
+        assert W is out and np.array_equal(W, want, equal_nan=True) and np.array_equal(ok, want_ok)
+    for bad, err in (
+        (np.zeros((q, k), np.float32), TypeError),
+        (np.zeros((q + 1, k)), ValueError),
+        (np.zeros((k, q)).T, ValueError),
+        ([[0.0] * k] * q, TypeError),
+    ):
+        with pytest.raises(err, match="out must be"):
+            solver.inverse(faces, bary, out=bad)
+    ro = np.zeros((q, k))
+    ro.flags.writeable = False
+    with pytest.raises(ValueError, match="out"):
+        solver.inverse(faces, bary, out=ro)
+
+
 def test_point_anchors_equal_vertex_anchors(surface, anchors, solver):
     faces, bary = surface.vertex_points(anchors)
     s2 = wavg.Solver(surface, (faces, bary))

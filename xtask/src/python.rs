@@ -101,13 +101,16 @@ pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
         .ok_or_else(|| format!("maturin built no wavg wheel in {}", out.display()))
 }
 
-/// Builds the wheel, installs it into the environment (replacing any earlier build) and
-/// runs `pytest python/tests` there; pytest's "no tests ran" (exit 5) fails too.
+/// Installs the package as the README says, `pip install .` (PEP 517 through maturin, with
+/// build isolation), but in cargo's dev profile and target directory (`MATURIN_PEP517_ARGS`)
+/// so the workspace build's dependencies are reused; then runs `pytest python/tests` there.
+/// pytest's "no tests ran" (exit 5) fails too.
 pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
-    let wheel = build_wheel(root)?;
-    let py = python(root);
-    let (py_s, wheel_s) = (py.to_string_lossy(), wheel.to_string_lossy());
-    steps::command(
+    let py = ensure_venv(root)?;
+    let py_s = py.to_string_lossy();
+    let target = steps::target_dir(root);
+    let target = target.to_string_lossy();
+    steps::command_env(
         root,
         &py_s,
         &[
@@ -118,7 +121,11 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
             "--disable-pip-version-check",
             "--force-reinstall",
             "--no-deps",
-            &wheel_s,
+            ".",
+        ],
+        &[
+            ("MATURIN_PEP517_ARGS", "--profile dev"),
+            ("CARGO_TARGET_DIR", &target),
         ],
     )?;
     let data = data_dir.to_string_lossy();
