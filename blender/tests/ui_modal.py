@@ -37,6 +37,29 @@ def finish():
     os._exit(1 if FAILURES else 0)
 
 
+def watch_esc():
+    """Records when the operator receives Esc and when its worker ends: Blender's simulated
+    events reach a modal operator, and timers fire, seconds late on a busy machine, which is
+    not the add-on's latency."""
+    from wavg_blender import op_precompute
+
+    modal = op_precompute.WAVG_OT_precompute.modal
+
+    def recorded(self, context, event):
+        if event.type == 'ESC':
+            STATE.setdefault("esc_seen", time.time())
+        return modal(self, context, event)
+
+    op_precompute.WAVG_OT_precompute.modal = recorded
+    run = op_precompute._Job.run
+
+    def timed_run(self):
+        run(self)
+        STATE.setdefault("worker_ended", time.time())
+
+    op_precompute._Job.run = timed_run
+
+
 def setup():
     scripts = os.path.join(TMP, "scripts")
     os.makedirs(os.path.join(scripts, "addons"))
@@ -44,6 +67,7 @@ def setup():
     bpy.utils.refresh_script_paths()
     bpy.ops.preferences.addon_install(filepath=ZIP, target='PREFS')
     bpy.ops.preferences.addon_enable(module="wavg_blender")
+    watch_esc()
     bm = bmesh.new()
     bmesh.ops.create_icosphere(bm, subdivisions=5, radius=1.0)
     me = bpy.data.meshes.new("big")
@@ -91,7 +115,13 @@ def step():
             stopped = threading.active_count() == STATE["threads"]
             if not stopped and time.time() - STATE["t"] < 120.0:
                 return 0.1
-            check("Esc stops the worker", stopped, f"(after {time.time() - STATE['t']:.1f} s)")
+            now = time.time()
+            seen = STATE.get("esc_seen", now)
+            ended = STATE.get("worker_ended", now)
+            # The callable is polled ten times a second and a cancelled call returns at
+            # once; 1 s leaves room for a loaded machine's timers.
+            check("Esc stops the worker within 1 s of reaching the operator", stopped and ended - seen < 1.0,
+                  f"(after {ended - seen:.2f} s; the simulated event took {seen - STATE['t']:.1f} s to arrive)")
             check("Esc cancels: nothing written", "wavg_key" not in obj and not cache_files(),
                   str(cache_files()))
             win, result = start_precompute()

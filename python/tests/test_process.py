@@ -73,3 +73,33 @@ def test_ctrl_c_interrupts_precompute():
         pytest.skip("the precompute finished before the signal")
     assert p.returncode == 3 and "interrupted True" in out, out
     assert waited < 1.5, waited
+
+
+@pytest.mark.parametrize("at", ["decimate", "geodesics", "mds"])
+def test_cancel_is_seen_at_once_in_every_stage(at):
+    # Like Blender's Esc: another thread asks to stop and the callable answers False the
+    # next time it is called. It is called at every poll, also while the progress stands
+    # still (the end of the geodesics, about a second here, overlaps a sparse
+    # factorization), and the call returns without waiting for the worker's next checkpoint.
+    import threading
+
+    from conftest import torus
+
+    S = wavg.Surface(*torus(240, 120))
+    stop = threading.Event()
+    asked = []
+
+    def ask():
+        asked.append(time.monotonic())
+        stop.set()
+
+    def progress(stage, done, total):
+        if stage == at and not asked and (at != "geodesics" or done == total):
+            threading.Timer(0.05, ask).start()
+        return not stop.is_set()
+
+    with pytest.raises(wavg.CancelledError):
+        S.precompute(landmarks=600, progress=progress)
+    waited = time.monotonic() - asked[0]
+    assert S.embedding is None
+    assert waited < 0.5, waited

@@ -48,6 +48,15 @@ pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
     }
 }
 
+/// The `CancelledError` of a computation stopped by its progress callable.
+pub(crate) fn cancelled(py: Python<'_>) -> PyErr {
+    raise(
+        py,
+        "CancelledError",
+        "cancelled by the progress callback".into(),
+    )
+}
+
 /// The error and its causes on one line.
 pub(crate) fn one_line(e: &dyn std::error::Error) -> String {
     let mut s = e.to_string();

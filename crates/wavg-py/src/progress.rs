@@ -1,8 +1,11 @@
 //! Long computations that Python can watch and stop: the work runs on a worker thread
-//! without the GIL while the calling thread checks for signals (Ctrl-C) and feeds the
+//! without the GIL while the calling thread checks for signals (Ctrl-C) and calls the
 //! progress callable, about ten times a second. Python code is only ever called from the
-//! calling thread.
+//! calling thread. A cancelled call returns at once: the worker owns its inputs and stops at
+//! its next checkpoint in the background (a long sparse factorization has none), its result
+//! dropped.
 
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
@@ -55,59 +58,51 @@ impl Shared {
     }
 }
 
-/// Runs `work` on a worker thread; meanwhile calls `callback(stage, done, total)` when the
-/// progress changes (a `False` return cancels) and checks for signals. A raised
+/// Runs `work` on a worker thread; meanwhile calls `callback(stage, done, total)` at every
+/// poll (a `False` return cancels: `CancelledError`) and checks for signals. A raised
 /// exception (`KeyboardInterrupt` from Ctrl-C, or the callback's) cancels the work and is
-/// raised once the worker has stopped.
-pub(crate) fn watch<T: Send>(
+/// raised at once; the worker is left to stop at its next checkpoint.
+pub(crate) fn watch<T: Send + 'static>(
     py: Python<'_>,
     callback: Option<&Bound<'_, PyAny>>,
-    work: impl FnOnce(&Shared) -> T + Send,
+    work: impl FnOnce(&Shared) -> T + Send + 'static,
 ) -> PyResult<T> {
-    let shared = Shared::default();
-    let mut raised: Option<PyErr> = None;
-    let mut last = None;
-    let out = std::thread::scope(|scope| {
-        let s = &shared;
-        let handle = scope.spawn(move || crate::args::run(|| work(s)));
-        loop {
-            let finished = py.detach(|| {
-                let t = Instant::now();
-                while !handle.is_finished() && t.elapsed() < POLL {
-                    std::thread::sleep(Duration::from_millis(5));
-                }
-                handle.is_finished()
-            });
-            if raised.is_none() {
-                if let Err(e) = py.check_signals() {
-                    shared.cancel.store(true, Ordering::Relaxed);
-                    raised = Some(e);
-                }
+    let shared = Arc::new(Shared::default());
+    let s = Arc::clone(&shared);
+    let handle = std::thread::Builder::new()
+        .name("wavg-watched".into())
+        .spawn(move || crate::args::run(|| work(&s)))
+        .map_err(|e| PyRuntimeError::new_err(format!("wavg: cannot start a thread: {e}")))?;
+    loop {
+        let finished = py.detach(|| {
+            let t = Instant::now();
+            while !handle.is_finished() && t.elapsed() < POLL {
+                std::thread::sleep(Duration::from_millis(5));
             }
-            if let (None, Some(cb)) = (&raised, callback) {
-                let now = shared.state();
-                if last != Some(now) {
-                    last = Some(now);
-                    match cb.call1(now) {
-                        Ok(r) if r.is(&*pyo3::types::PyBool::new(py, false)) => {
-                            shared.cancel.store(true, Ordering::Relaxed);
-                        }
-                        Ok(_) => {}
-                        Err(e) => {
-                            shared.cancel.store(true, Ordering::Relaxed);
-                            raised = Some(e);
-                        }
-                    }
-                }
-            }
-            if finished {
-                break;
-            }
+            handle.is_finished()
+        });
+        if finished {
+            break;
         }
-        handle.join()
-    });
-    if let Some(e) = raised {
-        return Err(e);
+        let stop = py.check_signals().err().or_else(|| {
+            let cb = callback?;
+            match cb.call1(shared.state()) {
+                Ok(r) if r.is(&*pyo3::types::PyBool::new(py, false)) => {
+                    Some(crate::errors::cancelled(py))
+                }
+                Ok(_) => None,
+                Err(e) => Some(e),
+            }
+        });
+        if let Some(e) = stop {
+            shared.cancel.store(true, Ordering::Relaxed);
+            return Err(e);
+        }
     }
-    out.map_err(|_| PyRuntimeError::new_err("wavg: internal error (a worker thread panicked)"))
+    if let Some(cb) = callback {
+        cb.call1(shared.state())?;
+    }
+    handle
+        .join()
+        .map_err(|_| PyRuntimeError::new_err("wavg: internal error (a worker thread panicked)"))
 }

@@ -177,8 +177,10 @@ impl Surface {
     /// and uses it from now on; returns the report (the keys of ``wavg precompute --json``).
     /// ``threads``: None for all cores. ``progress``: True draws a text bar on a terminal,
     /// False nothing, a callable ``(stage: str, done: int, total: int)`` is called about ten
-    /// times a second and cancels (``CancelledError``) by returning ``False``. Ctrl-C stops
-    /// it within a second (``KeyboardInterrupt``); on any error the surface is unchanged.
+    /// times a second (also while the progress stands still) and cancels (``CancelledError``)
+    /// by returning ``False``. Ctrl-C stops it within a second (``KeyboardInterrupt``). A
+    /// cancelled call returns at once; the abandoned work stops at its next checkpoint in
+    /// the background. On any error the surface is unchanged.
     #[pyo3(
         signature = (landmarks=1000, seed=0, threads=None, progress=None),
         text_signature = "($self, landmarks=1000, seed=0, threads=None, progress=True)"
@@ -219,7 +221,7 @@ impl Surface {
             seed,
             ..Default::default()
         };
-        let result = progress::watch(py, callback.as_ref(), |p| {
+        let result = progress::watch(py, callback.as_ref(), move |p| {
             par.install(|| s.precompute(&opts, p).map(|r| (r, s)))
         });
         if let Some(bar) = &callback {
