@@ -52,9 +52,12 @@ pub fn solver_for(
 ) -> Result<Solver, CliError> {
     let (valid, list) = mesh_and_anchors(mesh, anchors)?;
     let surface = embed(valid, embedding, mesh, cache)?;
-    surface
+    let t = std::time::Instant::now();
+    let solver = surface
         .solver(list)
-        .map_err(|e| CliError::input(one_line(&e)))
+        .map_err(|e| CliError::input(one_line(&e)));
+    crate::common::step("solver", t);
+    solver
 }
 
 /// The mesh (no embedding yet: see [`embed`]) and the anchors of `anchors`, checked
@@ -93,5 +96,9 @@ pub fn embed(
         }
         None => crate::cache::embedding(&mesh, name, cache.no_cache)?,
     };
-    Surface::from_valid_with_embedding(mesh, e).map_err(|e| CliError::failure(one_line(&e)))
+    let t = std::time::Instant::now();
+    let s =
+        Surface::from_valid_with_embedding(mesh, e).map_err(|e| CliError::failure(one_line(&e)));
+    crate::common::step("projector (embedded mesh, BVH)", t);
+    s
 }

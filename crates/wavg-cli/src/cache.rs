@@ -88,11 +88,16 @@ pub fn embedding(mesh: &ValidMesh, name: &str, no_cache: bool) -> Result<Embeddi
     let Some(folder) = folder else {
         return compute(mesh, name, &opts).map(|(e, _)| e);
     };
+    let t = Instant::now();
     let key = key(mesh, &opts);
+    let t = crate::common::step("cache key (mesh fingerprint)", t);
     let path = folder.join(format!("{key}.wavg"));
     if path.exists() {
         match wavg::embed::file::load(&path, mesh) {
-            Ok(e) => return Ok(e),
+            Ok(e) => {
+                crate::common::step("load the .wavg (checksum, fingerprint)", t);
+                return Ok(e);
+            }
             Err(e) => eprintln!(
                 "wavg: the cached embedding {} cannot be used ({}); computing it again",
                 path.display(),
