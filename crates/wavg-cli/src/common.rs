@@ -40,7 +40,13 @@ pub fn load_mesh_notes(path_or_builtin: &str) -> Result<(TriMesh, wavg::LoadNote
 pub fn load_valid(path_or_builtin: &str) -> Result<Arc<ValidMesh>, CliError> {
     let t = Instant::now();
     let mesh = load_mesh(path_or_builtin)?;
-    let t = step("read + parse the mesh", t);
+    step("read + parse the mesh", t);
+    validate(path_or_builtin, mesh)
+}
+
+/// The validation half of [`load_valid`], for a mesh already read from `path_or_builtin`.
+pub fn validate(path_or_builtin: &str, mesh: TriMesh) -> Result<Arc<ValidMesh>, CliError> {
+    let t = Instant::now();
     match ValidMesh::new(mesh) {
         Ok(m) => {
             step("validate + topology", t);
