@@ -73,13 +73,16 @@ pub fn mesh_and_anchors(
     mesh_and_anchors_with(mesh, anchors, false).map(|(m, a, _)| (m, a))
 }
 
+/// The mesh, the anchors and the cache's embedding when it was looked up and found.
+type MeshAnchorsCached = (Arc<ValidMesh>, Vec<Anchor>, Option<Embedding>);
+
 /// [`mesh_and_anchors`], with `lookup` also the embedding cache's entry for the mesh
 /// ([`crate::cache::lookup`]), read on a second thread while the mesh is validated.
 fn mesh_and_anchors_with(
     name: &str,
     anchors: &Path,
     lookup: bool,
-) -> Result<(Arc<ValidMesh>, Vec<Anchor>, Option<Embedding>), CliError> {
+) -> Result<MeshAnchorsCached, CliError> {
     let specs = read_points(anchors)?;
     if specs.is_empty() {
         return Err(CliError::input(format!("{}: no points", anchors.display())));
