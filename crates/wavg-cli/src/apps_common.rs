@@ -5,11 +5,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use wavg::{Anchor, Solver, Surface, ValidMesh};
+use wavg::{Anchor, Embedding, Solver, Surface, ValidMesh};
 
 use crate::CliError;
 use crate::cache::CacheArg;
-use crate::common::{load_valid, one_line};
+use crate::common::{load_mesh, one_line, validate};
 use crate::textio::{located, read_points, spec_anchor};
 
 /// Flags of the commands that relate two surfaces through anchors paired line by line
@@ -50,11 +50,18 @@ pub fn solver_for(
     anchors: &Path,
     cache: CacheArg,
 ) -> Result<Solver, CliError> {
-    let (valid, list) = mesh_and_anchors(mesh, anchors)?;
-    let surface = embed(valid, embedding, mesh, cache)?;
-    surface
+    let lookup = embedding.is_none() && !cache.no_cache;
+    let (valid, list, cached) = mesh_and_anchors_with(mesh, anchors, lookup)?;
+    let surface = match cached {
+        Some(e) => surface_of(valid, e)?,
+        None => embed(valid, embedding, mesh, cache)?,
+    };
+    let t = std::time::Instant::now();
+    let solver = surface
         .solver(list)
-        .map_err(|e| CliError::input(one_line(&e)))
+        .map_err(|e| CliError::input(one_line(&e)));
+    crate::common::step("solver", t);
+    solver
 }
 
 /// The mesh (no embedding yet: see [`embed`]) and the anchors of `anchors`, checked
@@ -63,11 +70,36 @@ pub fn mesh_and_anchors(
     mesh: &str,
     anchors: &Path,
 ) -> Result<(Arc<ValidMesh>, Vec<Anchor>), CliError> {
+    mesh_and_anchors_with(mesh, anchors, false).map(|(m, a, _)| (m, a))
+}
+
+/// The mesh, the anchors and the cache's embedding when it was looked up and found.
+type MeshAnchorsCached = (Arc<ValidMesh>, Vec<Anchor>, Option<Embedding>);
+
+/// [`mesh_and_anchors`], with `lookup` also the embedding cache's entry for the mesh
+/// ([`crate::cache::lookup`]), read on a second thread while the mesh is validated.
+fn mesh_and_anchors_with(
+    name: &str,
+    anchors: &Path,
+    lookup: bool,
+) -> Result<MeshAnchorsCached, CliError> {
     let specs = read_points(anchors)?;
     if specs.is_empty() {
         return Err(CliError::input(format!("{}: no points", anchors.display())));
     }
-    let mesh = load_valid(mesh)?;
+    let t = std::time::Instant::now();
+    let raw = load_mesh(name)?;
+    crate::common::step("read + parse the mesh", t);
+    let (mesh, cached) = if lookup {
+        std::thread::scope(|s| {
+            let cached = s.spawn(|| crate::cache::lookup(&raw));
+            let mesh = validate(name, raw.clone());
+            (mesh, cached.join().ok().flatten())
+        })
+    } else {
+        (validate(name, raw), None)
+    };
+    let mesh = mesh?;
     let list = specs
         .iter()
         .map(|&(line, s)| spec_anchor(s).map_err(|m| located(anchors, line, &m)))
@@ -75,7 +107,7 @@ pub fn mesh_and_anchors(
     for (&(line, _), a) in specs.iter().zip(&list) {
         wavg::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
     }
-    Ok((mesh, list))
+    Ok((mesh, list, cached))
 }
 
 /// The surface on `mesh` (named `name` in messages) with the embedding of the file
@@ -93,5 +125,14 @@ pub fn embed(
         }
         None => crate::cache::embedding(&mesh, name, cache.no_cache)?,
     };
-    Surface::from_valid_with_embedding(mesh, e).map_err(|e| CliError::failure(one_line(&e)))
+    surface_of(mesh, e)
+}
+
+/// The surface on `mesh` with the embedding `e` (its projector built here).
+fn surface_of(mesh: Arc<ValidMesh>, e: Embedding) -> Result<Surface, CliError> {
+    let t = std::time::Instant::now();
+    let s =
+        Surface::from_valid_with_embedding(mesh, e).map_err(|e| CliError::failure(one_line(&e)));
+    crate::common::step("projector (embedded mesh, BVH)", t);
+    s
 }

@@ -16,7 +16,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use wavg::embed::file::{FNV_OFFSET, fnv1a64, mesh_hash};
-use wavg::{Embedding, PrecomputeOptions, ValidMesh};
+use wavg::{Embedding, PrecomputeOptions, TriMesh, ValidMesh};
 
 use crate::CliError;
 use crate::common::one_line;
@@ -56,7 +56,7 @@ pub fn default_options(n_vertices: usize) -> PrecomputeOptions {
 
 /// The entry name of `mesh` under `opts`: 16 hex digits of the mesh fingerprint, a dash,
 /// 16 of the options' hash.
-pub fn key(mesh: &ValidMesh, opts: &PrecomputeOptions) -> String {
+pub fn key(mesh: &TriMesh, opts: &PrecomputeOptions) -> String {
     let o = fnv1a64(FNV_OFFSET, format!("{opts:?}").as_bytes());
     format!("{:016x}-{o:016x}", mesh_hash(mesh))
 }
@@ -88,11 +88,16 @@ pub fn embedding(mesh: &ValidMesh, name: &str, no_cache: bool) -> Result<Embeddi
     let Some(folder) = folder else {
         return compute(mesh, name, &opts).map(|(e, _)| e);
     };
+    let t = Instant::now();
     let key = key(mesh, &opts);
+    let t = crate::common::step("cache key (mesh fingerprint)", t);
     let path = folder.join(format!("{key}.wavg"));
     if path.exists() {
         match wavg::embed::file::load(&path, mesh) {
-            Ok(e) => return Ok(e),
+            Ok(e) => {
+                crate::common::step("load the .wavg (checksum, fingerprint)", t);
+                return Ok(e);
+            }
             Err(e) => eprintln!(
                 "wavg: the cached embedding {} cannot be used ({}); computing it again",
                 path.display(),
@@ -115,6 +120,20 @@ pub fn embedding(mesh: &ValidMesh, name: &str, no_cache: bool) -> Result<Embeddi
         ),
     }
     Ok(emb)
+}
+
+/// The cache's embedding of `mesh` (read, not yet validated: it runs beside validation)
+/// with [`default_options`], when an entry exists and loads; `None` otherwise (then
+/// [`embedding`] says why and computes it).
+pub fn lookup(mesh: &TriMesh) -> Option<Embedding> {
+    let t = Instant::now();
+    let path = dir()?.join(format!(
+        "{}.wavg",
+        key(mesh, &default_options(mesh.n_vertices()))
+    ));
+    let e = wavg::embed::file::load(&path, mesh).ok();
+    crate::common::step("cache key + load the .wavg (beside validation)", t);
+    e
 }
 
 /// The cache entry of `mesh` under [`default_options`] when it exists (and `no_cache` is

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 use std::sync::Arc;
+use std::time::Instant;
 
 use wavg::mesh::{io, procedural};
 use wavg::{MeshError, TriMesh, ValidMesh};
@@ -22,14 +23,35 @@ pub fn load_mesh(path_or_builtin: &str) -> Result<TriMesh, CliError> {
     }
 }
 
+/// Like [`load_mesh`], also returning what the file held beyond the triangle mesh
+/// ([`wavg::LoadNotes`]; default for builtins).
+pub fn load_mesh_notes(path_or_builtin: &str) -> Result<(TriMesh, wavg::LoadNotes), CliError> {
+    match path_or_builtin.strip_prefix(BUILTIN_PREFIX) {
+        Some(_) => Ok((load_mesh(path_or_builtin)?, Default::default())),
+        None => io::load_with_notes(Path::new(path_or_builtin))
+            .map_err(|e| CliError::input(one_line(&e))),
+    }
+}
+
 /// Loads and validates a mesh. When validation fails, the problems (counts and first
 /// offending indices) are printed to stderr with a hint, and the error is returned
 /// (exit status 2: the input is not usable).
 #[allow(dead_code)] // for precompute/forward/inverse
 pub fn load_valid(path_or_builtin: &str) -> Result<Arc<ValidMesh>, CliError> {
+    let t = Instant::now();
     let mesh = load_mesh(path_or_builtin)?;
+    step("read + parse the mesh", t);
+    validate(path_or_builtin, mesh)
+}
+
+/// The validation half of [`load_valid`], for a mesh already read from `path_or_builtin`.
+pub fn validate(path_or_builtin: &str, mesh: TriMesh) -> Result<Arc<ValidMesh>, CliError> {
+    let t = Instant::now();
     match ValidMesh::new(mesh) {
-        Ok(m) => Ok(Arc::new(m)),
+        Ok(m) => {
+            step("validate + topology", t);
+            Ok(Arc::new(m))
+        }
         Err(MeshError::Invalid(report)) => {
             eprintln!("{path_or_builtin}: the mesh is not a valid oriented manifold:");
             for line in report.lines() {
@@ -48,6 +70,17 @@ pub fn load_valid(path_or_builtin: &str) -> Result<Arc<ValidMesh>, CliError> {
         }
         Err(e) => Err(CliError::input(one_line(&e))),
     }
+}
+
+/// With `WAVG_STEP_TIMES` set (to anything), prints `step NAME MS` on stderr, the
+/// milliseconds since `since`, and returns now: where a command's start-up time goes
+/// (BENCHMARKS.md).
+pub fn step(name: &str, since: Instant) -> Instant {
+    let now = Instant::now();
+    if std::env::var_os("WAVG_STEP_TIMES").is_some() {
+        eprintln!("step {name} {:.1}", (now - since).as_secs_f64() * 1e3);
+    }
+    now
 }
 
 /// An error's message on one line (the CLI prints exactly one line per failure).

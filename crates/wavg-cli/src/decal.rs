@@ -2,7 +2,7 @@
 //! every vertex gets `uv = sum_i w_i uv_i` with the paper's inverse weights.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use wavg::apps::{DecalReport, decal_vertices};
@@ -10,6 +10,7 @@ use wavg::apps::{DecalReport, decal_vertices};
 use crate::CliError;
 use crate::apps_common::{embed, mesh_and_anchors};
 use crate::common::one_line;
+use crate::decal_material::{self, PLAIN, TEXTURED};
 use crate::textio::{self, located, write_numbers};
 
 /// Arguments.
@@ -22,11 +23,18 @@ over the surface) gets uv = sum_i w_i uv_i. A vertex is marked where its weights
 meaningful: they do not return to it through the forward problem, or one is below
 --max-negative (its uv is still written; 0 0 where the inverse problem failed).
 
-Output: an OBJ of the mesh with one `vt` per vertex and faces `f a/a b/b c/c`. --json prints
+Output: an OBJ of the mesh with one `vt` per vertex and faces `f a/a b/b c/c`; a face with
+a marked corner is written `f a b c` (no texture coordinates: it shows untextured instead of
+smearing the texture). Beside a file output go STEM.mtl (material `decal` with --texture as
+`map_Kd`, or STEM_checker.png, a checkerboard with a transparent border written there;
+material `plain` for the faces without coordinates) and the OBJ's `mtllib`/`usemtl` lines,
+so `wavg render OUT.obj --texture TEXTURE` and viewers show the decal. --json prints
 one object: vertices, valid_fraction (unmarked vertices), stretch (symmetrised L2 stretch of
 the surface-to-plane map over faces with three unmarked corners; null when there is none),
 flipped_faces (against the
-decal's own orientation), seconds, marked (the marked vertex ids), plus mesh and anchors.")]
+decal's own orientation), seconds, marked (the marked vertex ids), untextured_faces (faces
+with a marked corner), mtl and texture (the files the OBJ names; null for `-o -`), plus mesh
+and anchors.")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
@@ -48,6 +56,10 @@ pub struct Args {
     /// Output OBJ file (`-` for standard output).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
+    /// The decal's image (PNG), named in the .mtl written beside the OBJ (default: a
+    /// checkerboard written beside it as STEM_checker.png).
+    #[arg(long)]
+    pub texture: Option<PathBuf>,
     /// Print one JSON object on standard output.
     #[arg(long)]
     pub json: bool,
@@ -63,6 +75,9 @@ struct JsonReport<'a> {
     decal: DecalReport,
     seconds: f64,
     marked: Vec<usize>,
+    untextured_faces: usize,
+    mtl: Option<&'a Path>,
+    texture: Option<&'a Path>,
 }
 
 /// Runs the command.
@@ -86,6 +101,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if !args.max_negative.is_finite() {
         return Err(CliError::input("--max-negative must be a finite number"));
     }
+    if let Some(t) = &args.texture {
+        decal_material::check_texture(t)?;
+    }
     let (mesh, anchors) = mesh_and_anchors(&args.mesh, &args.anchors)?;
     if uv.len() != anchors.len() {
         return Err(CliError::input(format!(
@@ -105,7 +123,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map_err(|e| CliError::input(one_line(&e)))?;
     let seconds = t.elapsed().as_secs_f64();
     let mesh = surface.mesh();
+    let material = decal_material::write(&args.output, args.texture.as_deref())?;
+    let marked_face = |t: &[u32; 3]| t.iter().any(|&v| decal.uv.marked[v as usize]);
     textio::write_atomic(&args.output, |w: &mut dyn Write| {
+        if let Some(m) = &material {
+            writeln!(w, "mtllib {}", m.file_name())?;
+        }
         for p in &mesh.positions {
             write!(w, "v ")?;
             write_numbers(w, p.iter().copied())?;
@@ -116,12 +139,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
             write_numbers(w, p.iter().copied())?;
             writeln!(w)?;
         }
+        let mut current = None;
         for t in &mesh.triangles {
+            let plain = marked_face(t);
+            if material.is_some() && current != Some(plain) {
+                let name = if plain { PLAIN } else { TEXTURED };
+                writeln!(w, "usemtl {name}")?;
+                current = Some(plain);
+            }
             let [a, b, c] = t.map(|v| v + 1);
-            writeln!(w, "f {a}/{a} {b}/{b} {c}/{c}")?;
+            if plain {
+                writeln!(w, "f {a} {b} {c}")?;
+            } else {
+                writeln!(w, "f {a}/{a} {b}/{b} {c}/{c}")?;
+            }
         }
         Ok(())
     })?;
+    let untextured_faces = mesh.triangles.iter().filter(|t| marked_face(t)).count();
     let marked: Vec<usize> = (0..mesh.n_vertices())
         .filter(|&v| decal.uv.marked[v])
         .collect();
@@ -133,6 +168,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
             decal: report,
             seconds,
             marked,
+            untextured_faces,
+            mtl: material.as_ref().map(|m| m.mtl.as_path()),
+            texture: material.as_ref().map(|m| m.texture.as_path()),
         })
         .map_err(CliError::failure)?;
         println!("{j}");
@@ -148,6 +186,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
             report.flipped_faces,
             args.output.display()
         );
+        if let Some(m) = &material {
+            println!(
+                "material {} with texture {} ({untextured_faces} faces with a marked corner \
+                 untextured)",
+                m.mtl.display(),
+                m.texture.display()
+            );
+        }
     }
     Ok(())
 }

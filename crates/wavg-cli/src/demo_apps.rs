@@ -64,6 +64,7 @@ pub fn remesh_picture(solver: &Solver, opts: &RenderOptions) -> Result<Image, Cl
     let ov = Overlays {
         curves,
         points: Vec::new(),
+        ..Default::default()
     };
     wavg::apps::render(mesh, &Colouring::Plain, &ov, opts).map_err(|e| fail(&e))
 }
@@ -147,6 +148,7 @@ pub fn decal_picture(
             .iter()
             .map(|&v| mesh.positions[v as usize])
             .collect(),
+        ..Default::default()
     };
     wavg::apps::render(&textured, &Colouring::Texture(checker), &ov, opts).map_err(|e| fail(&e))
 }

@@ -75,6 +75,7 @@ pub fn write_pictures(
     let ov = Overlays {
         curves: vec![line],
         points: dots.clone(),
+        ..Default::default()
     };
     let img = wavg::apps::render(tri, &Colouring::Plain, &ov, &opts)
         .map_err(|e| fail("spline.png", &e))?;
@@ -86,6 +87,7 @@ pub fn write_pictures(
     let ov = Overlays {
         curves: vec![],
         points: dots[..1].to_vec(),
+        ..Default::default()
     };
     let img = wavg::apps::render(tri, &Colouring::Scalars(&dist), &ov, &opts)
         .map_err(|e| fail("distance.png", &e))?;
@@ -140,12 +142,7 @@ pub fn write_pictures(
     )?;
 
     // A decal around the first anchor; outside the square the board is transparent.
-    let mut board = checkerboard(256, 8).map_err(|e| fail("checkerboard", &e))?;
-    for i in 0..256 {
-        for (x, y) in [(i, 0), (i, 255), (0, i), (255, i)] {
-            board.set(x, y, [0; 4]);
-        }
-    }
+    let board = decal_board().map_err(|e| fail("checkerboard", &e))?;
     let img = crate::demo_apps::decal_picture(solver, anchors[0], &board, &opts);
     save("decal.png", img)?;
     Ok(pictures)
@@ -173,6 +170,19 @@ fn sheet(bent: bool) -> TriMesh {
         }
     }
     m
+}
+
+/// The decal's checkerboard (256 x 256, 8 x 8 squares) with a transparent one-pixel
+/// border, so that texture coordinates outside the unit square (clamped to the border)
+/// show the surface's own colour.
+pub fn decal_board() -> Result<Image, wavg::apps::AppError> {
+    let mut board = checkerboard(256, 8)?;
+    for i in 0..256 {
+        for (x, y) in [(i, 0), (i, 255), (0, i), (255, i)] {
+            board.set(x, y, [0; 4]);
+        }
+    }
+    Ok(board)
 }
 
 /// A `size` x `size` checkerboard of `n` x `n` squares in two colours, with a red and a

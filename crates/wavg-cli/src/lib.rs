@@ -16,6 +16,7 @@ mod common;
 mod completions;
 mod correspond;
 mod decal;
+mod decal_material;
 mod demo;
 mod demo_apps;
 mod demo_pictures;

@@ -10,7 +10,7 @@ use wavg::Vector3;
 use wavg::apps::{Colouring, Image, Overlays, RenderOptions, RenderReport, View, render};
 
 use crate::CliError;
-use crate::common::{load_mesh, one_line};
+use crate::common::{load_mesh_notes, one_line};
 use crate::textio::{self, read_points, read_text, resolve_points};
 
 /// Arguments.
@@ -22,11 +22,13 @@ light on smooth vertex normals, a perspective camera looking at the mesh's centr
 supersampling.
 
 Colour: light grey, or --texture T.png through the mesh's OBJ texture coordinates (`vt`,
-bilinear), or --scalar S.txt (one number per vertex and line) through the viridis colour map
-with a legend bar labelled with the minimum and maximum.
+bilinear; faces without them, as `wavg decal` writes the unusable ones, stay grey), or
+--scalar S.txt (one number per vertex and line) through the viridis colour map with a
+legend bar labelled with the minimum and maximum.
 Overlays: --curve C.txt (the output of `wavg spline`: `FACE B0 B1 B2 X Y Z` per sample,
 `none ...` lines break the curve) as a thick red line, --points P.txt (the anchors
-format: `v VERTEX` or `f FACE B0 B1 B2`) as dots, --wireframe the triangle edges. Curves and
+format: `v VERTEX` or `f FACE B0 B1 B2`) as dots, --wireframe the edges of the file's
+polygons (a quad mesh shows quads: the diagonals that triangulation added are not drawn). Curves and
 dots are depth-tested against the surface with a small bias, so parts behind it are hidden.
 
 Bad input (a missing texture, --texture on a mesh without UVs, a scalar count that differs
@@ -169,8 +171,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .transpose()?
         .unwrap_or_default();
     let t = Instant::now();
-    let mesh: TriMesh = load_mesh(&args.mesh)?;
-    let mut overlays = Overlays::default();
+    let (mut mesh, notes): (TriMesh, _) = load_mesh_notes(&args.mesh)?;
+    if args.texture.is_some() && mesh.uv.is_none() {
+        // Faces the file gave no texture coordinates are drawn plain.
+        mesh.uv = notes.partial_uv;
+    }
+    let mut overlays = Overlays {
+        polygons: notes.polygon_of,
+        ..Default::default()
+    };
     for c in &args.curve {
         overlays.curves.extend(read_curve(c)?);
     }

@@ -98,6 +98,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let curve = evaluate_spline(&solver, kind, args.samples, CHUNK)
         .map_err(|e| CliError::input(format!("{}: {}", args.control.display(), one_line(&e))))?;
     let seconds = t.elapsed().as_secs_f64();
+    let t = crate::common::step("spline", t);
     textio::write_atomic(&args.output, |w: &mut dyn Write| {
         for r in &curve.samples {
             match r {
@@ -114,6 +115,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
         Ok(())
     })?;
+    crate::common::step("write the curve", t);
     let ok = curve.ok_samples();
     crate::anchors::warn_if_low(
         ok as f64 / args.samples as f64,

@@ -162,6 +162,9 @@ fn decal_json_keys() {
         "flipped_area_fraction",
         "seconds",
         "marked",
+        "untextured_faces",
+        "mtl",
+        "texture",
     ];
     assert_keys(&args, &keys);
 }

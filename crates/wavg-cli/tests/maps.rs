@@ -121,8 +121,11 @@ fn decal_writes_one_vt_per_vertex() {
     let text = std::fs::read_to_string(&out).unwrap();
     assert_eq!(text.lines().filter(|l| l.starts_with("vt ")).count(), 2562);
     assert_eq!(text.lines().filter(|l| l.starts_with("v ")).count(), 2562);
-    let f = text.lines().find(|l| l.starts_with("f ")).unwrap();
-    assert!(f.contains('/'), "{f}");
+    // Faces without a marked corner carry the vertices' own coordinates.
+    let f = text
+        .lines()
+        .find(|l| l.starts_with("f ") && l.contains('/'));
+    assert!(f.is_some(), "no textured face");
     // Anchor 1 (vertex 1) gets its own coordinates.
     let vt: Vec<Vec<f64>> = text
         .lines()
@@ -374,5 +377,174 @@ fn a_decal_without_measured_faces_reports_no_stretch() {
     assert!(
         o["stretch"].is_null() && o["stretch_best95"].is_null(),
         "{o:?}"
+    );
+}
+
+/// A decal around the +z pole of `builtin:icosphere`: the pole vertex at (0.5, 0.5) and a
+/// ring of eight vertices 30 degrees from it on a circle of radius 0.4 around it.
+fn pole_decal(dir: &Path) -> (PathBuf, PathBuf) {
+    let mesh = wavg::mesh::procedural::builtin("icosphere").unwrap();
+    let nearest = |q: wavg::Vector3<f64>| {
+        (0..mesh.positions.len())
+            .min_by(|&a, &b| {
+                (mesh.positions[a] - q)
+                    .norm()
+                    .total_cmp(&(mesh.positions[b] - q).norm())
+            })
+            .unwrap()
+    };
+    let (mut anchors, mut uv) = (String::new(), String::new());
+    anchors += &format!("v {}\n", nearest(wavg::Vector3::z()));
+    uv += "0.5 0.5\n";
+    for k in 0..8 {
+        let a = std::f64::consts::TAU * k as f64 / 8.0;
+        let t = 30f64.to_radians();
+        let q = wavg::Vector3::new(t.sin() * a.cos(), t.sin() * a.sin(), t.cos());
+        anchors += &format!("v {}\n", nearest(q));
+        uv += &format!("{} {}\n", 0.5 + 0.4 * a.cos(), 0.5 + 0.4 * a.sin());
+    }
+    let (a, u) = (dir.join("a.txt"), dir.join("uv.txt"));
+    std::fs::write(&a, anchors).unwrap();
+    std::fs::write(&u, uv).unwrap();
+    (a, u)
+}
+
+#[test]
+fn decal_faces_with_a_marked_corner_have_no_uv_and_a_material_names_the_texture() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, u) = pole_decal(dir.path());
+    let out = dir.path().join("d.obj");
+    let args = [
+        "decal",
+        "builtin:icosphere",
+        "--anchors",
+        &s(&a),
+        "--uv",
+        &s(&u),
+        "-o",
+        &s(&out),
+        "--json",
+    ];
+    let (o, _) = json_object(&wavg_ok(&args));
+    let marked: std::collections::HashSet<u64> = o["marked"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    assert!(
+        marked.len() > 100,
+        "{} marked: the far side of the sphere should be",
+        marked.len()
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(text.lines().next(), Some("mtllib d.mtl"));
+    let (mut plain, mut textured) = (0, 0);
+    for l in text.lines().filter(|l| l.starts_with("f ")) {
+        let corners: Vec<&str> = l[2..].split(' ').collect();
+        let vs: Vec<u64> = corners
+            .iter()
+            .map(|c| c.split('/').next().unwrap().parse::<u64>().unwrap() - 1)
+            .collect();
+        if vs.iter().any(|v| marked.contains(v)) {
+            assert!(!l.contains('/'), "a face with a marked corner has UVs: {l}");
+            plain += 1;
+        } else {
+            for (c, v) in corners.iter().zip(&vs) {
+                assert_eq!(*c, format!("{0}/{0}", v + 1), "{l}");
+            }
+            textured += 1;
+        }
+    }
+    assert_eq!(o["untextured_faces"], plain);
+    assert!(
+        textured > 50 && plain > 100,
+        "{textured} textured, {plain} plain"
+    );
+    // The material beside it names the checkerboard written beside it.
+    assert_eq!(o["mtl"], s(&dir.path().join("d.mtl")));
+    let board = dir.path().join("d_checker.png");
+    assert_eq!(o["texture"], s(&board));
+    let mtl = std::fs::read_to_string(dir.path().join("d.mtl")).unwrap();
+    assert!(
+        mtl.contains("newmtl decal\n") && mtl.contains("map_Kd d_checker.png\n"),
+        "{mtl}"
+    );
+    assert!(mtl.contains("newmtl plain\n"), "{mtl}");
+    assert!(text.contains("usemtl decal\n") && text.contains("usemtl plain\n"));
+
+    // Rendered with the texture: the decal shows on the near side, and the far side looks
+    // exactly as the untextured mesh (no smear of the board over the faces left plain).
+    let render = |view: &str, texture: bool| {
+        let png = dir.path().join("r.png");
+        let mut args = vec!["render".to_string(), s(&out), "--view".into(), view.into()];
+        if texture {
+            args.extend(["--texture".into(), s(&board)]);
+        }
+        args.extend(["-o".into(), s(&png), "--size".into(), "160x120".into()]);
+        wavg_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        wavg::apps::Image::read_png(&png).unwrap()
+    };
+    let differ = |a: &wavg::apps::Image, b: &wavg::apps::Image| {
+        a.pixels
+            .iter()
+            .zip(&b.pixels)
+            .filter(|(p, q)| p != q)
+            .count()
+    };
+    let near = differ(&render("0,0", true), &render("0,0", false));
+    assert!(near > 1000, "{near} pixels show the decal");
+    let far = differ(&render("180,0", true), &render("180,0", false));
+    assert_eq!(far, 0, "{far} pixels of the far side are textured");
+}
+
+#[test]
+fn decal_names_a_given_texture_and_refuses_a_bad_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, u) = pole_decal(dir.path());
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let out = sub.join("d.obj");
+    let tex = dir.path().join("t.png");
+    let base = [
+        "decal",
+        "builtin:icosphere",
+        "--anchors",
+        &s(&a),
+        "--uv",
+        &s(&u),
+    ];
+    // Not a PNG: refused before anything is written.
+    std::fs::write(&tex, "not a png").unwrap();
+    let r = wavg(&[&base[..], &["--texture", &s(&tex), "-o", &s(&out)]].concat());
+    assert_eq!(r.status.code(), Some(2), "{r:?}");
+    assert!(String::from_utf8_lossy(&r.stderr).contains("--texture"));
+    assert!(std::fs::read_dir(&sub).unwrap().next().is_none());
+    // A real PNG elsewhere: named by its absolute path, no checkerboard written.
+    let png = dir.path().join("r.png");
+    wavg_ok(&[
+        "render",
+        "builtin:icosphere",
+        "--size",
+        "8x8",
+        "-o",
+        &s(&png),
+    ]);
+    std::fs::rename(&png, &tex).unwrap();
+    wavg_ok(&[&base[..], &["--texture", &s(&tex), "-o", &s(&out)]].concat());
+    let mtl = std::fs::read_to_string(sub.join("d.mtl")).unwrap();
+    let canon = std::fs::canonicalize(&tex).unwrap();
+    assert!(
+        mtl.contains(&format!("map_Kd {}\n", canon.display())),
+        "{mtl}"
+    );
+    assert!(!sub.join("d_checker.png").exists());
+    // Standard output: no material.
+    let r = wavg_ok(&[&base[..], &["-o", "-"]].concat());
+    let text = String::from_utf8_lossy(&r.stdout);
+    assert!(!text.contains("mtllib") && !text.contains("usemtl"));
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("f ") && !l.contains('/'))
     );
 }

@@ -80,3 +80,67 @@ fn bad_input_writes_nothing() {
         assert!(!out.exists());
     }
 }
+
+/// A 3 x 3 grid of unit quads in the z = 0 plane as OBJ: with `f a b c d` quads, or with
+/// the same quads split into the triangles `a b c`, `a c d` (what reading fans them into).
+fn grid_obj(quads: bool) -> String {
+    let n = 3;
+    let mut s = String::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            s += &format!("v {i} {j} 0\n");
+        }
+    }
+    let id = |i: usize, j: usize| j * (n + 1) + i + 1;
+    for j in 0..n {
+        for i in 0..n {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if quads {
+                s += &format!("f {a} {b} {c} {d}\n");
+            } else {
+                s += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+            }
+        }
+    }
+    s
+}
+
+#[test]
+fn the_wireframe_of_a_quad_mesh_draws_quads_and_of_triangles_every_edge() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut images = Vec::new();
+    for quads in [true, false] {
+        let obj = dir.path().join(format!("grid_{quads}.obj"));
+        std::fs::write(&obj, grid_obj(quads)).unwrap();
+        let png = dir.path().join(format!("grid_{quads}.png"));
+        wavg_ok(&[
+            "render",
+            obj.to_str().unwrap(),
+            "--wireframe",
+            "--view",
+            "0,0",
+            "--size",
+            "200x200",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        images.push(wavg::apps::Image::read_png(&png).unwrap());
+    }
+    let grey = |p: [u8; 4]| p[..3].iter().map(|&v| v as i32).sum::<i32>() / 3;
+    let (q, t) = (&images[0], &images[1]);
+    let (mut lighter, mut diagonal) = (0, 0);
+    for y in 0..200 {
+        for x in 0..200 {
+            let (a, b) = (grey(q.get(x, y)), grey(t.get(x, y)));
+            // Nothing the quads draw is missing from the triangles' picture...
+            lighter += usize::from(a < b - 2);
+            // ...and the triangles' picture has the nine diagonals on top.
+            diagonal += usize::from(b < a - 40);
+        }
+    }
+    assert_eq!(lighter, 0);
+    // Nine diagonals of about 40 pixels each (the picture is about 170 pixels across).
+    assert!(diagonal > 9 * 25, "{diagonal} pixels of diagonals");
+    // The diagonal of the cell at the centre of the picture passes through its middle.
+    assert!(grey(t.get(100, 100)) < grey(q.get(100, 100)) - 40);
+}

@@ -24,6 +24,28 @@ fn obj_index_forms() {
     let (m, n) = parse(&format!("{SQUARE}f 1 2 3 4\n"), Format::Obj).unwrap();
     assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
     assert_eq!((n.polygons, n.non_triangles), (1, 1));
+    // Both triangles came from polygon 0; a triangle after it is polygon 1.
+    assert_eq!(n.polygon_of, vec![0, 0]);
+    let (_, n) = parse(
+        &format!(
+            "{SQUARE}f 1 2 3 4
+f 1 2 4
+"
+        ),
+        Format::Obj,
+    )
+    .unwrap();
+    assert_eq!(n.polygon_of, vec![0, 0, 1]);
+    let (_, n) = parse(
+        &format!(
+            "{SQUARE}f 1 2 3
+f 1 3 4
+"
+        ),
+        Format::Obj,
+    )
+    .unwrap();
+    assert!(n.polygon_of.is_empty(), "all triangles: {:?}", n.polygon_of);
     let (m, _) = parse(&format!("{SQUARE}f -4 -3 -2\n"), Format::Obj).unwrap();
     assert_eq!(m.triangles, vec![[0, 1, 2]]);
     let (m, _) = parse(
@@ -116,6 +138,10 @@ fn obj_uvs_are_per_corner_and_positions_are_not_split() {
     let text = format!("{SQUARE}vt 0 0\nf 1/1 2/1 3/1\nf 1 3 4\n");
     let (m, n) = parse(&text, Format::Obj).unwrap();
     assert!(m.uv.is_none() && n.uv_dropped);
+    // The notes keep them, the face without any marked by NONE corners.
+    let partial = n.partial_uv.unwrap();
+    assert_eq!(partial.faces, vec![[0, 0, 0], [wavg_mesh::NONE; 3]]);
+    assert_eq!(partial.coords.len(), 1);
 }
 
 #[test]
@@ -127,6 +153,7 @@ fn off_variants() {
     .unwrap();
     assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
     assert_eq!(n.non_triangles, 1);
+    assert_eq!(n.polygon_of, vec![0, 0]);
     let (m, _) = parse("OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", Format::Off).unwrap();
     assert_eq!(m.n_faces(), 1);
     let (m, _) = parse(

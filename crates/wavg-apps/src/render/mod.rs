@@ -13,7 +13,7 @@ mod raster;
 mod report;
 
 use nalgebra::Vector3;
-use wavg_mesh::TriMesh;
+use wavg_mesh::{NONE, TriMesh};
 
 pub use camera::{Camera, FOV_DEGREES, View};
 pub use colormap::viridis;
@@ -29,7 +29,8 @@ pub enum Colouring<'a> {
     /// A light neutral grey.
     #[default]
     Plain,
-    /// The image through the mesh's texture coordinates, sampled bilinearly.
+    /// The image through the mesh's texture coordinates, sampled bilinearly; a triangle
+    /// whose three texture corners are [`NONE`] (a face the file gave none) is plain.
     Texture(&'a Image),
     /// One number per vertex, interpolated, through viridis from its minimum to maximum.
     Scalars(&'a [f64]),
@@ -42,6 +43,10 @@ pub struct Overlays {
     pub curves: Vec<Vec<Vector3<f64>>>,
     /// Points drawn as dots.
     pub points: Vec<Vector3<f64>>,
+    /// The polygon each triangle came from (`LoadNotes::polygon_of` of the mesh file);
+    /// the wireframe then leaves out the edges between two triangles of one polygon (the
+    /// diagonals that triangulating quads added). Empty: every triangle is its own polygon.
+    pub polygons: Vec<u32>,
 }
 
 /// Picture size, view and extras.
@@ -53,7 +58,7 @@ pub struct RenderOptions {
     pub height: u32,
     /// Camera direction.
     pub view: View,
-    /// Draw the triangle edges.
+    /// Draw the triangle edges (the polygon edges with [`Overlays::polygons`]).
     pub wireframe: bool,
     /// Supersampling factor per side (1 = none); 2 anti-aliases well.
     pub supersample: u32,
@@ -86,7 +91,12 @@ const AMBIENT: f64 = 0.3;
 
 /// Checks that the inputs fit together (finite positions, indices in range, UVs for a
 /// texture, one finite scalar per vertex) before anything is drawn.
-fn check(mesh: &TriMesh, colouring: &Colouring, opts: &RenderOptions) -> Result<(), AppError> {
+fn check(
+    mesh: &TriMesh,
+    colouring: &Colouring,
+    overlays: &Overlays,
+    opts: &RenderOptions,
+) -> Result<(), AppError> {
     let bad = |m: String| Err(AppError::Input(m));
     if mesh.triangles.is_empty() {
         return bad("the mesh has no triangles".into());
@@ -120,6 +130,13 @@ fn check(mesh: &TriMesh, colouring: &Colouring, opts: &RenderOptions) -> Result<
             MAX_SIDE / opts.supersample
         ));
     }
+    if !overlays.polygons.is_empty() && overlays.polygons.len() != mesh.triangles.len() {
+        return bad(format!(
+            "{} polygon ids for {} triangles",
+            overlays.polygons.len(),
+            mesh.triangles.len()
+        ));
+    }
     match colouring {
         Colouring::Plain => {}
         Colouring::Texture(_) => match &mesh.uv {
@@ -131,10 +148,12 @@ fn check(mesh: &TriMesh, colouring: &Colouring, opts: &RenderOptions) -> Result<
                 );
             }
             Some(uv) => {
+                let untextured = |t: &[u32; 3]| t.iter().all(|&i| i == NONE);
                 if uv.faces.len() != mesh.triangles.len()
                     || uv
                         .faces
                         .iter()
+                        .filter(|t| !untextured(t))
                         .flatten()
                         .any(|&i| i as usize >= uv.coords.len())
                     || !uv.coords.iter().flatten().all(|c| c.is_finite())
@@ -174,6 +193,33 @@ fn vertex_normals(mesh: &TriMesh) -> Vec<Vector3<f64>> {
     n
 }
 
+/// Per triangle, which of its edges (edge `i` opposite corner `i`) the wireframe draws:
+/// all of them, except an edge another triangle of the same polygon shares.
+fn wire_edges(mesh: &TriMesh, polygons: &[u32]) -> Vec<[bool; 3]> {
+    let mut out = vec![[true; 3]; mesh.triangles.len()];
+    if polygons.is_empty() {
+        return out;
+    }
+    let key = |f: usize, i: usize| {
+        let t = mesh.triangles[f];
+        let (a, b) = (t[(i + 1) % 3], t[(i + 2) % 3]);
+        (a.min(b), a.max(b), polygons[f])
+    };
+    let mut count: std::collections::HashMap<(u32, u32, u32), u32> =
+        std::collections::HashMap::new();
+    for f in 0..mesh.triangles.len() {
+        for i in 0..3 {
+            *count.entry(key(f, i)).or_default() += 1;
+        }
+    }
+    for (f, e) in out.iter_mut().enumerate() {
+        for (i, draw) in e.iter_mut().enumerate() {
+            *draw = count[&key(f, i)] < 2;
+        }
+    }
+    out
+}
+
 /// The bounding box's centre and the largest distance of a point from it.
 fn bounds(points: &[Vector3<f64>]) -> (Vector3<f64>, f64) {
     let mut lo = Vector3::repeat(f64::INFINITY);
@@ -195,7 +241,7 @@ pub fn render(
     overlays: &Overlays,
     opts: &RenderOptions,
 ) -> Result<Image, AppError> {
-    check(mesh, colouring, opts)?;
+    check(mesh, colouring, overlays, opts)?;
     let ss = opts.supersample;
     let (w, h) = ((opts.width * ss) as usize, (opts.height * ss) as usize);
     let (center, radius) = bounds(&mesh.positions);
@@ -207,6 +253,11 @@ pub fn render(
         vis.triangle(f as u32, t.map(|v| screen[v as usize]));
     }
     let normals = vertex_normals(mesh);
+    let wires = if opts.wireframe {
+        wire_edges(mesh, &overlays.polygons)
+    } else {
+        Vec::new()
+    };
     let light = (-cam.forward + cam.up * 0.4 - cam.right * 0.25).normalize();
     let (smin, smax) = match colouring {
         Colouring::Scalars(s) => s
@@ -237,12 +288,17 @@ pub fn render(
             Colouring::Plain => PLAIN,
             Colouring::Texture(img) => {
                 let uv = mesh.uv.as_ref().expect("checked");
-                let c = uv.faces[f as usize].map(|k| uv.coords[k as usize]);
-                let q = c[0] * b[0] + c[1] * b[1] + c[2] * b[2];
-                // Transparent texels (nothing transferred there) show the plain colour.
-                let s = img.sample_bilinear(q.x, q.y);
-                let a = s[3] / 255.0;
-                [0, 1, 2].map(|k| s[k] * a + PLAIN[k] * (1.0 - a))
+                let corners = uv.faces[f as usize];
+                if corners[0] == NONE {
+                    PLAIN
+                } else {
+                    let c = corners.map(|k| uv.coords[k as usize]);
+                    let q = c[0] * b[0] + c[1] * b[1] + c[2] * b[2];
+                    // Transparent texels (nothing transferred there) show the plain colour.
+                    let s = img.sample_bilinear(q.x, q.y);
+                    let a = s[3] / 255.0;
+                    [0, 1, 2].map(|k| s[k] * a + PLAIN[k] * (1.0 - a))
+                }
             }
             Colouring::Scalars(s) => {
                 let v: f64 = (0..3).map(|k| s[t[k] as usize] * b[k]).sum();
@@ -260,7 +316,9 @@ pub fn render(
             let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
             let d = raster::edge_distances(s, [x, y])
                 .into_iter()
-                .fold(f64::INFINITY, f64::min);
+                .zip(wires[f as usize])
+                .filter(|&(_, draw)| draw)
+                .fold(f64::INFINITY, |m, (d, _)| m.min(d));
             let a = (0.7 * ss as f64 + 0.5 - d).clamp(0.0, 1.0);
             *px = [0, 1, 2].map(|k| px[k] * (1.0 - a) + WIRE[k] * a);
         }
@@ -432,14 +490,103 @@ mod tests {
         let ov = Overlays {
             curves: vec![],
             points: vec![Vector3::new(0.0, 0.0, 1.0)],
+            ..Default::default()
         };
         let img = render(&mesh, &Colouring::Plain, &ov, &o).unwrap();
         assert!(img.get(100, 100)[2] < 100, "{:?}", img.get(100, 100));
         let ov = Overlays {
             curves: vec![],
             points: vec![Vector3::new(0.0, 0.0, -1.0)],
+            ..Default::default()
         };
         let img = render(&mesh, &Colouring::Plain, &ov, &o).unwrap();
         assert!(img.get(100, 100)[2] > 150, "{:?}", img.get(100, 100));
+    }
+
+    /// An n x n grid of unit quads in the z = 0 plane, as OBJ text.
+    fn quad_grid_obj(n: usize) -> String {
+        let mut s = String::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                s += &format!("v {i} {j} 0\n");
+            }
+        }
+        let id = |i: usize, j: usize| j * (n + 1) + i + 1;
+        for j in 0..n {
+            for i in 0..n {
+                let (a, b) = (id(i, j), id(i + 1, j));
+                let (c, d) = (id(i + 1, j + 1), id(i, j + 1));
+                s += &format!("f {a} {b} {c} {d}\n");
+            }
+        }
+        s
+    }
+
+    #[test]
+    fn the_wireframe_of_quads_has_no_diagonals_and_of_triangles_all_edges() {
+        let n = 3;
+        let (mesh, notes) = wavg_mesh::io::parse_bytes(
+            quad_grid_obj(n).as_bytes(),
+            wavg_mesh::Format::Obj,
+            std::path::Path::new("grid.obj"),
+        )
+        .unwrap();
+        assert_eq!(notes.polygon_of.len(), 2 * n * n);
+        let opts = RenderOptions {
+            width: 240,
+            height: 240,
+            view: View {
+                azimuth: 0.0,
+                elevation: 0.0,
+            },
+            wireframe: true,
+            supersample: 1,
+        };
+        let quads = Overlays {
+            polygons: notes.polygon_of.clone(),
+            ..Default::default()
+        };
+        let q = render(&mesh, &Colouring::Plain, &quads, &opts).unwrap();
+        let t = render(&mesh, &Colouring::Plain, &Overlays::default(), &opts).unwrap();
+        // The pixel under a point of the plane, as `render` places the camera.
+        let (c, r) = bounds(&mesh.positions);
+        let cam = Camera::fit(c, r, opts.view, 240, 240).framed(&mesh.positions);
+        let grey = |img: &Image, x: f64, y: f64| {
+            let p = cam.project(&Vector3::new(x, y, 0.0));
+            let px = img.get((p[0] - 0.5).round() as u32, (p[1] - 0.5).round() as u32);
+            px[..3].iter().map(|&v| v as f64).sum::<f64>() / 3.0
+        };
+        for j in 0..n {
+            for i in 0..n {
+                let (x, y) = (i as f64, j as f64);
+                // Inside the cell, away from every edge and from the diagonal.
+                let face = grey(&q, x + 0.8, y + 0.2);
+                assert!(face > 120.0, "cell {i},{j}: surface {face}");
+                assert_eq!(face, grey(&t, x + 0.8, y + 0.2));
+                for (dx, dy) in [(0.3, 0.3), (0.5, 0.5), (0.7, 0.7)] {
+                    // The diagonal (fan from the first corner): surface with the polygons,
+                    // a line without them.
+                    let (on_q, on_t) = (grey(&q, x + dx, y + dy), grey(&t, x + dx, y + dy));
+                    assert!((on_q - face).abs() < 3.0, "cell {i},{j}: {on_q} vs {face}");
+                    assert!(on_t < face - 40.0, "cell {i},{j}: {on_t} vs {face}");
+                }
+                // The quads' own (inner) edges are drawn in both.
+                for img in [&q, &t] {
+                    for (ex, ey, inner) in [(x + 0.5, y, j > 0), (x, y + 0.5, i > 0)] {
+                        let e = grey(img, ex, ey);
+                        assert!(
+                            !inner || e < face - 40.0,
+                            "cell {i},{j}: edge {e} vs {face}"
+                        );
+                    }
+                }
+            }
+        }
+        let bad = Overlays {
+            polygons: vec![0; 3],
+            ..Default::default()
+        };
+        let e = render(&mesh, &Colouring::Plain, &bad, &opts).unwrap_err();
+        assert!(e.to_string().contains("polygon ids"), "{e}");
     }
 }

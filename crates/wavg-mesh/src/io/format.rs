@@ -5,7 +5,7 @@ use std::path::Path;
 use crate::error::MeshError;
 
 /// Facts about a file that the [`TriMesh`](crate::TriMesh) does not keep, for diagnostics (`wavg info`).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct LoadNotes {
     /// The format that was read.
     pub format: Option<Format>,
@@ -17,6 +17,22 @@ pub struct LoadNotes {
     pub skipped_faces: usize,
     /// Texture coordinates were present on some but not all faces and were dropped.
     pub uv_dropped: bool,
+    /// The file's polygon (0-based, in file order) each triangle came from, so that the
+    /// diagonals fan triangulation added can be told from the file's own edges (a
+    /// wireframe of a quad mesh draws quads). Empty when every polygon was a triangle.
+    pub polygon_of: Vec<u32>,
+    /// When texture coordinates were dropped ([`Self::uv_dropped`], OBJ): the ones the file
+    /// had, the corners of the triangles without them being [`NONE`](crate::NONE), for
+    /// a renderer that draws those faces untextured.
+    pub partial_uv: Option<crate::TexCoords>,
+}
+
+impl LoadNotes {
+    /// Records that the polygon just counted in `polygons` became `triangles` triangles.
+    pub(crate) fn fan(&mut self, triangles: usize) {
+        let id = u32::try_from(self.polygons.saturating_sub(1)).unwrap_or(u32::MAX);
+        self.polygon_of.extend(std::iter::repeat_n(id, triangles));
+    }
 }
 
 /// The mesh file formats wavg reads and writes.

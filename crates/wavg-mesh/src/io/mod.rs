@@ -71,6 +71,9 @@ pub fn parse_bytes(
         Format::Ply => ply::parse(bytes).map_err(located)?,
     };
     notes.format = Some(format);
+    if notes.non_triangles == 0 {
+        notes.polygon_of = Vec::new();
+    }
     Ok((mesh, notes))
 }
 

@@ -11,7 +11,7 @@ use nalgebra::{Vector2, Vector3};
 
 use super::LoadNotes;
 use super::text::{ParseError, Result, next_float, strip_comment};
-use crate::mesh::{TexCoords, TriMesh};
+use crate::mesh::{NONE, TexCoords, TriMesh};
 
 /// One face corner: position index and optional texture index, both 0-based.
 #[derive(Clone, Copy)]
@@ -65,6 +65,7 @@ pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut uv_faces: Vec<[u32; 3]> = Vec::new();
     let mut faces_without_uv = 0usize;
+    let mut textured = 0usize;
     let mut notes = LoadNotes::default();
     let mut poly: Vec<Corner> = Vec::new();
 
@@ -113,19 +114,29 @@ pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
                     triangles.push([a.v, b.v, c.v]);
                     if has_uv {
                         uv_faces.push([a.vt.unwrap_or(0), b.vt.unwrap_or(0), c.vt.unwrap_or(0)]);
+                        textured += 1;
+                    } else {
+                        uv_faces.push([NONE; 3]);
                     }
                 }
+                notes.fan(poly.len() - 2);
             }
             _ => {} // vn, vp, o, g, s, usemtl, mtllib, l, p, curves: not needed.
         }
     }
-    let uv = if faces_without_uv == 0 && !uv_faces.is_empty() {
+    let uv = if faces_without_uv == 0 && textured > 0 {
         Some(TexCoords {
             coords,
             faces: uv_faces,
         })
     } else {
-        notes.uv_dropped = faces_without_uv > 0 && !uv_faces.is_empty();
+        notes.uv_dropped = faces_without_uv > 0 && textured > 0;
+        if notes.uv_dropped {
+            notes.partial_uv = Some(TexCoords {
+                coords,
+                faces: uv_faces,
+            });
+        }
         None
     };
     Ok((

@@ -155,6 +155,7 @@ pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
         for j in 1..n - 1 {
             triangles.push([poly[0], poly[j], poly[j + 1]]);
         }
+        notes.fan(n - 2);
     }
     Ok((TriMesh::new(positions, triangles), notes))
 }

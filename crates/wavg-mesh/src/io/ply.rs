@@ -244,6 +244,7 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<(TriMesh, LoadNotes)> {
                 }
             }
         }
+        notes.fan(idx.len() - 2);
     }
     let uv = if corner_uv_ok && !triangles.is_empty() {
         let faces = (0..triangles.len() as u32)
@@ -372,6 +373,7 @@ property int vertex2\nend_header\n"
         assert_eq!(m.positions[3], Vector3::new(0.0, 1.0, 3.0));
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
         assert_eq!((notes.polygons, notes.non_triangles), (1, 1));
+        assert_eq!(notes.polygon_of, vec![0, 0]);
         assert!(m.uv.is_none());
         // Cut inside the faces: a parse error, not a mesh.
         assert!(parse(&b[..b.len() - 12]).is_err());
