@@ -3,8 +3,8 @@
     python python/bench.py [--mesh meshes/armadillo.obj.gz] [--anchors 93] [--queries 100000]
                            [--threads 2] [--wheel target/wheels-release/wavg-*.whl]
 
-Solver.forward / Solver.inverse (paper weights) on N random surface points (uniform by
-area) of the mesh with K farthest-point anchors on T threads, best of 3, against
+Solver.forward / Solver.inverse (paper weights) on the N surface points and K anchors of
+`wavg bench roundtrip` (S.sample_points, S.spread_anchors) on T threads, best of 3, against
 `wavg bench roundtrip --json` (forward_us / inverse_us) on the same embedding, in
 interleaved rounds (medians compared); the time of
 `import wavg` (best of 5 fresh interpreters); the wheel's size. Needs the `wavg` CLI
@@ -37,16 +37,6 @@ def cli_path():
     sys.exit("the wavg CLI is not built (cargo build --release -p wavg-cli), or set WAVG_CLI")
 
 
-def random_points(S, n, seed):
-    V, F = S.vertices, S.faces
-    area = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
-    rng = np.random.default_rng(seed)
-    faces = rng.choice(len(F), size=n, p=area / area.sum())
-    r1, r2 = np.sqrt(rng.random(n)), rng.random(n)
-    bary = np.stack([1 - r1, r1 * (1 - r2), r1 * r2], axis=1)
-    return faces, bary
-
-
 def best(f, repeat=3):
     times = []
     for _ in range(repeat):
@@ -77,7 +67,8 @@ def main():
         pre = time.perf_counter() - t
         S.save_embedding(emb)
         sol = wavg.Solver(S, S.spread_anchors(a.anchors, seed=0))
-        faces, bary = random_points(S, a.queries, seed=1)
+        # The CLI's points and anchors (its seed 0 draws points with seed 1): the same work.
+        faces, bary = S.sample_points(a.queries, seed=1)
         W, ok = sol.inverse(faces, bary, verified=False, threads=a.threads)
         W_ok = np.ascontiguousarray(W[ok])  # selected once, outside the timed calls
         # Interleaved rounds: each round times Python once (best of 3) and the CLI once, so

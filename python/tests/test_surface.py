@@ -134,3 +134,21 @@ def test_precompute_threads_equal(torus_mesh):
 def test_real_mesh_with_uv(data_dir):
     S = wavg.Surface.open(data_dir / "textured" / "spot" / "spot_triangulated.obj")
     assert S.uv.shape == (S.face_count, 3, 2)
+
+
+def test_sample_points_are_seeded_and_uniform_by_area(surface):
+    faces, bary = surface.sample_points(60_000, seed=3)
+    again, bary2 = surface.sample_points(60_000, seed=3)
+    assert np.array_equal(faces, again) and np.array_equal(bary, bary2)
+    assert not np.array_equal(faces, surface.sample_points(60_000, seed=4)[0])
+    assert faces.dtype == np.int64 and bary.shape == (60_000, 3)
+    assert (bary >= 0).all() and np.allclose(bary.sum(axis=1), 1.0)
+    V, F = surface.vertices, surface.faces
+    area = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    expected = area / area.sum() * len(faces)
+    counts = np.bincount(faces, minlength=len(F))
+    # Each face's count within 5 standard deviations of a binomial with its area share.
+    assert (np.abs(counts - expected) <= 5 * np.sqrt(expected) + 1).all()
+    # Within a face, uniform: the mean barycentric coordinate is 1/3.
+    assert np.allclose(bary.mean(axis=0), 1 / 3, atol=0.01)
+    assert surface.sample_points(0)[0].shape == (0,)

@@ -374,6 +374,23 @@ impl Surface {
         array(py, v, &[k])
     }
 
+    /// S.sample_points(n, seed=0) -> (faces (n,) int64, bary (n, 3) float64): ``n`` random
+    /// surface points, uniform by area and seeded (the points ``wavg bench roundtrip
+    /// --seed S`` draws with seed ``S + 1``).
+    #[pyo3(signature = (n, seed=0))]
+    fn sample_points<'py>(
+        &self,
+        py: Python<'py>,
+        n: usize,
+        seed: u64,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let pts = wavg::sampling::uniform_surface_points(self.inner.mesh(), n, seed)
+            .map_err(|e| to_py(py, e.into()))?;
+        let faces: Vec<i64> = pts.iter().map(|p| i64::from(p.face)).collect();
+        let bary: Vec<f64> = pts.iter().flat_map(|p| p.bary).collect();
+        Ok((array(py, faces, &[n])?, array(py, bary, &[n, 3])?))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "wavg.Surface({} vertices, {} faces, {})",
