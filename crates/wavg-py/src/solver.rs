@@ -214,7 +214,11 @@ fn paper_rows(solver: &wavg::Solver, points: &[SurfacePoint], out: &mut [f64]) -
 }
 
 /// The caller's `out` array for `q` rows of `k` weights: float64, C-contiguous, writable.
-fn out_rows<'py>(o: &Bound<'py, PyAny>, q: usize, k: usize) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+fn out_rows<'py>(
+    o: &Bound<'py, PyAny>,
+    q: usize,
+    k: usize,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
     let expected = format!("a writable C-contiguous ({q}, {k}) float64 array");
     let a = o
         .cast::<numpy::PyArray2<f64>>()
@@ -223,7 +227,11 @@ fn out_rows<'py>(o: &Bound<'py, PyAny>, q: usize, k: usize) -> PyResult<Bound<'p
         return Err(value(format!(
             "out must be {expected}; got shape {:?}{}",
             a.shape(),
-            if a.is_c_contiguous() { "" } else { ", not C-contiguous" }
+            if a.is_c_contiguous() {
+                ""
+            } else {
+                ", not C-contiguous"
+            }
         )));
     }
     Ok(a.clone())
@@ -347,12 +355,8 @@ impl Solver {
             Some(o) => out_rows(o, q, k)?,
             None => numpy::PyArray2::<f64>::zeros(py, [q, k], false),
         };
-        let mut rw = w
-            .try_readwrite()
-            .map_err(|e| value(format!("out: {e}")))?;
-        let rows = rw
-            .as_slice_mut()
-            .map_err(|e| value(format!("out: {e}")))?;
+        let mut rw = w.try_readwrite().map_err(|e| value(format!("out: {e}")))?;
+        let rows = rw.as_slice_mut().map_err(|e| value(format!("out: {e}")))?;
         let ok = py
             .detach_run(|| -> Result<_, SolveError> {
                 if !verified {
