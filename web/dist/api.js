@@ -1,21 +1,32 @@
 // The server's API (docs/serve.md): JSON routes and the binary mesh.
 
-/** POST `body` as JSON to `route`; resolves to the parsed answer, or throws its message. */
+/** The duration `name` of a `Server-Timing` header (NaN when absent). */
+function timing(header, name) {
+  const m = header && header.match(new RegExp(`${name};dur=([0-9.]+)`));
+  return m ? parseFloat(m[1]) : NaN;
+}
+
+/**
+ * POST `body` as JSON to `route`; resolves to the parsed answer with the server's time
+ * (`serverMs`: from taking the request to the answer ready; `computeMs`: the computation),
+ * or throws its message.
+ */
 export async function post(route, body, format) {
   const res = await fetch(route, {
     method: 'POST',
     headers: { 'Content-Type': 'application/json' },
     body: JSON.stringify(format ? { ...body, format } : body),
   });
-  const timing = res.headers.get('Server-Timing');
-  const serverMs = timing ? parseFloat(timing.split('dur=')[1]) : NaN;
+  const header = res.headers.get('Server-Timing');
+  const serverMs = timing(header, 'total');
+  const computeMs = timing(header, 'compute');
   if (!res.ok) {
     let message = `${route}: HTTP ${res.status}`;
     try { message = (await res.json()).error || message; } catch (_) { /* not JSON */ }
     throw new Error(message);
   }
   const data = format ? await res.text() : await res.json();
-  return { data, serverMs };
+  return { data, serverMs, computeMs };
 }
 
 /** GET a JSON route. */

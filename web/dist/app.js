@@ -6,6 +6,7 @@ import { OrbitControls } from '/vendor/three/OrbitControls.js';
 import { getJson, getMesh } from '/api.js';
 import { buildPicker, pick } from '/picking.js';
 import { Modes } from '/modes.js';
+import { Frames } from '/frame.js';
 
 const $ = (id) => document.getElementById(id);
 const view = $('view');
@@ -17,13 +18,11 @@ export function status(text, error = false) {
   statusLine.classList.toggle('error', error);
 }
 
-const renderer = new THREE.WebGLRenderer({ antialias: false });
+const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1);
 view.appendChild(renderer.domElement);
-// Two scenes: the mesh, drawn into an off-screen colour + depth target only when the view
-// or its colours change, and the overlay (anchors, curves, cages), drawn every frame over
-// a copy of that target with its depth, so a frame during a drag costs a full-screen copy
-// and the overlay rather than the whole mesh.
+// Two scenes: the mesh, drawn only when the view or its colours change, and the overlay
+// (anchors, curves, cages), drawn every frame (frame.js).
 const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 1000);
 const controls = new OrbitControls(camera, renderer.domElement);
 function lit(scene) {
@@ -36,37 +35,17 @@ function lit(scene) {
 const meshScene = lit(new THREE.Scene());
 meshScene.background = new THREE.Color(0xf4f4f2);
 const scene = lit(new THREE.Scene());
-/** The off-screen colour + depth target of the mesh, at the canvas's size. */
-function makeTarget(w, h) {
-  const t = new THREE.WebGLRenderTarget(w, h, { depthTexture: new THREE.DepthTexture(w, h) });
-  t.texture.colorSpace = THREE.SRGBColorSpace;
-  return t;
-}
-let target = makeTarget(1, 1);
-const copy = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), new THREE.ShaderMaterial({
-  uniforms: { tColor: { value: target.texture }, tDepth: { value: target.depthTexture } },
-  vertexShader: 'varying vec2 vUv; void main() { vUv = uv; gl_Position = vec4(position.xy, 0.0, 1.0); }',
-  fragmentShader: `uniform sampler2D tColor; uniform sampler2D tDepth; varying vec2 vUv;
-    void main() {
-      gl_FragColor = texture2D(tColor, vUv);
-      gl_FragDepth = texture2D(tDepth, vUv).r;
-      #include <colorspace_fragment>
-    }`,
-  depthTest: true, depthWrite: true, depthFunc: THREE.AlwaysDepth,
-}));
-copy.frustumCulled = false;
-const copyScene = new THREE.Scene();
-copyScene.add(copy);
-const copyCamera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1);
-let meshDirty = true;
+const frames = new Frames(renderer, camera, meshScene, scene);
 
 // Everything the test suite reads (measurements, state) hangs off window.wavg.
-const stats = { readyMs: null, latencies: [], serverMs: [], requests: 0 };
+// latencies: mouse move -> frame drawn; requestMs: /api/spline's round trip (JSON parsed
+// included); serverMs: its time in the server; drawMs: the frame after the answer.
+const stats = { readyMs: null, latencies: [], serverMs: [], requestMs: [], drawMs: [], requests: 0 };
 const app = {
   THREE, scene, meshScene, camera, renderer, stats, status, measure: false,
   anchors: [], // {point: [face, b0, b1, b2], pos: THREE.Vector3, weight, sphere}
   mesh: null, info: null, picker: null, radius: 1, ready: false,
-  render, invalidate: () => { meshDirty = true; }, addAnchor, setAnchor, anchorScreen, surfaceScreen, refreshAnchorList,
+  render, invalidate: () => frames.invalidate(), retire: (g) => frames.retire(g), addAnchor, setAnchor, anchorScreen, surfaceScreen, refreshAnchorList,
 };
 window.wavg = app;
 
@@ -74,30 +53,16 @@ function resize() {
   const w = view.clientWidth;
   const h = view.clientHeight;
   renderer.setSize(w, h);
-  target.dispose();
-  target.depthTexture.dispose();
-  target = makeTarget(w, h);
-  copy.material.uniforms.tColor.value = target.texture;
-  copy.material.uniforms.tDepth.value = target.depthTexture;
-  meshDirty = true;
+  frames.resize(w, h);
   camera.aspect = w / Math.max(1, h);
   camera.updateProjectionMatrix();
   render();
 }
 
-/** Draws one frame (on demand: after a change, not continuously). */
-function render() {
-  if (meshDirty) {
-    renderer.setRenderTarget(target);
-    renderer.render(meshScene, camera);
-    renderer.setRenderTarget(null);
-    meshDirty = false;
-  }
-  renderer.autoClear = true;
-  renderer.render(copyScene, copyCamera);
-  renderer.autoClear = false;
-  renderer.render(scene, camera);
-  renderer.autoClear = true;
+/** Draws one frame (on demand: after a change, not continuously); `full` redraws the
+ * whole canvas from the cached mesh. */
+function render(full = false) {
+  frames.render(full);
   if (app.measure) {
     // Wait for the frame to be drawn, so measured times include the drawing.
     const gl = renderer.getContext();
@@ -105,7 +70,7 @@ function render() {
   }
 }
 
-controls.addEventListener('change', () => { meshDirty = true; render(); });
+controls.addEventListener('change', () => { frames.invalidate(); render(); });
 new ResizeObserver(() => { if (app.mesh) resize(); }).observe(view);
 
 /** Screen (page) coordinates of a 3-D point, and whether it faces the camera. */
@@ -206,7 +171,8 @@ el.addEventListener('pointermove', (e) => {
   if (!dragging) return;
   const hit = hitAt(e.clientX, e.clientY);
   if (!hit) return;
-  modes.moveStamp = performance.now();
+  // The latency measured runs from the event (before the ray cast) to the frame drawn.
+  modes.moveStamp = e.timeStamp;
   dragging.move(hit);
 });
 el.addEventListener('pointerup', (e) => {

@@ -20,6 +20,9 @@ export class Modes {
     this.overlay = new THREE.Group();
     app.scene.add(this.overlay);
     this.lineMaterial = new THREE.LineBasicMaterial({ color: 0x1f4fd0 });
+    // The spline's line segments, rewritten in place for each answer.
+    this.curve = new THREE.LineSegments(new THREE.BufferGeometry(), this.lineMaterial);
+    this.curve.frustumCulled = false;
     this.cageMaterial = new THREE.LineBasicMaterial({ color: 0xe0602a });
     this.pointMaterial = new THREE.MeshLambertMaterial({ color: 0x1aa34a });
     this.last = {}; // the latest answer of each mode (read by the tests)
@@ -54,8 +57,13 @@ export class Modes {
     this.moveStamp = null;
     this.update()
       .then(() => {
+        const t = performance.now();
         this.app.render();
-        if (stamp !== null) this.app.stats.latencies.push(performance.now() - stamp);
+        const done = performance.now();
+        if (stamp !== null) {
+          this.app.stats.latencies.push(done - stamp);
+          this.app.stats.drawMs.push(done - t);
+        }
       })
       .catch((e) => this.app.status(e.message, true))
       .finally(() => {
@@ -89,10 +97,11 @@ export class Modes {
     return { move: (hit) => app.setAnchor(i, hit.point, hit.pos) };
   }
 
+  /** Removes what the overlay shows (geometries are disposed once erased from the canvas). */
   clearOverlay() {
     for (const c of [...this.overlay.children]) {
       this.overlay.remove(c);
-      if (c.geometry && c.geometry !== this.app.sphereGeometry) c.geometry.dispose();
+      if (c.geometry && c !== this.curve) this.app.retire(c.geometry);
     }
   }
 
@@ -115,12 +124,15 @@ export class Modes {
       case 'spline': {
         const body = this.splineBody();
         if (!body) return idle(`spline: add at least ${this.minControls()} control points`);
+        const t = performance.now();
         const { data, serverMs } = await post('/api/spline', body);
+        this.app.stats.requestMs.push(performance.now() - t);
         this.app.stats.serverMs.push(serverMs);
         this.last.spline = data.points;
         this.clearOverlay();
         this.setColors(null);
-        this.overlay.add(polyline(data.points, body.closed && !body.bezier, this.lineMaterial));
+        polyline(this.curve.geometry, data.points, body.closed && !body.bezier);
+        this.overlay.add(this.curve);
         const ok = data.points.filter((p) => p).length;
         return this.app.status(`spline: ${ok} of ${data.points.length} samples, length ${data.length.toFixed(4)}`);
       }
@@ -264,18 +276,31 @@ export class Modes {
   }
 }
 
-/** Line segments through consecutive non-null points (and back to the first if closed). */
-function polyline(points, closed, material) {
-  const seg = [];
+/** Writes into `geometry` the line segments through consecutive non-null points (and back
+ * to the first if closed), reusing its buffer when it is large enough. */
+function polyline(geometry, points, closed) {
   const n = points.length;
+  let attr = geometry.getAttribute('position');
+  if (!attr || attr.count < 2 * n) {
+    if (attr) geometry.dispose();
+    attr = new THREE.BufferAttribute(new Float32Array(6 * Math.max(n, 64)), 3);
+    attr.setUsage(THREE.DynamicDrawUsage);
+    geometry.setAttribute('position', attr);
+  }
+  const seg = attr.array;
+  let k = 0;
   for (let i = 0; i + 1 < n + (closed ? 1 : 0); i++) {
     const a = points[i];
     const b = points[(i + 1) % n];
-    if (a && b) seg.push(a[4], a[5], a[6], b[4], b[5], b[6]);
+    if (a && b) {
+      seg[k++] = a[4]; seg[k++] = a[5]; seg[k++] = a[6];
+      seg[k++] = b[4]; seg[k++] = b[5]; seg[k++] = b[6];
+    }
   }
-  const g = new THREE.BufferGeometry();
-  g.setAttribute('position', new THREE.Float32BufferAttribute(seg, 3));
-  return new THREE.LineSegments(g, material);
+  attr.clearUpdateRanges();
+  attr.addUpdateRange(0, k);
+  attr.needsUpdate = true;
+  geometry.setDrawRange(0, k / 3);
 }
 
 /** The edges of polygons over `vertices`. */

@@ -42,8 +42,11 @@ class Server:
     """A running `wavg serve MESH --port 0`; `url` is where it listens."""
 
     def __init__(self, mesh, extra=()):
+        # An embedding the server computes goes to a cache folder of the build, not $HOME's.
+        env = {**os.environ, "WAVG_CACHE_DIR": os.environ.get("WAVG_CACHE_DIR", str(ROOT / "target" / "web-cache"))}
         self.proc = subprocess.Popen(
             [wavg_bin(), "serve", mesh, "--port", "0", *extra],
+            env=env,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,

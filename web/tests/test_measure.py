@@ -61,7 +61,7 @@ def test_measure_drag_latency_and_page_ready(browser, big_server):
             page.page.mouse.click(s["x"], s["y"])
             page.idle()
         assert page.js("window.wavg.anchors.length") == 6
-        page.js("window.wavg.stats.latencies = []; window.wavg.stats.serverMs = []")
+        page.js("for (const k of ['latencies', 'serverMs', 'requestMs', 'drawMs']) window.wavg.stats[k] = []")
         start = page.js("window.wavg.anchorScreen(2)")
         m = page.page.mouse
         m.move(start["x"], start["y"])
@@ -80,6 +80,8 @@ def test_measure_drag_latency_and_page_ready(browser, big_server):
         page.idle()
         lat = page.js("window.wavg.stats.latencies")
         server_ms = page.js("window.wavg.stats.serverMs")
+        request_ms = page.js("window.wavg.stats.requestMs")
+        draw_ms = page.js("window.wavg.stats.drawMs")
         samples = page.js("window.wavg.modes.splineBody().samples")
     finally:
         page.close()
@@ -97,6 +99,9 @@ def test_measure_drag_latency_and_page_ready(browser, big_server):
         "drag_latency_ms_median": statistics.median(lat),
         "drag_latency_ms_p90": sorted(lat)[int(0.9 * len(lat))],
         "server_spline_ms_median": statistics.median(server_ms),
+        "server_spline_ms_p90": sorted(server_ms)[int(0.9 * len(server_ms))],
+        "request_ms_median": statistics.median(request_ms),
+        "draw_ms_median": statistics.median(draw_ms),
         "roundtrip_spline_ms_median_python": statistics.median(t),
         "page_ready_ms": ready,
     }

@@ -13,7 +13,7 @@ from conftest import ROOT, wavg_bin
 
 # Pixel statistics of the WebGL canvas, computed in the page (full resolution).
 SNAP = """(name) => {
-    window.wavg.render(); // the drawing buffer is not preserved: draw, then read
+    window.wavg.render(); // draw, then read
     const c = window.wavg.renderer.domElement;
     const g = document.createElement('canvas');
     g.width = c.width; g.height = c.height;
@@ -91,6 +91,36 @@ def test_clicks_and_drags_change_the_spline_as_the_api_computes_it(page, server)
     m.move(120, 60, steps=5)
     m.up()
     assert page.js("window.wavg.anchors.length") == 5
+    assert page.errors == []
+
+
+def test_a_drag_frame_equals_a_full_redraw(page):
+    """A frame during a drag erases the previous overlay and draws the new one; the pixels
+    must be those of the whole canvas redrawn from the cached mesh (no trail left)."""
+    add_anchors(page, 5)
+    target = page.visible_vertices(7)[6]
+    start = page.js("window.wavg.anchorScreen(1)")
+    m = page.page.mouse
+    m.move(start["x"], start["y"])
+    m.down()
+    for k in range(1, 11):
+        m.move(start["x"] + (target["x"] - start["x"]) * k / 10, start["y"] + (target["y"] - start["y"]) * k / 10)
+        page.idle()
+    m.up()
+    page.idle()
+    grab = """() => { const c = window.wavg.renderer.domElement; const g = document.createElement('canvas');
+        g.width = c.width; g.height = c.height; const ctx = g.getContext('2d'); ctx.drawImage(c, 0, 0);
+        window.__grab = ctx.getImageData(0, 0, c.width, c.height).data; }"""
+    page.js(grab)  # the canvas as the drag's partial frames left it
+    assert page.js("window.__grab.length") > 0
+    page.js("window.wavg.render(true)")
+    diff = page.js(
+        "(p) => { const c = window.wavg.renderer.domElement; const g = document.createElement('canvas');"
+        " g.width = c.width; g.height = c.height; const ctx = g.getContext('2d'); ctx.drawImage(c, 0, 0);"
+        " const d = ctx.getImageData(0, 0, c.width, c.height).data; let n = 0;"
+        " for (let i = 0; i < d.length; i++) if (d[i] !== window.__grab[i]) n++; return n; }"
+    )
+    assert diff == 0, f"{diff} channel values differ between the drag's frame and a full redraw"
     assert page.errors == []
 
 

@@ -147,6 +147,26 @@ pub fn existing(mesh: &ValidMesh, no_cache: bool) -> Option<PathBuf> {
     path.exists().then_some(path)
 }
 
+/// Stores `emb`, computed with [`default_options`] in `seconds` by a command that
+/// precomputes itself, as the cache entry of `mesh` (nothing with `no_cache` or without a
+/// cache folder); one line on stderr says where, or why not (a warning, not a failure).
+pub fn store_computed(mesh: &ValidMesh, name: &str, emb: &Embedding, seconds: f64, no_cache: bool) {
+    let Some(folder) = (if no_cache { None } else { dir() }) else {
+        return;
+    };
+    let key = key(mesh, &default_options(mesh.n_vertices()));
+    match store(&folder, &key, emb, mesh, name, seconds) {
+        Ok(()) => eprintln!(
+            "wavg: embedding of {name} cached in {}; later runs on this mesh reuse it",
+            folder.join(format!("{key}.wavg")).display()
+        ),
+        Err(e) => eprintln!(
+            "wavg: warning: the embedding could not be cached in {} ({e})",
+            folder.display()
+        ),
+    }
+}
+
 /// Precomputes with progress bars on stderr when it is a terminal; returns the seconds.
 fn compute(
     mesh: &ValidMesh,

@@ -26,9 +26,10 @@ the formats of `wavg spline`, `wavg decal` and `wavg remesh`. Routes and bodies:
 docs/serve.md.
 
 Without --embedding the embedding cache's entry for the mesh is used when there is one
-(the one `wavg spline` and the other commands compute); else the embedding is precomputed in memory (a tenth of the vertices as
+(the one `wavg spline` and the other commands compute); else the embedding is precomputed (a tenth of the vertices as
 landmarks, 50 to 1000) while the server already answers: the page shows the mesh and the
-progress, and the computing routes answer 503 until it is ready.
+progress, and the computing routes answer 503 until it is ready; then it is stored in the
+cache as the other commands do (not with --no-cache).
 
 Only this machine can connect unless --host names another interface (a warning is
 printed: anyone who can reach it can use the server). Ctrl-C stops the server.")]
@@ -90,13 +91,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let t = Instant::now();
         let handle = app.precompute_in_background(Some(bars));
         let app2 = app.clone();
+        let (name, no_cache) = (mesh_name.clone(), args.cache.no_cache);
         std::thread::spawn(move || {
             let _ = handle.join();
             match app2.status() {
-                wavg_serve::Status::Ready => eprintln!(
-                    "embedding ready in {:.1} s; every route answers",
-                    t.elapsed().as_secs_f64()
-                ),
+                wavg_serve::Status::Ready => {
+                    let seconds = t.elapsed().as_secs_f64();
+                    eprintln!("embedding ready in {seconds:.1} s; every route answers");
+                    if let Some(s) = app2.ready_surface()
+                        && let Some(emb) = s.embedding()
+                    {
+                        crate::cache::store_computed(s.mesh(), &name, emb, seconds, no_cache);
+                    }
+                }
                 s => eprintln!("wavg: the embedding could not be computed: {s:?}"),
             }
         });

@@ -7,9 +7,22 @@ use std::net::TcpStream;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// Starts `wavg serve ARGS --port 0`; returns the child and its address.
+/// Starts `wavg serve ARGS --port 0` (embedding cache in a folder of target/); returns the
+/// child and its address.
 fn serve(args: &[&str]) -> (Child, String) {
+    serve_cached(args, &cache_dir("serve"))
+}
+
+/// A fresh cache folder under the test's temporary folder.
+fn cache_dir(name: &str) -> std::path::PathBuf {
+    let d = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("serve-cache-{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn serve_cached(args: &[&str], cache: &std::path::Path) -> (Child, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .env("WAVG_CACHE_DIR", cache)
         .arg("serve")
         .args(args)
         .args(["--port", "0"])
@@ -64,6 +77,64 @@ fn serve_answers_and_becomes_ready() {
         child.kill().unwrap();
         child.wait().unwrap();
     }
+}
+
+/// Waits until the embedding is ready.
+fn wait_ready(addr: &str) {
+    let t = Instant::now();
+    while !get(addr, "/api/status").contains("\"ready\"") {
+        assert!(t.elapsed() < Duration::from_secs(120), "never ready");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+#[test]
+fn a_computed_embedding_is_cached_unless_no_cache() {
+    let entries = |d: &std::path::Path| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(d)
+            .map(|r| {
+                r.map(|e| e.unwrap().file_name().into_string().unwrap())
+                    .collect()
+            })
+            .unwrap_or_default();
+        v.sort();
+        v
+    };
+    let dir = cache_dir("computed");
+    let (mut child, addr) = serve_cached(&["builtin:sphere-small", "--no-cache"], &dir);
+    wait_ready(&addr);
+    std::thread::sleep(Duration::from_millis(500));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(entries(&dir).is_empty(), "{:?}", entries(&dir));
+    let (mut child, addr) = serve_cached(&["builtin:sphere-small"], &dir);
+    wait_ready(&addr);
+    let t = Instant::now();
+    while entries(&dir).len() < 2 {
+        assert!(
+            t.elapsed() < Duration::from_secs(30),
+            "not cached: {:?}",
+            entries(&dir)
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let e = entries(&dir);
+    assert!(e[0].ends_with(".json") && e[1].ends_with(".wavg"), "{e:?}");
+    // The next server loads the entry: ready at once, nothing precomputed.
+    let (mut child, addr) = serve_cached(&["builtin:sphere-small"], &dir);
+    assert!(get(&addr, "/api/status").contains("\"ready\""));
+    child.kill().unwrap();
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    child.wait().unwrap();
+    assert!(!err.contains("precomputing"), "{err}");
 }
 
 #[test]

@@ -27,6 +27,7 @@ static FILES: &[(&str, &str, &[u8])] = &[
     file!("/picking.js", JS, "picking.js"),
     file!("/modes.js", JS, "modes.js"),
     file!("/colors.js", JS, "colors.js"),
+    file!("/frame.js", JS, "frame.js"),
     file!(
         "/vendor/three/three.module.js",
         JS,

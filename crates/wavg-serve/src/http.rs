@@ -7,6 +7,7 @@ use std::net::SocketAddr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
 use std::thread::JoinHandle;
+use std::time::Instant;
 
 use tiny_http::{Header, Method, Request, Response, Server, StatusCode};
 
@@ -72,6 +73,7 @@ pub fn start(app: App, addr: &str) -> Result<Running, std::io::Error> {
 
 /// Reads, routes and answers one request.
 fn answer(app: &App, mut request: Request) {
+    let start = Instant::now();
     let method = request.method().clone();
     let url = request.url().to_owned();
     let reply = match read_body(&mut request) {
@@ -79,10 +81,13 @@ fn answer(app: &App, mut request: Request) {
             .unwrap_or_else(|_| Err(ApiError::status(500, "internal error (a bug)"))),
         Err(e) => Err(e),
     };
-    let reply = reply.unwrap_or_else(|e| {
+    let mut reply = reply.unwrap_or_else(|e| {
         let body = serde_json::json!({ "error": e.message }).to_string();
         Reply::json(body.into_bytes()).with_status(e.status)
     });
+    if reply.compute_ms.is_some() {
+        reply.total_ms = Some(start.elapsed().as_secs_f64() * 1e3);
+    }
     if reply.status == 413 {
         // The body was not read: `into_writer` would first drain it (up to its declared
         // length), so answer through tiny_http, which writes before it drains.
@@ -127,7 +132,11 @@ fn write_response(mut w: Box<dyn Write + Send>, reply: &Reply, head: bool) -> st
         reply.body.len()
     );
     if let Some(ms) = reply.compute_ms {
-        out.push_str(&format!("Server-Timing: compute;dur={ms:.3}\r\n"));
+        out.push_str(&format!("Server-Timing: compute;dur={ms:.3}"));
+        if let Some(total) = reply.total_ms {
+            out.push_str(&format!(", total;dur={total:.3}"));
+        }
+        out.push_str("\r\n");
     }
     out.push_str("\r\n");
     w.write_all(out.as_bytes())?;

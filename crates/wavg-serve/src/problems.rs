@@ -1,6 +1,7 @@
 //! The routes of the method itself: forward and inverse problems, splines, and the
 //! embedding distance.
 
+use serde::Serialize;
 use serde_json::{Value, json};
 use wavg::apps::{SplineKind, evaluate_spline};
 use wavg::{DEFAULT_TOLERANCE, ForwardOptions, ForwardResult, Normalization, SolveError, Solver};
@@ -12,15 +13,35 @@ use crate::{ApiError, App, MAX_ROWS, MAX_SAMPLES};
 /// Samples evaluated in sequence, warm-started, per parallel chunk (as `wavg spline`).
 const CHUNK: usize = 256;
 
-/// A forward result as `[face, b0, b1, b2, x, y, z]`, `null` where there is no average.
-pub(crate) fn point_json(r: &Result<ForwardResult, SolveError>) -> Value {
-    match r {
-        Ok(r) => {
-            let (p, x) = (r.point, r.position);
-            json!([p.face, p.bary[0], p.bary[1], p.bary[2], x.x, x.y, x.z])
-        }
-        Err(_) => Value::Null,
-    }
+/// A point returned: `[face, b0, b1, b2, x, y, z]`, serialized as a JSON array.
+type PointRow = (u32, f64, f64, f64, f64, f64, f64);
+
+/// A forward result as a [`PointRow`], `None` (JSON `null`) where there is no average.
+pub(crate) fn point_row(r: &Result<ForwardResult, SolveError>) -> Option<PointRow> {
+    r.as_ref().ok().map(|r| {
+        let (p, x) = (r.point, r.position);
+        (p.face, p.bary[0], p.bary[1], p.bary[2], x.x, x.y, x.z)
+    })
+}
+
+/// The answer of `/api/forward`, serialized without an intermediate `Value` tree.
+#[derive(Serialize)]
+struct Points {
+    points: Vec<Option<PointRow>>,
+}
+
+/// The answer of `/api/spline` (fields in the order a JSON object's keys are written).
+#[derive(Serialize)]
+struct SplinePoints {
+    length: f64,
+    points: Vec<Option<PointRow>>,
+}
+
+/// 200 with `answer` as JSON.
+fn reply_json(answer: &impl Serialize) -> Result<Reply, ApiError> {
+    serde_json::to_vec(answer)
+        .map(Reply::json)
+        .map_err(|e| ApiError::status(500, format!("the answer could not be written: {e}")))
 }
 
 /// A solver for the field `key`'s anchors (at least `min`).
@@ -58,8 +79,9 @@ pub(crate) fn forward(app: &App, body: &Body) -> Result<Reply, ApiError> {
         ..Default::default()
     };
     let results = solver.forward_batch(&weights, &opts);
-    let points: Vec<Value> = results.iter().map(point_json).collect();
-    Ok(Reply::value(&json!({ "points": points })))
+    reply_json(&Points {
+        points: results.iter().map(point_row).collect(),
+    })
 }
 
 /// `POST /api/inverse` `{"anchors": [...], "points": [...], "verified": false}` ->
@@ -125,10 +147,10 @@ pub(crate) fn spline(app: &App, body: &Body) -> Result<Reply, ApiError> {
         }
         return Ok(Reply::text(out));
     }
-    let points: Vec<Value> = curve.samples.iter().map(point_json).collect();
-    Ok(Reply::value(
-        &json!({ "points": points, "length": curve.length() }),
-    ))
+    reply_json(&SplinePoints {
+        length: curve.length(),
+        points: curve.samples.iter().map(point_row).collect(),
+    })
 }
 
 /// Whether `"format"` asks for the command line's file format `name` (else JSON).

@@ -11,13 +11,15 @@ use crate::parse::Body;
 use crate::state::Status;
 use crate::{ApiError, App};
 
-/// An answer: status, content type, body, and the time the computation took (sent as a
-/// `Server-Timing: compute;dur=MS` header).
+/// An answer: status, content type, body, the time the computation took (its JSON
+/// included) and the time from taking the request to the answer ready to send (sent as a
+/// `Server-Timing: compute;dur=MS, total;dur=MS` header).
 pub(crate) struct Reply {
     pub(crate) status: u16,
     pub(crate) content_type: &'static str,
     pub(crate) body: Vec<u8>,
     pub(crate) compute_ms: Option<f64>,
+    pub(crate) total_ms: Option<f64>,
 }
 
 impl Reply {
@@ -28,6 +30,7 @@ impl Reply {
             content_type: "application/json",
             body,
             compute_ms: None,
+            total_ms: None,
         }
     }
 

@@ -120,6 +120,15 @@ impl App {
         &self.inner.mesh_bytes
     }
 
+    /// The surface with its embedding once it is ready (to store a computed embedding).
+    pub fn ready_surface(&self) -> Option<Surface> {
+        self.inner
+            .ready
+            .read()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
+    }
+
     /// The surface with its embedding, or 503 while it is being computed.
     pub(crate) fn surface(&self) -> Result<Surface, ApiError> {
         if let Some(s) = &*self.inner.ready.read().unwrap_or_else(|e| e.into_inner()) {

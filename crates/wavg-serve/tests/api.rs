@@ -180,6 +180,58 @@ fn spline_gives_the_samples_of_evaluate_spline_in_json_and_text() {
 }
 
 #[test]
+fn spline_numbers_are_the_library_values_exactly_and_timed() {
+    let s = surface();
+    let control = json!([[100, 0.2, 0.3, 0.5], 400, 600, [700, 0.125, 0.625, 0.25]]);
+    let anchors = [
+        Anchor::Point(SurfacePoint::new(100, [0.2, 0.3, 0.5])),
+        Anchor::Vertex(400),
+        Anchor::Vertex(600),
+        Anchor::Point(SurfacePoint::new(700, [0.125, 0.625, 0.25])),
+    ];
+    let curve = evaluate_spline(
+        &s.solver(anchors).unwrap(),
+        SplineKind::BSpline {
+            degree: 3,
+            closed: false,
+        },
+        400,
+        256,
+    )
+    .unwrap();
+    let a = post("/api/spline", &json!({"control": control, "samples": 400}));
+    assert_eq!(a.status, 200);
+    // Server-Timing: the computation, then the whole request; both durations in ms.
+    let timing = a.header("server-timing").unwrap().to_owned();
+    let durs: Vec<f64> = timing
+        .split(", ")
+        .zip(["compute;dur=", "total;dur="])
+        .map(|(part, name)| part.strip_prefix(name).unwrap().parse().unwrap())
+        .collect();
+    assert!(
+        durs.len() == 2 && durs[0] >= 0.0 && durs[1] >= durs[0],
+        "{timing}"
+    );
+    let j = a.json();
+    let pts = j["points"].as_array().unwrap();
+    assert_eq!(pts.len(), 400);
+    for (p, r) in pts.iter().zip(&curve.samples) {
+        let r = r.as_ref().unwrap();
+        let want = [r.point.bary[0], r.point.bary[1], r.point.bary[2]]
+            .into_iter()
+            .chain(r.position.iter().copied());
+        assert_eq!(p[0].as_u64(), Some(u64::from(r.point.face)));
+        for (k, w) in want.enumerate() {
+            assert_eq!(p[1 + k].as_f64().unwrap().to_bits(), w.to_bits(), "{p}");
+        }
+    }
+    assert_eq!(
+        j["length"].as_f64().unwrap().to_bits(),
+        curve.length().to_bits()
+    );
+}
+
+#[test]
 fn distance_is_the_embedding_distance_and_zero_at_the_source() {
     let s = surface();
     let a = post("/api/distance", &json!({"source": 123}));
@@ -291,6 +343,30 @@ fn the_page_and_three_come_from_memory() {
                 .starts_with("text/javascript")
         );
     }
+    // Every file of web/dist is served, with its bytes.
+    let dist = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../web/dist");
+    let mut dirs = vec![dist.clone()];
+    let mut files = 0;
+    while let Some(dir) = dirs.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let path = e.unwrap().path();
+            if path.is_dir() {
+                dirs.push(path);
+                continue;
+            }
+            let url = path
+                .strip_prefix(&dist)
+                .unwrap()
+                .to_str()
+                .unwrap()
+                .to_owned();
+            let a = get(&format!("/{url}"));
+            assert_eq!(a.status, 200, "{url} is in web/dist but not served");
+            assert_eq!(a.body, std::fs::read(&path).unwrap(), "{url}");
+            files += 1;
+        }
+    }
+    assert!(files >= 10, "{files} files in web/dist");
     for path in [
         "/../Cargo.toml",
         "/etc/passwd",

@@ -124,8 +124,6 @@ pub struct Solver {
     projector: Arc<Projector>,
     anchors: AnchorSet,
     gamma: f64,
-    /// Mean 3-D edge length of the mesh (the unit of round-trip tolerances).
-    mean_edge: f64,
 }
 
 impl Solver {
@@ -136,7 +134,6 @@ impl Solver {
     ) -> Result<Self, SolveError> {
         let set = AnchorSet::with_anchors(projector.embedded().clone(), anchors)?;
         Ok(Self {
-            mean_edge: wavg_mesh::geometry::mean_edge_length(projector.embedded().mesh()),
             projector,
             anchors: set,
             gamma: DEFAULT_GAMMA,
@@ -154,7 +151,6 @@ impl Solver {
             ));
         }
         Ok(Self {
-            mean_edge: wavg_mesh::geometry::mean_edge_length(projector.embedded().mesh()),
             projector,
             anchors,
             gamma: DEFAULT_GAMMA,
@@ -189,7 +185,7 @@ impl Solver {
     /// assert!(s.mean_edge_length() > 0.25 && s.mean_edge_length() < 0.36);
     /// ```
     pub fn mean_edge_length(&self) -> f64 {
-        self.mean_edge
+        self.projector.mesh_mean_edge_length()
     }
 
     /// The projector.

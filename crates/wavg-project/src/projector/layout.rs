@@ -225,6 +225,7 @@ impl Projector {
             faces,
             bvh,
             cones: std::sync::OnceLock::new(),
+            mesh_mean_edge: std::sync::OnceLock::new(),
             reach,
             walk_origin,
             walk_inv_step,

@@ -84,6 +84,8 @@ pub struct Projector {
     bvh: Bvh,
     /// Built on first use: most workloads' searches end before they would ask.
     cones: std::sync::OnceLock<Cones>,
+    /// Mean 3-D edge length of the mesh, computed on first use.
+    mesh_mean_edge: std::sync::OnceLock<f64>,
     /// Per-vertex reach, filled on first use.
     reach: reach::Reach,
     walk_origin: Vec8,
@@ -103,6 +105,14 @@ impl Projector {
     /// The embedded mesh.
     pub fn embedded(&self) -> &Arc<EmbeddedMesh> {
         &self.emb
+    }
+
+    /// Mean 3-D edge length of the mesh (each interior edge counted twice), computed once
+    /// and shared by every solver on this projector.
+    pub fn mesh_mean_edge_length(&self) -> f64 {
+        *self
+            .mesh_mean_edge
+            .get_or_init(|| wavg_mesh::geometry::mean_edge_length(self.emb.mesh()))
     }
 
     /// Tangent frame of vertex `v` (orthonormal rows, as stored in f32).
