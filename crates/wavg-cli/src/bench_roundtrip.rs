@@ -95,7 +95,7 @@ struct JsonReport<'a> {
 }
 
 /// The 1-minute load average (Linux), to judge how busy the machine was.
-fn load_average() -> String {
+pub(crate) fn load_average() -> String {
     std::fs::read_to_string("/proc/loadavg")
         .ok()
         .and_then(|s| s.split_whitespace().next().map(str::to_string))

@@ -10,6 +10,7 @@ mod apps_common;
 mod bench_load;
 mod bench_project;
 mod bench_roundtrip;
+mod bench_spline;
 mod cache;
 mod cache_cmd;
 mod common;
@@ -104,6 +105,8 @@ enum BenchCommand {
     Project(bench_project::Args),
     /// The paper's Table 1 protocol: inverse then forward round trips.
     Roundtrip(bench_roundtrip::Args),
+    /// Time per sample of a curve on the surface, checked against cold answers.
+    Spline(bench_spline::Args),
 }
 
 /// The `wavg` command: every subcommand with its options and help text.
@@ -135,6 +138,7 @@ pub fn main() -> ExitCode {
         Command::Bench(BenchCommand::Load(a)) => bench_load::run(a),
         Command::Bench(BenchCommand::Project(a)) => bench_project::run(a),
         Command::Bench(BenchCommand::Roundtrip(a)) => bench_roundtrip::run(a),
+        Command::Bench(BenchCommand::Spline(a)) => bench_spline::run(a),
         Command::Cache(c) => cache_cmd::run(c),
         Command::Completions(a) => completions::run(a),
     };

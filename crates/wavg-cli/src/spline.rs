@@ -73,7 +73,7 @@ struct JsonReport<'a> {
 }
 
 /// Samples evaluated in sequence, warm-started, per parallel chunk.
-const CHUNK: usize = 256;
+pub(crate) const CHUNK: usize = 256;
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {

@@ -201,6 +201,14 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "noisy-sphere",
         "icosphere (level 4) with seeded noise of 0.2 mean edge lengths",
     ),
+    (
+        "genus2",
+        "plate with 2 square holes, 51,390 vertices, genus 2 (spline benchmark)",
+    ),
+    (
+        "genus12",
+        "thin plate with 4x3 square holes, 7,146 vertices, genus 12, thin straps",
+    ),
 ];
 
 /// A procedural mesh by name (see [`BUILTINS`]).
@@ -217,6 +225,8 @@ pub fn builtin(name: &str) -> Result<TriMesh, MeshError> {
         "grid" => grid(40, 20, 2.0, 1.0),
         "bump" => bump_sphere(4, 0.5),
         "noisy-sphere" => with_noise(icosphere(4), 0.2, 1),
+        "genus2" => holed_plate(2, 1, 44, 2.0 / 44.0),
+        "genus12" => holed_plate(4, 3, 8, 0.05),
         _ => {
             let names: Vec<&str> = BUILTINS.iter().map(|b| b.0).collect();
             return Err(MeshError::InvalidArgument(format!(

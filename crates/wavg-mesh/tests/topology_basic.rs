@@ -62,3 +62,22 @@ fn builtins_are_valid() {
         assert!(a.report.is_valid(), "{name}: {}", a.report);
     }
 }
+
+/// The benchmark plates have the genus and vertex count their descriptions give.
+#[test]
+fn benchmark_plates_have_their_genus_and_size() {
+    for (name, genus, n) in [("genus2", 2, 51_390), ("genus12", 12, 7_146)] {
+        let m = procedural::builtin(name).unwrap();
+        let st = analyze(&m).stats;
+        assert_eq!(st.genus, Some(genus), "{name}");
+        assert_eq!(m.n_vertices(), n, "{name}");
+        let desc = procedural::BUILTINS.iter().find(|b| b.0 == name).unwrap().1;
+        let count = n.to_string();
+        let shown = format!(
+            "{},{}",
+            &count[..count.len() - 3],
+            &count[count.len() - 3..]
+        );
+        assert!(desc.contains(&shown), "{name}: {desc}");
+    }
+}
