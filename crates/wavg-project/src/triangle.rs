@@ -345,11 +345,14 @@ impl System {
                 return renormalize([xi[0] + d[0], xi[1] + d[1], xi[2] + d[2]]).ok_or(None);
             }
             if t < 1e-9 {
-                // On the boundary and pushing out: slide (clamp the full step); twice in
-                // a row means the root is outside.
-                stuck += 1;
-                if stuck >= 2 {
-                    return Err(block);
+                // On the boundary and pushing out: slide (clamp the full step). Pushing out
+                // by more than BARY_EPS twice in a row means the root is outside; by less,
+                // the root lies on this edge (up to rounding) and sliding converges to it.
+                if block.is_some_and(|k| -d[k] > BARY_EPS) {
+                    stuck += 1;
+                    if stuck >= 2 {
+                        return Err(block);
+                    }
                 }
                 xi = renormalize([xi[0] + d[0], xi[1] + d[1], xi[2] + d[2]]).ok_or(None)?;
             } else {
