@@ -103,3 +103,17 @@ def test_cancel_is_seen_at_once_in_every_stage(at):
     waited = time.monotonic() - asked[0]
     assert S.embedding is None
     assert waited < 0.5, waited
+
+
+def test_the_callable_sees_every_stage_in_order():
+    # However short a stage, the callable is called for it: a small mesh passes through
+    # some stages between two polls.
+    from conftest import torus
+
+    calls = []
+    S = wavg.Surface(*torus(40, 20))
+    S.precompute(landmarks=100, progress=lambda *a: calls.append(a))
+    stages = [s for i, (s, _, _) in enumerate(calls) if i == 0 or calls[i - 1][0] != s]
+    assert stages == ["decimate", "geodesics", "mds", "lsmesh", "quality"], calls
+    assert all(0 <= d <= t for _, d, t in calls)
+    assert calls[-1][1] == calls[-1][2], calls[-1]

@@ -1,12 +1,13 @@
 //! Long computations that Python can watch and stop: the work runs on a worker thread
 //! without the GIL while the calling thread checks for signals (Ctrl-C) and calls the
-//! progress callable, about ten times a second. Python code is only ever called from the
+//! progress callable at the start, at every change of stage and about ten times a second in
+//! between, so every stage is seen however short. Python code is only ever called from the
 //! calling thread. A cancelled call returns at once: the worker owns its inputs and stops at
 //! its next checkpoint in the background (a long sparse factorization has none), its result
 //! dropped.
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use pyo3::exceptions::PyRuntimeError;
@@ -28,20 +29,20 @@ const STAGES: [Stage; 5] = [
 /// Steps of a stage reported to Python (`done` out of this `total`).
 pub(crate) const TOTAL: u64 = 1000;
 
-/// The latest progress and the stop flag, shared with the worker.
+/// Each stage's latest fraction (as `f64` bits) and the stop flag, shared with the worker.
+/// Some stages run alongside others (the quality check's fast marching with the
+/// decimation, the least-squares factorization with the geodesics), so the stage shown is
+/// the first one in pipeline order that has not finished.
 #[derive(Default)]
 pub(crate) struct Shared {
-    stage: AtomicU8,
-    fraction: AtomicU64,
+    fractions: [AtomicU64; 5],
     cancel: AtomicBool,
 }
 
 impl Progress for Shared {
     fn report(&self, stage: Stage, fraction: f64) {
-        let code = STAGES.iter().position(|s| *s == stage).unwrap_or(0) as u8;
-        self.stage.store(code, Ordering::Relaxed);
-        self.fraction
-            .store(fraction.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
+        let code = STAGES.iter().position(|s| *s == stage).unwrap_or(0);
+        self.fractions[code].store(fraction.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
     }
 
     fn cancelled(&self) -> bool {
@@ -50,22 +51,62 @@ impl Progress for Shared {
 }
 
 impl Shared {
-    /// `(stage name, done, total)` now.
-    fn state(&self) -> (&'static str, u64, u64) {
-        let stage = STAGES[usize::from(self.stage.load(Ordering::Relaxed)).min(4)];
-        let f = f64::from_bits(self.fraction.load(Ordering::Relaxed));
-        (stage.name(), (f * TOTAL as f64).round() as u64, TOTAL)
+    /// The stage shown now (an index into [`STAGES`], 5 when all have finished) and its
+    /// fraction.
+    fn current(&self) -> (usize, f64) {
+        (0..STAGES.len())
+            .map(|i| (i, f64::from_bits(self.fractions[i].load(Ordering::Relaxed))))
+            .find(|&(_, f)| f < 1.0)
+            .unwrap_or((STAGES.len(), 1.0))
+    }
+
+    /// The calls owed to the callable: `(stage, total, total)` for each stage finished since
+    /// the last calls (`shown` counts the stages already shown as finished), then the current
+    /// `(stage, done, total)`. `finished`: the work has succeeded, so every stage has finished.
+    fn calls(&self, shown: &mut usize, finished: bool) -> Vec<(&'static str, u64, u64)> {
+        let (current, f) = if finished {
+            (STAGES.len(), 1.0)
+        } else {
+            self.current()
+        };
+        let mut calls: Vec<_> = (*shown..current)
+            .map(|i| (STAGES[i].name(), TOTAL, TOTAL))
+            .collect();
+        *shown = current.max(*shown);
+        if let Some(stage) = STAGES.get(current) {
+            calls.push((stage.name(), (f * TOTAL as f64).round() as u64, TOTAL));
+        }
+        calls
     }
 }
 
-/// Runs `work` on a worker thread; meanwhile calls `callback(stage, done, total)` at every
-/// poll (a `False` return cancels: `CancelledError`) and checks for signals. A raised
-/// exception (`KeyboardInterrupt` from Ctrl-C, or the callback's) cancels the work and is
-/// raised at once; the worker is left to stop at its next checkpoint.
+/// Calls `callback` with each of `calls`; `Ok(false)` when one answered `False` (the later
+/// calls are not made), the callable's exception as the error.
+fn tell(
+    py: Python<'_>,
+    callback: &Bound<'_, PyAny>,
+    calls: Vec<(&'static str, u64, u64)>,
+) -> PyResult<bool> {
+    let no = pyo3::types::PyBool::new(py, false);
+    for args in calls {
+        if callback.call1(args)?.is(&*no) {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}
+
+/// Runs `work` on a worker thread; meanwhile checks for signals and calls
+/// `callback(stage, done, total)` at once, at every new stage (each stage is shown, however
+/// short) and at every poll. A `False` answer (`CancelledError`) or a raised exception
+/// (`KeyboardInterrupt` from Ctrl-C, or the callable's) cancels the work and is raised at
+/// once; the worker is left to stop at its next checkpoint. `succeeded` tells whether the
+/// result means every stage ran (the last call then shows them all finished).
 pub(crate) fn watch<T: Send + 'static>(
     py: Python<'_>,
     callback: Option<&Bound<'_, PyAny>>,
     work: impl FnOnce(&Shared) -> T + Send + 'static,
+    succeeded: impl FnOnce(&T) -> bool,
 ) -> PyResult<T> {
     let shared = Arc::new(Shared::default());
     let s = Arc::clone(&shared);
@@ -73,24 +114,26 @@ pub(crate) fn watch<T: Send + 'static>(
         .name("wavg-watched".into())
         .spawn(move || crate::args::run(|| work(&s)))
         .map_err(|e| PyRuntimeError::new_err(format!("wavg: cannot start a thread: {e}")))?;
+    let mut shown = 0;
+    let mut first = true;
     loop {
-        let finished = py.detach(|| {
-            let t = Instant::now();
-            while !handle.is_finished() && t.elapsed() < POLL {
-                std::thread::sleep(Duration::from_millis(5));
-            }
-            handle.is_finished()
-        });
+        let finished = !first
+            && py.detach(|| {
+                let t = Instant::now();
+                let stage = shared.current().0;
+                while !handle.is_finished() && t.elapsed() < POLL && shared.current().0 == stage {
+                    std::thread::sleep(Duration::from_millis(5));
+                }
+                handle.is_finished()
+            });
+        first = false;
         if finished {
             break;
         }
         let stop = py.check_signals().err().or_else(|| {
-            let cb = callback?;
-            match cb.call1(shared.state()) {
-                Ok(r) if r.is(&*pyo3::types::PyBool::new(py, false)) => {
-                    Some(crate::errors::cancelled(py))
-                }
-                Ok(_) => None,
+            match tell(py, callback?, shared.calls(&mut shown, false)) {
+                Ok(true) => None,
+                Ok(false) => Some(crate::errors::cancelled(py)),
                 Err(e) => Some(e),
             }
         });
@@ -99,10 +142,13 @@ pub(crate) fn watch<T: Send + 'static>(
             return Err(e);
         }
     }
-    if let Some(cb) = callback {
-        cb.call1(shared.state())?;
-    }
-    handle
+    let result = handle
         .join()
-        .map_err(|_| PyRuntimeError::new_err("wavg: internal error (a worker thread panicked)"))
+        .map_err(|_| PyRuntimeError::new_err("wavg: internal error (a worker thread panicked)"))?;
+    if let Some(cb) = callback {
+        // The work has ended (every stage has when it succeeded): a `False` now cancels
+        // nothing.
+        tell(py, cb, shared.calls(&mut shown, succeeded(&result)))?;
+    }
+    Ok(result)
 }

@@ -176,8 +176,9 @@ impl Surface {
     /// Computes the 8-D embedding (landmarks, geodesic distances, MDS, least-squares mesh)
     /// and uses it from now on; returns the report (the keys of ``wavg precompute --json``).
     /// ``threads``: None for all cores. ``progress``: True draws a text bar on a terminal,
-    /// False nothing, a callable ``(stage: str, done: int, total: int)`` is called about ten
-    /// times a second (also while the progress stands still) and cancels (``CancelledError``)
+    /// False nothing, a callable ``(stage: str, done: int, total: int)`` is called at the
+    /// start, at every new stage and about ten times a second in between (also while the
+    /// progress stands still) and cancels (``CancelledError``)
     /// by returning ``False``. Ctrl-C stops it within a second (``KeyboardInterrupt``). A
     /// cancelled call returns at once; the abandoned work stops at its next checkpoint in
     /// the background. On any error the surface is unchanged.
@@ -221,9 +222,12 @@ impl Surface {
             seed,
             ..Default::default()
         };
-        let result = progress::watch(py, callback.as_ref(), move |p| {
-            par.install(|| s.precompute(&opts, p).map(|r| (r, s)))
-        });
+        let result = progress::watch(
+            py,
+            callback.as_ref(),
+            move |p| par.install(|| s.precompute(&opts, p).map(|r| (r, s))),
+            |r| matches!(r, Ok(Ok(_))),
+        );
         if let Some(bar) = &callback {
             if bar.hasattr("close")? {
                 bar.call_method0("close")?;
