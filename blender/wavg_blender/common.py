@@ -80,8 +80,3 @@ def closest_points(tree, V, F, points):
         faces[i], xyz[i], dist[i] = index, loc, d
         bary[i] = poly_3d_calc(corners, loc)
     return faces, bary, xyz, dist
-
-
-def as_float_rows(xyz):
-    """``xyz`` as a flat float32 array (for ``foreach_set``)."""
-    return np.ascontiguousarray(xyz, dtype=np.float32).ravel()

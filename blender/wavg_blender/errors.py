@@ -16,8 +16,14 @@ def add_vendor_path():
         sys.path.insert(0, VENDOR)
 
 
+_MODULE = []
+
+
 def wavg():
-    """The ``wavg`` module, or an :class:`AddonError` saying why it cannot be imported."""
+    """The ``wavg`` module, or an :class:`AddonError` saying why it cannot be imported
+    (looked up once: live updates call this at every move)."""
+    if _MODULE:
+        return _MODULE[0]
     add_vendor_path()
     try:
         import wavg as module
@@ -26,6 +32,7 @@ def wavg():
             f"the wavg Python package cannot be imported ({e}); install the add-on from "
             "wavg_blender.zip, which ships it, and make sure NumPy is available"
         ) from e
+    _MODULE.append(module)
     return module
 
 

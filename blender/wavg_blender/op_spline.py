@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 
 from . import surfaces
-from .common import ActiveMeshOperator, active_mesh, as_float_rows, closest_points
+from .common import ActiveMeshOperator, active_mesh, closest_points
 from .errors import AddonError, describe, wavg
 from .meshdata import selected_vertices
 
@@ -21,13 +21,15 @@ def evaluate(surface, faces, bary, settings):
         )
     except (w.WavgError, ValueError, TypeError) as e:
         raise AddonError(f"wavg cannot make this spline: {describe(e)}") from e
-    if not bool(np.any(pts.ok)):
+    if not pts.ok.any():
         raise AddonError("no sample of this spline has a point on the surface")
     return pts
 
 
 def runs(ok):
     """``(start, stop)`` of each run of consecutive valid samples."""
+    if ok.all():
+        return [(0, len(ok))]
     edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(np.int8), [0]])))
     return list(zip(edges[::2], edges[1::2]))
 
@@ -44,9 +46,9 @@ def write_curve(curve, xyz, ok, closed):
         for a, b in parts:
             curve.splines.new('POLY').points.add(int(b - a) - 1)
     for sp, (a, b) in zip(curve.splines, parts):
-        xyzw = np.ones((b - a, 4))
+        xyzw = np.ones((b - a, 4), dtype=np.float32)
         xyzw[:, :3] = xyz[a:b]
-        sp.points.foreach_set("co", as_float_rows(xyzw))
+        sp.points.foreach_set("co", xyzw.ravel())
         sp.use_cyclic_u = cyclic
     curve.update_tag()
 
@@ -126,8 +128,15 @@ class WAVG_OT_surface_spline(ActiveMeshOperator, bpy.types.Operator):
 
 
 def store_control(curve_obj, faces, bary):
-    curve_obj["wavg_faces"] = [int(f) for f in faces]
-    curve_obj["wavg_bary"] = [float(x) for x in np.asarray(bary).ravel()]
+    curve_obj["wavg_faces"] = np.asarray(faces, dtype=np.int64).tolist()
+    curve_obj["wavg_bary"] = np.asarray(bary, dtype=np.float64).ravel().tolist()
+
+
+def unchanged(curve_obj, faces, bary):
+    """Whether the curve was last evaluated for the control points ``(faces, bary)``."""
+    old_faces = np.array(curve_obj["wavg_faces"], dtype=np.int64)
+    old_bary = np.array(curve_obj["wavg_bary"], dtype=np.float64).reshape(-1, 3)
+    return np.array_equal(faces, old_faces) and np.array_equal(bary, old_bary)
 
 
 def control_objects(curve_obj):
@@ -139,6 +148,36 @@ def control_objects(curve_obj):
     return sorted(cvs, key=lambda c: c.get("wavg_index", 0))
 
 
+# The last control points of each curve and where they snapped to, by curve name: while a
+# control point is dragged only it is looked up again. The snap is a function of the point
+# and the mesh (the key), so an entry never goes stale.
+_SNAPS = {}
+
+
+def snap(name, key, surface, points):
+    """``((faces, bary, xyz, dist), moved)``: the closest surface point of each of
+    ``points`` (object-space tuples), reusing the answers of points unchanged since the last
+    call; ``moved`` tells whether any point changed."""
+    old = _SNAPS.get(name)
+    if old is not None and old[0] == key and len(old[1]) == len(points):
+        moved = [i for i, (p, q) in enumerate(zip(points, old[1])) if p != q]
+        if not moved:
+            return old[2], False
+        faces, bary, xyz, dist = (a.copy() for a in old[2])
+    else:
+        moved = range(len(points))
+        faces, bary, xyz, dist = (
+            np.empty(len(points), dtype=np.int64), np.empty((len(points), 3)),
+            np.empty((len(points), 3)), np.empty(len(points)),
+        )
+    V, F, tree, _diagonal = surfaces.geometry(key, surface)
+    for i, row in zip(moved, zip(*closest_points(tree, V, F, [points[i] for i in moved]))):
+        faces[i], bary[i], xyz[i], dist[i] = row
+    result = (faces, bary, xyz, dist)
+    _SNAPS[name] = (key, points, result)
+    return result, True
+
+
 def follow_controls(curve_obj, force=False):
     """Slides the curve's control Empties onto the surface and re-evaluates the curve when
     one of them moved (or ``force``); True when the curve changed. This is the live update
@@ -148,18 +187,20 @@ def follow_controls(curve_obj, force=False):
     surface = surfaces.cached(key)
     if mesh_obj is None or surface is None:
         return False
-    V, F, tree, diagonal = surfaces.geometry(key, surface)
     cvs = control_objects(curve_obj)
     if len(cvs) < 2:
         return False
-    to_local = mesh_obj.matrix_world.inverted()
-    points = [
-        c.location if c.parent == mesh_obj else to_local @ c.matrix_world.translation for c in cvs
-    ]
-    faces, bary, xyz, dist = closest_points(tree, V, F, points)
-    old_faces = np.array(curve_obj["wavg_faces"], dtype=np.int64)
-    old_bary = np.array(curve_obj["wavg_bary"], dtype=np.float64).reshape(-1, 3)
-    if not force and np.array_equal(faces, old_faces) and np.array_equal(bary, old_bary):
+    to_local = None
+    points = []
+    for c in cvs:
+        if c.parent == mesh_obj:
+            points.append(tuple(c.location))
+        else:
+            if to_local is None:
+                to_local = mesh_obj.matrix_world.inverted()
+            points.append(tuple(to_local @ c.matrix_world.translation))
+    (faces, bary, xyz, dist), moved = snap(curve_obj.name, key, surface, points)
+    if not (force or moved) and unchanged(curve_obj, faces, bary):
         return False
     try:
         pts = evaluate(surface, faces, bary, settings_of(curve_obj))
@@ -167,7 +208,7 @@ def follow_controls(curve_obj, force=False):
         return False
     write_curve(curve_obj.data, pts.xyz, np.asarray(pts.ok, dtype=bool), curve_obj["wavg_closed"])
     store_control(curve_obj, faces, bary)
-    tol = 1e-9 * diagonal
+    tol = 1e-9 * surfaces.geometry(key, surface)[3]
     for c, p, d in zip(cvs, xyz, dist):
         if d > tol and c.parent == mesh_obj:
             c.location = p
