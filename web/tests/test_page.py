@@ -201,10 +201,30 @@ def test_downloads_are_the_command_lines_files(page, server, tmp_path):
     assert sum(line.startswith("v ") for line in obj) == info["vertices"]
     assert sum(line.startswith("vt ") for line in obj) == info["vertices"]
     faces = [line for line in obj if line.startswith("f ")]
-    assert len(faces) == info["faces"] and all(len(f.split()) == 4 and "/" in f for f in faces)
+    assert len(faces) == info["faces"] and all(len(f.split()) == 4 for f in faces)
+    # A face with a marked corner has no texture coordinates (it shows untextured).
+    marked = set(page.js("window.wavg.modes.last.decal.marked"))
+    assert marked, "this decal marks no vertex: the test shows nothing"
+    for f in faces:
+        corners = [int(c.split("/")[0]) - 1 for c in f.split()[1:]]
+        assert ("/" in f) == (not marked.intersection(corners)), f
     uv = page.js("window.wavg.modes.last.decal.uv")
     vts = [float(x) for line in obj if line.startswith("vt ") for x in line.split()[1:]]
     assert vts == pytest.approx([x for p in uv for x in p], abs=1e-12)
+    # `wavg decal` with the same anchors and (u, v) writes the same file.
+    if os.environ.get("WAVG_SERVE_EMBEDDING") is None:
+        body = page.js("window.wavg.modes.decalBody()")
+        anchors, uvs = tmp_path / "anchors.txt", tmp_path / "uv.txt"
+        anchors.write_text("".join(
+            f"v {a}\n" if isinstance(a, int) else f"f {a[0]} {a[1]!r} {a[2]!r} {a[3]!r}\n"
+            for a in body["anchors"]))
+        uvs.write_text("".join(f"{u!r} {v!r}\n" for u, v in body["uv"]))
+        cli = subprocess.run(
+            [wavg_bin(), "decal", "--mesh", mesh, "--anchors", str(anchors), "--uv", str(uvs),
+             "--max-negative", repr(body.get("max_negative", -0.1)), "-o", "-"],
+            check=True, capture_output=True, text=True,
+        ).stdout
+        assert cli.splitlines() == obj
     page.page.select_option("#mode", "remesh")
     page.idle()
     obj = download(page, "#dl-remesh").splitlines()

@@ -40,9 +40,11 @@ pub mod internal {
 }
 
 mod decal;
+mod decal_obj;
 mod morph;
 
 pub use decal::{Decal, DecalReport, DecalUv, decal_uv, decal_vertices};
+pub use decal_obj::{DECAL_MATERIAL, PLAIN_MATERIAL, untextured_faces, write_decal_obj};
 pub use morph::{MorphReport, harmonic_fill, morph_frames};
 mod error;
 mod render;

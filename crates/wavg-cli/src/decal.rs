@@ -5,13 +5,13 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use wavg::apps::{DecalReport, decal_vertices};
+use wavg::apps::{DecalReport, decal_vertices, untextured_faces, write_decal_obj};
 
 use crate::CliError;
 use crate::apps_common::{embed, mesh_and_anchors};
 use crate::common::one_line;
-use crate::decal_material::{self, PLAIN, TEXTURED};
-use crate::textio::{self, located, write_numbers};
+use crate::decal_material;
+use crate::textio::{self, located};
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -124,39 +124,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let seconds = t.elapsed().as_secs_f64();
     let mesh = surface.mesh();
     let material = decal_material::write(&args.output, args.texture.as_deref())?;
-    let marked_face = |t: &[u32; 3]| t.iter().any(|&v| decal.uv.marked[v as usize]);
+    let mtllib = material.as_ref().map(decal_material::Material::file_name);
     textio::write_atomic(&args.output, |w: &mut dyn Write| {
-        if let Some(m) = &material {
-            writeln!(w, "mtllib {}", m.file_name())?;
-        }
-        for p in &mesh.positions {
-            write!(w, "v ")?;
-            write_numbers(w, p.iter().copied())?;
-            writeln!(w)?;
-        }
-        for p in &decal.uv.uv {
-            write!(w, "vt ")?;
-            write_numbers(w, p.iter().copied())?;
-            writeln!(w)?;
-        }
-        let mut current = None;
-        for t in &mesh.triangles {
-            let plain = marked_face(t);
-            if material.is_some() && current != Some(plain) {
-                let name = if plain { PLAIN } else { TEXTURED };
-                writeln!(w, "usemtl {name}")?;
-                current = Some(plain);
-            }
-            let [a, b, c] = t.map(|v| v + 1);
-            if plain {
-                writeln!(w, "f {a} {b} {c}")?;
-            } else {
-                writeln!(w, "f {a}/{a} {b}/{b} {c}/{c}")?;
-            }
-        }
-        Ok(())
+        write_decal_obj(w, mesh, &decal.uv, mtllib.as_deref())
     })?;
-    let untextured_faces = mesh.triangles.iter().filter(|t| marked_face(t)).count();
+    let untextured_faces = untextured_faces(mesh, &decal.uv);
     let marked: Vec<usize> = (0..mesh.n_vertices())
         .filter(|&v| decal.uv.marked[v])
         .collect();

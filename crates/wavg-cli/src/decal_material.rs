@@ -5,16 +5,11 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use wavg::apps::Image;
+use wavg::apps::{DECAL_MATERIAL as TEXTURED, Image, PLAIN_MATERIAL as PLAIN};
 
 use crate::CliError;
 use crate::common::one_line;
 use crate::textio;
-
-/// Material of the faces whose three corners have decal coordinates.
-pub const TEXTURED: &str = "decal";
-/// Material of the faces with a marked corner (written without texture coordinates).
-pub const PLAIN: &str = "plain";
 
 /// What was written beside the OBJ.
 pub struct Material {

@@ -2,7 +2,7 @@
 //! starts remeshing from.
 
 use serde_json::{Value, json};
-use wavg::apps::{BaseMesh, Remesher, decal_vertices, polygons_to_obj};
+use wavg::apps::{BaseMesh, Remesher, decal_vertices, polygons_to_obj, write_decal_obj};
 use wavg::{DecimateOptions, NoProgress, Vector3};
 
 use crate::parse::{self, Body};
@@ -43,20 +43,7 @@ pub(crate) fn decal(app: &App, body: &Body) -> Result<Reply, ApiError> {
     let mesh = surface.mesh();
     if obj {
         let mut out = Vec::new();
-        for p in &mesh.positions {
-            out.extend_from_slice(b"v ");
-            wavg::text::push_numbers(&mut out, p.iter().copied());
-            out.push(b'\n');
-        }
-        for p in &d.uv.uv {
-            out.extend_from_slice(b"vt ");
-            wavg::text::push_numbers(&mut out, p.iter().copied());
-            out.push(b'\n');
-        }
-        for t in &mesh.triangles {
-            let [a, b, c] = t.map(|v| v + 1);
-            out.extend_from_slice(format!("f {a}/{a} {b}/{b} {c}/{c}\n").as_bytes());
-        }
+        write_decal_obj(&mut out, mesh, &d.uv, None).map_err(|e| ApiError::bad(e.to_string()))?;
         return Ok(Reply::text(out));
     }
     let marked: Vec<usize> = (0..mesh.n_vertices()).filter(|&v| d.uv.marked[v]).collect();

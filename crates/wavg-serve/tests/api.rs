@@ -278,6 +278,9 @@ fn decal_matches_decal_vertices_and_its_obj_carries_the_uvs() {
         text.lines().filter(|l| l.starts_with("f ")).count(),
         s.n_faces()
     );
+    let mut want_obj = Vec::new();
+    wavg::apps::write_decal_obj(&mut want_obj, s.mesh(), &want.uv, None).unwrap();
+    assert_eq!(text.as_bytes(), &want_obj[..]);
 }
 
 #[test]
