@@ -111,3 +111,29 @@ def test_examples_run(example, tmp_path):
     r = subprocess.run([sys.executable, str(example), str(tmp_path)], capture_output=True,
                        text=True, timeout=600)
     assert r.returncode == 0, r.stderr
+
+
+def test_wireframe_of_an_opened_quad_mesh_leaves_out_the_diagonals(tmp_path):
+    # A torus of quads: opened from the file, the wireframe draws the quads' edges only;
+    # the same triangles given as arrays draw every triangle edge.
+    n, m = 24, 12
+    u, v = np.meshgrid(np.arange(n) * 2 * np.pi / n, np.arange(m) * 2 * np.pi / m, indexing="ij")
+    V = np.stack([(1 + 0.4 * np.cos(v)) * np.cos(u), (1 + 0.4 * np.cos(v)) * np.sin(u),
+                  0.4 * np.sin(v)], axis=-1).reshape(-1, 3)
+    idx = lambda i, j: (i % n) * m + (j % m) + 1  # noqa: E731
+    quads = [(idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1))
+             for i in range(n) for j in range(m)]
+    path = tmp_path / "quads.obj"
+    path.write_text("".join(f"v {float(x)!r} {float(y)!r} {float(z)!r}\n" for x, y, z in V)
+                    + "".join("f %d %d %d %d\n" % q for q in quads))
+    opened = wavg.Surface.open(path)
+    assert opened.face_count == 2 * len(quads)
+    arrays = wavg.Surface(opened.vertices, opened.faces)
+    kw = dict(size=(160, 120), view=(30, 40))
+    plain = wavg.render(arrays, **kw)
+    assert np.array_equal(plain, wavg.render(opened, **kw))
+    wire_q = np.any(wavg.render(opened, wireframe=True, **kw) != plain, axis=-1)
+    wire_t = np.any(wavg.render(arrays, wireframe=True, **kw) != plain, axis=-1)
+    assert wire_q.sum() > 200, wire_q.sum()  # the quads' edges are drawn
+    assert wire_q.sum() < 0.85 * wire_t.sum(), (wire_q.sum(), wire_t.sum())
+    assert (wire_q & ~wire_t).sum() < 0.02 * wire_q.sum()  # no edge the triangles lack

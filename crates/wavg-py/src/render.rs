@@ -41,7 +41,9 @@ fn xyz_rows(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<Vector3<f64>>> {
 /// ``size`` = (width, height) pixels. ``curves``: polylines, each a ``(p, 3)`` array or a
 /// ``wavg.Points`` (unanswered rows skipped); ``points``: ``(p, 3)`` dots; ``texture``: an
 /// ``(H, W, 3|4)`` uint8 image through the surface's texture coordinates; ``scalar``: one
-/// float per vertex ``(n,)`` coloured with viridis. Save it with ``wavg.save_png``.
+/// float per vertex ``(n,)`` coloured with viridis; ``wireframe``: the polygons' edges (a
+/// surface opened from a file with quads leaves out their diagonals). Save it with
+/// ``wavg.save_png``.
 #[pyfunction]
 #[pyo3(
     signature = (S, size=(800, 600), view=(35.0, 20.0), curves=None, points=None, texture=None, scalar=None, wireframe=false),
@@ -65,7 +67,10 @@ pub(crate) fn render<'py>(
             "view must be (azimuth, elevation) in degrees, elevation -90 to 90; got {view:?}"
         )));
     }
-    let mut overlays = Overlays::default();
+    let mut overlays = Overlays {
+        polygons: S.polygons.to_vec(),
+        ..Default::default()
+    };
     if let Some(c) = curves.filter(|c| !c.is_none()) {
         for (i, curve) in c.try_iter()?.enumerate() {
             overlays

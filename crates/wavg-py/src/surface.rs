@@ -24,6 +24,10 @@ use crate::progress;
 #[pyclass(module = "wavg", name = "Surface")]
 pub(crate) struct Surface {
     pub(crate) inner: wavg::Surface,
+    /// The polygon of the mesh file each triangle came from (`Surface.open`; empty when
+    /// every triangle is its own polygon): `render`'s wireframe leaves out the diagonals
+    /// that triangulating the file's quads added.
+    pub(crate) polygons: std::sync::Arc<Vec<u32>>,
 }
 
 /// `(V, F)` of a mesh as NumPy arrays.
@@ -132,7 +136,10 @@ impl Surface {
         let inner = py
             .detach_run(|| wavg::Surface::from_mesh(mesh))
             .map_err(|e| to_py(py, e))?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            polygons: Default::default(),
+        })
     }
 
     /// Surface.open(path, embedding=None) -> Surface
@@ -146,14 +153,20 @@ impl Surface {
         if let Some(e) = &embedding {
             require_file(e)?;
         }
-        let mut inner = py
-            .detach_run(|| wavg::Surface::open(&path))
+        let (mut inner, notes) = py
+            .detach_run(|| {
+                let (mesh, notes) = wavg::mesh::io::load_with_notes(&path)?;
+                wavg::Surface::from_mesh(mesh).map(|s| (s, notes))
+            })
             .map_err(|e| to_py(py, e))?;
         if let Some(e) = embedding {
             py.detach_run(|| inner.load_embedding(&e))
                 .map_err(|e| to_py(py, e))?;
         }
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            polygons: std::sync::Arc::new(notes.polygon_of),
+        })
     }
 
     /// Surface.from_trimesh(mesh) -> Surface
@@ -435,12 +448,14 @@ impl Surface {
         // Immutable mesh and embedding are shared; later changes replace them.
         Self {
             inner: self.inner.clone(),
+            polygons: self.polygons.clone(),
         }
     }
 
     fn __copy__(&self) -> Self {
         Self {
             inner: self.inner.clone(),
+            polygons: self.polygons.clone(),
         }
     }
 }
