@@ -5,8 +5,8 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
+use wavg::Par;
 use wavg::SolveError;
-use wavg::internal::prefetch_point_data;
 use wavg::{BatchWeights, ForwardOptions, RoundTrip, Solver, SurfacePoint};
 
 use crate::boundary::{
@@ -268,45 +268,18 @@ enum Row {
     Failed(SolveError),
 }
 
-/// Paper weights of each point straight into its row of `out` (NaN for failures), in
-/// parallel: `Solver::inverse_batch_into`'s loop, without its buffer and the copy out of
-/// it (a visible share of a batch this fast).
+/// Paper weights of each point straight into its row of `out` (NaN for failures), on the
+/// current pool.
 fn inverse_rows(solver: &Solver, points: &[wavg_point], out: &mut [f64]) -> Vec<Row> {
-    const CHUNK: usize = 64;
-    let n = solver.n_anchors();
-    let proj = solver.projector();
-    out.par_chunks_mut(n * CHUNK)
-        .zip(points.par_chunks(CHUNK))
-        .flat_map_iter(|(rows, pts)| {
-            let mut scratch = Default::default();
-            let mut buf = Vec::with_capacity(n);
-            // Random points read random face records, then their corners' records:
-            // request both a few points ahead so the waits overlap.
-            for p in pts.iter().take(4) {
-                prefetch_point_data(proj, p.face, false);
-            }
-            let mut done = Vec::with_capacity(pts.len());
-            for (k, (row, p)) in rows.chunks_exact_mut(n).zip(pts).enumerate() {
-                if let Some(q) = pts.get(k + 4) {
-                    prefetch_point_data(proj, q.face, false);
-                }
-                if let Some(q) = pts.get(k + 2) {
-                    prefetch_point_data(proj, q.face, true);
-                }
-                match solver.inverse_into(&point_in(p), &mut scratch, &mut buf) {
-                    Ok(()) => {
-                        row.copy_from_slice(&buf);
-                        done.push(Row::Ok);
-                    }
-                    Err(e) => {
-                        row.fill(f64::NAN);
-                        done.push(Row::Failed(e));
-                    }
-                }
-            }
-            done
-        })
-        .collect()
+    let pts: Vec<_> = points.iter().map(point_in).collect();
+    match solver.inverse_rows_into(&pts, out, Par::Rayon) {
+        Ok(status) => status
+            .into_iter()
+            .map(|r| r.map_or_else(Row::Failed, |()| Row::Ok))
+            .collect(),
+        // `Par::Rayon` always starts.
+        Err(e) => points.iter().map(|_| Row::Failed(e.clone())).collect(),
+    }
 }
 
 /// Verified weights of each point into its row of `out` (NaN when there are none),

@@ -174,45 +174,6 @@ pub(crate) fn points_tuple<'py>(
     ))
 }
 
-/// The paper's weights of each point straight into its row of `out` (NaN rows where there
-/// are none), in parallel on the current pool: the loop of `Solver::inverse_batch_into`
-/// without its buffer and the copy out of it (a visible share of a batch this fast).
-fn paper_rows(solver: &wavg::Solver, points: &[SurfacePoint], out: &mut [f64]) -> Vec<bool> {
-    use rayon::prelude::*;
-    const CHUNK: usize = 64;
-    let n = solver.n_anchors().max(1);
-    let proj = solver.projector();
-    let hint = wavg::internal::prefetch_point_data;
-    out.par_chunks_mut(n * CHUNK)
-        .zip(points.par_chunks(CHUNK))
-        .flat_map_iter(|(rows, pts)| {
-            let mut scratch = Default::default();
-            let mut buf = Vec::with_capacity(n);
-            // Random points read random face records, then their corners' records: request
-            // both a few points ahead so the waits overlap.
-            for p in pts.iter().take(4) {
-                hint(proj, p.face, false);
-            }
-            let mut ok = Vec::with_capacity(pts.len());
-            for (i, (row, p)) in rows.chunks_exact_mut(n).zip(pts).enumerate() {
-                if let Some(q) = pts.get(i + 4) {
-                    hint(proj, q.face, false);
-                }
-                if let Some(q) = pts.get(i + 2) {
-                    hint(proj, q.face, true);
-                }
-                let r = solver.inverse_into(p, &mut scratch, &mut buf);
-                match r {
-                    Ok(()) => row.copy_from_slice(&buf),
-                    Err(_) => row.fill(f64::NAN),
-                }
-                ok.push(r.is_ok());
-            }
-            ok
-        })
-        .collect()
-}
-
 /// The caller's `out` array for `q` rows of `k` weights: float64, C-contiguous, writable.
 fn out_rows<'py>(
     o: &Bound<'py, PyAny>,
@@ -360,7 +321,8 @@ impl Solver {
         let ok = py
             .detach_run(|| -> Result<_, SolveError> {
                 if !verified {
-                    return Ok(par.install(|| paper_rows(&self.inner, &pts, rows))?);
+                    let status = self.inner.inverse_rows_into(&pts, rows, par)?;
+                    return Ok(status.iter().map(Result::is_ok).collect());
                 }
                 let mut batch = wavg::BatchWeights::default();
                 let mut trips = Vec::new();

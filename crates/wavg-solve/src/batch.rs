@@ -162,16 +162,36 @@ impl Solver {
         out.n = n;
         out.data.resize(points.len() * n.max(1), 0.0);
         out.status.clear();
+        out.status = self.inverse_rows_into(points, &mut out.data, par)?;
+        Ok(())
+    }
+
+    /// The paper's weights of each point straight into its row of `rows` (`n_anchors`
+    /// weights per point, one row per point; NaN where the inverse problem fails), and each
+    /// point's outcome: [`Solver::inverse_batch_into`] into the caller's memory (a binding's
+    /// output array), without a copy out of a buffer. Fails only when `par`'s threads
+    /// cannot start.
+    ///
+    /// # Panics
+    /// When `rows` does not hold `points.len() * n_anchors` values.
+    pub fn inverse_rows_into(
+        &self,
+        points: &[SurfacePoint],
+        rows: &mut [f64],
+        par: Par,
+    ) -> Result<Vec<Result<(), SolveError>>, SolveError> {
+        let n = self.n_anchors().max(1);
+        assert_eq!(rows.len(), points.len() * n, "one row of weights per point");
         // Random points read random face records and then their corners' records: request
         // both a few points ahead (software pipelining), so the waits overlap.
         let proj = self.projector();
-        let rows_per = n.max(1) * INVERSE_CHUNK;
+        let mut status = Vec::with_capacity(points.len());
         par.zip_chunks_mut(
-            &mut out.data,
-            rows_per,
+            rows,
+            n * INVERSE_CHUNK,
             points,
             INVERSE_CHUNK,
-            &mut out.status,
+            &mut status,
             |rows, pts| {
                 let mut scratch = InverseScratch::default();
                 let mut buf = Vec::with_capacity(n);
@@ -180,7 +200,7 @@ impl Solver {
                     wavg_project::internal::prefetch_point_data(proj, f, false);
                 }
                 let mut status = Vec::with_capacity(pts.len());
-                for (k, (row, p)) in rows.chunks_mut(n.max(1)).zip(pts).enumerate() {
+                for (k, (row, p)) in rows.chunks_mut(n).zip(pts).enumerate() {
                     if let Some(f) = ahead(k + 4) {
                         wavg_project::internal::prefetch_point_data(proj, f, false);
                     }
@@ -188,15 +208,16 @@ impl Solver {
                         wavg_project::internal::prefetch_point_data(proj, f, true);
                     }
                     let r = self.inverse_into(p, &mut scratch, &mut buf);
-                    if r.is_ok() {
-                        row.copy_from_slice(&buf);
+                    match r {
+                        Ok(()) => row.copy_from_slice(&buf),
+                        Err(_) => row.fill(f64::NAN),
                     }
                     status.push(r);
                 }
                 status
             },
         )?;
-        Ok(())
+        Ok(status)
     }
 }
 

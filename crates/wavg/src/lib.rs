@@ -80,15 +80,6 @@ pub use wavg_mesh::{
 /// draw them.
 pub use wavg_solve::sampling;
 
-/// Hints for this workspace's C ABI.
-///
-/// **Unstable**: not part of the public API; anything here may change or disappear in any
-/// release.
-#[doc(hidden)]
-pub mod internal {
-    pub use wavg_project::internal::prefetch_point_data;
-}
-
 pub use wavg_apps as apps;
 pub use wavg_embed as embed;
 pub use wavg_mesh as mesh;
