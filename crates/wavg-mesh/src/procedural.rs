@@ -209,6 +209,10 @@ pub const BUILTINS: &[(&str, &str)] = &[
         "genus12",
         "thin plate with 4x3 square holes, 7,146 vertices, genus 12, thin straps",
     ),
+    (
+        "ladder8",
+        "very thin strip with 8 square holes, 1,650 vertices, genus 8, straps 0.02 thick (edges 0.25)",
+    ),
 ];
 
 /// A procedural mesh by name (see [`BUILTINS`]).
@@ -227,6 +231,7 @@ pub fn builtin(name: &str) -> Result<TriMesh, MeshError> {
         "noisy-sphere" => with_noise(icosphere(4), 0.2, 1),
         "genus2" => holed_plate(2, 1, 44, 2.0 / 44.0),
         "genus12" => holed_plate(4, 3, 8, 0.05),
+        "ladder8" => holed_plate(8, 1, 4, 0.02),
         _ => {
             let names: Vec<&str> = BUILTINS.iter().map(|b| b.0).collect();
             return Err(MeshError::InvalidArgument(format!(

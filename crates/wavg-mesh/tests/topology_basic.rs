@@ -66,7 +66,11 @@ fn builtins_are_valid() {
 /// The benchmark plates have the genus and vertex count their descriptions give.
 #[test]
 fn benchmark_plates_have_their_genus_and_size() {
-    for (name, genus, n) in [("genus2", 2, 51_390), ("genus12", 12, 7_146)] {
+    for (name, genus, n) in [
+        ("genus2", 2, 51_390),
+        ("genus12", 12, 7_146),
+        ("ladder8", 8, 1_650),
+    ] {
         let m = procedural::builtin(name).unwrap();
         let st = analyze(&m).stats;
         assert_eq!(st.genus, Some(genus), "{name}");

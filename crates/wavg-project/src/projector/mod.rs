@@ -327,12 +327,16 @@ impl Projector {
     }
 
     fn is_zero(&self, b: &Best) -> bool {
-        let [p, q, r] = self.corners(b.face);
-        let scale2 = (q - p)
+        b.d2 <= ZERO_DISTANCE * ZERO_DISTANCE * self.longest_edge2(b.face)
+    }
+
+    /// The squared length of face `f`'s longest embedded edge.
+    fn longest_edge2(&self, f: FaceId) -> f64 {
+        let [p, q, r] = self.corners(f);
+        (q - p)
             .norm_squared()
             .max((r - q).norm_squared())
-            .max((p - r).norm_squared());
-        b.d2 <= ZERO_DISTANCE * ZERO_DISTANCE * scale2
+            .max((p - r).norm_squared())
     }
 
     #[inline]

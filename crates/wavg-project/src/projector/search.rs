@@ -24,6 +24,8 @@ pub enum SearchGoal {
     /// end, then rings of their neighbours until one holds a projection, then certifies
     /// its best answer: at once when the query's ball of that radius lies within the reach
     /// of the walk's end (no triangle not around that vertex comes so close), otherwise
+    /// (after a search from the vertex nearest to the query when the answer is far from it
+    /// for its face's size: the walk may have stopped on the wrong sheet of a thin part)
     /// against the bounding volume hierarchy. When nothing is found within
     /// [`LOCAL_BUDGET`] faces, the search runs again from the vertex nearest to the query,
     /// then the global search answers. Path [`ProjectionPath::Certified`] or
@@ -99,6 +101,14 @@ fn plane_bary(p: [[f32; 8]; 3], y: &[f32; 8]) -> Option<[f32; 3]> {
 fn outside(p: [[f32; 8]; 3], y: &[f32; 8]) -> f32 {
     plane_bary(p, y).map_or(f32::INFINITY, |[l0, l1, l2]| (-l0).max(-l1).max(-l2))
 }
+
+/// A local answer farther from the query than this fraction of its face's longest edge
+/// (in R^8) is searched for once more from the vertex nearest to the query before the
+/// hierarchy certifies it (see `Projector::across_thin_parts`). A walk on the wrong
+/// sheet of a thin part finds answers about the sheets' distance away; nearer answers
+/// are those of queries just off their own sheet, for which the extra search would
+/// nearly always be wasted.
+const THIN_PART: f64 = 0.2;
 
 /// Faces the closest goal's point-location walk may step through.
 const LOCATE_STEPS: usize = 8;
@@ -267,7 +277,7 @@ impl Projector {
         };
         match (goal, local) {
             (SearchGoal::FirstHit, Some(b)) => Ok(Self::finish(b, ProjectionPath::Local)),
-            (SearchGoal::Closest, Some(b)) => Ok(self.certify(y, b, v, &tried)),
+            (SearchGoal::Closest, Some(b)) => Ok(self.certify(y, b, v, &tried, true)),
             // The walk may end in a local minimum of the distance with no projection
             // nearby (on another sheet that lies close in R^8): once more from the nearest
             // vertex, much cheaper than the global search and usually its answer.
@@ -275,10 +285,33 @@ impl Projector {
                 Some((b, _, _)) if goal == SearchGoal::FirstHit => {
                     Ok(Self::finish(b, ProjectionPath::Local))
                 }
-                Some((b, u, tried)) => Ok(self.certify(y, b, u, &tried)),
+                Some((b, u, tried)) => Ok(self.certify(y, b, u, &tried, false)),
                 None => global(y),
             },
         }
+    }
+
+    /// A projection strictly closer than `local` (the answer of the local search from the
+    /// walk's end `v`) found by the local search from the vertex nearest to `y`, with that
+    /// vertex and the faces it tried; `None` when no vertex is strictly closer to `y` than
+    /// `v` or the search from it finds nothing closer. On a thin part (a strap or plate whose two sheets lie close in
+    /// R^8, joined only around a rim) a walk that starts on one sheet stops on it, at the
+    /// point nearest to a query on the other, where the local search finds a projection
+    /// about the sheets' distance away that certification would beat; the nearest vertex
+    /// lies on the right sheet. The search for it is bounded by `|y - x_v|`, so it opens
+    /// only a few boxes: much less than the certification it may spare.
+    fn across_thin_parts(
+        &self,
+        y: &Vec8,
+        local: &Best,
+        v: VertexId,
+    ) -> Option<(Best, VertexId, FaceSet)> {
+        let x = self.verts[v as usize].x;
+        let u = self.nearest_vertex_within(y, (y - x).norm_squared())?;
+        let cands = self.faces_by_promise(y, u);
+        let mut tried = FaceSet::new();
+        let b = self.local_search(y, u, &cands, SearchGoal::Closest, &mut tried)?;
+        (b.d2 < local.d2).then_some((b, u, tried))
     }
 
     /// The local search from the vertex nearest to `y`, unless that is `v` (where the
@@ -302,10 +335,25 @@ impl Projector {
     /// Certifies the local search's answer `local` (from the walk's end `v`): by its zero
     /// distance, by `v`'s reach (see the `reach` module) or against the hierarchy (faces in
     /// `tried` are skipped): `Certified` if nothing is strictly closer, else the closest
-    /// projection found, as `Fallback`.
-    fn certify(&self, y: &Vec8, local: Best, v: VertexId, tried: &FaceSet) -> Projection {
+    /// projection found, as `Fallback`. With `retry`, before the hierarchy, a closer
+    /// answer from the vertex nearest to `y` replaces `local` and is certified in turn
+    /// (see [`Projector::across_thin_parts`]) when `local` is farther than [`THIN_PART`]
+    /// of its face's longest edge.
+    fn certify(
+        &self,
+        y: &Vec8,
+        local: Best,
+        v: VertexId,
+        tried: &FaceSet,
+        retry: bool,
+    ) -> Projection {
         if self.is_zero(&local) || self.certified_by_reach(y, &local, v, tried) {
             return Self::finish(local, ProjectionPath::Certified);
+        }
+        if retry && local.d2 > THIN_PART * THIN_PART * self.longest_edge2(local.face) {
+            if let Some((b, u, tried)) = self.across_thin_parts(y, &local, v) {
+                return self.certify(y, b, u, &tried, false);
+            }
         }
         let mut improved = None;
         let mut bound = local.d2;
