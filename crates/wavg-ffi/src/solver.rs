@@ -271,8 +271,7 @@ enum Row {
 /// Paper weights of each point straight into its row of `out` (NaN for failures), on the
 /// current pool.
 fn inverse_rows(solver: &Solver, points: &[wavg_point], out: &mut [f64]) -> Vec<Row> {
-    let pts: Vec<_> = points.iter().map(point_in).collect();
-    match solver.inverse_rows_into(&pts, out, Par::Rayon) {
+    match solver.inverse_rows_into_by(points, point_in, out, Par::Rayon) {
         Ok(status) => status
             .into_iter()
             .map(|r| r.map_or_else(Row::Failed, |()| Row::Ok))

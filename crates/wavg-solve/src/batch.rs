@@ -180,6 +180,22 @@ impl Solver {
         rows: &mut [f64],
         par: Par,
     ) -> Result<Vec<Result<(), SolveError>>, SolveError> {
+        self.inverse_rows_into_by(points, |p| *p, rows, par)
+    }
+
+    /// [`Solver::inverse_rows_into`] for points in the caller's own type, each turned into
+    /// a [`SurfacePoint`] by `point` as it is solved (a binding's point records, without
+    /// a converted copy of the batch).
+    ///
+    /// # Panics
+    /// When `rows` does not hold `points.len() * n_anchors` values.
+    pub fn inverse_rows_into_by<P: Sync>(
+        &self,
+        points: &[P],
+        point: impl Fn(&P) -> SurfacePoint + Sync + Send,
+        rows: &mut [f64],
+        par: Par,
+    ) -> Result<Vec<Result<(), SolveError>>, SolveError> {
         let n = self.n_anchors().max(1);
         assert_eq!(rows.len(), points.len() * n, "one row of weights per point");
         // Random points read random face records and then their corners' records: request
@@ -195,12 +211,13 @@ impl Solver {
             |rows, pts| {
                 let mut scratch = InverseScratch::default();
                 let mut buf = Vec::with_capacity(n);
-                let ahead = |k: usize| pts.get(k).map(|p| p.face);
+                let ahead = |k: usize| pts.get(k).map(|p| point(p).face);
                 for f in (0..4).filter_map(ahead) {
                     wavg_project::internal::prefetch_point_data(proj, f, false);
                 }
                 let mut status = Vec::with_capacity(pts.len());
                 for (k, (row, p)) in rows.chunks_mut(n).zip(pts).enumerate() {
+                    let p = &point(p);
                     if let Some(f) = ahead(k + 4) {
                         wavg_project::internal::prefetch_point_data(proj, f, false);
                     }
