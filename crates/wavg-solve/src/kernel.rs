@@ -18,7 +18,7 @@
 //! `d_min` is zero.
 
 use crate::error::SolveError;
-use crate::simd::{LANES, dispatch, dot, sum_lanes};
+use crate::simd::{LANES, Plain, Quad, Wide, dispatch, dot, sum_lanes};
 use crate::{DIM, Mat2x8, Vec8};
 
 /// Default `gamma`: how much more the distance off the tangent plane counts (the paper's 10).
@@ -263,18 +263,20 @@ impl pulp::WithSimd for InverseKernel<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) -> Self::Output {
-        kernel(simd, self.ctx, self.ys, self.sc, self.out)
+        match Wide::new(simd) {
+            Some(q) => kernel(q, self.ctx, self.ys, self.sc, self.out),
+            None => kernel(Plain, self.ctx, self.ys, self.sc, self.out),
+        }
     }
 }
 
-/// The inverse problem's passes over the anchors, built for the instruction set `S`: loops
-/// over contiguous arrays with [`LANES`]-wide partial sums, which the compiler vectorises
-/// for `S` (the same operations in the same order whatever `S`, so the same bits). `sc` and
-/// `out` have the padded length; padded entries get `d = inf`, hence `s = 0` and no
-/// influence.
+/// The inverse problem's passes over the anchors, [`LANES`] at a time in vectors of `q`
+/// (the same operations in the same order whatever the instruction set, so the same bits).
+/// `sc` and `out` have the padded length; padded entries get `d = inf`, hence `s = 0` and
+/// no influence.
 #[inline(always)]
-fn kernel<S: pulp::Simd>(
-    _simd: S,
+fn kernel<Q: Quad>(
+    q: Q,
     ctx: &Ctx,
     ys: &AnchorCoords,
     sc: &mut InverseScratch,
@@ -292,82 +294,83 @@ fn kernel<S: pulp::Simd>(
     let len = ys.padded();
     let (a0, a1, ds) = (&mut sc.a0[..len], &mut sc.a1[..len], &mut sc.d[..len]);
     let out = &mut out[..len];
-    // Pass 1, [`LANES`] anchors at a time with the sums in registers:
-    // a_j = Psi (y_j - yhat), |v_j|^2 and d_j = |v_T|^2 + gamma |v_O|^2, where
+    // Pass 1: a_j = Psi (y_j - yhat), |v_j|^2 and d_j = |v_T|^2 + gamma |v_O|^2, where
     // |v_O|^2 = |v|^2 - |v_T|^2 >= 0.
-    let gm1 = gamma - 1.0;
-    let chunks = a0
-        .chunks_exact_mut(LANES)
-        .zip(a1.chunks_exact_mut(LANES))
-        .zip(ds.chunks_exact_mut(LANES))
-        .enumerate();
-    for (c, ((x0s, x1s), dd)) in chunks {
-        let mut vv = [0.0; LANES];
-        let mut x0 = [0.0; LANES];
-        let mut x1 = [0.0; LANES];
+    let (h0, h01, h2) = (q.splat(h[0]), q.splat(2.0 * h[1]), q.splat(h[2]));
+    let (gv, gm1) = (q.splat(gamma), q.splat(gamma - 1.0));
+    let (yhs, p0s, p1s) = (
+        yh.map(|x| q.splat(x)),
+        p0.map(|x| q.splat(x)),
+        p1.map(|x| q.splat(x)),
+    );
+    let zero = q.splat(0.0);
+    for c in 0..len / LANES {
+        let at = c * LANES;
+        let (mut vv, mut x0, mut x1) = (zero, zero, zero);
         for k in 0..DIM {
-            let y = &ys.dims[k][c * LANES..(c + 1) * LANES];
-            for l in 0..LANES {
-                let v = y[l] - yh[k];
-                vv[l] += v * v;
-                x0[l] += p0[k] * v;
-                x1[l] += p1[k] * v;
-            }
+            let v = q.sub(q.load(&ys.dims[k][at..]), yhs[k]);
+            vv = q.add(vv, q.mul(v, v));
+            x0 = q.add(x0, q.mul(p0s[k], v));
+            x1 = q.add(x1, q.mul(p1s[k], v));
         }
-        for l in 0..LANES {
-            let vt = h[0] * x0[l] * x0[l] + 2.0 * h[1] * x0[l] * x1[l] + h[2] * x1[l] * x1[l];
-            let vt = if vt < vv[l] { vt } else { vv[l] };
-            dd[l] = gamma * vv[l] - gm1 * vt;
-            x0s[l] = x0[l];
-            x1s[l] = x1[l];
-        }
+        let vt = q.add(
+            q.add(q.mul(q.mul(h0, x0), x0), q.mul(q.mul(h01, x0), x1)),
+            q.mul(q.mul(h2, x1), x1),
+        );
+        let vt = q.min_left(vt, vv);
+        q.store(q.sub(q.mul(gv, vv), q.mul(gm1, vt)), &mut ds[at..]);
+        q.store(x0, &mut a0[at..]);
+        q.store(x1, &mut a1[at..]);
     }
-    // Smallest d (first index), largest, and a NaN check.
-    let (mut dmin, mut m, mut dmax, mut bad) = (f64::INFINITY, 0, 0.0f64, false);
-    for (j, &d) in ds[..n].iter().enumerate() {
-        if d < dmin {
-            dmin = d;
-            m = j;
-        }
-        if d > dmax {
-            dmax = d;
-        }
-        bad |= d.is_nan();
+    // Smallest d (first index), largest, and a NaN check, over the n real anchors.
+    let full = n / LANES * LANES;
+    let (mut lo, mut hi, mut bad) = (q.splat(f64::INFINITY), zero, zero);
+    for c in (0..full).step_by(LANES) {
+        let d = q.load(&ds[c..]);
+        lo = q.min_left(d, lo);
+        hi = q.max_left(d, hi);
+        // d - d is 0 for finite d, NaN for NaN and infinite d: an infinite d is caught below.
+        bad = q.add(bad, q.sub(d, d));
     }
-    if bad || !dmax.is_finite() {
-        return Err(distance_overflow(bad, gamma));
+    let (mut dmin, mut dmax) = (f64::INFINITY, 0.0f64);
+    let mut nan = q.lanes(bad).iter().any(|x| x.is_nan());
+    for (l, h) in q.lanes(lo).into_iter().zip(q.lanes(hi)) {
+        dmin = if l < dmin { l } else { dmin };
+        dmax = if h > dmax { h } else { dmax };
+    }
+    for &d in &ds[full..n] {
+        dmin = if d < dmin { d } else { dmin };
+        dmax = if d > dmax { d } else { dmax };
+        nan |= d.is_nan();
+    }
+    if nan || !dmax.is_finite() {
+        return Err(distance_overflow(ds[..n].iter().any(|d| d.is_nan()), gamma));
     }
     if dmin <= 0.0 {
         one_hot(&ds[..n], &mut out[..n]);
         return Ok(());
     }
+    let m = ds[..n].iter().position(|&d| d == dmin).unwrap_or(0);
     ds[n..].fill(f64::INFINITY);
     let (am0, am1) = (a0[m], a1[m]);
+    let (am0s, am1s, dmins) = (q.splat(am0), q.splat(am1), q.splat(dmin));
     // Pass 2: constraint rows centred on anchor m, s_j = (d_min/d_j)^2 (kept in `out`).
-    let mut acc = [[0.0; LANES]; 6];
-    let chunks = a0
-        .chunks_exact(LANES)
-        .zip(a1.chunks_exact(LANES))
-        .zip(ds.chunks_exact(LANES))
-        .zip(out.chunks_exact_mut(LANES));
-    for (((x0, x1), d), ss) in chunks {
-        for l in 0..LANES {
-            let r = dmin / d[l];
-            let s = r * r;
-            let c0 = x0[l] - am0;
-            let c1 = x1[l] - am1;
-            let sc0 = s * c0;
-            let sc1 = s * c1;
-            acc[0][l] += sc0 * c0;
-            acc[1][l] += sc0 * c1;
-            acc[2][l] += sc0;
-            acc[3][l] += sc1 * c1;
-            acc[4][l] += sc1;
-            acc[5][l] += s;
-            ss[l] = s;
-        }
+    let mut acc = [zero; 6];
+    for c in (0..len).step_by(LANES) {
+        let r = q.div(dmins, q.load(&ds[c..]));
+        let s = q.mul(r, r);
+        let c0 = q.sub(q.load(&a0[c..]), am0s);
+        let c1 = q.sub(q.load(&a1[c..]), am1s);
+        let (sc0, sc1) = (q.mul(s, c0), q.mul(s, c1));
+        acc[0] = q.add(acc[0], q.mul(sc0, c0));
+        acc[1] = q.add(acc[1], q.mul(sc0, c1));
+        acc[2] = q.add(acc[2], sc0);
+        acc[3] = q.add(acc[3], q.mul(sc1, c1));
+        acc[4] = q.add(acc[4], sc1);
+        acc[5] = q.add(acc[5], s);
+        q.store(s, &mut out[c..]);
     }
-    let [m00, m01, m02, m11, m12, m22] = acc.map(sum_lanes);
+    let [m00, m01, m02, m11, m12, m22] = acc.map(|a| sum_lanes(q.lanes(a)));
     let b = [-am0, -am1, 1.0];
     let Some(z) = solve_scaled_3x3([[m00, m01, m02], [m01, m11, m12], [m02, m12, m22]], b) else {
         // Singular: either the other anchors' contributions underflowed because the point
@@ -379,25 +382,26 @@ fn kernel<S: pulp::Simd>(
         return Err(SolveError::DegenerateAnchors);
     };
     // Pass 3: w_j = s_j c_j . z.
-    let mut sums = [0.0; LANES];
-    let chunks = a0
-        .chunks_exact(LANES)
-        .zip(a1.chunks_exact(LANES))
-        .zip(out.chunks_exact_mut(LANES));
-    for ((x0, x1), ws) in chunks {
-        for l in 0..LANES {
-            let w = ws[l] * ((x0[l] - am0) * z[0] + (x1[l] - am1) * z[1] + z[2]);
-            ws[l] = w;
-            sums[l] += w;
-        }
+    let (z0, z1, z2) = (q.splat(z[0]), q.splat(z[1]), q.splat(z[2]));
+    let mut sums = zero;
+    for c in (0..len).step_by(LANES) {
+        let c0 = q.sub(q.load(&a0[c..]), am0s);
+        let c1 = q.sub(q.load(&a1[c..]), am1s);
+        let w = q.mul(
+            q.load(&out[c..]),
+            q.add(q.add(q.mul(c0, z0), q.mul(c1, z1)), z2),
+        );
+        q.store(w, &mut out[c..]);
+        sums = q.add(sums, w);
     }
-    let sum = sum_lanes(sums);
+    let sum = sum_lanes(q.lanes(sums));
     if !sum.is_finite() || (sum - 1.0).abs() > 1e-6 {
         return Err(SolveError::DegenerateAnchors);
     }
-    let inv = 1.0 / sum;
-    for w in out.iter_mut() {
-        *w *= inv;
+    let inv = q.splat(1.0 / sum);
+    for c in (0..len).step_by(LANES) {
+        let w = q.mul(q.load(&out[c..]), inv);
+        q.store(w, &mut out[c..]);
     }
     Ok(())
 }
@@ -472,17 +476,28 @@ mod tests {
     #[test]
     fn simd_and_portable_kernels_agree_exactly() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
-        for n in [1usize, 3, 4, 5, 27, 100] {
+        // Anchor counts around the vector width; points anywhere, near an anchor (down to
+        // rounding level) and at one (one-hot).
+        let cases = [1usize, 3, 4, 5, 27, 93, 100]
+            .into_iter()
+            .flat_map(|n| [0.0, 1e-3, 1e-9, 1e-160, -1.0].map(move |near| (n, near)))
+            .chain((0..200).map(|i| (1 + i % 130, 0.0)));
+        for (n, near) in cases {
             let ys: Vec<Vec8> = (0..n)
                 .map(|_| Vec8::from_fn(|_, _| rng.random_range(-1.0..1.0)))
                 .collect();
             let coords = AnchorCoords::from_points(&ys);
+            let yh: [f64; DIM] = std::array::from_fn(|k| match near {
+                0.0 => rng.random_range(-1.0..1.0),
+                -1.0 => ys[n / 2][k],
+                e => ys[n / 2][k] + e * rng.random_range(-1.0..1.0),
+            });
             let ctx = Ctx {
                 p0: std::array::from_fn(|_| rng.random_range(-1.0..1.0)),
                 p1: std::array::from_fn(|_| rng.random_range(-1.0..1.0)),
-                yh: std::array::from_fn(|_| rng.random_range(-1.0..1.0)),
+                yh,
                 h: [1.1, 0.1, 0.9],
-                gamma: 10.0,
+                gamma: [10.0, 1.0, 3.5][n % 3],
                 n,
             };
             let padded = coords.padded();
@@ -504,9 +519,149 @@ mod tests {
                     out,
                 })
             });
-            let b = run(&|sc, out| kernel(pulp::Scalar::new(), &ctx, &coords, sc, out));
-            assert_eq!(a, b, "n = {n}");
+            let b = run(&|sc, out| kernel(Plain, &ctx, &coords, sc, out));
+            let c = run(&|sc, out| reference_kernel(&ctx, &coords, sc, out));
+            let bits = |r: &Result<Vec<f64>, SolveError>| {
+                r.as_ref()
+                    .map(|w| w.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+                    .ok()
+            };
+            assert!(a.is_ok() || n < 4, "n = {n}, near {near}");
+            assert_eq!(a.is_ok(), c.is_ok(), "n = {n}");
+            assert_eq!(bits(&a), bits(&b), "n = {n}");
+            assert_eq!(bits(&a), bits(&c), "n = {n}");
         }
+    }
+
+    /// The kernel as plain per-lane loops, each lane's operations written out in order:
+    /// the vector kernel must give its bits.
+    fn reference_kernel(
+        ctx: &Ctx,
+        ys: &AnchorCoords,
+        sc: &mut InverseScratch,
+        out: &mut [f64],
+    ) -> Result<(), SolveError> {
+        let Ctx {
+            p0,
+            p1,
+            yh,
+            h,
+            gamma,
+            n,
+        } = ctx;
+        let (gamma, n) = (*gamma, *n);
+        let len = ys.padded();
+        let (a0, a1, ds) = (&mut sc.a0[..len], &mut sc.a1[..len], &mut sc.d[..len]);
+        let out = &mut out[..len];
+        // Pass 1, [`LANES`] anchors at a time with the sums in registers:
+        // a_j = Psi (y_j - yhat), |v_j|^2 and d_j = |v_T|^2 + gamma |v_O|^2, where
+        // |v_O|^2 = |v|^2 - |v_T|^2 >= 0.
+        let gm1 = gamma - 1.0;
+        let chunks = a0
+            .chunks_exact_mut(LANES)
+            .zip(a1.chunks_exact_mut(LANES))
+            .zip(ds.chunks_exact_mut(LANES))
+            .enumerate();
+        for (c, ((x0s, x1s), dd)) in chunks {
+            let mut vv = [0.0; LANES];
+            let mut x0 = [0.0; LANES];
+            let mut x1 = [0.0; LANES];
+            for k in 0..DIM {
+                let y = &ys.dims[k][c * LANES..(c + 1) * LANES];
+                for l in 0..LANES {
+                    let v = y[l] - yh[k];
+                    vv[l] += v * v;
+                    x0[l] += p0[k] * v;
+                    x1[l] += p1[k] * v;
+                }
+            }
+            for l in 0..LANES {
+                let vt = h[0] * x0[l] * x0[l] + 2.0 * h[1] * x0[l] * x1[l] + h[2] * x1[l] * x1[l];
+                let vt = if vt < vv[l] { vt } else { vv[l] };
+                dd[l] = gamma * vv[l] - gm1 * vt;
+                x0s[l] = x0[l];
+                x1s[l] = x1[l];
+            }
+        }
+        // Smallest d (first index), largest, and a NaN check.
+        let (mut dmin, mut m, mut dmax, mut bad) = (f64::INFINITY, 0, 0.0f64, false);
+        for (j, &d) in ds[..n].iter().enumerate() {
+            if d < dmin {
+                dmin = d;
+                m = j;
+            }
+            if d > dmax {
+                dmax = d;
+            }
+            bad |= d.is_nan();
+        }
+        if bad || !dmax.is_finite() {
+            return Err(distance_overflow(bad, gamma));
+        }
+        if dmin <= 0.0 {
+            one_hot(&ds[..n], &mut out[..n]);
+            return Ok(());
+        }
+        ds[n..].fill(f64::INFINITY);
+        let (am0, am1) = (a0[m], a1[m]);
+        // Pass 2: constraint rows centred on anchor m, s_j = (d_min/d_j)^2 (kept in `out`).
+        let mut acc = [[0.0; LANES]; 6];
+        let chunks = a0
+            .chunks_exact(LANES)
+            .zip(a1.chunks_exact(LANES))
+            .zip(ds.chunks_exact(LANES))
+            .zip(out.chunks_exact_mut(LANES));
+        for (((x0, x1), d), ss) in chunks {
+            for l in 0..LANES {
+                let r = dmin / d[l];
+                let s = r * r;
+                let c0 = x0[l] - am0;
+                let c1 = x1[l] - am1;
+                let sc0 = s * c0;
+                let sc1 = s * c1;
+                acc[0][l] += sc0 * c0;
+                acc[1][l] += sc0 * c1;
+                acc[2][l] += sc0;
+                acc[3][l] += sc1 * c1;
+                acc[4][l] += sc1;
+                acc[5][l] += s;
+                ss[l] = s;
+            }
+        }
+        let [m00, m01, m02, m11, m12, m22] = acc.map(sum_lanes);
+        let b = [-am0, -am1, 1.0];
+        let Some(z) = solve_scaled_3x3([[m00, m01, m02], [m01, m11, m12], [m02, m12, m22]], b)
+        else {
+            // Singular: either the other anchors' contributions underflowed because the point
+            // is (to within ~1e-150 relative) at an anchor, or the anchors are degenerate.
+            if dmin <= 1e-100 * dmax {
+                one_hot(&ds[..n], &mut out[..n]);
+                return Ok(());
+            }
+            return Err(SolveError::DegenerateAnchors);
+        };
+        // Pass 3: w_j = s_j c_j . z.
+        let mut sums = [0.0; LANES];
+        let chunks = a0
+            .chunks_exact(LANES)
+            .zip(a1.chunks_exact(LANES))
+            .zip(out.chunks_exact_mut(LANES));
+        for ((x0, x1), ws) in chunks {
+            for l in 0..LANES {
+                let w = ws[l] * ((x0[l] - am0) * z[0] + (x1[l] - am1) * z[1] + z[2]);
+                ws[l] = w;
+                sums[l] += w;
+            }
+        }
+        let sum = sum_lanes(sums);
+        if !sum.is_finite() || (sum - 1.0).abs() > 1e-6 {
+            return Err(SolveError::DegenerateAnchors);
+        }
+        let inv = 1.0 / sum;
+        for w in out.iter_mut() {
+            *w *= inv;
+        }
+        Ok(())
     }
 
     #[test]

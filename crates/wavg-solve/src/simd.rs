@@ -63,6 +63,144 @@ pub(crate) fn dot<S: pulp::Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
     s
 }
 
+/// Vectors of [`LANES`] `f64`s and the lane-wise IEEE operations the kernels use, on one
+/// register of an instruction set exactly [`LANES`] wide ([`Wide`]) or on arrays in plain
+/// loops ([`Plain`], any other). Lane-wise operations round the same way in both (no fused
+/// multiply-adds), so both give the same bits; written with these, a kernel compiles to
+/// vector instructions where plain loops over lanes would be vectorised across rows, with
+/// shuffles, or not at all.
+pub(crate) trait Quad: Copy {
+    /// A vector.
+    type V: Copy;
+    /// Lanes `x[..LANES]`.
+    fn load(self, x: &[f64]) -> Self::V;
+    /// Writes the lanes to `x[..LANES]`.
+    fn store(self, v: Self::V, x: &mut [f64]);
+    /// `v` in every lane.
+    fn splat(self, v: f64) -> Self::V;
+    /// `a + b`.
+    fn add(self, a: Self::V, b: Self::V) -> Self::V;
+    /// `a - b`.
+    fn sub(self, a: Self::V, b: Self::V) -> Self::V;
+    /// `a * b`.
+    fn mul(self, a: Self::V, b: Self::V) -> Self::V;
+    /// `a / b`.
+    fn div(self, a: Self::V, b: Self::V) -> Self::V;
+    /// `if a < b { a } else { b }`, lane by lane (`b` where either is NaN).
+    fn min_left(self, a: Self::V, b: Self::V) -> Self::V;
+    /// `if a > b { a } else { b }`, lane by lane (`b` where either is NaN).
+    fn max_left(self, a: Self::V, b: Self::V) -> Self::V;
+    /// The lanes.
+    fn lanes(self, v: Self::V) -> [f64; LANES];
+}
+
+/// [`Quad`] on arrays, in plain loops.
+#[derive(Clone, Copy)]
+pub(crate) struct Plain;
+
+impl Quad for Plain {
+    type V = [f64; LANES];
+    #[inline(always)]
+    fn load(self, x: &[f64]) -> Self::V {
+        std::array::from_fn(|l| x[l])
+    }
+    #[inline(always)]
+    fn store(self, v: Self::V, x: &mut [f64]) {
+        x[..LANES].copy_from_slice(&v);
+    }
+    #[inline(always)]
+    fn splat(self, v: f64) -> Self::V {
+        [v; LANES]
+    }
+    #[inline(always)]
+    fn add(self, a: Self::V, b: Self::V) -> Self::V {
+        std::array::from_fn(|l| a[l] + b[l])
+    }
+    #[inline(always)]
+    fn sub(self, a: Self::V, b: Self::V) -> Self::V {
+        std::array::from_fn(|l| a[l] - b[l])
+    }
+    #[inline(always)]
+    fn mul(self, a: Self::V, b: Self::V) -> Self::V {
+        std::array::from_fn(|l| a[l] * b[l])
+    }
+    #[inline(always)]
+    fn div(self, a: Self::V, b: Self::V) -> Self::V {
+        std::array::from_fn(|l| a[l] / b[l])
+    }
+    #[inline(always)]
+    fn min_left(self, a: Self::V, b: Self::V) -> Self::V {
+        std::array::from_fn(|l| if a[l] < b[l] { a[l] } else { b[l] })
+    }
+    #[inline(always)]
+    fn max_left(self, a: Self::V, b: Self::V) -> Self::V {
+        std::array::from_fn(|l| if a[l] > b[l] { a[l] } else { b[l] })
+    }
+    #[inline(always)]
+    fn lanes(self, v: Self::V) -> [f64; LANES] {
+        v
+    }
+}
+
+/// [`Quad`] in registers of an instruction set `S` exactly [`LANES`] wide (see
+/// [`Wide::new`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Wide<S>(S);
+
+impl<S: pulp::Simd> Wide<S> {
+    /// `S`'s vectors, when they hold exactly [`LANES`] `f64`s.
+    #[inline(always)]
+    pub(crate) fn new(simd: S) -> Option<Self> {
+        (S::F64_LANES == LANES).then_some(Self(simd))
+    }
+}
+
+impl<S: pulp::Simd> Quad for Wide<S> {
+    type V = S::f64s;
+    #[inline(always)]
+    fn load(self, x: &[f64]) -> Self::V {
+        S::as_simd_f64s(&x[..LANES]).0[0]
+    }
+    #[inline(always)]
+    fn store(self, v: Self::V, x: &mut [f64]) {
+        S::as_mut_simd_f64s(&mut x[..LANES]).0[0] = v;
+    }
+    #[inline(always)]
+    fn splat(self, v: f64) -> Self::V {
+        self.0.splat_f64s(v)
+    }
+    #[inline(always)]
+    fn add(self, a: Self::V, b: Self::V) -> Self::V {
+        self.0.add_f64s(a, b)
+    }
+    #[inline(always)]
+    fn sub(self, a: Self::V, b: Self::V) -> Self::V {
+        self.0.sub_f64s(a, b)
+    }
+    #[inline(always)]
+    fn mul(self, a: Self::V, b: Self::V) -> Self::V {
+        self.0.mul_f64s(a, b)
+    }
+    #[inline(always)]
+    fn div(self, a: Self::V, b: Self::V) -> Self::V {
+        self.0.div_f64s(a, b)
+    }
+    #[inline(always)]
+    fn min_left(self, a: Self::V, b: Self::V) -> Self::V {
+        self.0.select_f64s(self.0.less_than_f64s(a, b), a, b)
+    }
+    #[inline(always)]
+    fn max_left(self, a: Self::V, b: Self::V) -> Self::V {
+        self.0.select_f64s(self.0.greater_than_f64s(a, b), a, b)
+    }
+    #[inline(always)]
+    fn lanes(self, v: Self::V) -> [f64; LANES] {
+        let mut l = [0.0; LANES];
+        self.store(v, &mut l);
+        l
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

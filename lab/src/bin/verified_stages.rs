@@ -5,7 +5,8 @@
 //! threads (from `/proc/self/task/*/schedstat`; CPU time is what a loaded machine distorts
 //! least).
 //!
-//! `cargo xtask lab verified_stages MESH EMB.wavg ANCHORS QUERIES [THREADS]`
+//! `cargo xtask lab verified_stages MESH EMB.wavg ANCHORS QUERIES [THREADS]` (with
+//! `VERIFIED_ONLY` set: only the library's verified batch, five times, for a profiler)
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -54,6 +55,18 @@ fn main() {
             / 1e9
     };
     let cpu_us = |c0: f64| (cpu() - c0) / n * 1e6;
+    if std::env::var_os("VERIFIED_ONLY").is_some() {
+        // Only the library's verified batch, for a profiler.
+        let (mut w2, mut trips) = (BatchWeights::default(), Vec::new());
+        for _ in 0..5 {
+            let (t, c) = (Instant::now(), cpu());
+            solver
+                .inverse_verified_batch_into(&points, 1e-3, &mut w2, &mut trips, par)
+                .unwrap();
+            println!("verified {:.3} us (cpu {:.3})", us(t), cpu_us(c));
+        }
+        return;
+    }
     for rep in 0..3 {
         let (t_all, c_all) = (Instant::now(), cpu());
         let mut w = BatchWeights::default();
