@@ -58,7 +58,7 @@ impl AnchorCoords {
     }
 
     /// Padded length of the coordinate arrays.
-    fn padded(&self) -> usize {
+    pub(crate) fn padded(&self) -> usize {
         self.dims[0].len()
     }
 
@@ -95,6 +95,11 @@ impl AnchorCoords {
                 d.truncate(padded - LANES);
             }
         }
+    }
+
+    /// Coordinate `k` of every anchor, zero-padded to [`AnchorCoords::padded`].
+    pub(crate) fn dim(&self, k: usize) -> &[f64] {
+        &self.dims[k]
     }
 
     /// Anchor `i`'s coordinates (panics when out of range).
@@ -199,32 +204,7 @@ pub fn inverse_weights(
 ) -> Result<(), SolveError> {
     out.clear();
     let n = anchors.len();
-    if n == 0 {
-        return Err(SolveError::NoAnchors);
-    }
-    if gamma.is_nan() || gamma <= 0.0 || !gamma.is_finite() {
-        return Err(SolveError::InvalidParameter(format!(
-            "gamma must be finite and positive, got {gamma}"
-        )));
-    }
-    let p0: [f64; DIM] = std::array::from_fn(|k| psi[(0, k)]);
-    let p1: [f64; DIM] = std::array::from_fn(|k| psi[(1, k)]);
-    let g00: f64 = p0.iter().map(|x| x * x).sum();
-    let g11: f64 = p1.iter().map(|x| x * x).sum();
-    let g01: f64 = p0.iter().zip(&p1).map(|(x, y)| x * y).sum();
-    let det = g00 * g11 - g01 * g01;
-    if det.is_nan() || det <= 1e-12 * g00 * g11 || !det.is_finite() {
-        return Err(SolveError::DegenerateTangentPlane);
-    }
-    let ctx = Ctx {
-        p0,
-        p1,
-        yh: std::array::from_fn(|k| yhat[k]),
-        // Inverse Gram matrix, so |v_T|^2 = a^T G^{-1} a.
-        h: [g11 / det, -g01 / det, g00 / det],
-        gamma,
-        n,
-    };
+    let ctx = Ctx::new(psi, yhat, n, gamma)?;
     let padded = anchors.padded();
     scratch.a0.resize(padded, 0.0);
     scratch.a1.resize(padded, 0.0);
@@ -241,13 +221,100 @@ pub fn inverse_weights(
 }
 
 /// The per-query constants of the kernel.
-struct Ctx {
+pub(crate) struct Ctx {
     p0: [f64; DIM],
     p1: [f64; DIM],
     yh: [f64; DIM],
+    /// The inverse Gram matrix of `Psi`'s rows, `(h00, h01, h11)`: `|v_T|^2 = a^T G^{-1} a`.
     h: [f64; 3],
     gamma: f64,
     n: usize,
+}
+
+impl Ctx {
+    /// The constants at the point `yhat` with tangent plane `psi`, for `n` anchors:
+    /// [`SolveError::NoAnchors`], [`SolveError::InvalidParameter`] for a `gamma` that is
+    /// not finite and positive, [`SolveError::DegenerateTangentPlane`] for a `psi` of
+    /// (nearly) rank 1.
+    pub(crate) fn new(psi: &Mat2x8, yhat: &Vec8, n: usize, gamma: f64) -> Result<Self, SolveError> {
+        if n == 0 {
+            return Err(SolveError::NoAnchors);
+        }
+        if gamma.is_nan() || gamma <= 0.0 || !gamma.is_finite() {
+            return Err(SolveError::InvalidParameter(format!(
+                "gamma must be finite and positive, got {gamma}"
+            )));
+        }
+        let p0: [f64; DIM] = std::array::from_fn(|k| psi[(0, k)]);
+        let p1: [f64; DIM] = std::array::from_fn(|k| psi[(1, k)]);
+        let g00: f64 = p0.iter().map(|x| x * x).sum();
+        let g11: f64 = p1.iter().map(|x| x * x).sum();
+        let g01: f64 = p0.iter().zip(&p1).map(|(x, y)| x * y).sum();
+        let det = g00 * g11 - g01 * g01;
+        if det.is_nan() || det <= 1e-12 * g00 * g11 || !det.is_finite() {
+            return Err(SolveError::DegenerateTangentPlane);
+        }
+        Ok(Self {
+            p0,
+            p1,
+            yh: std::array::from_fn(|k| yhat[k]),
+            h: [g11 / det, -g01 / det, g00 / det],
+            gamma,
+            n,
+        })
+    }
+
+    /// The embedded point.
+    pub(crate) fn yhat(&self) -> &[f64; DIM] {
+        &self.yh
+    }
+}
+
+/// The kernel's first pass, `LANES` anchors at a time: `a_j = Psi (y_j - yhat)` into `a0`
+/// and `a1` and `d_j = |v_T|^2 + gamma |v_O|^2` into `ds` (all of the padded length), where
+/// `|v_O|^2 = |v|^2 - |v_T|^2 >= 0`. Padded entries hold the values of a zero anchor.
+#[inline(always)]
+pub(crate) fn offsets<Q: Quad>(
+    q: Q,
+    ctx: &Ctx,
+    ys: &AnchorCoords,
+    a0: &mut [f64],
+    a1: &mut [f64],
+    ds: &mut [f64],
+) {
+    let Ctx {
+        p0,
+        p1,
+        yh,
+        h,
+        gamma,
+        ..
+    } = ctx;
+    let (h0, h01, h2) = (q.splat(h[0]), q.splat(2.0 * h[1]), q.splat(h[2]));
+    let (gv, gm1) = (q.splat(*gamma), q.splat(gamma - 1.0));
+    let (yhs, p0s, p1s) = (
+        yh.map(|x| q.splat(x)),
+        p0.map(|x| q.splat(x)),
+        p1.map(|x| q.splat(x)),
+    );
+    let zero = q.splat(0.0);
+    for c in (0..ys.padded()).step_by(LANES) {
+        let (mut vv, mut x0, mut x1) = (zero, zero, zero);
+        for k in 0..DIM {
+            let v = q.sub(q.load(&ys.dims[k][c..]), yhs[k]);
+            vv = q.add(vv, q.mul(v, v));
+            x0 = q.add(x0, q.mul(p0s[k], v));
+            x1 = q.add(x1, q.mul(p1s[k], v));
+        }
+        let vt = q.add(
+            q.add(q.mul(q.mul(h0, x0), x0), q.mul(q.mul(h01, x0), x1)),
+            q.mul(q.mul(h2, x1), x1),
+        );
+        let vt = q.min_left(vt, vv);
+        q.store(q.sub(q.mul(gv, vv), q.mul(gm1, vt)), &mut ds[c..]);
+        q.store(x0, &mut a0[c..]);
+        q.store(x1, &mut a1[c..]);
+    }
 }
 
 /// [`kernel`] for one query as one SIMD operation.
@@ -282,46 +349,12 @@ fn kernel<Q: Quad>(
     sc: &mut InverseScratch,
     out: &mut [f64],
 ) -> Result<(), SolveError> {
-    let Ctx {
-        p0,
-        p1,
-        yh,
-        h,
-        gamma,
-        n,
-    } = ctx;
-    let (gamma, n) = (*gamma, *n);
+    let (gamma, n) = (ctx.gamma, ctx.n);
     let len = ys.padded();
     let (a0, a1, ds) = (&mut sc.a0[..len], &mut sc.a1[..len], &mut sc.d[..len]);
     let out = &mut out[..len];
-    // Pass 1: a_j = Psi (y_j - yhat), |v_j|^2 and d_j = |v_T|^2 + gamma |v_O|^2, where
-    // |v_O|^2 = |v|^2 - |v_T|^2 >= 0.
-    let (h0, h01, h2) = (q.splat(h[0]), q.splat(2.0 * h[1]), q.splat(h[2]));
-    let (gv, gm1) = (q.splat(gamma), q.splat(gamma - 1.0));
-    let (yhs, p0s, p1s) = (
-        yh.map(|x| q.splat(x)),
-        p0.map(|x| q.splat(x)),
-        p1.map(|x| q.splat(x)),
-    );
+    offsets(q, ctx, ys, a0, a1, ds);
     let zero = q.splat(0.0);
-    for c in 0..len / LANES {
-        let at = c * LANES;
-        let (mut vv, mut x0, mut x1) = (zero, zero, zero);
-        for k in 0..DIM {
-            let v = q.sub(q.load(&ys.dims[k][at..]), yhs[k]);
-            vv = q.add(vv, q.mul(v, v));
-            x0 = q.add(x0, q.mul(p0s[k], v));
-            x1 = q.add(x1, q.mul(p1s[k], v));
-        }
-        let vt = q.add(
-            q.add(q.mul(q.mul(h0, x0), x0), q.mul(q.mul(h01, x0), x1)),
-            q.mul(q.mul(h2, x1), x1),
-        );
-        let vt = q.min_left(vt, vv);
-        q.store(q.sub(q.mul(gv, vv), q.mul(gm1, vt)), &mut ds[at..]);
-        q.store(x0, &mut a0[at..]);
-        q.store(x1, &mut a1[at..]);
-    }
     // Smallest d (first index), largest, and a NaN check, over the n real anchors.
     let full = n / LANES * LANES;
     let (mut lo, mut hi, mut bad) = (q.splat(f64::INFINITY), zero, zero);

@@ -1,21 +1,22 @@
 //! The verified inverse's penalised weights: the paper's objective plus an offset penalty
 //! `lambda * d_ref * |ybar - yhat|^2`, solved for a ladder of `lambda`s at one point.
 //!
-//! Everything that does not depend on `lambda` (the anchors' offsets, their `D_ii`, the
-//! constraint rows, the off-diagonal part of the Woodbury system) is computed once per
-//! point by [`PenaltySystem::new`]; each rung then costs an 8x8 Cholesky factor and a few
-//! passes over the anchors. The arithmetic is the same, operation for operation, as
-//! solving each rung from scratch, so the weights are too.
+//! Everything that does not depend on `lambda` (the anchors' `D_ii` and constraint rows,
+//! the sums `V D^-2 V^T` and `V D^-2 C^T`) is computed once per point by
+//! [`PenaltySystem::new`]; each rung then costs an 8x8 Cholesky factor and two passes over
+//! the anchors. The passes run [`LANES`] anchors at a time in vectors (see
+//! [`crate::simd::Quad`]), so the results are the same on every machine.
 
-use nalgebra::{SMatrix, Vector2, Vector3};
+use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use crate::error::SolveError;
-use crate::kernel::AnchorCoords;
+use crate::kernel::{AnchorCoords, Ctx, distance_overflow, offsets};
+use crate::simd::{LANES, Plain, Quad, Wide, dispatch, sum_lanes};
 use crate::{DIM, Mat2x8, Vec8};
 
 /// The lambda-independent part of the penalised problem at one point.
 #[derive(Clone, Debug)]
-pub(crate) enum PenaltySystem {
+pub(crate) enum PenaltySystem<'a> {
     /// The point is an anchor: every penalty gives the one-hot weight of anchor `i`.
     OneHot {
         /// Anchor count.
@@ -24,105 +25,81 @@ pub(crate) enum PenaltySystem {
         i: usize,
     },
     /// The general case.
-    Solve(Box<System>),
+    Solve(Box<System<'a>>),
 }
 
-/// Per-anchor data and lambda-independent sums of [`PenaltySystem::Solve`].
+/// Per-anchor data (padded, structure of arrays) and lambda-independent sums of
+/// [`PenaltySystem::Solve`], with `v_i = y_i - yhat` and `s_i = (d_ref / D_ii)^2`.
 #[derive(Clone, Debug)]
-pub(crate) struct System {
-    /// `v_i = y_i - yhat`.
-    v: Vec<Vec8>,
-    /// `(d_ref / D_ii)^2`.
-    dinv2: Vec<f64>,
-    /// The constraint rows `c_i = (Psi v_i, 1)`.
-    c: Vec<Vector3<f64>>,
-    /// `c_i (d_ref / D_ii)^2`: the rows of `Q` before the Woodbury correction.
-    q0: Vec<Vector3<f64>>,
-    /// `sum v_i q0_i^T`.
+pub(crate) struct System<'a> {
+    anchors: &'a AnchorCoords,
+    yhat: [f64; DIM],
+    /// `Psi v_i`: the first two entries of the constraint rows `c_i = (Psi v_i, 1)`.
+    a0: Vec<f64>,
+    a1: Vec<f64>,
+    /// `s_i`; zero in the padding.
+    s: Vec<f64>,
+    /// `V S C^T = sum s_i v_i c_i^T`.
     t: SMatrix<f64, DIM, 3>,
-    /// The strict upper triangle of `V D^-2 V^T` (zero on and below the diagonal).
-    upper: SMatrix<f64, DIM, DIM>,
+    /// `V S V^T = sum s_i v_i v_i^T`.
+    vsv: SMatrix<f64, DIM, DIM>,
     /// The fourth smallest `D_ii`.
     d_ref: f64,
 }
 
-impl PenaltySystem {
+impl<'a> PenaltySystem<'a> {
     /// The system at the point `yhat` with tangent plane `psi` (errors as
     /// [`penalized_weights`]'s, except for `lambda`'s).
     pub(crate) fn new(
         psi: &Mat2x8,
         yhat: &Vec8,
-        anchors: &AnchorCoords,
+        anchors: &'a AnchorCoords,
         gamma: f64,
     ) -> Result<Self, SolveError> {
         let n = anchors.len();
-        if n == 0 {
-            return Err(SolveError::NoAnchors);
+        let ctx = Ctx::new(psi, yhat, n, gamma)?;
+        let len = anchors.padded();
+        let (mut a0, mut a1, mut d) = (vec![0.0; len], vec![0.0; len], vec![0.0; len]);
+        dispatch(Offsets {
+            ctx: &ctx,
+            anchors,
+            a0: &mut a0,
+            a1: &mut a1,
+            d: &mut d,
+        });
+        let d = &mut d[..];
+        if let Some(x) = d[..n].iter().find(|x| !x.is_finite()) {
+            return Err(distance_overflow(x.is_nan(), gamma));
         }
-        if !(gamma.is_finite() && gamma > 0.0) {
-            return Err(SolveError::InvalidParameter(format!(
-                "gamma must be finite and positive, got {gamma}"
-            )));
-        }
-        let g = psi * psi.transpose();
-        let gi = g
-            .try_inverse()
-            .filter(|m| m.iter().all(|x| x.is_finite()))
-            .ok_or(SolveError::DegenerateTangentPlane)?;
-        let v: Vec<Vec8> = (0..n).map(|i| anchors.get(i) - yhat).collect();
-        let a: Vec<Vector2<f64>> = v.iter().map(|v| psi * v).collect();
-        let d: Vec<f64> = v
-            .iter()
-            .zip(&a)
-            .map(|(v, a)| {
-                let vv = v.norm_squared();
-                let vt = (a.transpose() * gi * a)[0].clamp(0.0, vv);
-                vt + gamma * (vv - vt)
-            })
-            .collect();
-        if d.iter().any(|x| !x.is_finite()) {
-            return Err(crate::kernel::distance_overflow(
-                d.iter().any(|x| x.is_nan()),
-                gamma,
-            ));
-        }
-        let mut sorted = d.clone();
-        let k = 3.min(n - 1);
-        sorted.select_nth_unstable_by(k, f64::total_cmp);
-        if sorted[..=k].iter().any(|&x| x <= 0.0) {
+        if let Some(i) = d[..n].iter().position(|&x| x <= 0.0) {
             // The point is an anchor: the one-hot weight is exact (and has no offset).
-            let i = d.iter().position(|&x| x <= 0.0).unwrap_or(0);
             return Ok(Self::OneHot { n, i });
         }
         // Scale-free: D / d_ref, and the penalty scaled the same way.
-        let d_ref = sorted[k];
-        let dinv2: Vec<f64> = d.iter().map(|x| (d_ref / x).powi(2)).collect();
-        // S = I / mu + V D^-2 V^T is built by rank-one updates of its upper triangle, in
-        // anchor order; off the diagonal the sums start at zero whatever mu is.
-        let mut upper = SMatrix::<f64, DIM, DIM>::zeros();
-        for (vi, &di) in v.iter().zip(&dinv2) {
-            for c in 1..DIM {
-                let x = vi[c] * di;
-                for r in 0..c {
-                    upper[(r, c)] += vi[r] * x;
-                }
-            }
-        }
-        let c: Vec<Vector3<f64>> = a.iter().map(|a| Vector3::new(a[0], a[1], 1.0)).collect();
-        let q0: Vec<Vector3<f64>> = c.iter().zip(&dinv2).map(|(ci, &di)| ci * di).collect();
-        let mut t = SMatrix::<f64, DIM, 3>::zeros();
-        for (vi, qi) in v.iter().zip(&q0) {
-            t += vi * qi.transpose();
-        }
-        Ok(Self::Solve(Box::new(System {
-            v,
-            dinv2,
-            c,
-            q0,
-            t,
-            upper,
+        let mut sorted = d[..n].to_vec();
+        let k = 3.min(n - 1);
+        let d_ref = *sorted.select_nth_unstable_by(k, f64::total_cmp).1;
+        // Zero in the padding.
+        d[n..].fill(f64::INFINITY);
+        let s = d
+            .iter()
+            .map(|&x| {
+                let r = d_ref / x;
+                r * r
+            })
+            .collect();
+        let mut system = System {
+            anchors,
+            yhat: *ctx.yhat(),
+            a0,
+            a1,
+            s,
+            t: SMatrix::zeros(),
+            vsv: SMatrix::zeros(),
             d_ref,
-        })))
+        };
+        dispatch(Sums(&mut system));
+        Ok(Self::Solve(Box::new(system)))
     }
 
     /// The weights for penalty `lambda` (finite, non-negative).
@@ -139,53 +116,209 @@ impl PenaltySystem {
     }
 }
 
-impl System {
-    fn weights(&self, lambda: f64) -> Result<Vec<f64>, SolveError> {
-        let mu = lambda / self.d_ref;
-        // M = D^2 + mu V^T V; M^-1 x = z - D^-2 V^T S^-1 V z with z = D^-2 x and
-        // S = I / mu + V D^-2 V^T (8x8), symmetric positive definite for mu > 0.
-        let s_chol = (mu > 0.0)
-            .then(|| {
-                let mut s = self.upper;
-                let diag = 1.0 / mu;
-                for c in 0..DIM {
-                    s[(c, c)] = diag;
+/// [`offsets`] as one SIMD operation.
+struct Offsets<'a> {
+    ctx: &'a Ctx,
+    anchors: &'a AnchorCoords,
+    a0: &'a mut [f64],
+    a1: &'a mut [f64],
+    d: &'a mut [f64],
+}
+
+impl pulp::WithSimd for Offsets<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
+        match Wide::new(simd) {
+            Some(q) => offsets(q, self.ctx, self.anchors, self.a0, self.a1, self.d),
+            None => offsets(Plain, self.ctx, self.anchors, self.a0, self.a1, self.d),
+        }
+    }
+}
+
+/// [`System::sums`] as one SIMD operation.
+struct Sums<'s, 'a>(&'s mut System<'a>);
+
+impl pulp::WithSimd for Sums<'_, '_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
+        match Wide::new(simd) {
+            Some(q) => self.0.sums(q),
+            None => self.0.sums(Plain),
+        }
+    }
+}
+
+/// [`System::rung`] as one SIMD operation.
+struct Rung<'s, 'a> {
+    system: &'s System<'a>,
+    ut: &'s SMatrix<f64, 3, DIM>,
+    q: &'s mut [f64],
+}
+
+impl pulp::WithSimd for Rung<'_, '_> {
+    type Output = Matrix3<f64>;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> Matrix3<f64> {
+        match Wide::new(simd) {
+            Some(q) => self.system.rung(q, self.ut, self.q),
+            None => self.system.rung(Plain, self.ut, self.q),
+        }
+    }
+}
+
+/// [`combine`] as one SIMD operation.
+struct Combine<'s> {
+    q: &'s [f64],
+    z: [f64; 3],
+    out: &'s mut [f64],
+}
+
+impl pulp::WithSimd for Combine<'_> {
+    type Output = f64;
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> f64 {
+        match Wide::new(simd) {
+            Some(q) => combine(q, self.q, self.z, self.out),
+            None => combine(Plain, self.q, self.z, self.out),
+        }
+    }
+}
+
+/// `out_i = q_i . z` for the rows `q_i` stored as three arrays of `out`'s length in `q`;
+/// returns their sum.
+#[inline(always)]
+fn combine<Q: Quad>(qv: Q, q: &[f64], z: [f64; 3], out: &mut [f64]) -> f64 {
+    let len = out.len();
+    let (q0, rest) = q.split_at(len);
+    let (q1, q2) = rest.split_at(len);
+    let [z0, z1, z2] = z.map(|x| qv.splat(x));
+    let mut sum = qv.splat(0.0);
+    for c in (0..len).step_by(LANES) {
+        let w = qv.add(
+            qv.add(qv.mul(qv.load(&q0[c..]), z0), qv.mul(qv.load(&q1[c..]), z1)),
+            qv.mul(qv.load(&q2[c..]), z2),
+        );
+        qv.store(w, &mut out[c..]);
+        sum = qv.add(sum, w);
+    }
+    sum_lanes(qv.lanes(sum))
+}
+
+impl System<'_> {
+    /// `v` of the anchors `c .. c + LANES`, coordinate by coordinate.
+    #[inline(always)]
+    fn v<Q: Quad>(&self, q: Q, c: usize) -> [Q::V; DIM] {
+        std::array::from_fn(|k| q.sub(q.load(&self.anchors.dim(k)[c..]), q.splat(self.yhat[k])))
+    }
+
+    /// Fills in `t` and `vsv` (`s` and the rows already set).
+    #[inline(always)]
+    fn sums<Q: Quad>(&mut self, q: Q) {
+        let zero = q.splat(0.0);
+        let mut t = [[zero; 3]; DIM];
+        let mut vsv = [[zero; DIM]; DIM];
+        for c in (0..self.s.len()).step_by(LANES) {
+            let v = self.v(q, c);
+            let s = q.load(&self.s[c..]);
+            let sc = [
+                q.mul(s, q.load(&self.a0[c..])),
+                q.mul(s, q.load(&self.a1[c..])),
+                s,
+            ];
+            for k in 0..DIM {
+                for j in 0..3 {
+                    t[k][j] = q.add(t[k][j], q.mul(v[k], sc[j]));
                 }
-                for (vi, &di) in self.v.iter().zip(&self.dinv2) {
-                    for c in 0..DIM {
-                        let x = vi[c] * di;
-                        s[(c, c)] += vi[c] * x;
-                    }
+                let sv = q.mul(s, v[k]);
+                for l in k..DIM {
+                    vsv[k][l] = q.add(vsv[k][l], q.mul(sv, v[l]));
                 }
-                s.fill_lower_triangle_with_upper_triangle();
-                s.cholesky()
-            })
-            .flatten();
-        // Q = M^-1 C^T, row by row, for the constraint rows C = [a_0; a_1; 1] (3 x n).
-        let mut q = self.q0.clone();
-        if let Some(s_chol) = &s_chol {
-            // Woodbury: subtract D^-2 V^T S^-1 V z from z = D^-2 x, for the three columns.
-            let ut = s_chol.solve(&self.t).transpose();
-            for ((qi, vi), &di) in q.iter_mut().zip(&self.v).zip(&self.dinv2) {
-                *qi -= (ut * vi) * di;
             }
         }
-        let gm: nalgebra::Matrix3<f64> = self
-            .c
-            .iter()
-            .zip(&q)
-            .map(|(ci, qi)| ci * qi.transpose())
-            .sum();
+        self.t = SMatrix::from_fn(|k, j| sum_lanes(q.lanes(t[k][j])));
+        self.vsv = SMatrix::from_fn(|k, l| sum_lanes(q.lanes(vsv[k.min(l)][k.max(l)])));
+    }
+
+    /// The rows `q_i = s_i (c_i - U^T v_i)` into three arrays of the padded length in
+    /// `out`, and their Gram matrix with the constraint rows, `sum c_i q_i^T`.
+    #[inline(always)]
+    fn rung<Q: Quad>(&self, q: Q, ut: &SMatrix<f64, 3, DIM>, out: &mut [f64]) -> Matrix3<f64> {
+        let len = self.s.len();
+        let (o0, rest) = out.split_at_mut(len);
+        let (o1, o2) = rest.split_at_mut(len);
+        let u: [[Q::V; DIM]; 3] =
+            std::array::from_fn(|j| std::array::from_fn(|k| q.splat(ut[(j, k)])));
+        let one = q.splat(1.0);
+        let zero = q.splat(0.0);
+        let mut gm = [[zero; 3]; 3];
+        for c in (0..len).step_by(LANES) {
+            let v = self.v(q, c);
+            let s = q.load(&self.s[c..]);
+            let cr = [q.load(&self.a0[c..]), q.load(&self.a1[c..]), one];
+            let mut rows = [zero; 3];
+            for j in 0..3 {
+                let mut corr = zero;
+                for k in 0..DIM {
+                    corr = q.add(corr, q.mul(u[j][k], v[k]));
+                }
+                rows[j] = q.mul(s, q.sub(cr[j], corr));
+            }
+            for r in 0..3 {
+                for j in 0..3 {
+                    gm[r][j] = q.add(gm[r][j], q.mul(cr[r], rows[j]));
+                }
+            }
+            q.store(rows[0], &mut o0[c..]);
+            q.store(rows[1], &mut o1[c..]);
+            q.store(rows[2], &mut o2[c..]);
+        }
+        Matrix3::from_fn(|r, j| sum_lanes(q.lanes(gm[r][j])))
+    }
+
+    fn weights(&self, lambda: f64) -> Result<Vec<f64>, SolveError> {
+        let mu = lambda / self.d_ref;
+        // M = S^-1 + mu V^T V (S = diag s); with the Woodbury identity
+        // M^-1 x = S x - S V^T (I / mu + V S V^T)^-1 V S x, an 8x8 system.
+        let ut = (mu > 0.0)
+            .then(|| {
+                let mut m = self.vsv;
+                for c in 0..DIM {
+                    m[(c, c)] += 1.0 / mu;
+                }
+                m.cholesky()
+            })
+            .flatten()
+            .map_or(SMatrix::<f64, 3, DIM>::zeros(), |chol| {
+                chol.solve(&self.t).transpose()
+            });
+        let len = self.s.len();
+        let mut q = vec![0.0; 3 * len];
+        let gm = dispatch(Rung {
+            system: self,
+            ut: &ut,
+            q: &mut q,
+        });
         let z = gm
             .lu()
             .solve(&Vector3::new(0.0, 0.0, 1.0))
             .filter(|z| z.iter().all(|x| x.is_finite()))
             .ok_or(SolveError::DegenerateTangentPlane)?;
-        let mut w: Vec<f64> = q.iter().map(|qi| qi.dot(&z)).collect();
-        let sum: f64 = w.iter().sum();
+        let mut w = vec![0.0; len];
+        let sum = dispatch(Combine {
+            q: &q,
+            z: [z[0], z[1], z[2]],
+            out: &mut w,
+        });
         if !(sum.is_finite() && sum.abs() > 1e-12) {
             return Err(SolveError::DegenerateTangentPlane);
         }
+        w.truncate(self.anchors.len());
         for x in &mut w {
             *x /= sum;
         }
@@ -239,6 +372,7 @@ pub fn penalized_weights(
 
 #[cfg(test)]
 mod tests {
+    use nalgebra::Vector2;
     use rand::{Rng, SeedableRng};
 
     use super::*;
@@ -308,9 +442,10 @@ mod tests {
         w
     }
 
-    /// Every rung of one system gives the from-scratch weights to the last bit.
+    /// Every rung of one system gives the from-scratch weights, to rounding (the vector
+    /// passes sum in a different order; up to 8e-13 of the largest weight seen).
     #[test]
-    fn rungs_equal_the_from_scratch_solve_bit_for_bit() {
+    fn rungs_equal_the_from_scratch_solve() {
         let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         for case in 0..200 {
             let n = 4 + case % 120;
@@ -323,10 +458,15 @@ mod tests {
             for lambda in [0.0, 10.0, 100.0, 1e3, 1e4, 3.7] {
                 let want = from_scratch(&psi, &yhat, &anchors, 10.0, lambda);
                 let got = system.weights(lambda).unwrap();
-                assert_eq!(
-                    got.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
-                    want.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
-                    "case {case}, lambda {lambda}"
+                let scale = want.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                let err = got
+                    .iter()
+                    .zip(&want)
+                    .map(|(g, w)| (g - w).abs())
+                    .fold(0.0f64, f64::max);
+                assert!(
+                    err <= 1e-10 * scale,
+                    "case {case}, lambda {lambda}: {err:e}"
                 );
             }
         }
@@ -338,8 +478,8 @@ mod tests {
         let mut psi = Mat2x8::zeros();
         psi[(0, 0)] = 1.0;
         psi[(1, 1)] = 1.0;
-        let system =
-            PenaltySystem::new(&psi, &ys[2], &AnchorCoords::from_points(&ys), 10.0).unwrap();
+        let anchors = AnchorCoords::from_points(&ys);
+        let system = PenaltySystem::new(&psi, &ys[2], &anchors, 10.0).unwrap();
         for lambda in [0.0, 10.0, 1e4] {
             assert_eq!(
                 system.weights(lambda).unwrap(),
