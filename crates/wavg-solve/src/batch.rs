@@ -63,16 +63,45 @@ impl Solver {
         } = scratch;
         // A failed validation is the query's answer (sorted last).
         par.map_range(weights.len(), PREPARE_CHUNK, prepared, |i| {
-            let p = self.prepare(weights[i].as_ref(), opts);
-            let key = match &p {
-                Ok(p) => u64::from(wavg_project::internal::locality_key(
-                    self.projector(),
-                    &p.ybar,
-                )),
-                Err(_) => u64::MAX,
-            };
-            (key, p)
+            self.prepare_keyed(weights[i].as_ref(), opts)
         })?;
+        self.search_prepared(prepared, opts, order, pos, done, out, par, |_, r| r)
+    }
+
+    /// [`Solver::prepare`] with the Morton key of the average (`u64::MAX` for a failed
+    /// validation, so such queries sort last).
+    pub(crate) fn prepare_keyed(
+        &self,
+        weights: &[f64],
+        opts: &ForwardOptions,
+    ) -> (u64, Result<Prepared, SolveError>) {
+        let p = self.prepare(weights, opts);
+        let key = match &p {
+            Ok(p) => u64::from(wavg_project::internal::locality_key(
+                self.projector(),
+                &p.ybar,
+            )),
+            Err(_) => u64::MAX,
+        };
+        (key, p)
+    }
+
+    /// The searches of prepared queries (from [`Solver::prepare_keyed`]) in the Morton order
+    /// of their averages (nearby queries together, so they share cached mesh data), each
+    /// result mapped by `f(query index, result)`; into `out` in input order. `order`,
+    /// `pos` and `done` are buffers. Fails only when `par`'s threads cannot start.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn search_prepared<T: Clone + Send + Sync>(
+        &self,
+        prepared: &[(u64, Result<Prepared, SolveError>)],
+        opts: &ForwardOptions,
+        order: &mut Vec<(u64, u32)>,
+        pos: &mut Vec<u32>,
+        done: &mut Vec<T>,
+        out: &mut Vec<T>,
+        par: Par,
+        f: impl Fn(usize, Result<ForwardResult, SolveError>) -> T + Sync + Send,
+    ) -> Result<(), SolveError> {
         order.clear();
         order.extend(prepared.iter().enumerate().map(|(i, p)| (p.0, i as u32)));
         par.sort(order)?;
@@ -83,10 +112,12 @@ impl Solver {
             if let Some(&(_, j)) = order.get(k + AHEAD) {
                 wavg_project::internal::prefetch(&prepared[j as usize]);
             }
-            match &prepared[order[k].1 as usize].1 {
+            let i = order[k].1 as usize;
+            let r = match &prepared[i].1 {
                 Ok(p) => self.forward_prepared(p, opts),
                 Err(e) => Err(e.clone()),
-            }
+            };
+            f(i, r)
         })?;
         // Back in input order: one gather, no intermediate lists.
         pos.clear();
@@ -196,18 +227,34 @@ impl Solver {
         rows: &mut [f64],
         par: Par,
     ) -> Result<Vec<Result<(), SolveError>>, SolveError> {
+        self.inverse_rows_then(points, point, rows, par, |r| r.map(|_| ()))
+    }
+
+    /// [`Solver::inverse_rows_into_by`], each point's outcome (its row of weights, or the
+    /// error) mapped by `then` while the row is in cache.
+    ///
+    /// # Panics
+    /// When `rows` does not hold `points.len() * n_anchors` values.
+    pub(crate) fn inverse_rows_then<P: Sync, T: Send>(
+        &self,
+        points: &[P],
+        point: impl Fn(&P) -> SurfacePoint + Sync + Send,
+        rows: &mut [f64],
+        par: Par,
+        then: impl Fn(Result<&[f64], SolveError>) -> T + Sync + Send,
+    ) -> Result<Vec<T>, SolveError> {
         let n = self.n_anchors().max(1);
         assert_eq!(rows.len(), points.len() * n, "one row of weights per point");
         // Random points read random face records and then their corners' records: request
         // both a few points ahead (software pipelining), so the waits overlap.
         let proj = self.projector();
-        let mut status = Vec::with_capacity(points.len());
+        let mut out = Vec::with_capacity(points.len());
         par.zip_chunks_mut(
             rows,
             n * INVERSE_CHUNK,
             points,
             INVERSE_CHUNK,
-            &mut status,
+            &mut out,
             |rows, pts| {
                 let mut scratch = InverseScratch::default();
                 let mut buf = Vec::with_capacity(n);
@@ -215,7 +262,7 @@ impl Solver {
                 for f in (0..4).filter_map(ahead) {
                     wavg_project::internal::prefetch_point_data(proj, f, false);
                 }
-                let mut status = Vec::with_capacity(pts.len());
+                let mut out = Vec::with_capacity(pts.len());
                 for (k, (row, p)) in rows.chunks_mut(n).zip(pts).enumerate() {
                     let p = &point(p);
                     if let Some(f) = ahead(k + 4) {
@@ -224,26 +271,30 @@ impl Solver {
                     if let Some(f) = ahead(k + 2) {
                         wavg_project::internal::prefetch_point_data(proj, f, true);
                     }
-                    let r = self.inverse_into(p, &mut scratch, &mut buf);
-                    match r {
-                        Ok(()) => row.copy_from_slice(&buf),
-                        Err(_) => row.fill(f64::NAN),
-                    }
-                    status.push(r);
+                    out.push(match self.inverse_into(p, &mut scratch, &mut buf) {
+                        Ok(()) => {
+                            row.copy_from_slice(&buf);
+                            then(Ok(row))
+                        }
+                        Err(e) => {
+                            row.fill(f64::NAN);
+                            then(Err(e))
+                        }
+                    });
                 }
-                status
+                out
             },
         )?;
-        Ok(status)
+        Ok(out)
     }
 }
 
 /// Weights of a batch of inverse problems: one row of `n_anchors` weights per point.
 #[derive(Clone, Debug, Default)]
 pub struct BatchWeights {
-    n: usize,
-    data: Vec<f64>,
-    status: Vec<Result<(), SolveError>>,
+    pub(crate) n: usize,
+    pub(crate) data: Vec<f64>,
+    pub(crate) status: Vec<Result<(), SolveError>>,
 }
 
 impl BatchWeights {

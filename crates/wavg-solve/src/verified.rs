@@ -17,11 +17,11 @@ use wavg_mesh::SurfacePoint;
 
 use wavg_project::Par;
 
-use crate::batch::{BatchWeights, ForwardScratch};
+use crate::batch::BatchWeights;
 use crate::error::SolveError;
 use crate::penalty::PenaltySystem;
 use crate::points::check_point;
-use crate::solver::{ForwardOptions, ForwardResult, Solver};
+use crate::solver::{ForwardOptions, Solver};
 
 /// The penalties tried, in order, after the paper's weights.
 pub const PENALTY_LADDER: [f64; 4] = [10.0, 100.0, 1_000.0, 10_000.0];
@@ -164,8 +164,9 @@ impl Solver {
     /// [`Solver::inverse_verified_batch`] into existing buffers, with explicit parallelism
     /// (the results do not depend on it): row `i` of `weights` and `round_trips[i]` belong
     /// to `points[i]` (both carry the error when it failed). In stages, each a batch: the
-    /// paper's weights for all points ([`Solver::inverse_batch_into`]) and their forward
-    /// problems ([`Solver::forward_batch_into`], which orders them for cache locality);
+    /// paper's weights for all points, each prepared for its forward problem while still in
+    /// cache; the forward problems in the Morton order of their averages (as
+    /// [`Solver::forward_batch_into`]), each reduced to whether it returns to its point;
     /// then the points still not returned, each up the penalty ladder on its own (the
     /// lambda-independent part of its problem set up once).
     /// Fails only when `par`'s threads cannot start.
@@ -194,9 +195,9 @@ impl Solver {
         round_trips: &mut Vec<Result<RoundTrip, SolveError>>,
         par: Par,
     ) -> Result<(), SolveError> {
-        self.inverse_batch_into(points, weights, par)?;
         round_trips.clear();
         if !(tolerance.is_finite() && tolerance > 0.0) {
+            self.inverse_batch_into(points, weights, par)?;
             let e = SolveError::InvalidParameter(format!(
                 "the round-trip tolerance must be finite and positive, got {tolerance}"
             ));
@@ -208,20 +209,49 @@ impl Solver {
         }
         let mesh = self.mesh();
         let tol = tolerance * self.mean_edge_length();
-        let returns = |p: &SurfacePoint, f: &Result<ForwardResult, SolveError>| {
-            f.as_ref().is_ok_and(|f| {
-                check_point(mesh, p).is_ok_and(|c| (f.position - c.position(mesh)).norm() <= tol)
-            })
-        };
         let opts = ForwardOptions::default();
-        let (mut scratch, mut fwd) = (ForwardScratch::default(), Vec::new());
-        let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
-        self.forward_batch_into(&rows, &opts, &mut scratch, &mut fwd, par)?;
+        // The paper's weights, each prepared for its forward problem while in cache.
+        let n = self.n_anchors();
+        weights.n = n;
+        weights.data.resize(points.len() * n.max(1), 0.0);
+        let mut prepared = Vec::new();
+        weights.status.clear();
+        for (status, p) in self.inverse_rows_then(
+            points,
+            |p| *p,
+            &mut weights.data,
+            par,
+            |r| match r {
+                Ok(row) => (Ok(()), self.prepare_keyed(row, &opts)),
+                Err(e) => (Err(e.clone()), (u64::MAX, Err(e))),
+            },
+        )? {
+            weights.status.push(status);
+            prepared.push(p);
+        }
+        // Their forward problems, reduced to whether each returns to its point.
+        let (mut order, mut pos, mut done, mut back) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        self.search_prepared(
+            &prepared,
+            &opts,
+            &mut order,
+            &mut pos,
+            &mut done,
+            &mut back,
+            par,
+            |i, f| {
+                f.is_ok_and(|f| {
+                    check_point(mesh, &points[i])
+                        .is_ok_and(|c| (f.position - c.position(mesh)).norm() <= tol)
+                })
+            },
+        )?;
         let paper = &*weights;
         par.map_range(points.len(), CHECK_CHUNK, round_trips, |i| {
             match paper.get(i) {
                 Err(e) => Err(e.clone()),
-                Ok(_) if returns(&points[i], &fwd[i]) => Ok(RoundTrip::Paper),
+                Ok(_) if back[i] => Ok(RoundTrip::Paper),
                 Ok(_) => Ok(RoundTrip::NotReached),
             }
         })?;
