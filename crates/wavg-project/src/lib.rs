@@ -47,7 +47,8 @@ mod triangle;
 // The embedded mesh and its projector.
 pub use embedded::EmbeddedMesh;
 pub use projector::{
-    FACE_WALK, LOCAL_BUDGET, ProjectScratch, Projection, ProjectionPath, Projector, SearchGoal,
+    FACE_WALK, HINT_STEPS, LOCAL_BUDGET, ProjectScratch, Projection, ProjectionPath, Projector,
+    SearchGoal,
 };
 
 // How batches run.

@@ -237,10 +237,11 @@ impl Solver {
     /// query would cost more than the query) onto the surface. The search starts at the
     /// nearest corner of `opts.warm_start` when given, else of `near` (a point expected
     /// close to the answer, e.g. the highest-weight input point). With a warm start in
-    /// [`SearchMode::Fast`], its face is tried first, then up to
-    /// [`wavg_project::FACE_WALK`] faces in all that Newton's method exits into (a
-    /// previous answer's face usually holds the new one when the inputs moved a little),
-    /// before that search. The solver's own anchors are not used. A non-finite `ybar` is
+    /// [`SearchMode::Fast`], the face the average lies over is tried first (found within
+    /// [`wavg_project::HINT_STEPS`] steps over faces from the warm start's face), then up
+    /// to [`wavg_project::FACE_WALK`] faces in all that Newton's method exits into (a
+    /// previous answer's face or a neighbour usually holds the new one when the inputs
+    /// moved a little), before that search. The solver's own anchors are not used. A non-finite `ybar` is
     /// [`SolveError::InvalidParameter`].
     pub fn forward_embedded(
         &self,

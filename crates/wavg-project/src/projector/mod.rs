@@ -39,7 +39,7 @@ use locate::StartGrid;
 
 pub use batch::ProjectScratch;
 pub use order::FaceOrder;
-pub use search::{FACE_WALK, LOCAL_BUDGET, SearchGoal};
+pub use search::{FACE_WALK, HINT_STEPS, LOCAL_BUDGET, SearchGoal};
 pub use walk::WALK_GROUP;
 
 /// A distance below this fraction of the triangle's longest edge counts as zero: such a
@@ -362,8 +362,9 @@ impl Projector {
 
     /// The projection of `y` that `goal` asks for, searching from vertex `start`. With a
     /// `hint` face (a warm start: the previous answer's face when the query moved a
-    /// little), if the query lies over it, the hint and up to [`FACE_WALK`] faces in all
-    /// that Newton's method exits into are tried first: for [`SearchGoal::FirstHit`] a valid projection there is the answer;
+    /// little), the face the query lies over, found within [`HINT_STEPS`] steps over faces
+    /// from the hint, and up to [`FACE_WALK`] faces in all that Newton's method exits into
+    /// are tried first: for [`SearchGoal::FirstHit`] a valid projection there is the answer;
     /// for [`SearchGoal::Closest`] only one at (numerically) zero distance is, since
     /// anything else still needs certifying.
     ///

@@ -12,10 +12,14 @@ pub const LOCAL_BUDGET: usize = 96;
 /// the vertex search.
 pub const FACE_WALK: usize = 4;
 
-/// How far outside a warm start's hint face (in barycentric units) the query's
-/// Euclidean projection onto its plane may fall for the face walk to be tried: none, so a
-/// hint that does not hold the query costs a few dot products, not Newton solves.
+/// How far outside a face (in barycentric units) the query's Euclidean projection onto its
+/// plane may fall for a warm start's face walk to try Newton's method there: none, so a
+/// face that does not hold the query costs a few dot products, not a Newton solve.
 const HINT_MARGIN: f64 = 0.0;
+
+/// Steps over faces a warm start may take from its hint face towards the face the query
+/// lies over (samples along a curve usually move into a neighbour of the last face).
+pub const HINT_STEPS: usize = 3;
 
 /// What the caller wants from [`Projector::project_with`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -373,28 +377,43 @@ impl Projector {
         }
     }
 
-    /// A warm start's face walk: face `f`, then up to [`FACE_WALK`] faces in all that
-    /// Newton's method exits into; the first valid projection, if it is at least as close
-    /// to `y` as the corners of its face. A projection farther than a point of the
-    /// surface next to it is likely not the one the walk would find (a query far off a
-    /// curved surface can have several); the full search decides then.
+    /// A warm start's face walk: from face `f`, up to [`HINT_STEPS`] steps over faces to
+    /// the one over which the query lies (its Euclidean projection onto the face's plane
+    /// falls inside; each step crosses the edge opposite the most negative barycentric
+    /// coordinate), then that face and up to [`FACE_WALK`] faces in all that Newton's
+    /// method exits into; the first valid projection, if it is at least as close to `y`
+    /// as the corners of its face. A projection farther than a point of the surface next
+    /// to it is likely not the one the walk would find (a query far off a curved surface
+    /// can have several); the full search decides then, as it does when no face within
+    /// the steps lies under the query.
     pub(super) fn face_walk(&self, y: &Vec8, mut f: FaceId) -> Option<Best> {
         let topo = self.emb.mesh().topology();
-        // Newton's method is worth trying only when the query is over the hint: the
-        // Euclidean projection onto its plane falls inside.
-        let [a, b, c] = self.corners(f);
-        let (e1, e2, r) = (b - a, c - a, y - a);
-        let (aa, ab, bb, d, e) = (
-            e1.dot(&e1),
-            e1.dot(&e2),
-            e2.dot(&e2),
-            e1.dot(&r),
-            e2.dot(&r),
-        );
-        let det = aa * bb - ab * ab;
-        let (l1, l2) = ((bb * d - ab * e) / det, (aa * e - ab * d) / det);
-        if !(l1.min(l2).min(1.0 - l1 - l2) >= -HINT_MARGIN) {
-            return None;
+        // Newton's method is worth trying only on a face the query is over.
+        for step in 0..=HINT_STEPS {
+            let [a, b, c] = self.corners(f);
+            let (e1, e2, r) = (b - a, c - a, y - a);
+            let (aa, ab, bb, d, e) = (
+                e1.dot(&e1),
+                e1.dot(&e2),
+                e2.dot(&e2),
+                e1.dot(&r),
+                e2.dot(&r),
+            );
+            let det = aa * bb - ab * ab;
+            let (l1, l2) = ((bb * d - ab * e) / det, (aa * e - ab * d) / det);
+            let l = [1.0 - l1 - l2, l1, l2];
+            let k = (0..3).min_by(|&i, &j| l[i].total_cmp(&l[j]))?;
+            if l[k] >= -HINT_MARGIN {
+                break;
+            }
+            // NaN (a degenerate face) and running out of steps end the walk.
+            if !(l[k] < -HINT_MARGIN) || step == HINT_STEPS {
+                return None;
+            }
+            f = topo.face_neighbors(f)[(k + 1) % 3];
+            if f == NONE {
+                return None;
+            }
         }
         for _ in 0..FACE_WALK {
             match self.try_face_or_exit(f, y) {
