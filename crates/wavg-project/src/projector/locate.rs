@@ -177,22 +177,47 @@ impl StartGrid {
     }
 
     /// Greedy walk over the cells from the one holding walk point `p`: moves to the
-    /// neighbouring cell whose vertex is closest to `p` (squared distance in walk units)
-    /// while that improves; returns the last cell's vertex and its squared distance.
+    /// neighbouring cell whose vertex is closest to `p` (squared distance in walk units;
+    /// ties to the first in [`StartGrid::neighbours`]' order) while that improves; returns
+    /// the last cell's vertex and its squared distance.
     #[inline]
     pub(super) fn walk(&self, p: &[f32; 8]) -> (VertexId, f32) {
         let dist2 = |cell: &Cell| super::layout::dist2_packed(&cell.c, p);
         let mut c = self.cell_of(p).0;
         let mut v = self.cells[c].v;
         let mut d = dist2(&self.cells[c]);
+        let [d0, d1, d2] = self.dims.map(|d| d as usize);
+        // Index offsets of the 26 neighbours of a cell off the grid's sides, in
+        // `neighbours`' order.
+        let mut offsets = [0isize; 26];
+        let mut m = 0;
+        for di in -1isize..=1 {
+            for dj in -1isize..=1 {
+                for dk in -1isize..=1 {
+                    if (di, dj, dk) != (0, 0, 0) {
+                        offsets[m] = (di * d1 as isize + dj) * d2 as isize + dk;
+                        m += 1;
+                    }
+                }
+            }
+        }
         for _ in 0..MAX_CELL_STEPS {
             let mut next = c;
-            for n in self.neighbours(c, true).into_iter().flatten() {
+            let (i, j, k) = (c / (d1 * d2), c / d2 % d1, c % d2);
+            let inside = (1..d0.saturating_sub(1)).contains(&i)
+                && (1..d1.saturating_sub(1)).contains(&j)
+                && (1..d2.saturating_sub(1)).contains(&k);
+            let mut visit = |n: usize| {
                 let cell = &self.cells[n];
                 let du = dist2(cell);
                 if du < d {
                     (next, v, d) = (n, cell.v, du);
                 }
+            };
+            if inside {
+                offsets.iter().for_each(|&o| visit(c.wrapping_add_signed(o)));
+            } else {
+                self.neighbours(c, true).into_iter().flatten().for_each(visit);
             }
             if next == c {
                 break;
@@ -269,6 +294,44 @@ mod tests {
             );
         }
         assert!(own.iter().any(|&o| !o), "some cells are empty (and filled)");
+        // The walk's inner-cell shortcut visits the neighbours of `neighbours` in its
+        // order: the same walk as through `neighbours` alone, from everywhere.
+        let reference = |p: &[f32; 8]| {
+            let dist2 = |cell: &Cell| crate::projector::layout::dist2_packed(&cell.c, p);
+            let mut c = g.cell_of(p).0;
+            let (mut v, mut d) = (g.cells[c].v, dist2(&g.cells[c]));
+            for _ in 0..MAX_CELL_STEPS {
+                let mut next = c;
+                for n in g.neighbours(c, true).into_iter().flatten() {
+                    let du = dist2(&g.cells[n]);
+                    if du < d {
+                        (next, v, d) = (n, g.cells[n].v, du);
+                    }
+                }
+                if next == c {
+                    break;
+                }
+                c = next;
+            }
+            (v, d)
+        };
+        let mut inner = 0;
+        for (v, w) in p.walk_coords.iter().enumerate().step_by(7) {
+            let mut q = w.unpack();
+            // Off the surface in every coordinate, some points past the grid's sides.
+            for (k, x) in q.iter_mut().enumerate() {
+                *x += ((v * 31 + k * 17) % 23) as f32 * 40.0 - 440.0;
+                if v % 5 == 0 {
+                    *x = if k % 2 == 0 { -3e4 } else { 1e5 };
+                }
+            }
+            assert_eq!(g.walk(&q), reference(&q), "vertex {v}");
+            let [d0, d1, d2] = g.dims;
+            let c = g.cell_of(&q).0 as u32;
+            let (i, j, k) = (c / (d1 * d2), c / d2 % d1, c % d2);
+            inner += usize::from(i > 0 && j > 0 && k > 0 && i + 1 < d0 && j + 1 < d1 && k + 1 < d2);
+        }
+        assert!(inner > 50, "{inner} walks started inside");
         for threads in [1, 3] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
