@@ -88,6 +88,25 @@ pub(crate) struct Prepared {
     hint: Option<FaceId>,
 }
 
+/// The index of the highest of (finite, validated) `weights`, ties to the lowest index:
+/// the maximum in four running lanes, then its first position.
+fn highest(weights: &[f64]) -> usize {
+    let mut lanes = [f64::NEG_INFINITY; 4];
+    let chunks = weights.chunks_exact(4);
+    for &w in chunks.remainder() {
+        lanes[0] = if w > lanes[0] { w } else { lanes[0] };
+    }
+    for c in chunks {
+        for (l, &w) in lanes.iter_mut().zip(c) {
+            *l = if w > *l { w } else { *l };
+        }
+    }
+    let max = lanes
+        .into_iter()
+        .fold(f64::NEG_INFINITY, |m, l| if l > m { l } else { m });
+    weights.iter().position(|&w| w == max).unwrap_or(0)
+}
+
 /// Answer of the forward problem.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ForwardResult {
@@ -288,13 +307,7 @@ impl Solver {
                 Start::Warm(nearest_corner(self.mesh(), &p))
             }
             (_, None) => {
-                // Highest weight; ties to the lowest index.
-                let mut anchor = 0;
-                for (i, &w) in weights.iter().enumerate() {
-                    if w > weights[anchor] {
-                        anchor = i;
-                    }
-                }
+                let anchor = highest(weights);
                 Start::HighestWeight {
                     anchor,
                     vertex: self.anchors.starts()[anchor],
@@ -401,6 +414,42 @@ impl Solver {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The first index of the largest weight, as a scan with a strict comparison finds
+    /// it, for lengths around the lane count, ties and signed zeros.
+    #[test]
+    fn highest_is_the_first_largest() {
+        let scan = |w: &[f64]| {
+            let mut a = 0;
+            for (i, &x) in w.iter().enumerate() {
+                if x > w[a] {
+                    a = i;
+                }
+            }
+            a
+        };
+        for n in 1..40usize {
+            for pattern in 0..6u64 {
+                let w: Vec<f64> = (0..n as u64)
+                    .map(|i| match pattern {
+                        0 => ((i * 7919 + 13) % 31) as f64 - 15.0,
+                        1 => 1.0,
+                        2 => {
+                            if i % 3 == 0 {
+                                -0.0
+                            } else {
+                                0.0
+                            }
+                        }
+                        3 => -(i as f64),
+                        4 => i as f64,
+                        _ => ((i * 31) % 5) as f64,
+                    })
+                    .collect();
+                assert_eq!(highest(&w), scan(&w), "n {n}, pattern {pattern}: {w:?}");
+            }
+        }
+    }
 
     #[test]
     fn forward_embedded_equals_forward_with_the_same_average() {
