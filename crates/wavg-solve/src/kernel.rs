@@ -298,10 +298,13 @@ pub(crate) fn offsets<Q: Quad>(
         p1.map(|x| q.splat(x)),
     );
     let zero = q.splat(0.0);
-    for c in (0..ys.padded()).step_by(LANES) {
+    let nc = ys.padded() / LANES;
+    let dims: [&[[f64; LANES]]; DIM] = std::array::from_fn(|k| quads(&ys.dims[k], nc));
+    let (a0, a1, ds) = (quads_mut(a0, nc), quads_mut(a1, nc), quads_mut(ds, nc));
+    for c in 0..nc {
         let (mut vv, mut x0, mut x1) = (zero, zero, zero);
         for k in 0..DIM {
-            let v = q.sub(q.load(&ys.dims[k][c..]), yhs[k]);
+            let v = q.sub(q.load(&dims[k][c]), yhs[k]);
             vv = q.add(vv, q.mul(v, v));
             x0 = q.add(x0, q.mul(p0s[k], v));
             x1 = q.add(x1, q.mul(p1s[k], v));
@@ -311,10 +314,22 @@ pub(crate) fn offsets<Q: Quad>(
             q.mul(q.mul(h2, x1), x1),
         );
         let vt = q.min_left(vt, vv);
-        q.store(q.sub(q.mul(gv, vv), q.mul(gm1, vt)), &mut ds[c..]);
-        q.store(x0, &mut a0[c..]);
-        q.store(x1, &mut a1[c..]);
+        q.store(q.sub(q.mul(gv, vv), q.mul(gm1, vt)), &mut ds[c]);
+        q.store(x0, &mut a0[c]);
+        q.store(x1, &mut a1[c]);
     }
+}
+
+/// The first `nc` groups of [`LANES`] of `x` (panics when shorter).
+#[inline(always)]
+pub(crate) fn quads(x: &[f64], nc: usize) -> &[[f64; LANES]] {
+    bytemuck::cast_slice(&x[..nc * LANES])
+}
+
+/// [`quads`], mutable.
+#[inline(always)]
+pub(crate) fn quads_mut(x: &mut [f64], nc: usize) -> &mut [[f64; LANES]] {
+    bytemuck::cast_slice_mut(&mut x[..nc * LANES])
 }
 
 /// [`kernel`] for one query as one SIMD operation.
@@ -358,8 +373,8 @@ fn kernel<Q: Quad>(
     // Smallest d (first index), largest, and a NaN check, over the n real anchors.
     let full = n / LANES * LANES;
     let (mut lo, mut hi, mut bad) = (q.splat(f64::INFINITY), zero, zero);
-    for c in (0..full).step_by(LANES) {
-        let d = q.load(&ds[c..]);
+    for d in quads(ds, n / LANES) {
+        let d = q.load(d);
         lo = q.min_left(d, lo);
         hi = q.max_left(d, hi);
         // d - d is 0 for finite d, NaN for NaN and infinite d: an infinite d is caught below.
@@ -388,12 +403,15 @@ fn kernel<Q: Quad>(
     let (am0, am1) = (a0[m], a1[m]);
     let (am0s, am1s, dmins) = (q.splat(am0), q.splat(am1), q.splat(dmin));
     // Pass 2: constraint rows centred on anchor m, s_j = (d_min/d_j)^2 (kept in `out`).
+    let nc = len / LANES;
+    let (a0, a1, ds) = (quads(a0, nc), quads(a1, nc), quads(ds, nc));
+    let out = quads_mut(out, nc);
     let mut acc = [zero; 6];
-    for c in (0..len).step_by(LANES) {
-        let r = q.div(dmins, q.load(&ds[c..]));
+    for c in 0..nc {
+        let r = q.div(dmins, q.load(&ds[c]));
         let s = q.mul(r, r);
-        let c0 = q.sub(q.load(&a0[c..]), am0s);
-        let c1 = q.sub(q.load(&a1[c..]), am1s);
+        let c0 = q.sub(q.load(&a0[c]), am0s);
+        let c1 = q.sub(q.load(&a1[c]), am1s);
         let (sc0, sc1) = (q.mul(s, c0), q.mul(s, c1));
         acc[0] = q.add(acc[0], q.mul(sc0, c0));
         acc[1] = q.add(acc[1], q.mul(sc0, c1));
@@ -401,7 +419,7 @@ fn kernel<Q: Quad>(
         acc[3] = q.add(acc[3], q.mul(sc1, c1));
         acc[4] = q.add(acc[4], sc1);
         acc[5] = q.add(acc[5], s);
-        q.store(s, &mut out[c..]);
+        q.store(s, &mut out[c]);
     }
     let [m00, m01, m02, m11, m12, m22] = acc.map(|a| sum_lanes(q.lanes(a)));
     let b = [-am0, -am1, 1.0];
@@ -409,7 +427,7 @@ fn kernel<Q: Quad>(
         // Singular: either the other anchors' contributions underflowed because the point
         // is (to within ~1e-150 relative) at an anchor, or the anchors are degenerate.
         if dmin <= 1e-100 * dmax {
-            one_hot(&ds[..n], &mut out[..n]);
+            one_hot(&ds.as_flattened()[..n], &mut out.as_flattened_mut()[..n]);
             return Ok(());
         }
         return Err(SolveError::DegenerateAnchors);
@@ -417,14 +435,14 @@ fn kernel<Q: Quad>(
     // Pass 3: w_j = s_j c_j . z.
     let (z0, z1, z2) = (q.splat(z[0]), q.splat(z[1]), q.splat(z[2]));
     let mut sums = zero;
-    for c in (0..len).step_by(LANES) {
-        let c0 = q.sub(q.load(&a0[c..]), am0s);
-        let c1 = q.sub(q.load(&a1[c..]), am1s);
+    for c in 0..nc {
+        let c0 = q.sub(q.load(&a0[c]), am0s);
+        let c1 = q.sub(q.load(&a1[c]), am1s);
         let w = q.mul(
-            q.load(&out[c..]),
+            q.load(&out[c]),
             q.add(q.add(q.mul(c0, z0), q.mul(c1, z1)), z2),
         );
-        q.store(w, &mut out[c..]);
+        q.store(w, &mut out[c]);
         sums = q.add(sums, w);
     }
     let sum = sum_lanes(q.lanes(sums));
@@ -432,9 +450,8 @@ fn kernel<Q: Quad>(
         return Err(SolveError::DegenerateAnchors);
     }
     let inv = q.splat(1.0 / sum);
-    for c in (0..len).step_by(LANES) {
-        let w = q.mul(q.load(&out[c..]), inv);
-        q.store(w, &mut out[c..]);
+    for w in out {
+        q.store(q.mul(q.load(w), inv), w);
     }
     Ok(())
 }

@@ -10,7 +10,7 @@
 use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use crate::error::SolveError;
-use crate::kernel::{AnchorCoords, Ctx, distance_overflow, offsets};
+use crate::kernel::{AnchorCoords, Ctx, distance_overflow, offsets, quads, quads_mut};
 use crate::simd::{LANES, Plain, Quad, Wide, dispatch, sum_lanes};
 use crate::{DIM, Mat2x8, Vec8};
 
@@ -199,12 +199,15 @@ fn combine<Q: Quad>(qv: Q, q: &[f64], z: [f64; 3], out: &mut [f64]) -> f64 {
     let (q1, q2) = rest.split_at(len);
     let [z0, z1, z2] = z.map(|x| qv.splat(x));
     let mut sum = qv.splat(0.0);
-    for c in (0..len).step_by(LANES) {
+    let nc = len / LANES;
+    let (q0, q1, q2) = (quads(q0, nc), quads(q1, nc), quads(q2, nc));
+    let out = quads_mut(out, nc);
+    for c in 0..nc {
         let w = qv.add(
-            qv.add(qv.mul(qv.load(&q0[c..]), z0), qv.mul(qv.load(&q1[c..]), z1)),
-            qv.mul(qv.load(&q2[c..]), z2),
+            qv.add(qv.mul(qv.load(&q0[c]), z0), qv.mul(qv.load(&q1[c]), z1)),
+            qv.mul(qv.load(&q2[c]), z2),
         );
-        qv.store(w, &mut out[c..]);
+        qv.store(w, &mut out[c]);
         sum = qv.add(sum, w);
     }
     sum_lanes(qv.lanes(sum))
@@ -214,7 +217,13 @@ impl System<'_> {
     /// `v` of the anchors `c .. c + LANES`, coordinate by coordinate.
     #[inline(always)]
     fn v<Q: Quad>(&self, q: Q, c: usize) -> [Q::V; DIM] {
-        std::array::from_fn(|k| q.sub(q.load(&self.anchors.dim(k)[c..]), q.splat(self.yhat[k])))
+        std::array::from_fn(|k| {
+            let y = &self.anchors.dim(k)[c * LANES..(c + 1) * LANES];
+            q.sub(
+                q.load(y.try_into().expect("LANES long")),
+                q.splat(self.yhat[k]),
+            )
+        })
     }
 
     /// Fills in `t` and `vsv` (`s` and the rows already set).
@@ -223,14 +232,12 @@ impl System<'_> {
         let zero = q.splat(0.0);
         let mut t = [[zero; 3]; DIM];
         let mut vsv = [[zero; DIM]; DIM];
-        for c in (0..self.s.len()).step_by(LANES) {
+        let nc = self.s.len() / LANES;
+        let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
+        for c in 0..nc {
             let v = self.v(q, c);
-            let s = q.load(&self.s[c..]);
-            let sc = [
-                q.mul(s, q.load(&self.a0[c..])),
-                q.mul(s, q.load(&self.a1[c..])),
-                s,
-            ];
+            let s = q.load(&ss[c]);
+            let sc = [q.mul(s, q.load(&a0[c])), q.mul(s, q.load(&a1[c])), s];
             for k in 0..DIM {
                 for j in 0..3 {
                     t[k][j] = q.add(t[k][j], q.mul(v[k], sc[j]));
@@ -257,10 +264,13 @@ impl System<'_> {
         let one = q.splat(1.0);
         let zero = q.splat(0.0);
         let mut gm = [[zero; 3]; 3];
-        for c in (0..len).step_by(LANES) {
+        let nc = len / LANES;
+        let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
+        let (o0, o1, o2) = (quads_mut(o0, nc), quads_mut(o1, nc), quads_mut(o2, nc));
+        for c in 0..nc {
             let v = self.v(q, c);
-            let s = q.load(&self.s[c..]);
-            let cr = [q.load(&self.a0[c..]), q.load(&self.a1[c..]), one];
+            let s = q.load(&ss[c]);
+            let cr = [q.load(&a0[c]), q.load(&a1[c]), one];
             let mut rows = [zero; 3];
             for j in 0..3 {
                 let mut corr = zero;
@@ -274,9 +284,9 @@ impl System<'_> {
                     gm[r][j] = q.add(gm[r][j], q.mul(cr[r], rows[j]));
                 }
             }
-            q.store(rows[0], &mut o0[c..]);
-            q.store(rows[1], &mut o1[c..]);
-            q.store(rows[2], &mut o2[c..]);
+            q.store(rows[0], &mut o0[c]);
+            q.store(rows[1], &mut o1[c]);
+            q.store(rows[2], &mut o2[c]);
         }
         Matrix3::from_fn(|r, j| sum_lanes(q.lanes(gm[r][j])))
     }

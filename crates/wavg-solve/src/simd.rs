@@ -72,10 +72,10 @@ pub(crate) fn dot<S: pulp::Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
 pub(crate) trait Quad: Copy {
     /// A vector.
     type V: Copy;
-    /// Lanes `x[..LANES]`.
-    fn load(self, x: &[f64]) -> Self::V;
-    /// Writes the lanes to `x[..LANES]`.
-    fn store(self, v: Self::V, x: &mut [f64]);
+    /// The lanes `x`.
+    fn load(self, x: &[f64; LANES]) -> Self::V;
+    /// Writes the lanes to `x`.
+    fn store(self, v: Self::V, x: &mut [f64; LANES]);
     /// `v` in every lane.
     fn splat(self, v: f64) -> Self::V;
     /// `a + b`.
@@ -101,12 +101,12 @@ pub(crate) struct Plain;
 impl Quad for Plain {
     type V = [f64; LANES];
     #[inline(always)]
-    fn load(self, x: &[f64]) -> Self::V {
-        std::array::from_fn(|l| x[l])
+    fn load(self, x: &[f64; LANES]) -> Self::V {
+        *x
     }
     #[inline(always)]
-    fn store(self, v: Self::V, x: &mut [f64]) {
-        x[..LANES].copy_from_slice(&v);
+    fn store(self, v: Self::V, x: &mut [f64; LANES]) {
+        *x = v;
     }
     #[inline(always)]
     fn splat(self, v: f64) -> Self::V {
@@ -158,12 +158,12 @@ impl<S: pulp::Simd> Wide<S> {
 impl<S: pulp::Simd> Quad for Wide<S> {
     type V = S::f64s;
     #[inline(always)]
-    fn load(self, x: &[f64]) -> Self::V {
-        S::as_simd_f64s(&x[..LANES]).0[0]
+    fn load(self, x: &[f64; LANES]) -> Self::V {
+        S::as_simd_f64s(x).0[0]
     }
     #[inline(always)]
-    fn store(self, v: Self::V, x: &mut [f64]) {
-        S::as_mut_simd_f64s(&mut x[..LANES]).0[0] = v;
+    fn store(self, v: Self::V, x: &mut [f64; LANES]) {
+        S::as_mut_simd_f64s(x).0[0] = v;
     }
     #[inline(always)]
     fn splat(self, v: f64) -> Self::V {

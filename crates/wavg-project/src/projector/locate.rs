@@ -215,9 +215,14 @@ impl StartGrid {
                 }
             };
             if inside {
-                offsets.iter().for_each(|&o| visit(c.wrapping_add_signed(o)));
+                offsets
+                    .iter()
+                    .for_each(|&o| visit(c.wrapping_add_signed(o)));
             } else {
-                self.neighbours(c, true).into_iter().flatten().for_each(visit);
+                self.neighbours(c, true)
+                    .into_iter()
+                    .flatten()
+                    .for_each(visit);
             }
             if next == c {
                 break;
