@@ -18,7 +18,7 @@
 //! `d_min` is zero.
 
 use crate::error::SolveError;
-use crate::simd::{LANES, Plain, Quad, Wide, dispatch, dot, sum_lanes};
+use crate::simd::{LANES, Plain, Quad, Wide, dispatch, sum_lanes};
 use crate::{DIM, Mat2x8, Vec8};
 
 /// Default `gamma`: how much more the distance off the tangent plane counts (the paper's 10).
@@ -120,18 +120,30 @@ impl AnchorCoords {
         })
     }
 
-    /// [`AnchorCoords::weighted_sum`] built for the instruction set `S`.
+    /// [`AnchorCoords::weighted_sum`] in vectors of `q`: one pass over the weights for all
+    /// coordinates, each summed as [`LANES`] running lanes, added pairwise, then the
+    /// remainder in order (what a dot product per coordinate would do).
     #[inline(always)]
-    fn weighted_sum_with<S: pulp::Simd>(&self, simd: S, weights: &[f64], scale: f64) -> Vec8 {
+    fn weighted_sum_with<Q: Quad>(&self, q: Q, weights: &[f64], scale: f64) -> Vec8 {
         let n = self.n.min(weights.len());
-        let w = &weights[..n];
-        // A loop, not a closure: a closure is compiled without `S`'s instruction set, and
-        // `S`'s operations would not inline into it.
-        let mut out = [0.0; DIM];
-        for (o, dim) in out.iter_mut().zip(&self.dims) {
-            *o = dot(simd, w, &dim[..n]) * scale;
+        let nc = n / LANES;
+        let w = quads(weights, nc);
+        let dims: [&[[f64; LANES]]; DIM] = std::array::from_fn(|k| quads(&self.dims[k], nc));
+        let mut acc = [q.splat(0.0); DIM];
+        for c in 0..nc {
+            let wc = q.load(&w[c]);
+            for k in 0..DIM {
+                acc[k] = q.add(acc[k], q.mul(wc, q.load(&dims[k][c])));
+            }
         }
-        Vec8::from(out)
+        Vec8::from_fn(|k, _| {
+            let mut s = sum_lanes(q.lanes(acc[k]));
+            let tail = nc * LANES..n;
+            for (w, y) in weights[tail.clone()].iter().zip(&self.dims[k][tail]) {
+                s += w * y;
+            }
+            s * scale
+        })
     }
 }
 
@@ -147,8 +159,12 @@ impl pulp::WithSimd for WeightedSum<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) -> Vec8 {
-        self.coords
-            .weighted_sum_with(simd, self.weights, self.scale)
+        match Wide::new(simd) {
+            Some(q) => self.coords.weighted_sum_with(q, self.weights, self.scale),
+            None => self
+                .coords
+                .weighted_sum_with(Plain, self.weights, self.scale),
+        }
     }
 }
 
@@ -511,8 +527,13 @@ mod tests {
                 .map(|i| ((i as f64) * 1.37).cos() / n as f64)
                 .collect();
             let a = c.weighted_sum(&w, 1.25);
-            let b = c.weighted_sum_with(pulp::Scalar::new(), &w, 1.25);
+            let b = c.weighted_sum_with(Plain, &w, 1.25);
             assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "{n}");
+            // One dot product per coordinate, in the same order.
+            let dots = Vec8::from_fn(|k, _| {
+                crate::simd::dot(pulp::Scalar::new(), &w, &c.dims[k][..n]) * 1.25
+            });
+            assert_eq!(a.map(f64::to_bits), dots.map(f64::to_bits), "{n}");
             let direct: Vec8 = pts.iter().zip(&w).map(|(p, w)| p * (*w * 1.25)).sum();
             assert!((a - direct).norm() < 1e-12, "{n}");
         }

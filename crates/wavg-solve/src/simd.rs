@@ -29,10 +29,11 @@ pub(crate) fn sum_lanes(l: [f64; LANES]) -> f64 {
 }
 
 /// `sum_i a_i b_i` over the common length, as [`LANES`] partial sums added by
-/// [`sum_lanes`], then the remainder in order. With `S` exactly [`LANES`] wide the partial
-/// sums live in one register and use explicit vector operations (compiled from plain loops,
-/// the compiler vectorises across rows instead, with shuffles, at half the speed); any
-/// other `S` runs the same operations as plain loops. Both give the same bits.
+/// [`sum_lanes`], then the remainder in order: the tests' reference for reductions
+/// written with [`Quad`]. With `S` exactly [`LANES`] wide the partial sums live in one
+/// register; any other `S` runs the same operations as plain loops. Both give the same
+/// bits.
+#[cfg(test)]
 #[inline(always)]
 pub(crate) fn dot<S: pulp::Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
