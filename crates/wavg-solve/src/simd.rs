@@ -1,11 +1,12 @@
 //! Run-time SIMD dispatch and the vector building blocks of the inverse problem.
 //!
-//! The crate's convention: a hot loop is one function generic over `S: pulp::Simd`, wrapped
-//! in a [`pulp::WithSimd`] operation and run through [`dispatch`] once per call, which
+//! The crate's convention: a hot loop is one function generic over [`Quad`] (vectors of
+//! [`LANES`] lanes), wrapped in a [`pulp::WithSimd`] operation that picks [`Wide`] or
+//! [`Plain`] for its instruction set, and run through [`dispatch`] once per call, which
 //! compiles it for the widest instruction set this CPU has (AVX2 and up) and picks that
 //! build at run time. Reductions keep [`LANES`] partial sums whatever the vector width, so
-//! every build runs the same operations in the same order and gives the same bits; only the
-//! registers are wider. No `unsafe`.
+//! every build runs the same operations in the same order and gives the same bits. No
+//! `unsafe`.
 
 use std::sync::LazyLock;
 
