@@ -18,8 +18,8 @@ pub const FACE_WALK: usize = 4;
 const HINT_MARGIN: f64 = 0.0;
 
 /// Steps over faces a warm start may take from its hint face towards the face the query
-/// lies over (samples along a curve usually move into a neighbour of the last face).
-pub const HINT_STEPS: usize = 3;
+/// lies over (samples along a curve usually move a face or a few from the last one).
+pub const HINT_STEPS: usize = 6;
 
 /// What the caller wants from [`Projector::project_with`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -380,7 +380,8 @@ impl Projector {
     /// A warm start's face walk: from face `f`, up to [`HINT_STEPS`] steps over faces to
     /// the one over which the query lies (its Euclidean projection onto the face's plane
     /// falls inside; each step crosses the edge opposite the most negative barycentric
-    /// coordinate), then that face and up to [`FACE_WALK`] faces in all that Newton's
+    /// coordinate; a step back to the previous face ends the walk where it is), then that
+    /// face and up to [`FACE_WALK`] faces in all that Newton's
     /// method exits into; the first valid projection, if it is at least as close to `y`
     /// as the corners of its face. A projection farther than a point of the surface next
     /// to it is likely not the one the walk would find (a query far off a curved surface
@@ -388,7 +389,8 @@ impl Projector {
     /// the steps lies under the query.
     pub(super) fn face_walk(&self, y: &Vec8, mut f: FaceId) -> Option<Best> {
         let topo = self.emb.mesh().topology();
-        // Newton's method is worth trying only on a face the query is over.
+        let mut prev = NONE;
+        // Newton's method is worth trying only on a face the query is over (or beside).
         for step in 0..=HINT_STEPS {
             let [a, b, c] = self.corners(f);
             let (e1, e2, r) = (b - a, c - a, y - a);
@@ -410,10 +412,16 @@ impl Projector {
             if !(l[k] < -HINT_MARGIN) || step == HINT_STEPS {
                 return None;
             }
-            f = topo.face_neighbors(f)[(k + 1) % 3];
-            if f == NONE {
+            let next = topo.face_neighbors(f)[(k + 1) % 3];
+            if next == NONE {
                 return None;
             }
+            // Back to the face it came from: the query lies beside the edge between
+            // the two (past both planes, as over a ridge); Newton's method decides here.
+            if next == prev {
+                break;
+            }
+            (prev, f) = (f, next);
         }
         for _ in 0..FACE_WALK {
             match self.try_face_or_exit(f, y) {
