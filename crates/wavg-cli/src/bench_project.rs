@@ -33,7 +33,7 @@ pub struct Args {
     #[arg(long)]
     embedding: Option<PathBuf>,
     /// Number of random queries per test.
-    #[arg(long, default_value_t = 100_000)]
+    #[arg(long, default_value_t = 100_000, value_parser = crate::common::parse_queries)]
     queries: usize,
     /// Random seed.
     #[arg(long, default_value_t = 1)]

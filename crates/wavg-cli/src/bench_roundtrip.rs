@@ -52,7 +52,7 @@ pub struct Args {
     #[arg(long)]
     pub anchors: usize,
     /// Number of random query points N.
-    #[arg(long, default_value_t = 100_000)]
+    #[arg(long, default_value_t = 100_000, value_parser = crate::common::parse_queries)]
     pub queries: usize,
     /// Worker threads T (default: all cores; at most 4 per CPU, or 64).
     #[arg(long, value_parser = crate::common::parse_threads)]

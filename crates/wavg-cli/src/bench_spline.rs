@@ -41,7 +41,7 @@ pub struct Args {
     #[arg(long)]
     pub closed: bool,
     /// Samples along the curve.
-    #[arg(long, default_value_t = 500)]
+    #[arg(long, default_value_t = 500, value_parser = crate::common::parse_samples)]
     pub samples: usize,
     /// Timed runs.
     #[arg(long, default_value_t = 50)]

@@ -136,6 +136,42 @@ pub fn parse_threads(s: &str) -> Result<usize, String> {
     Ok(n)
 }
 
+/// The most samples or queries one command takes (each costs tens to hundreds of bytes, so
+/// this stays within a few gigabytes; more is better done in several runs).
+pub const MAX_COUNT: usize = 10_000_000;
+
+/// The most frames `morph` writes or `remesh` times.
+pub const MAX_FRAMES: usize = 100_000;
+
+/// A whole number from 0 to `max`, `what` naming it in the error.
+fn parse_up_to(s: &str, max: usize, what: &str) -> Result<usize, String> {
+    let n: usize = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a whole number of {what}"))?;
+    if n > max {
+        return Err(format!(
+            "{n} {what} is more than {max}, the most one run takes"
+        ));
+    }
+    Ok(n)
+}
+
+/// Parses a `--samples` value: at most [`MAX_COUNT`].
+pub fn parse_samples(s: &str) -> Result<usize, String> {
+    parse_up_to(s, MAX_COUNT, "samples")
+}
+
+/// Parses a `--queries` value: at most [`MAX_COUNT`].
+pub fn parse_queries(s: &str) -> Result<usize, String> {
+    parse_up_to(s, MAX_COUNT, "queries")
+}
+
+/// Parses a `--frames` value: at most [`MAX_FRAMES`].
+pub fn parse_frames(s: &str) -> Result<usize, String> {
+    parse_up_to(s, MAX_FRAMES, "frames")
+}
+
 /// Whether two paths name the same existing file (after resolving links and `..`).
 pub fn same_file(a: &Path, b: &Path) -> bool {
     match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {

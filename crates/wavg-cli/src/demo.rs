@@ -62,10 +62,10 @@ pub struct Args {
     #[arg(long)]
     pub anchors: Option<usize>,
     /// Samples along the spline.
-    #[arg(long, default_value_t = 400)]
+    #[arg(long, default_value_t = 400, value_parser = crate::common::parse_samples)]
     pub samples: usize,
     /// Random points for the round trips.
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = 2000, value_parser = crate::common::parse_queries)]
     pub queries: usize,
     /// Seed of the anchors and the random points.
     #[arg(long, default_value_t = 0)]

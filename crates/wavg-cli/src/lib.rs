@@ -114,9 +114,29 @@ pub fn command() -> clap::Command {
     Cli::command()
 }
 
+/// Makes a report printed to a closed pipe (`wavg info M | head -1`) end the process
+/// quietly with status 0, as `-o -` does, instead of a panic: `println!` panics when its
+/// stream is gone, and the reader has taken all it wanted.
+fn quiet_on_closed_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.starts_with("failed printing to std") && msg.contains("Broken pipe") {
+            std::process::exit(0);
+        }
+        default(info);
+    }));
+}
+
 /// Parses the process's arguments, runs the command and reports a failure on stderr as
 /// `wavg: MESSAGE`; the exit status is the binary's.
 pub fn main() -> ExitCode {
+    quiet_on_closed_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(a) => demo::run(a),

@@ -28,7 +28,7 @@ pub struct Args {
     pub map: MapArgs,
     /// Number of frames (at least 1; the first is the source, the last the mapped shape; a
     /// single frame is the mapped shape).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = crate::common::parse_frames)]
     pub frames: usize,
     /// Output folder.
     #[arg(short = 'o', long = "output")]

@@ -58,7 +58,7 @@ pub struct Args {
     #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_BASE_DISTANCE, allow_negative_numbers = true)]
     pub max_distance: f64,
     /// Recomputations to time while dragging a base vertex (0: none).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = crate::common::parse_frames)]
     pub frames: usize,
     /// The base vertex dragged by --frames.
     #[arg(long, default_value_t = 0)]

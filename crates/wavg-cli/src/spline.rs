@@ -47,7 +47,7 @@ pub struct Args {
     #[arg(long)]
     pub bezier: bool,
     /// Samples along the curve.
-    #[arg(long, default_value_t = 500)]
+    #[arg(long, default_value_t = 500, value_parser = crate::common::parse_samples)]
     pub samples: usize,
     /// Output file (`-` for standard output).
     #[arg(short = 'o', long = "output")]

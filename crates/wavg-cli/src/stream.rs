@@ -198,8 +198,14 @@ enum Source {
 
 impl Source {
     fn open(input: &Path) -> Result<Self, CliError> {
+        Self::open_from(input, input)
+    }
+
+    /// [`Source::open`] reading the file at `path`, a copy of `input` (which names it in
+    /// messages and decides its format).
+    fn open_from(path: &Path, input: &Path) -> Result<Self, CliError> {
         let file =
-            File::open(input).map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
+            File::open(path).map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
         Ok(if is_npy(input) {
             // A small buffer for the header: the values' reads, larger, then go past it
             // straight into their blocks.
@@ -332,6 +338,28 @@ impl Dest<'_> {
     }
 }
 
+/// The query file `input`, or its copy `spooled` when there is one.
+fn open_input(input: &Path, spooled: Option<&tempfile::NamedTempFile>) -> Result<Source, CliError> {
+    match spooled {
+        Some(copy) => Source::open_from(copy.path(), input),
+        None => Source::open(input),
+    }
+}
+
+/// A temporary copy of `input` (a pipe or other stream that can be read only once).
+fn spool(input: &Path) -> Result<tempfile::NamedTempFile, CliError> {
+    let io = |e: std::io::Error| CliError::input(format!("{}: {e}", input.display()));
+    let mut from = File::open(input).map_err(io)?;
+    let mut copy = tempfile::NamedTempFile::new().map_err(|e| {
+        CliError::failure(format!(
+            "cannot make a temporary copy of {}: {e}",
+            input.display()
+        ))
+    })?;
+    std::io::copy(&mut from, copy.as_file_mut()).map_err(io)?;
+    Ok(copy)
+}
+
 /// Streams the query file `input` through bounded memory: each chunk of rows is parsed
 /// (text in parallel) and handed to `each`, which puts its answers in the sink (text,
 /// or with an `output` ending in `.npy` rows of `npy_cols` values) and fails on the
@@ -354,8 +382,14 @@ pub fn stream_queries<T: Send>(
     // A device or pipe is written as the rows come (no rename can take back a bad row):
     // like stdout, it gets the first pass.
     let special = wavg::mesh::io::is_special_destination(output);
+    // An input that can be read only once (a pipe, stdin) is copied to a temporary file
+    // first when it has to be read twice.
+    let mut spooled = None;
     if output == Path::new("-") || special || (npy_out && !is_npy(input)) {
-        let mut source = Source::open(input)?;
+        if !std::fs::metadata(input).is_ok_and(|m| m.is_file()) {
+            spooled = Some(spool(input)?);
+        }
+        let mut source = open_input(input, spooled.as_ref())?;
         let mut n = 0;
         while let Some(raw) = source.next_raw(input)? {
             let chunk = parse(raw, input, &format)?;
@@ -364,7 +398,7 @@ pub fn stream_queries<T: Send>(
         }
         rows = Some(n);
     }
-    let source = Source::open(input)?;
+    let source = open_input(input, spooled.as_ref())?;
     if let (Source::Npy { reader, .. }, None) = (&source, rows) {
         rows = Some(reader.rows());
     }

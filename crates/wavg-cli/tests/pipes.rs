@@ -96,3 +96,91 @@ fn a_reader_that_stops_early_is_no_failure() {
     assert_eq!(stdout.trim(), "status 0", "{stderr}");
     assert!(!stderr.contains("Broken pipe"), "{stderr}");
 }
+
+/// A query file that can be read only once (a pipe as `--weights /dev/stdin`) with an
+/// output that needs two passes (`-o -`, or `.npy` from text): the same answers as from a
+/// regular file.
+#[test]
+fn a_piped_query_file_read_twice_gives_every_answer() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = sphere_anchors(dir.path());
+    let k = 31;
+    let text: String = (0..300)
+        .map(|i| {
+            let mut w = vec![0.0; k];
+            w[i % k] = 0.6;
+            w[(i + 7) % k] = 0.4;
+            w.iter().map(|x| format!("{x} ")).collect::<String>() + "\n"
+        })
+        .collect();
+    let file = dir.path().join("w.txt");
+    std::fs::write(&file, &text).unwrap();
+    let forward = |weights: &str, out: &str| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_wavg"));
+        c.args([
+            "forward",
+            "--mesh",
+            "builtin:icosphere",
+            "--embedding",
+            "none",
+        ])
+        .arg("--anchors")
+        .arg(&anchors)
+        .args(["--weights", weights, "-o", out])
+        .current_dir(dir.path());
+        c
+    };
+    let from_file = forward("w.txt", "-").output().unwrap();
+    assert!(from_file.status.success());
+    let from_file = String::from_utf8(from_file.stdout).unwrap();
+    assert_eq!(from_file.lines().count(), 300);
+    for out in ["-", "o.npy"] {
+        let mut child = forward("/dev/stdin", out)
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(text.as_bytes())
+            .unwrap();
+        let piped = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&piped.stderr);
+        assert!(piped.status.success(), "-o {out}: {stderr}");
+        if out == "-" {
+            assert!(
+                String::from_utf8_lossy(&piped.stdout) == from_file,
+                "-o -: other answers than from the file ({} bytes); {stderr}",
+                piped.stdout.len()
+            );
+        } else {
+            let npy = std::fs::read(dir.path().join(out)).unwrap();
+            // 300 rows of 7 float64 after the header.
+            assert!(npy.len() > 300 * 7 * 8, "{} bytes", npy.len());
+            assert!(npy.len() < 300 * 7 * 8 + 256, "{} bytes", npy.len());
+        }
+    }
+}
+
+/// A report printed to a reader that has stopped (`wavg info M | true`): no panic, status 0.
+#[test]
+fn a_report_to_a_closed_pipe_is_no_failure() {
+    let cmd = format!(
+        "'{}' info builtin:torus | true; echo \"status ${{PIPESTATUS[0]}}\"",
+        env!("CARGO_BIN_EXE_wavg"),
+    );
+    let out = std::process::Command::new("bash")
+        .args(["-c", &cmd])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(stdout.trim(), "status 0", "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

@@ -102,3 +102,38 @@ fn bad_input_writes_nothing() {
     assert!(String::from_utf8_lossy(&r.stderr).contains(":4:"));
     assert!(!out.exists());
 }
+
+/// Counts beyond what one run takes are refused before any work (they once tried to
+/// allocate terabytes and aborted).
+#[test]
+fn huge_counts_are_refused() {
+    for args in [
+        &[
+            "spline",
+            "builtin:torus",
+            "--control",
+            "c.txt",
+            "--samples",
+            "100000000000",
+            "-o",
+            "x.txt",
+        ][..],
+        &[
+            "bench",
+            "roundtrip",
+            "builtin:torus",
+            "--queries",
+            "18446744073709551615",
+        ][..],
+        &["demo", "--samples", "20000000"][..],
+    ] {
+        let out = common::wavg(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("the most one run takes"),
+            "{args:?}: {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}

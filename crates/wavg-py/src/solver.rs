@@ -32,6 +32,9 @@ pub(crate) fn named_tuple<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'p
 pub(crate) struct Solver {
     pub(crate) inner: wavg::Solver,
     pub(crate) surface: Py<Surface>,
+    /// The surface (mesh and embedding) as it was when the solver was made: what a pickled
+    /// or copied solver is rebuilt from, whatever `surface` computed or loaded since.
+    pub(crate) made_from: wavg::Surface,
 }
 
 /// Surface points from `faces (q,)` and `bary (q, 3)`, checked against `n_faces`.
@@ -266,6 +269,7 @@ impl Solver {
         Ok(Self {
             inner,
             surface: surface.unbind(),
+            made_from: s,
         })
     }
 
@@ -363,9 +367,14 @@ impl Solver {
         vertex_or_point: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
         let k = self.inner.n_anchors();
-        let i = indices(&[i], k, "i")?[0] as usize;
-        let s = self.surface.bind(py).borrow().inner.clone();
-        let a = one_anchor(&s, vertex_or_point)?;
+        if !(0..k as i64).contains(&i) {
+            return Err(value(format!(
+                "i = {i} is not an anchor index: the solver has {k} anchors (0 to {})",
+                k - 1
+            )));
+        }
+        let i = i as usize;
+        let a = one_anchor(&self.made_from, vertex_or_point)?;
         self.inner.anchors_mut().set(i, a).map_err(lib(py))
     }
 
@@ -426,8 +435,13 @@ impl Solver {
         }
         let k = ids.len();
         let restore = py.import("wavg._wavg")?.getattr("_restore_solver")?;
+        // The surface as the solver saw it: `self.surface` may have a newer embedding.
+        let snapshot = Surface {
+            inner: self.made_from.clone(),
+            polygons: self.surface.borrow(py).polygons.clone(),
+        };
         let args = (
-            self.surface.clone_ref(py),
+            Py::new(py, snapshot)?,
             array(py, ids, &[k])?,
             array(py, faces, &[k])?,
             array(py, bary, &[k, 3])?,
@@ -446,7 +460,16 @@ impl Solver {
         Ok(Self {
             inner: self.inner.clone(),
             surface: surface.unbind(),
+            made_from: self.made_from.clone(),
         })
+    }
+
+    fn __copy__(&self, py: Python<'_>) -> Self {
+        Self {
+            inner: self.inner.clone(),
+            surface: self.surface.clone_ref(py),
+            made_from: self.made_from.clone(),
+        }
     }
 }
 
@@ -479,5 +502,6 @@ pub(crate) fn _restore_solver(
     Ok(Solver {
         inner,
         surface: surface.unbind(),
+        made_from: s,
     })
 }
