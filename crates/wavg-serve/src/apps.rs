@@ -66,8 +66,17 @@ pub(crate) fn remesh(app: &App, body: &Body) -> Result<Reply, ApiError> {
         (None, Some(text)) => BaseMesh::from_obj_str(text).map_err(|e| ApiError::from_lib(&e))?,
         _ => return Err(ApiError::bad("give exactly one of \"cage\" and \"base\"")),
     };
-    base.validate().map_err(|e| ApiError::from_lib(&e))?;
     let levels = body.usize_or("levels", 2, 0, wavg::apps::MAX_LEVELS.min(5))?;
+    let corners: usize = base.faces.iter().map(Vec::len).sum();
+    let faces = corners.saturating_mul(4usize.pow(levels.saturating_sub(1) as u32));
+    if faces > crate::MAX_FACES {
+        return Err(ApiError::bad(format!(
+            "{levels} levels on this base make about {faces} faces, more than {} in one \
+             answer: use fewer levels or a smaller base",
+            crate::MAX_FACES
+        )));
+    }
+    base.validate().map_err(|e| ApiError::from_lib(&e))?;
     let smooth = body.usize_or("smooth", 3, 0, wavg::apps::MAX_SMOOTH_STEPS)?;
     let max_distance = body.f64_or("max_distance", wavg::apps::DEFAULT_MAX_BASE_DISTANCE)?;
     let obj = text_format(body, "obj")?;

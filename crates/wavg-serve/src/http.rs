@@ -1,24 +1,27 @@
-//! The HTTP side: tiny_http on [`crate::WORKERS`] threads that each take the next request,
-//! read its body within [`crate::MAX_BODY`], route it and answer; a panic in a handler is
-//! caught and answered with 500, so nothing a client sends stops the server.
+//! The HTTP side: tiny_http hands each request to a thread of its own, which reads its body
+//! within [`crate::MAX_BODY`], routes it (at most [`crate::WORKERS`] requests compute at
+//! once) and answers; a client that sends or reads slowly holds only its own thread. A
+//! panic in a handler is caught and answered with 500, so nothing a client sends stops
+//! the server.
 
 use std::io::{Cursor, Read, Write};
 use std::net::SocketAddr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::Arc;
+use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use tiny_http::{Header, Method, Request, Response, Server, StatusCode};
 
 use crate::routes::{Reply, route};
 use crate::{ApiError, App, MAX_BODY, WORKERS};
 
-/// A server answering on its worker threads.
+/// A server answering on its threads.
 pub struct Running {
     server: Arc<Server>,
     addr: SocketAddr,
-    workers: Vec<JoinHandle<()>>,
+    acceptor: JoinHandle<()>,
+    in_flight: Arc<Counter>,
 }
 
 impl Running {
@@ -27,26 +30,52 @@ impl Running {
         self.addr
     }
 
-    /// Stops taking requests and waits for the workers to finish the ones they have.
+    /// Stops taking requests and waits (up to a minute) for the ones being answered.
     pub fn stop(self) {
         self.server.unblock();
-        for _ in 1..self.workers.len() {
-            self.server.unblock();
-        }
-        for w in self.workers {
-            let _ = w.join();
-        }
+        let _ = self.acceptor.join();
+        self.in_flight.wait_for_zero(Duration::from_secs(60));
     }
 
     /// Serves until the process ends.
     pub fn join(self) {
-        for w in self.workers {
-            let _ = w.join();
-        }
+        let _ = self.acceptor.join();
     }
 }
 
-/// Binds `addr` (`host:port`; port 0 picks a free one) and serves `app` on worker threads.
+/// A count that threads raise and lower, and wait on.
+#[derive(Default)]
+struct Counter {
+    n: Mutex<usize>,
+    changed: Condvar,
+}
+
+impl Counter {
+    fn lock(&self) -> std::sync::MutexGuard<'_, usize> {
+        self.n.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Raises the count once it is below `limit`.
+    fn acquire(&self, limit: usize) {
+        let mut n = self.lock();
+        while *n >= limit {
+            n = self.changed.wait(n).unwrap_or_else(|e| e.into_inner());
+        }
+        *n += 1;
+    }
+
+    fn release(&self) {
+        *self.lock() -= 1;
+        self.changed.notify_all();
+    }
+
+    fn wait_for_zero(&self, limit: Duration) {
+        let n = self.lock();
+        let _ = self.changed.wait_timeout_while(n, limit, |n| *n > 0);
+    }
+}
+
+/// Binds `addr` (`host:port`; port 0 picks a free one) and serves `app`.
 pub fn start(app: App, addr: &str) -> Result<Running, std::io::Error> {
     let server = Server::http(addr).map_err(std::io::Error::other)?;
     let addr = server
@@ -54,31 +83,51 @@ pub fn start(app: App, addr: &str) -> Result<Running, std::io::Error> {
         .to_ip()
         .ok_or_else(|| std::io::Error::other("not an IP address"))?;
     let server = Arc::new(server);
-    let workers = (0..WORKERS)
-        .map(|_| {
-            let (server, app) = (server.clone(), app.clone());
-            std::thread::spawn(move || {
-                while let Ok(request) = server.recv() {
-                    answer(&app, request);
+    let in_flight = Arc::new(Counter::default());
+    let computing = Arc::new(Counter::default());
+    let acceptor = {
+        let (server, in_flight) = (server.clone(), in_flight.clone());
+        std::thread::spawn(move || {
+            while let Ok(request) = server.recv() {
+                let (app, in_flight2, computing) =
+                    (app.clone(), in_flight.clone(), computing.clone());
+                in_flight.acquire(usize::MAX);
+                let spawned = std::thread::Builder::new()
+                    .name("wavg-serve request".into())
+                    .spawn(move || {
+                        answer(&app, request, &computing);
+                        in_flight2.release();
+                    });
+                // Without a thread (the system's limit), the request is dropped unanswered
+                // and tiny_http closes its connection.
+                if spawned.is_err() {
+                    in_flight.release();
                 }
-            })
+            }
         })
-        .collect();
+    };
     Ok(Running {
         server,
         addr,
-        workers,
+        acceptor,
+        in_flight,
     })
 }
 
-/// Reads, routes and answers one request.
-fn answer(app: &App, mut request: Request) {
+/// Reads, routes (once fewer than [`WORKERS`] requests are `computing`) and answers one
+/// request.
+fn answer(app: &App, mut request: Request, computing: &Counter) {
     let start = Instant::now();
     let method = request.method().clone();
     let url = request.url().to_owned();
     let reply = match read_body(&mut request) {
-        Ok(body) => catch_unwind(AssertUnwindSafe(|| route(app, &method, &url, &body)))
-            .unwrap_or_else(|_| Err(ApiError::status(500, "internal error (a bug)"))),
+        Ok(body) => {
+            computing.acquire(WORKERS);
+            let r = catch_unwind(AssertUnwindSafe(|| route(app, &method, &url, &body)))
+                .unwrap_or_else(|_| Err(ApiError::status(500, "internal error (a bug)")));
+            computing.release();
+            r
+        }
         Err(e) => Err(e),
     };
     let mut reply = reply.unwrap_or_else(|e| {

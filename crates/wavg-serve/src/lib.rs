@@ -43,6 +43,12 @@ pub const MAX_ANCHORS: usize = 4096;
 pub const MAX_ROWS: usize = 200_000;
 /// Most samples of one spline.
 pub const MAX_SAMPLES: usize = 100_000;
+/// Most numbers in one answer's weights (points x anchors of `/api/inverse`): about 40 MB
+/// of memory and 100 MB of JSON.
+pub const MAX_ANSWER: usize = 1 << 22;
+/// Most faces one `/api/remesh` may make (counted before remeshing as the base's corners
+/// times 4 per level after the first).
+pub const MAX_FACES: usize = 1 << 20;
 /// Worker threads answering requests.
 pub const WORKERS: usize = 8;
 

@@ -4,11 +4,13 @@
 use serde::Serialize;
 use serde_json::{Value, json};
 use wavg::apps::{SplineKind, evaluate_spline};
-use wavg::{DEFAULT_TOLERANCE, ForwardOptions, ForwardResult, Normalization, SolveError, Solver};
+use wavg::{
+    DEFAULT_TOLERANCE, ForwardOptions, ForwardResult, Normalization, RoundTrip, SolveError, Solver,
+};
 
 use crate::parse::{self, Body};
 use crate::routes::Reply;
-use crate::{ApiError, App, MAX_ROWS, MAX_SAMPLES};
+use crate::{ApiError, App, MAX_ANSWER, MAX_ROWS, MAX_SAMPLES};
 
 /// Samples evaluated in sequence, warm-started, per parallel chunk (as `wavg spline`).
 const CHUNK: usize = 256;
@@ -95,11 +97,24 @@ pub(crate) fn inverse(app: &App, body: &Body) -> Result<Reply, ApiError> {
         .enumerate()
         .map(|(i, p)| parse::point(p, &format!("points[{i}]"), solver.mesh()))
         .collect::<Result<Vec<_>, _>>()?;
+    let k = solver.n_anchors();
+    if points.len().saturating_mul(k) > MAX_ANSWER {
+        return Err(ApiError::bad(format!(
+            "{} points x {k} anchors is more than {MAX_ANSWER} weights in one answer: send \
+             fewer points per request",
+            points.len()
+        )));
+    }
     let weights: Vec<Value> = if body.bool_or("verified", false)? {
+        // Points no weights of the ladder bring back have none (`wavg inverse --verified`
+        // prints `none not-reached`).
         solver
             .inverse_verified_batch(&points, DEFAULT_TOLERANCE)
             .into_iter()
-            .map(|r| r.map_or(Value::Null, |v| json!(v.weights)))
+            .map(|r| match r {
+                Ok(v) if v.round_trip != RoundTrip::NotReached => json!(v.weights),
+                _ => Value::Null,
+            })
             .collect()
     } else {
         let batch = solver.inverse_batch(&points);

@@ -53,6 +53,17 @@ impl Reply {
     }
 }
 
+/// The API's routes answered on GET (and HEAD).
+const GET_ROUTES: [&str; 3] = ["/api/info", "/api/status", "/api/mesh"];
+
+/// `path` as an error message shows it: at most 200 characters.
+fn shown(path: &str) -> String {
+    match path.char_indices().nth(200) {
+        Some((i, _)) => format!("{}...", &path[..i]),
+        None => path.to_owned(),
+    }
+}
+
 /// Answers `method url` with `body` (empty unless POST).
 pub(crate) fn route(app: &App, method: &Method, url: &str, body: &[u8]) -> Result<Reply, ApiError> {
     let path = url.split(['?', '#']).next().unwrap_or("");
@@ -74,10 +85,13 @@ pub(crate) fn route(app: &App, method: &Method, url: &str, body: &[u8]) -> Resul
         "/api/decal" => post(crate::apps::decal),
         "/api/remesh" => post(crate::apps::remesh),
         "/api/cage" => post(crate::apps::cage),
-        _ if *method != Method::Get && *method != Method::Head => Err(ApiError::status(
-            if path.starts_with("/api/") { 404 } else { 405 },
-            format!("no route {path} for {method}"),
-        )),
+        _ if *method != Method::Get && *method != Method::Head => {
+            let known = !path.starts_with("/api/") || GET_ROUTES.contains(&path);
+            Err(ApiError::status(
+                if known { 405 } else { 404 },
+                format!("no route {} for {method}", shown(path)),
+            ))
+        }
         "/api/info" => Ok(Reply::value(&info(app))),
         "/api/status" => Ok(Reply::value(&status(app))),
         "/api/mesh" => Ok(Reply {
@@ -89,7 +103,10 @@ pub(crate) fn route(app: &App, method: &Method, url: &str, body: &[u8]) -> Resul
                 content_type,
                 ..Reply::json(bytes.to_vec())
             }),
-            None => Err(ApiError::status(404, format!("no page or route {path}"))),
+            None => Err(ApiError::status(
+                404,
+                format!("no page or route {}", shown(path)),
+            )),
         },
     }
 }
@@ -114,10 +131,14 @@ fn info(app: &App) -> Value {
 /// "message"}`.
 fn status(app: &App) -> Value {
     match app.status() {
-        Status::Ready => json!({"state": "ready", "fraction": 1.0}),
-        Status::Precomputing { stage, fraction } => {
-            json!({"state": "precomputing", "stage": stage, "fraction": fraction})
+        Status::Ready => {
+            json!({"state": "ready", "stage": null, "fraction": 1.0, "message": null})
         }
-        Status::Failed(m) => json!({"state": "failed", "message": m}),
+        Status::Precomputing { stage, fraction } => {
+            json!({"state": "precomputing", "stage": stage, "fraction": fraction, "message": null})
+        }
+        Status::Failed(m) => {
+            json!({"state": "failed", "stage": null, "fraction": null, "message": m})
+        }
     }
 }

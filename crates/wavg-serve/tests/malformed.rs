@@ -7,7 +7,7 @@ use std::io::Write;
 use std::net::TcpStream;
 use std::time::Duration;
 
-use common::{get, raw, request, server};
+use common::{get, post, raw, request, server};
 use serde_json::json;
 
 /// Over 200 malformed bodies and requests, each refused with a message; the server
@@ -420,4 +420,120 @@ fn a_burst_of_keep_alive_connections_is_answered() {
         h.join().unwrap();
     }
     drop(idle);
+}
+
+/// With `verified`, a point that no weights of the penalty ladder bring back has none
+/// (`null`, as `wavg inverse --verified` prints `none not-reached`): three anchors on a
+/// torus reach only some points.
+#[test]
+fn verified_inverse_gives_no_weights_where_none_return() {
+    let s = common::surface();
+    let anchors = [0u32, 100, 500];
+    let solver = s.solver(anchors).unwrap();
+    let points: Vec<serde_json::Value> = (0..s.n_faces() as u32)
+        .step_by(23)
+        .map(|f| json!([f, 0.2, 0.3, 0.5]))
+        .collect();
+    let a = post(
+        "/api/inverse",
+        &json!({"anchors": anchors, "points": points, "verified": true}),
+    );
+    assert_eq!(a.status, 200, "{}", String::from_utf8_lossy(&a.body));
+    let got = a.json()["weights"].as_array().unwrap().clone();
+    let (mut nulls, mut rows) = (0, 0);
+    for (p, w) in points.iter().zip(&got) {
+        let f = p[0].as_u64().unwrap() as u32;
+        let v = solver
+            .inverse_verified(
+                &wavg::SurfacePoint::new(f, [0.2, 0.3, 0.5]),
+                wavg::DEFAULT_TOLERANCE,
+            )
+            .unwrap();
+        if v.round_trip == wavg::RoundTrip::NotReached {
+            assert!(w.is_null(), "face {f}: {w}");
+            nulls += 1;
+        } else {
+            assert!(w.is_array(), "face {f}: {w}");
+            rows += 1;
+        }
+    }
+    assert!(nulls > 0 && rows > 0, "{nulls} null, {rows} rows");
+}
+
+/// Answers too large to hold are refused before any work: points x anchors of an inverse,
+/// faces of a remeshing.
+#[test]
+fn answers_beyond_the_limits_are_refused() {
+    // 3072 distinct anchors (two points on each face of the torus) x 1400 points.
+    let anchors: Vec<serde_json::Value> = (0..1536)
+        .flat_map(|f| [json!([f, 0.2, 0.3, 0.5]), json!([f, 0.5, 0.3, 0.2])])
+        .collect();
+    let points: Vec<u32> = (0..1400).map(|v| v % 768).collect();
+    let a = post(
+        "/api/inverse",
+        &json!({"anchors": anchors, "points": points}),
+    );
+    assert_eq!(a.status, 400, "{}", String::from_utf8_lossy(&a.body));
+    assert!(
+        a.json()["error"]
+            .as_str()
+            .unwrap()
+            .contains("weights in one answer")
+    );
+    // A cage of 1200 quads at 5 levels: 4800 x 4^4 faces.
+    let mut cage = Vec::new();
+    for i in 0..1200u32 {
+        cage.push(json!([4 * i, 4 * i + 1, 4 * i + 2, 4 * i + 3]));
+    }
+    let verts: Vec<[f64; 3]> = (0..4800).map(|v| [v as f64, 0.0, 0.0]).collect();
+    let a = post(
+        "/api/remesh",
+        &json!({"cage": {"vertices": verts, "faces": cage}, "levels": 5}),
+    );
+    assert_eq!(a.status, 400, "{}", String::from_utf8_lossy(&a.body));
+    let e = a.json()["error"].as_str().unwrap().to_owned();
+    assert!(e.contains("faces, more than"), "{e}");
+}
+
+/// The GET routes answer another method with 405; unknown API routes with 404; the
+/// message shows at most 200 characters of the path.
+#[test]
+fn methods_and_routes() {
+    let addr = common::server();
+    for path in ["/api/info", "/api/status", "/api/mesh", "/"] {
+        let a = request(addr, "POST", path, b"{}");
+        assert_eq!(a.status, 405, "POST {path}");
+    }
+    assert_eq!(request(addr, "POST", "/api/nothing", b"{}").status, 404);
+    let long = format!("/api/{}", "a".repeat(100_000));
+    let a = request(addr, "DELETE", &long, b"");
+    assert_eq!(a.status, 404);
+    assert!(a.body.len() < 1000, "{} bytes", a.body.len());
+    let status = request(addr, "GET", "/api/status", b"").json();
+    for key in ["state", "stage", "fraction", "message"] {
+        assert!(status.get(key).is_some(), "no {key} in {status}");
+    }
+}
+
+/// Clients that send half a body and wait hold only their own connections: with more of
+/// them than the server computes at once, other requests are still answered.
+#[test]
+fn slow_clients_do_not_hold_the_server() {
+    let addr = common::server();
+    let slow: Vec<TcpStream> = (0..(wavg_serve::WORKERS + 4))
+        .map(|_| {
+            let mut c = TcpStream::connect(addr).unwrap();
+            c.write_all(
+                b"POST /api/forward HTTP/1.1\r\nHost: x\r\nContent-Length: 100000\r\n\r\n{",
+            )
+            .unwrap();
+            c
+        })
+        .collect();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let t = std::time::Instant::now();
+    let a = request(addr, "GET", "/api/status", b"");
+    assert_eq!(a.status, 200);
+    assert!(t.elapsed().as_secs() < 10, "{:?}", t.elapsed());
+    drop(slow);
 }
