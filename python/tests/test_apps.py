@@ -1,6 +1,7 @@
 """The applications: splines, correspondence, decals, texture transfer, remeshing, rendering."""
 
 import pathlib
+import pickle
 import subprocess
 import sys
 
@@ -137,3 +138,16 @@ def test_wireframe_of_an_opened_quad_mesh_leaves_out_the_diagonals(tmp_path):
     assert wire_q.sum() > 200, wire_q.sum()  # the quads' edges are drawn
     assert wire_q.sum() < 0.85 * wire_t.sum(), (wire_q.sum(), wire_t.sum())
     assert (wire_q & ~wire_t).sum() < 0.02 * wire_q.sum()  # no edge the triangles lack
+    # A pickled copy keeps the file's polygons.
+    again = pickle.loads(pickle.dumps(opened))
+    assert np.array_equal(wavg.render(again, wireframe=True, **kw),
+                          wavg.render(opened, wireframe=True, **kw))
+
+
+def test_png_errors_are_io_errors(tmp_path):
+    (tmp_path / "not.png").write_text("hello")
+    for bad in (tmp_path, tmp_path / "not.png"):
+        with pytest.raises(wavg.WavgIOError):
+            wavg.read_png(bad)
+    with pytest.raises(wavg.WavgIOError, match="nodir"):
+        wavg.save_png(tmp_path / "nodir" / "a.png", np.zeros((4, 4, 4), np.uint8))

@@ -140,6 +140,45 @@ def test_pickle_and_deepcopy(surface, solver):
     assert np.array_equal(S2.faces, surface.faces)
 
 
+def test_copies_keep_the_embedding_the_solver_was_made_with(torus_mesh, anchors):
+    S = wavg.Surface(*torus_mesh)  # the 3-D positions as the embedding
+    sol = wavg.Solver(S, anchors)
+    W = random_weights(np.random.default_rng(8), 50, sol.anchor_count)
+    ref = sol.forward(W)
+    S.precompute(landmarks=60, progress=False)  # the surface moves on; the solver does not
+    for s in (pickle.loads(pickle.dumps(sol)), copy.copy(sol), copy.deepcopy(sol)):
+        out = s.forward(W)
+        assert np.array_equal(out.face, ref.face) and np.array_equal(out.xyz, ref.xyz)
+    assert not np.array_equal(wavg.Solver(S, anchors).forward(W).xyz, ref.xyz)
+
+
+def test_integer_and_thread_arguments_are_checked_by_name(surface, solver):
+    W = random_weights(np.random.default_rng(9), 3, solver.anchor_count)
+    for bad in (0, -1, 10**6, 2**70):
+        with pytest.raises(ValueError, match="threads"):
+            solver.forward(W, threads=bad)
+    with pytest.raises(ValueError, match="n must be"):
+        surface.sample_points(10**9)
+    with pytest.raises(ValueError, match="n must be"):
+        surface.sample_points(-1)
+    with pytest.raises(ValueError, match="seed"):
+        surface.sample_points(3, seed=-1)
+    with pytest.raises(ValueError, match="k must be"):
+        surface.spread_anchors(-1)
+    with pytest.raises(ValueError, match="k must be"):
+        surface.spread_anchors(surface.vertex_count + 1)
+    with pytest.raises(ValueError, match="landmarks"):
+        surface.precompute(landmarks=2**70, progress=False)
+    with pytest.raises(ValueError, match="seed"):
+        surface.precompute(seed=-1, progress=False)
+    with pytest.raises(TypeError, match="n"):
+        surface.sample_points(2.5)
+    with pytest.raises(ValueError, match="i = 99"):
+        wavg.Solver(surface, solver.anchor_points).set_anchor(99, 3)
+    f, b = surface.sample_points(5, seed=2**64 - 1)
+    assert f.shape == (5,) and b.shape == (5, 3)
+
+
 def _forward_in_worker(args):
     solver, W = args
     return solver.forward(W).xyz

@@ -114,8 +114,7 @@ pub fn cpu_seconds(thread: bool) -> Option<f64> {
 /// Far more threads than cores only add overhead (thousands of them take seconds to start
 /// and to hand work to).
 pub fn max_threads() -> usize {
-    let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
-    (4 * cpus).max(64)
+    wavg::Par::max_threads()
 }
 
 /// Parses a `--threads` value: an integer from 1 to [`max_threads`].

@@ -44,6 +44,18 @@ impl Par {
         }
     }
 
+    /// The most threads worth asking for: 4 per CPU this process may use, and at least 64.
+    /// Far more threads than cores only add overhead (thousands of them take seconds to
+    /// start and to hand work to); the command line and Python refuse more.
+    ///
+    /// ```
+    /// assert!(wavg_project::Par::max_threads() >= 64);
+    /// ```
+    pub fn max_threads() -> usize {
+        let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
+        (4 * cpus).max(64)
+    }
+
     /// Runs `f` with this parallelism: rayon's parallel iterators inside `f` use one
     /// thread ([`Par::Seq`]), the current pool ([`Par::Rayon`]) or `n` threads
     /// ([`Par::Threads`]). [`ProjectError::ThreadPool`] when the threads cannot start.

@@ -10,7 +10,7 @@ use wavg::apps::{
     decal_vertices, evaluate_spline,
 };
 
-use crate::args::{array, data, finite, par, reals};
+use crate::args::{Int, array, data, finite, par, reals};
 use crate::errors::{app, lib, to_py, value};
 use crate::solver::{anchors, named_tuple, points_tuple};
 use crate::surface::Surface;
@@ -63,7 +63,7 @@ fn spline<'py>(
     degree: i64,
     closed: bool,
     bezier: bool,
-    threads: Option<i64>,
+    threads: Option<Int>,
 ) -> PyResult<Bound<'py, PyAny>> {
     if !(1..=10_000_000).contains(&samples) {
         return Err(value(format!(
@@ -114,7 +114,7 @@ fn correspond<'py>(
     verified: bool,
     max_negative: f64,
     max_stretch: f64,
-    threads: Option<i64>,
+    threads: Option<Int>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let test = match validity {
         "local" => ValidityTest::Local,
@@ -233,7 +233,7 @@ fn decal<'py>(
     anchors: &Bound<'py, PyAny>,
     uv: &Bound<'py, PyAny>,
     max_negative: f64,
-    threads: Option<i64>,
+    threads: Option<Int>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let solver = solver_for(py, &S.inner, anchors, "anchors")?;
     let k = solver.n_anchors();
@@ -295,7 +295,7 @@ fn transfer_texture<'py>(
     size: Option<(i64, i64)>,
     verified: bool,
     stride: i64,
-    threads: Option<i64>,
+    threads: Option<Int>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let texture: Image = image::image_arg(src_texture, "src_texture")?;
     let (width, height) = match size {

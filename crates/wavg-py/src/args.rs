@@ -205,15 +205,68 @@ impl DetachRun for Python<'_> {
     }
 }
 
-/// A thread count: `None` is all cores (the current rayon pool), 1 the calling thread.
-pub(crate) fn par(threads: Option<i64>) -> PyResult<wavg::Par> {
-    match threads {
-        None => Ok(wavg::Par::Rayon),
-        Some(n) if n >= 1 => wavg::Par::from_threads(Some(n.min(1024) as usize))
-            .map_err(|e| value(format!("threads: {e}"))),
-        Some(n) => Err(value(format!(
-            "threads must be None (all cores) or a positive integer, got {n}"
-        ))),
+/// A thread count: `None` is all cores (the current rayon pool), 1 the calling thread, at
+/// most [`wavg::Par::max_threads`].
+pub(crate) fn par(threads: Option<Int>) -> PyResult<wavg::Par> {
+    let Some(n) = threads else {
+        return Ok(wavg::Par::Rayon);
+    };
+    let max = wavg::Par::max_threads();
+    if !(1..=max as i128).contains(&n.0) {
+        return Err(value(format!(
+            "threads must be None (all cores) or an integer from 1 to {max} (4 per CPU, at \
+             least 64: more only add overhead), got {n}"
+        )));
+    }
+    wavg::Par::from_threads(Some(n.0 as usize)).map_err(|e| value(format!("threads: {e}")))
+}
+
+/// An integer argument: any Python `int` (or object with `__index__`); a value beyond 128
+/// bits is kept as the nearest 128-bit one, so the range check of the function taking it
+/// names the argument (a non-integer is a `TypeError` that PyO3 names).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Int(pub(crate) i128);
+
+impl std::fmt::Display for Int {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            i128::MAX => f.write_str("a larger number"),
+            i128::MIN => f.write_str("a more negative number"),
+            v => write!(f, "{v}"),
+        }
+    }
+}
+
+impl FromPyObject<'_, '_> for Int {
+    type Error = PyErr;
+
+    fn extract(obj: pyo3::Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        match obj.extract::<i128>() {
+            Ok(v) => Ok(Int(v)),
+            Err(e) if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(obj.py()) => {
+                let negative = obj.lt(0i32)?;
+                Ok(Int(if negative { i128::MIN } else { i128::MAX }))
+            }
+            Err(e) => Err(e),
+        }
+    }
+}
+
+impl Int {
+    /// The value when it lies in `lo..=hi`; otherwise a `ValueError` naming `name`.
+    pub(crate) fn within(self, name: &str, lo: i128, hi: i128) -> PyResult<i128> {
+        if (lo..=hi).contains(&self.0) {
+            Ok(self.0)
+        } else {
+            Err(value(format!(
+                "{name} must be an integer from {lo} to {hi}, got {self}"
+            )))
+        }
+    }
+
+    /// A seed: any integer from 0 to 2^64 - 1.
+    pub(crate) fn seed(self, name: &str) -> PyResult<u64> {
+        Ok(self.within(name, 0, u64::MAX as i128)? as u64)
     }
 }
 

@@ -101,6 +101,15 @@ pub(crate) fn require_file(path: &Path) -> PyResult<()> {
     }
 }
 
+/// The Python exception for an error reading, decoding or encoding a PNG image:
+/// `WavgIOError` (an `OSError`), as for meshes and embeddings.
+pub(crate) fn png(py: Python<'_>, e: &wavg::apps::AppError) -> PyErr {
+    match e {
+        wavg::apps::AppError::Image(m) => raise(py, "WavgIOError", m.clone()),
+        e => app(py, e),
+    }
+}
+
 /// The Python exception for an application's error (the message with its causes).
 pub(crate) fn app(py: Python<'_>, e: &wavg::apps::AppError) -> PyErr {
     raise(py, "InvalidArgumentError", one_line(e))

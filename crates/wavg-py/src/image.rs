@@ -7,15 +7,18 @@ use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use wavg::apps::{Image, MAX_SIDE};
 
+use crate::args::DetachRun;
 use crate::args::array;
-use crate::errors::{app, require_file, type_error, value};
+use crate::errors::{png, raise, require_file, type_error, value};
 
 /// An image argument: an `(H, W, 3)` or `(H, W, 4)` uint8 array (or a PNG path).
 pub(crate) fn image_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Image> {
     let py = obj.py();
     if let Ok(path) = obj.extract::<PathBuf>() {
         require_file(&path)?;
-        return Image::read_png(&path).map_err(|e| app(py, &e));
+        return py
+            .detach_run(|| Image::read_png(&path))
+            .map_err(|e| png(py, &e));
     }
     let expected = "an (H, W, 3) or (H, W, 4) uint8 image array (or a PNG path)";
     let np = crate::args::numpy(py)?;
@@ -84,29 +87,34 @@ pub(crate) fn to_array<'py>(py: Python<'py>, img: &Image) -> PyResult<Bound<'py,
 #[pyfunction]
 pub(crate) fn save_png(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>) -> PyResult<()> {
     let img = image_arg(image, "image")?;
-    let mut bytes = Vec::new();
-    img.encode_png(&mut bytes).map_err(|e| app(py, &e))?;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    std::fs::write(&tmp, &bytes)
-        .and_then(|_| std::fs::rename(&tmp, &path))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            PyErr::from(e)
-        })
+    py.detach_run(|| -> Result<(), String> {
+        let mut bytes = Vec::new();
+        img.encode_png(&mut bytes).map_err(|e| e.to_string())?;
+        let dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."));
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+        std::fs::write(&tmp, &bytes)
+            .and_then(|_| std::fs::rename(&tmp, &path))
+            .map_err(|e| {
+                let _ = std::fs::remove_file(&tmp);
+                format!("{}: {e}", path.display())
+            })
+    })
+    .map_err(|m| raise(py, "WavgIOError", m))
 }
 
 /// read_png(path) -> (H, W, 4) uint8: reads a PNG file as RGBA.
 #[pyfunction]
 pub(crate) fn read_png<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
     require_file(&path)?;
-    let img = Image::read_png(&path).map_err(|e| app(py, &e))?;
+    let img = py
+        .detach_run(|| Image::read_png(&path))
+        .map_err(|e| png(py, &e))?;
     to_array(py, &img)
 }

@@ -9,7 +9,7 @@ use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyList, PyTuple};
 use wavg::{Anchor, ForwardOptions, ForwardResult, SolveError, SurfacePoint};
 
-use crate::args::{array, data, finite, indices, ints, par, reals};
+use crate::args::{Int, array, data, finite, indices, ints, par, reals};
 use crate::errors::{lib, to_py, type_error, value};
 use crate::surface::Surface;
 
@@ -207,7 +207,7 @@ impl Solver {
         &self,
         py: Python<'py>,
         w: &Bound<'py, PyAny>,
-        threads: Option<i64>,
+        threads: Option<Int>,
         name: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
         let k = self.inner.n_anchors();
@@ -287,7 +287,7 @@ impl Solver {
         &self,
         py: Python<'py>,
         W: &Bound<'py, PyAny>,
-        threads: Option<i64>,
+        threads: Option<Int>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.forward_rows(py, W, threads, "W")
     }
@@ -309,7 +309,7 @@ impl Solver {
         faces: &Bound<'py, PyAny>,
         bary: &Bound<'py, PyAny>,
         verified: bool,
-        threads: Option<i64>,
+        threads: Option<Int>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let pts = points(faces, bary, self.inner.mesh().n_faces(), "faces", "bary")?;

@@ -10,7 +10,7 @@ use pyo3::types::{PyBytes, PyTuple};
 use wavg::mesh::TexCoords;
 use wavg::{PrecomputeOptions, TriMesh, Vector3};
 
-use crate::args::{self, array, data, finite, indices, ints, reals};
+use crate::args::{self, Int, array, data, finite, indices, ints, reals};
 use crate::errors::{lib, require_file, to_py, value};
 use crate::progress;
 
@@ -29,6 +29,9 @@ pub(crate) struct Surface {
     /// that triangulating the file's quads added.
     pub(crate) polygons: std::sync::Arc<Vec<u32>>,
 }
+
+/// The most points one `sample_points` call draws (32 bytes each in the answer).
+const MAX_POINTS: usize = 100_000_000;
 
 /// `(V, F)` of a mesh as NumPy arrays.
 pub(crate) fn mesh_arrays<'py>(
@@ -196,22 +199,19 @@ impl Surface {
     /// cancelled call returns at once; the abandoned work stops at its next checkpoint in
     /// the background. On any error the surface is unchanged.
     #[pyo3(
-        signature = (landmarks=1000, seed=0, threads=None, progress=None),
+        signature = (landmarks=Int(1000), seed=Int(0), threads=None, progress=None),
         text_signature = "($self, landmarks=1000, seed=0, threads=None, progress=True)"
     )]
     fn precompute(
         slf: &Bound<'_, Self>,
         py: Python<'_>,
-        landmarks: i64,
-        seed: u64,
-        threads: Option<i64>,
+        landmarks: Int,
+        seed: Int,
+        threads: Option<Int>,
         progress: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Py<PyAny>> {
-        if landmarks < 1 {
-            return Err(value(format!(
-                "landmarks must be a positive integer, got {landmarks}"
-            )));
-        }
+        let landmarks = landmarks.within("landmarks", 1, u32::MAX as i128)?;
+        let seed = seed.seed("seed")?;
         let par = args::par(threads)?;
         let bar = match &progress {
             None => true,
@@ -370,16 +370,18 @@ impl Surface {
 
     /// S.spread_anchors(k, seed=0) -> (k,) int64: ``k`` vertices spread over the surface by
     /// farthest-point sampling (a good default anchor set).
-    #[pyo3(signature = (k, seed=0))]
+    #[pyo3(signature = (k, seed=Int(0)), text_signature = "($self, k, seed=0)")]
     fn spread_anchors<'py>(
         &self,
         py: Python<'py>,
-        k: usize,
-        seed: u64,
+        k: Int,
+        seed: Int,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let a = self
-            .inner
-            .spread_anchors(k, seed)
+        let k = k.within("k", 1, self.inner.n_vertices() as i128)? as usize;
+        let seed = seed.seed("seed")?;
+        let s = &self.inner;
+        let a = py
+            .detach_run(|| s.spread_anchors(k, seed))
             .map_err(|e| to_py(py, e))?;
         let v: Vec<i64> = a
             .iter()
@@ -394,17 +396,24 @@ impl Surface {
     /// S.sample_points(n, seed=0) -> (faces (n,) int64, bary (n, 3) float64): ``n`` random
     /// surface points, uniform by area and seeded (the points ``wavg bench roundtrip
     /// --seed S`` draws with seed ``S + 1``).
-    #[pyo3(signature = (n, seed=0))]
+    #[pyo3(signature = (n, seed=Int(0)), text_signature = "($self, n, seed=0)")]
     fn sample_points<'py>(
         &self,
         py: Python<'py>,
-        n: usize,
-        seed: u64,
+        n: Int,
+        seed: Int,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let pts = wavg::sampling::uniform_surface_points(self.inner.mesh(), n, seed)
-            .map_err(|e| to_py(py, e.into()))?;
-        let faces: Vec<i64> = pts.iter().map(|p| i64::from(p.face)).collect();
-        let bary: Vec<f64> = pts.iter().flat_map(|p| p.bary).collect();
+        let n = n.within("n", 0, MAX_POINTS as i128)? as usize;
+        let seed = seed.seed("seed")?;
+        let mesh = self.inner.mesh();
+        let (faces, bary) = py
+            .detach_run(|| {
+                let pts = wavg::sampling::uniform_surface_points(mesh, n, seed)?;
+                let faces: Vec<i64> = pts.iter().map(|p| i64::from(p.face)).collect();
+                let bary: Vec<f64> = pts.iter().flat_map(|p| p.bary).collect();
+                Ok((faces, bary))
+            })
+            .map_err(|e: wavg::SolveError| to_py(py, e.into()))?;
         Ok((array(py, faces, &[n])?, array(py, bary, &[n, 3])?))
     }
 
@@ -430,6 +439,8 @@ impl Surface {
         let uv = self.uv(py)?;
         let emb = embedding_bytes(&self.inner)?.map(|b| PyBytes::new(py, &b));
         let restore = py.import("wavg._wavg")?.getattr("_restore_surface")?;
+        // The file's polygons, so that a wireframe still leaves out triangulation edges.
+        let polygons = (!self.polygons.is_empty()).then(|| self.polygons.to_vec());
         Ok((
             restore,
             PyTuple::new(
@@ -439,6 +450,7 @@ impl Surface {
                     f,
                     uv.into_pyobject(py)?.into_any(),
                     emb.into_pyobject(py)?.into_any(),
+                    polygons.into_pyobject(py)?.into_any(),
                 ],
             )?,
         ))
@@ -462,15 +474,26 @@ impl Surface {
 
 /// Rebuilds a pickled surface.
 #[pyfunction]
-#[pyo3(signature = (v, f, uv, embedding))]
+#[pyo3(signature = (v, f, uv, embedding, polygons=None))]
 pub(crate) fn _restore_surface(
     py: Python<'_>,
     v: &Bound<'_, PyAny>,
     f: &Bound<'_, PyAny>,
     uv: &Bound<'_, PyAny>,
     embedding: Option<&[u8]>,
+    polygons: Option<Vec<u32>>,
 ) -> PyResult<Surface> {
     let mut s = Surface::new(py, v, f, Some(uv))?;
+    if let Some(p) = polygons {
+        if p.len() != s.inner.n_faces() {
+            return Err(value(format!(
+                "the pickled surface has {} polygon ids for {} triangles",
+                p.len(),
+                s.inner.n_faces()
+            )));
+        }
+        s.polygons = std::sync::Arc::new(p);
+    }
     if let Some(bytes) = embedding {
         let e = wavg::embed::file::decode(
             bytes,
