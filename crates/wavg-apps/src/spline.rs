@@ -50,7 +50,8 @@ impl Curve {
             .iter()
             .filter_map(|r| r.as_ref().ok().map(|r| r.position))
             .collect();
-        let open: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        // A fold from +0 (an empty `sum` of floats is -0).
+        let open = pts.windows(2).fold(0.0, |s, w| s + (w[1] - w[0]).norm());
         match (self.closed, pts.first(), pts.last()) {
             (true, Some(a), Some(b)) if pts.len() > 2 => open + (a - b).norm(),
             _ => open,

@@ -85,6 +85,11 @@ struct JsonAnchor {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::common::check_outputs(
+        &[std::path::Path::new(&*args.mesh)],
+        &[("-o", &args.output)],
+        args.json,
+    )?;
     let mesh = load_valid(&args.mesh)?;
     if args.count == 0 || args.count > mesh.n_vertices() {
         return Err(CliError::input(format!(

@@ -171,6 +171,57 @@ pub fn parse_frames(s: &str) -> Result<usize, String> {
     parse_up_to(s, MAX_FRAMES, "frames")
 }
 
+/// Checks a command's outputs before any work: each (named by its option, e.g. `-o`)
+/// goes to an existing folder, standard output (`-`) is not also where `--json` prints,
+/// no two outputs are one file and none is one of the `inputs` (whose contents would be
+/// lost). Input errors (exit status 2).
+pub fn check_outputs(
+    inputs: &[&Path],
+    outputs: &[(&str, &Path)],
+    json: bool,
+) -> Result<(), CliError> {
+    for (i, &(opt, path)) in outputs.iter().enumerate() {
+        if path == Path::new("-") {
+            if json {
+                return Err(CliError::input(format!(
+                    "--json prints its report to standard output, where {opt} - writes too: \
+                     give {opt} a file name"
+                )));
+            }
+            continue;
+        }
+        if wavg::mesh::io::is_special_destination(path) {
+            continue;
+        }
+        let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+        if let Some(dir) = parent
+            && !dir.is_dir()
+        {
+            return Err(CliError::input(format!(
+                "{opt} {}: the folder {} does not exist",
+                path.display(),
+                dir.display()
+            )));
+        }
+        for &(other, q) in &outputs[..i] {
+            if q == path || same_file(q, path) {
+                return Err(CliError::input(format!(
+                    "{other} and {opt} name the same file {}",
+                    path.display()
+                )));
+            }
+        }
+        if let Some(input) = inputs.iter().find(|&&q| q == path || same_file(q, path)) {
+            return Err(CliError::input(format!(
+                "{opt} {} is an input of this command ({}): write to another file",
+                path.display(),
+                input.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Whether two paths name the same existing file (after resolving links and `..`).
 pub fn same_file(a: &Path, b: &Path) -> bool {
     match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {

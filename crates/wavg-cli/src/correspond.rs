@@ -211,6 +211,7 @@ struct JsonReport<'a> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::common::check_outputs(&[], &[("-o", &args.output)], args.json)?;
     let c = compute(&args.map)?;
     let truth = if args.ground_truth {
         Some(ground_truth(&c)?)

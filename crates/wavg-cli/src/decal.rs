@@ -82,6 +82,23 @@ struct JsonReport<'a> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::common::check_outputs(
+        &[std::path::Path::new(&*args.mesh), &args.anchors, &args.uv],
+        &[("-o", &args.output)],
+        args.json,
+    )?;
+    if args.output != std::path::Path::new("-")
+        && !args
+            .output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+    {
+        return Err(CliError::input(format!(
+            "-o {}: a decal is written as an OBJ file (with its .mtl and texture): give a \
+             name ending in .obj",
+            args.output.display()
+        )));
+    }
     let text = textio::read_text(&args.uv)?;
     let lines =
         wavg::text::parse_weights(&text, 1).map_err(|e| located(&args.uv, e.line, &e.message))?;

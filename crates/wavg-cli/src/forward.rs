@@ -54,6 +54,11 @@ pub struct Args {
 /// Runs the command: the weights stream through in chunks (parsed, checked, solved and
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::common::check_outputs(
+        &[&args.weights, std::path::Path::new(&*args.problem.mesh)],
+        &[("-o", &args.problem.output)],
+        false,
+    )?;
     let solver = textio::load_solver(&args.problem)?;
     let normalization = if args.normalize {
         Normalization::Normalize

@@ -52,6 +52,11 @@ pub struct Args {
 /// Runs the command: the points stream through in chunks (parsed, resolved, solved and
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::common::check_outputs(
+        &[&args.points, std::path::Path::new(&*args.problem.mesh)],
+        &[("-o", &args.problem.output)],
+        false,
+    )?;
     let mut solver = textio::load_solver(&args.problem)?;
     solver
         .set_gamma(args.gamma)

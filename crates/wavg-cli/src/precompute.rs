@@ -93,6 +93,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // Ctrl-C asks the pipeline to stop at its next check; the output is only written after
     // success, so an interrupted run leaves no file behind.
     check_args(&args)?;
+    let mut outputs = vec![("-o", args.output.as_path())];
+    if let Some(m) = &args.repaired_mesh {
+        outputs.push(("--repaired-mesh", m.as_path()));
+    }
+    crate::common::check_outputs(&[std::path::Path::new(&*args.mesh)], &outputs, args.json)?;
     let interrupted = Arc::new(AtomicBool::new(false));
     let flag = interrupted.clone();
     let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));

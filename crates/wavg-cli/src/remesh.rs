@@ -76,6 +76,11 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::common::check_outputs(
+        &[std::path::Path::new(&*args.mesh), &args.base],
+        &[("-o", &args.output)],
+        args.json,
+    )?;
     let text = std::fs::read_to_string(&args.base)
         .map_err(|e| CliError::input(format!("{}: {e}", args.base.display())))?;
     let base = BaseMesh::from_obj_str(&text)

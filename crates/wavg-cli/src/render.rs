@@ -163,6 +163,11 @@ pub fn write_png(path: &Path, img: &Image) -> Result<(), CliError> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::common::check_outputs(
+        &[std::path::Path::new(&*args.mesh)],
+        &[("-o", &args.output)],
+        args.json,
+    )?;
     let (width, height) = parse_size(&args.size, "--size")?;
     let view = args
         .view

@@ -58,6 +58,11 @@ pub struct Args {
 
 /// Runs `wavg repair`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    let mut outputs = vec![("-o", args.output.as_path())];
+    if let Some(m) = &args.map {
+        outputs.push(("--map", m.as_path()));
+    }
+    crate::common::check_outputs(&[std::path::Path::new(&*args.mesh)], &outputs, args.json)?;
     if !(args.weld >= 0.0 && args.weld.is_finite()) {
         return Err(CliError::input(format!(
             "--weld must be a finite distance >= 0, got {}",

@@ -77,8 +77,19 @@ pub(crate) const CHUNK: usize = 256;
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::common::check_outputs(
+        &[std::path::Path::new(&*args.mesh), &args.control],
+        &[("-o", &args.output)],
+        args.json,
+    )?;
     if args.samples == 0 {
         return Err(CliError::input("--samples must be at least 1"));
+    }
+    if !args.bezier && !(1..=64).contains(&args.degree) {
+        return Err(CliError::input(format!(
+            "--degree must be 1 to 64, got {}",
+            args.degree
+        )));
     }
     let kind = if args.bezier {
         SplineKind::Bezier

@@ -212,6 +212,14 @@ impl Source {
             let reader = BufReader::with_capacity(NPY_HEADER_BUFFER, file);
             let reader = NpyReader::new(reader)
                 .map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
+            if reader.cols() == 0 && reader.rows() > 0 {
+                return Err(CliError::input(format!(
+                    "{}: the array's {} rows hold no values (shape ({}, 0))",
+                    input.display(),
+                    reader.rows(),
+                    reader.rows()
+                )));
+            }
             Source::Npy {
                 reader,
                 done: 0,

@@ -35,6 +35,11 @@ pub struct Args {
 
 /// Runs `wavg subdivide`.
 pub fn run(args: Args) -> Result<(), CliError> {
+    crate::common::check_outputs(
+        &[std::path::Path::new(&*args.mesh)],
+        &[("-o", &args.output)],
+        args.json,
+    )?;
     let input = load_valid(&args.mesh)?;
     let t = Instant::now();
     let (nv0, nf0) = (input.n_vertices(), input.n_faces());

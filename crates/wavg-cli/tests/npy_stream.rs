@@ -51,3 +51,26 @@ fn long_npy_weights_give_the_text_answers() {
     assert_eq!(from_text.iter().filter(|&&b| b == b'\n').count(), n);
     assert!(from_text == from_npy, "the .npy rows give other answers");
 }
+
+/// An array of rows without values (shape (5, 0)) is an input error, not an empty answer.
+#[test]
+fn rows_without_values_are_an_input_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let anchors = sphere_anchors(dir.path());
+    let w_npy = dir.path().join("w.npy");
+    // A version 1.0 header for float64 (5, 0), padded to 64 bytes, and no data.
+    let mut dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (5, 0), }".to_owned();
+    while (10 + dict.len() + 1) % 64 != 0 {
+        dict.push(' ');
+    }
+    dict.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend((dict.len() as u16).to_le_bytes());
+    bytes.extend(dict.as_bytes());
+    std::fs::write(&w_npy, bytes).unwrap();
+    let out = icosphere_forward(&anchors, &w_npy, &dir.path().join("o.txt"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("hold no values"), "{stderr}");
+    assert!(!dir.path().join("o.txt").exists());
+}

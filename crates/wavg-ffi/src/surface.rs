@@ -400,6 +400,11 @@ pub unsafe extern "C" fn wavg_surface_landmarks(
             *n = lm.len();
             return Ok(());
         }
+        if out.is_null() {
+            return Err(Failure::arg(format!(
+                "out is NULL with len {len}: pass NULL and 0 to ask for the count"
+            )));
+        }
         if len < lm.len() {
             return Err(Failure::arg(format!(
                 "the output holds {len} landmarks, there are {}",

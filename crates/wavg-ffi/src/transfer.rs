@@ -18,11 +18,12 @@ unsafe fn tex_coords(
     n_faces: usize,
     what: &str,
 ) -> Result<TexCoords, Failure> {
+    let faces_name = format!("{what}_faces");
     // SAFETY: per this function's contract.
     let (uv, faces) = unsafe {
         (
             slice(uv, product(n_uv, 2, what)?, what)?,
-            slice(faces, product(n_faces, 3, what)?, what)?,
+            slice(faces, product(n_faces, 3, &faces_name)?, &faces_name)?,
         )
     };
     Ok(TexCoords {

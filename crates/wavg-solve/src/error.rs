@@ -20,7 +20,10 @@ pub enum SolveError {
         value: f64,
     },
     /// The weights do not sum to 1 (and normalisation was not requested).
-    #[error("weights sum to {sum}, not 1 (tolerance {tolerance:e}; normalisation not requested)")]
+    #[error(
+        "weights sum to {}, not 1 (tolerance {tolerance:e}; normalisation not requested)",
+        short(*.sum)
+    )]
     WeightSum {
         /// The sum.
         sum: f64,
@@ -28,7 +31,7 @@ pub enum SolveError {
         tolerance: f64,
     },
     /// Normalisation was requested but the weights sum to (almost) zero.
-    #[error("weights sum to {sum}: cannot normalise")]
+    #[error("weights sum to {}: cannot normalise", short(*.sum))]
     ZeroWeightSum {
         /// The sum.
         sum: f64,
@@ -102,5 +105,15 @@ impl SolveError {
                 | SolveError::DegenerateTangentPlane
                 | SolveError::Project(wavg_project::ProjectError::NoProjection)
         )
+    }
+}
+
+/// `x` for a message: plain decimals between 1e-4 and 1e6, else scientific notation (a sum
+/// of 1e-320 would otherwise print 320 digits).
+fn short(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e6).contains(&x.abs()) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
     }
 }

@@ -156,12 +156,17 @@ pub fn parse_weights(text: &str, first_line: usize) -> Result<Vec<(usize, Vec<f6
 
 /// Runs `parse` (line number, line, a scratch value of each task) on every line, in
 /// parallel over groups of lines, keeping input order, dropping lines without content
-/// (`None`) and reporting the first error.
+/// (`None`) and reporting the first error. A UTF-8 byte order mark opening the file (some
+/// editors write one; it is invisible in messages) is skipped.
 fn parse_lines<'t, T: Send, S: Default>(
     text: &'t str,
     first_line: usize,
     parse: impl Fn(usize, &'t str, &mut S) -> Result<Option<T>, LineError> + Sync,
 ) -> Result<Vec<(usize, T)>, LineError> {
+    let text = match text.strip_prefix('\u{feff}') {
+        Some(rest) if first_line == 1 => rest,
+        _ => text,
+    };
     let lines: Vec<&str> = text.lines().collect();
     let groups: Vec<Result<Vec<(usize, T)>, LineError>> = lines
         .par_chunks(LINES_PER_TASK)
@@ -394,6 +399,20 @@ pub fn format_lines_in<T: Sync>(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// A byte order mark opening a file is skipped; anywhere else it is an error.
+    #[test]
+    fn a_byte_order_mark_opens_a_file() {
+        let p = parse_points("\u{feff}v 3\nv 4\n", 1).unwrap();
+        assert_eq!(
+            p,
+            vec![(1, PointSpec::Vertex(3)), (2, PointSpec::Vertex(4))]
+        );
+        let w = parse_weights("\u{feff}0.5 0.5\n", 1).unwrap();
+        assert_eq!(w, vec![(1, vec![0.5, 0.5])]);
+        assert!(parse_points("\u{feff}v 3\n", 7).is_err());
+        assert!(parse_points("v 3\n\u{feff}v 4\n", 1).is_err());
+    }
 
     #[test]
     fn parses_points_with_comments_and_blank_lines() {
