@@ -43,6 +43,10 @@ def test_embedding_round_trip(tmp_path, surface, torus_mesh):
     write_obj(tmp_path / "t.obj", *torus_mesh)
     S3 = wavg.Surface.open(tmp_path / "t.obj", embedding=path)
     assert np.array_equal(S3.embedding, surface.embedding)
+    before = (tmp_path / "t.obj").read_bytes()
+    with pytest.raises(ValueError, match="mesh file"):
+        surface.save_embedding(tmp_path / "t.obj")  # would destroy the mesh
+    assert (tmp_path / "t.obj").read_bytes() == before
 
 
 def test_embedding_of_another_mesh_is_refused(tmp_path, surface):

@@ -118,7 +118,13 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, s: &MeshIn
             b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2], b.diagonal
         );
     }
-    if s.valid {
+    if s.valid && s.components > 1 {
+        let _ = writeln!(
+            o,
+            "valid:                yes (oriented manifold); precompute, anchors and the \
+             solvers need one component: `wavg repair MESH -o OUT --largest-component`"
+        );
+    } else if s.valid {
         let _ = writeln!(
             o,
             "valid:                yes (oriented manifold, usable by wavg)"

@@ -266,6 +266,13 @@ impl Surface {
 
     /// S.save_embedding(path): writes the embedding to a ``.wavg`` file (atomically).
     fn save_embedding(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        // As `wavg precompute`: a mesh file's name is a mistake that would destroy a mesh.
+        if wavg::mesh::Format::from_path(&path).is_ok() {
+            return Err(value(format!(
+                "path {} has a mesh file's extension; the embedding is a .wavg file",
+                path.display()
+            )));
+        }
         py.detach_run(|| self.inner.save_embedding(&path))
             .map_err(|e| to_py(py, e))
     }
