@@ -222,6 +222,22 @@ pub fn check_outputs(
     Ok(())
 }
 
+/// Refuses an output `path` (unless `-`) whose name does not end in `.EXT`: the command
+/// writes only that kind of file (`what` says which).
+pub fn require_extension(path: &Path, ext: &str, what: &str) -> Result<(), CliError> {
+    let ok = path == Path::new("-")
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext));
+    if ok {
+        return Ok(());
+    }
+    Err(CliError::input(format!(
+        "-o {}: {what}: give a name ending in .{ext}",
+        path.display()
+    )))
+}
+
 /// Whether two paths name the same existing file (after resolving links and `..`).
 pub fn same_file(a: &Path, b: &Path) -> bool {
     match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {

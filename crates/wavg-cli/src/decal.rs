@@ -87,18 +87,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &[("-o", &args.output)],
         args.json,
     )?;
-    if args.output != std::path::Path::new("-")
-        && !args
-            .output
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
-    {
-        return Err(CliError::input(format!(
-            "-o {}: a decal is written as an OBJ file (with its .mtl and texture): give a \
-             name ending in .obj",
-            args.output.display()
-        )));
-    }
+    crate::common::require_extension(
+        &args.output,
+        "obj",
+        "a decal is written as an OBJ file (with its .mtl and texture)",
+    )?;
     let text = textio::read_text(&args.uv)?;
     let lines =
         wavg::text::parse_weights(&text, 1).map_err(|e| located(&args.uv, e.line, &e.message))?;

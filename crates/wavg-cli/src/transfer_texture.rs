@@ -85,17 +85,7 @@ struct JsonReport<'a> {
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(&[&args.source_texture], &[("-o", &args.output)], args.json)?;
-    if args.output != std::path::Path::new("-")
-        && !args
-            .output
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
-    {
-        return Err(CliError::input(format!(
-            "-o {}: the texture is written as a PNG file: give a name ending in .png",
-            args.output.display()
-        )));
-    }
+    crate::common::require_extension(&args.output, "png", "the texture is written as a PNG file")?;
     crate::textio::with_threads(args.pair.threads, || run_inner(args))?
 }
 

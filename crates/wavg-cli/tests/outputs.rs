@@ -32,8 +32,8 @@ fn bad_outputs_are_refused_before_any_work() {
         &["subdivide", &mesh, "-o", &d("nodir/x.obj")],
         "does not exist",
     );
-    refused(
-        &[
+    let spline = |out: &str| {
+        let args = [
             "spline",
             &mesh,
             "--embedding",
@@ -41,9 +41,14 @@ fn bad_outputs_are_refused_before_any_work() {
             "--control",
             &control,
             "-o",
-            "-",
-            "--json",
-        ],
+            out,
+        ];
+        args.map(str::to_owned).to_vec()
+    };
+    let mut json = spline("-");
+    json.push("--json".into());
+    refused(
+        &json.iter().map(String::as_str).collect::<Vec<_>>(),
         "--json",
     );
     refused(
@@ -63,16 +68,10 @@ fn bad_outputs_are_refused_before_any_work() {
         "is an input",
     );
     refused(
-        &[
-            "spline",
-            &mesh,
-            "--embedding",
-            "none",
-            "--control",
-            &control,
-            "-o",
-            &control,
-        ],
+        &spline(&control)
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
         "is an input",
     );
     refused(

@@ -85,16 +85,23 @@ fn a_reader_that_stops_early_is_no_failure() {
         anchors.display(),
         points.display()
     );
+    let stderr = exits_zero(&cmd);
+    assert!(!stderr.contains("Broken pipe"), "{stderr}");
+}
+
+/// Runs the bash pipeline `cmd`, which ends by echoing `status $?` of its first command;
+/// asserts that it was 0 and returns the standard error.
+fn exits_zero(cmd: &str) -> String {
     let out = std::process::Command::new("bash")
-        .args(["-c", &cmd])
+        .args(["-c", cmd])
         .output()
         .unwrap();
     let (stdout, stderr) = (
         String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
     );
     assert_eq!(stdout.trim(), "status 0", "{stderr}");
-    assert!(!stderr.contains("Broken pipe"), "{stderr}");
+    stderr
 }
 
 /// A query file that can be read only once (a pipe as `--weights /dev/stdin`) with an
@@ -173,14 +180,6 @@ fn a_report_to_a_closed_pipe_is_no_failure() {
         "'{}' info builtin:torus | true; echo \"status ${{PIPESTATUS[0]}}\"",
         env!("CARGO_BIN_EXE_wavg"),
     );
-    let out = std::process::Command::new("bash")
-        .args(["-c", &cmd])
-        .output()
-        .unwrap();
-    let (stdout, stderr) = (
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr),
-    );
-    assert_eq!(stdout.trim(), "status 0", "{stderr}");
+    let stderr = exits_zero(&cmd);
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
