@@ -302,8 +302,9 @@ pub fn render(
             }
             Colouring::Scalars(s) => {
                 let v: f64 = (0..3).map(|k| s[t[k] as usize] * b[k]).sum();
+                // In halves: exact, and the range of values near +-f64::MAX stays finite.
                 let x = if smax > smin {
-                    (v - smin) / (smax - smin)
+                    (v / 2.0 - smin / 2.0) / (smax / 2.0 - smin / 2.0)
                 } else {
                     0.5
                 };
@@ -455,6 +456,35 @@ mod tests {
         assert!(c[1] as u32 > c[2] as u32 + 60, "{c:?}");
         let far = img.get(32, 48);
         assert!(far[2] > far[1] / 2, "{far:?}");
+    }
+
+    /// Scalars spanning almost all of f64 (+-1e308: their difference overflows) colour the
+    /// same as the same scalars scaled down.
+    #[test]
+    fn scalars_near_the_largest_float_keep_their_colours() {
+        let mesh = procedural::icosphere(2);
+        let small: Vec<f64> = mesh.positions.iter().map(|p| p.z).collect();
+        let huge: Vec<f64> = small.iter().map(|z| z * 1e308).collect();
+        let opts = RenderOptions {
+            width: 64,
+            height: 48,
+            ..Default::default()
+        };
+        let none = Overlays::default();
+        let a = render(&mesh, &Colouring::Scalars(&small), &none, &opts).unwrap();
+        let b = render(&mesh, &Colouring::Scalars(&huge), &none, &opts).unwrap();
+        // The left half away from the top and bottom: the surface without the legend and
+        // its labels (which differ).
+        let mut shaded = 0;
+        for y in 12..opts.height - 12 {
+            for x in 0..opts.width / 2 {
+                let (p, q) = (a.get(x, y), b.get(x, y));
+                let same = p.iter().zip(q).all(|(u, v)| u.abs_diff(v) <= 1);
+                assert!(same, "({x}, {y}): {p:?} {q:?}");
+                shaded += usize::from(!is_bg(p));
+            }
+        }
+        assert!(shaded > 300, "{shaded}");
     }
 
     #[test]
