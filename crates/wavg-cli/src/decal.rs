@@ -137,6 +137,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mtllib = material.as_ref().map(decal_material::Material::file_name);
     textio::write_atomic(&args.output, |w: &mut dyn Write| {
         write_decal_obj(w, mesh, &decal.uv, mtllib.as_deref())
+    })
+    .inspect_err(|_| {
+        if let Some(m) = &material {
+            m.remove();
+        }
     })?;
     let untextured_faces = untextured_faces(mesh, &decal.uv);
     let marked: Vec<usize> = (0..mesh.n_vertices())

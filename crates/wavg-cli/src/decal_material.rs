@@ -17,9 +17,20 @@ pub struct Material {
     pub mtl: PathBuf,
     /// The image it names (the given texture or the generated checkerboard).
     pub texture: PathBuf,
+    /// Whether the image is the checkerboard this command wrote.
+    pub generated: bool,
 }
 
 impl Material {
+    /// Removes the files written for this material (the OBJ naming them could not be
+    /// written: nothing of the command is left).
+    pub fn remove(&self) {
+        let _ = std::fs::remove_file(&self.mtl);
+        if self.generated {
+            let _ = std::fs::remove_file(&self.texture);
+        }
+    }
+
     /// The `mtllib` line's argument: the `.mtl`'s file name (it sits beside the OBJ).
     pub fn file_name(&self) -> String {
         self.mtl
@@ -39,6 +50,7 @@ pub fn write(obj: &Path, texture: Option<&Path>) -> Result<Option<Material>, Cli
     let stem = obj
         .file_stem()
         .map_or_else(|| "decal".into(), |s| s.to_string_lossy().into_owned());
+    let texture_arg = texture;
     let texture = match texture {
         Some(t) => t.to_path_buf(),
         None => {
@@ -48,17 +60,24 @@ pub fn write(obj: &Path, texture: Option<&Path>) -> Result<Option<Material>, Cli
             t
         }
     };
+    let generated = texture_arg.is_none();
     let mtl = dir.join(format!("{stem}.mtl"));
     let name = relative_to(&texture, dir);
-    textio::write_atomic(&mtl, |w: &mut dyn Write| {
+    let material = Material {
+        mtl,
+        texture,
+        generated,
+    };
+    textio::write_atomic(&material.mtl, |w: &mut dyn Write| {
         writeln!(w, "# written by wavg decal")?;
         writeln!(w, "newmtl {TEXTURED}")?;
         writeln!(w, "Ka 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1")?;
         writeln!(w, "map_Kd {name}")?;
         writeln!(w, "\nnewmtl {PLAIN}")?;
         writeln!(w, "Ka 1 1 1\nKd 0.8 0.82 0.85\nKs 0 0 0\nd 1\nillum 1")
-    })?;
-    Ok(Some(Material { mtl, texture }))
+    })
+    .inspect_err(|_| material.remove())?;
+    Ok(Some(material))
 }
 
 /// Refuses a `--texture` that is not a readable PNG (before anything is computed).

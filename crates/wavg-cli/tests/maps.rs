@@ -102,6 +102,31 @@ fn decal_json(
     (o, keys, out)
 }
 
+/// A decal whose `.mtl` cannot be written leaves none of its files (the checkerboard was
+/// left behind).
+#[test]
+fn a_decal_that_fails_leaves_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, u) = (dir.path().join("a.txt"), dir.path().join("uv.txt"));
+    std::fs::write(&a, "v 0\nv 1\nv 2\nv 3\n").unwrap();
+    std::fs::write(&u, "0 0\n1 0\n0 1\n1 1\n").unwrap();
+    std::fs::create_dir(dir.path().join("d.mtl")).unwrap();
+    let out = dir.path().join("d.obj");
+    let r = wavg(&[
+        "decal",
+        "--mesh",
+        "builtin:icosphere",
+        "--anchors",
+        &s(&a),
+        "--uv",
+        &s(&u),
+        "-o",
+        &s(&out),
+    ]);
+    assert!(!r.status.success());
+    assert!(!out.exists() && !dir.path().join("d_checker.png").exists());
+}
+
 #[test]
 fn decal_writes_one_vt_per_vertex() {
     let dir = tempfile::tempdir().unwrap();
