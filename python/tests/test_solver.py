@@ -173,10 +173,25 @@ def test_integer_and_thread_arguments_are_checked_by_name(surface, solver):
         surface.precompute(seed=-1, progress=False)
     with pytest.raises(TypeError, match="n"):
         surface.sample_points(2.5)
-    with pytest.raises(ValueError, match="i = 99"):
+    with pytest.raises(ValueError, match="i must be"):
         wavg.Solver(surface, solver.anchor_points).set_anchor(99, 3)
     f, b = surface.sample_points(5, seed=2**64 - 1)
     assert f.shape == (5,) and b.shape == (5, 3)
+    for bad in (True, 1.5, np.float64(2.0), "2"):
+        with pytest.raises(TypeError, match="threads"):
+            solver.forward(W, threads=bad)
+    anchors = solver.anchor_points
+    with pytest.raises(ValueError, match="samples"):
+        wavg.spline(surface, anchors, samples=2**70)
+    with pytest.raises(TypeError, match="degree"):
+        wavg.spline(surface, anchors, degree=2.0)
+    with pytest.raises(ValueError, match="width"):
+        wavg.render(surface, size=(2**70, 10))
+    s = wavg.Solver(surface, anchors)
+    with pytest.raises(ValueError, match="i must be"):
+        s.set_anchor(2**70, 3)
+    with pytest.raises(ValueError, match="vertex_or_point"):
+        s.set_anchor(0, 2**70)
 
 
 def _forward_in_worker(args):

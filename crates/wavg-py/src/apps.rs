@@ -53,26 +53,23 @@ fn solver_for(
 /// Returns ``samples`` points uniform in the curve parameter as ``wavg.Points``
 /// (``face (samples,)``, ``bary``, ``xyz (samples, 3)``, ``ok``).
 #[pyfunction]
-#[pyo3(signature = (S, control, samples=200, degree=3, closed=false, bezier=false, threads=None))]
+#[pyo3(
+    signature = (S, control, samples=Int::of(200), degree=Int::of(3), closed=false, bezier=false, threads=None),
+    text_signature = "(S, control, samples=200, degree=3, closed=False, bezier=False, threads=None)"
+)]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 fn spline<'py>(
     py: Python<'py>,
     S: PyRef<'py, Surface>,
     control: &Bound<'py, PyAny>,
-    samples: i64,
-    degree: i64,
+    samples: Int,
+    degree: Int,
     closed: bool,
     bezier: bool,
     threads: Option<Int>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if !(1..=10_000_000).contains(&samples) {
-        return Err(value(format!(
-            "samples must be 1 to 10000000, got {samples}"
-        )));
-    }
-    if !(1..=64).contains(&degree) {
-        return Err(value(format!("degree must be 1 to 64, got {degree}")));
-    }
+    let samples = samples.within("samples", 1, 10_000_000)?;
+    let degree = degree.within("degree", 1, 64)?;
     let solver = solver_for(py, &S.inner, control, "control")?;
     let kind = if bezier {
         SplineKind::Bezier
@@ -283,7 +280,7 @@ fn decal<'py>(
 /// ``Surface(V, F, uv=...)``). ``size``: ``(W, H)`` of the result (default: the source
 /// texture's). Texels nothing maps to have alpha 0.
 #[pyfunction]
-#[pyo3(signature = (src, src_texture, dst, src_anchors, dst_anchors, size=None, verified=true, stride=4, threads=None))]
+#[pyo3(signature = (src, src_texture, dst, src_anchors, dst_anchors, size=None, verified=true, stride=Int::of(4), threads=None), text_signature = "(src, src_texture, dst, src_anchors, dst_anchors, size=None, verified=True, stride=4, threads=None)")]
 #[allow(clippy::too_many_arguments)]
 fn transfer_texture<'py>(
     py: Python<'py>,
@@ -292,9 +289,9 @@ fn transfer_texture<'py>(
     dst: PyRef<'py, Surface>,
     src_anchors: &Bound<'py, PyAny>,
     dst_anchors: &Bound<'py, PyAny>,
-    size: Option<(i64, i64)>,
+    size: Option<(Int, Int)>,
     verified: bool,
-    stride: i64,
+    stride: Int,
     threads: Option<Int>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let texture: Image = image::image_arg(src_texture, "src_texture")?;
@@ -302,9 +299,7 @@ fn transfer_texture<'py>(
         None => (texture.width, texture.height),
         Some(s) => image::size_arg(s, "size")?,
     };
-    if !(1..=64).contains(&stride) {
-        return Err(value(format!("stride must be 1 to 64, got {stride}")));
-    }
+    let stride = stride.within("stride", 1, 64)?;
     let ss = solver_for(py, &src.inner, src_anchors, "src_anchors")?;
     let ts = solver_for(py, &dst.inner, dst_anchors, "dst_anchors")?;
     let opts = TransferOptions {

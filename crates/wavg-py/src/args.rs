@@ -212,27 +212,33 @@ pub(crate) fn par(threads: Option<Int>) -> PyResult<wavg::Par> {
         return Ok(wavg::Par::Rayon);
     };
     let max = wavg::Par::max_threads();
-    if !(1..=max as i128).contains(&n.0) {
-        return Err(value(format!(
-            "threads must be None (all cores) or an integer from 1 to {max} (4 per CPU, at \
-             least 64: more only add overhead), got {n}"
-        )));
-    }
-    wavg::Par::from_threads(Some(n.0 as usize)).map_err(|e| value(format!("threads: {e}")))
+    let n = match n.0 {
+        Ok(v) if (1..=max as i128).contains(&v) => v,
+        Ok(_) => {
+            return Err(value(format!(
+                "threads must be None (all cores) or an integer from 1 to {max} (4 per CPU, \
+                 at least 64: more only add overhead), got {n}"
+            )));
+        }
+        Err(_) => n.within("threads", 1, max as i128)?,
+    };
+    wavg::Par::from_threads(Some(n as usize)).map_err(|e| value(format!("threads: {e}")))
 }
 
-/// An integer argument: any Python `int` (or object with `__index__`); a value beyond 128
-/// bits is kept as the nearest 128-bit one, so the range check of the function taking it
-/// names the argument (a non-integer is a `TypeError` that PyO3 names).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Int(pub(crate) i128);
+/// An integer argument as given: any Python `int` (or object with `__index__`), a value
+/// beyond 128 bits kept as the nearest 128-bit one, or the type name of anything else
+/// (`bool` included), so that the function taking it checks the range and the type with
+/// messages naming the argument.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Int(Result<i128, String>);
 
 impl std::fmt::Display for Int {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.0 {
-            i128::MAX => f.write_str("a larger number"),
-            i128::MIN => f.write_str("a more negative number"),
-            v => write!(f, "{v}"),
+        match &self.0 {
+            Ok(i128::MAX) => f.write_str("a larger number"),
+            Ok(i128::MIN) => f.write_str("a more negative number"),
+            Ok(v) => write!(f, "{v}"),
+            Err(t) => write!(f, "a {t}"),
         }
     }
 }
@@ -241,31 +247,50 @@ impl FromPyObject<'_, '_> for Int {
     type Error = PyErr;
 
     fn extract(obj: pyo3::Borrowed<'_, '_, PyAny>) -> PyResult<Self> {
+        let type_name = || {
+            obj.get_type()
+                .name()
+                .map_or_else(|_| "value".to_owned(), |n| n.to_string())
+        };
+        if obj.is_instance_of::<pyo3::types::PyBool>() {
+            return Ok(Int(Err(type_name())));
+        }
         match obj.extract::<i128>() {
-            Ok(v) => Ok(Int(v)),
+            Ok(v) => Ok(Int(Ok(v))),
             Err(e) if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(obj.py()) => {
                 let negative = obj.lt(0i32)?;
-                Ok(Int(if negative { i128::MIN } else { i128::MAX }))
+                Ok(Int(Ok(if negative { i128::MIN } else { i128::MAX })))
             }
-            Err(e) => Err(e),
+            Err(_) => Ok(Int(Err(type_name()))),
         }
     }
 }
 
 impl Int {
-    /// The value when it lies in `lo..=hi`; otherwise a `ValueError` naming `name`.
-    pub(crate) fn within(self, name: &str, lo: i128, hi: i128) -> PyResult<i128> {
-        if (lo..=hi).contains(&self.0) {
-            Ok(self.0)
-        } else {
-            Err(value(format!(
+    /// The integer, when one was given.
+    pub(crate) fn value(&self) -> Option<i128> {
+        self.0.as_ref().ok().copied()
+    }
+
+    /// A value given in Rust (a default).
+    pub(crate) const fn of(v: i128) -> Self {
+        Int(Ok(v))
+    }
+
+    /// The value when it is an integer in `lo..=hi`; otherwise a `TypeError` or
+    /// `ValueError` naming `name`.
+    pub(crate) fn within(&self, name: &str, lo: i128, hi: i128) -> PyResult<i128> {
+        match self.0 {
+            Ok(v) if (lo..=hi).contains(&v) => Ok(v),
+            Ok(_) => Err(value(format!(
                 "{name} must be an integer from {lo} to {hi}, got {self}"
-            )))
+            ))),
+            Err(_) => Err(type_error(format!("{name} must be an integer, got {self}"))),
         }
     }
 
     /// A seed: any integer from 0 to 2^64 - 1.
-    pub(crate) fn seed(self, name: &str) -> PyResult<u64> {
+    pub(crate) fn seed(&self, name: &str) -> PyResult<u64> {
         Ok(self.within(name, 0, u64::MAX as i128)? as u64)
     }
 }

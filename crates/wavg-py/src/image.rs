@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use wavg::apps::{Image, MAX_SIDE};
 
 use crate::args::DetachRun;
-use crate::args::array;
+use crate::args::{Int, array};
 use crate::errors::{png, raise, require_file, type_error, value};
 
 /// An image argument: an `(H, W, 3)` or `(H, W, 4)` uint8 array (or a PNG path).
@@ -65,15 +65,11 @@ pub(crate) fn image_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Image> {
 }
 
 /// `(W, H)` of a picture.
-pub(crate) fn size_arg(s: (i64, i64), name: &str) -> PyResult<(u32, u32)> {
-    let ok = |x: i64| (1..=i64::from(MAX_SIDE)).contains(&x);
-    if ok(s.0) && ok(s.1) {
-        Ok((s.0 as u32, s.1 as u32))
-    } else {
-        Err(value(format!(
-            "{name} must be (width, height), each 1 to {MAX_SIDE}; got {s:?}"
-        )))
-    }
+pub(crate) fn size_arg(s: (Int, Int), name: &str) -> PyResult<(u32, u32)> {
+    let max = i128::from(MAX_SIDE);
+    let w = s.0.within(&format!("{name}[0] (width)"), 1, max)?;
+    let h = s.1.within(&format!("{name}[1] (height)"), 1, max)?;
+    Ok((w as u32, h as u32))
 }
 
 /// An image as an `(H, W, 4)` uint8 array.

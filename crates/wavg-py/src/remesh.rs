@@ -8,7 +8,7 @@ use crate::args::DetachRun;
 use wavg::Vector3;
 use wavg::apps::BaseMesh;
 
-use crate::args::{array, data, ints, reals};
+use crate::args::{Int, array, data, ints, reals};
 use crate::errors::{remesh, value};
 use crate::surface::Surface;
 
@@ -32,24 +32,21 @@ pub(crate) struct Remesher {
 #[pymethods]
 impl Remesher {
     #[new]
-    #[pyo3(signature = (S, base_V, base_F, levels=2, smooth=3))]
+    #[pyo3(
+        signature = (S, base_V, base_F, levels=Int::of(2), smooth=Int::of(3)),
+        text_signature = "(S, base_V, base_F, levels=2, smooth=3)"
+    )]
     #[allow(non_snake_case)]
     fn new(
         py: Python<'_>,
         S: PyRef<'_, Surface>,
         base_V: &Bound<'_, PyAny>,
         base_F: &Bound<'_, PyAny>,
-        levels: i64,
-        smooth: i64,
+        levels: Int,
+        smooth: Int,
     ) -> PyResult<Self> {
-        let max_l = wavg::apps::MAX_LEVELS as i64;
-        let max_s = wavg::apps::MAX_SMOOTH_STEPS as i64;
-        if !(0..=max_l).contains(&levels) {
-            return Err(value(format!("levels must be 0 to {max_l}, got {levels}")));
-        }
-        if !(0..=max_s).contains(&smooth) {
-            return Err(value(format!("smooth must be 0 to {max_s}, got {smooth}")));
-        }
+        let levels = levels.within("levels", 0, wavg::apps::MAX_LEVELS as i128)?;
+        let smooth = smooth.within("smooth", 0, wavg::apps::MAX_SMOOTH_STEPS as i128)?;
         let v = reals(
             base_V,
             "base_V",
@@ -88,11 +85,9 @@ impl Remesher {
 
     /// r.move_vertex(i, xyz): moves base vertex ``i`` to the surface point closest to ``xyz``
     /// ``(3,)`` float.
-    fn move_vertex(&mut self, py: Python<'_>, i: i64, xyz: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn move_vertex(&mut self, py: Python<'_>, i: Int, xyz: &Bound<'_, PyAny>) -> PyResult<()> {
         let n = self.inner.base_points().len();
-        if !(0..n as i64).contains(&i) {
-            return Err(value(format!("i = {i} is out of range: must be in 0..{n}")));
-        }
+        let i = i.within("i", 0, n as i128 - 1)?;
         let a = reals(xyz, "xyz", 1, &[], "a (3,) array of float coordinates")?;
         let p = data(&a);
         if p.len() != 3 || !p.iter().all(|x| x.is_finite()) {

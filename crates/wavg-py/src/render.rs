@@ -7,7 +7,7 @@ use crate::args::DetachRun;
 use wavg::Vector3;
 use wavg::apps::{Colouring, Overlays, RenderOptions, View};
 
-use crate::args::{data, reals};
+use crate::args::{Int, data, reals};
 use crate::errors::{app, value};
 use crate::image::{image_arg, size_arg, to_array};
 use crate::surface::Surface;
@@ -46,14 +46,14 @@ fn xyz_rows(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<Vector3<f64>>> {
 /// ``wavg.save_png``.
 #[pyfunction]
 #[pyo3(
-    signature = (S, size=(800, 600), view=(35.0, 20.0), curves=None, points=None, texture=None, scalar=None, wireframe=false),
+    signature = (S, size=(Int::of(800), Int::of(600)), view=(35.0, 20.0), curves=None, points=None, texture=None, scalar=None, wireframe=false),
     text_signature = "(S, size=(800, 600), view=(35, 20), curves=(), points=None, texture=None, scalar=None, wireframe=False)"
 )]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 pub(crate) fn render<'py>(
     py: Python<'py>,
     S: PyRef<'py, Surface>,
-    size: (i64, i64),
+    size: (Int, Int),
     view: (f64, f64),
     curves: Option<&Bound<'py, PyAny>>,
     points: Option<&Bound<'py, PyAny>>,

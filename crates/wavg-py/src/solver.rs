@@ -109,9 +109,9 @@ pub(crate) fn anchors(
 
 /// One anchor: a vertex id or a pair `(face, bary (3,))`.
 fn one_anchor(s: &wavg::Surface, obj: &Bound<'_, PyAny>) -> PyResult<Anchor> {
-    if let Ok(v) = obj.extract::<i64>() {
-        let v = indices(&[v], s.n_vertices(), "vertex_or_point")?[0];
-        return Ok(Anchor::Vertex(v));
+    if let Some(v) = obj.extract::<Int>()?.value().map(Int::of) {
+        let v = v.within("vertex_or_point", 0, s.n_vertices() as i128 - 1)?;
+        return Ok(Anchor::Vertex(v as u32));
     }
     let (f, b): (Bound<'_, PyAny>, Bound<'_, PyAny>) = obj.extract().map_err(|_| {
         type_error(
@@ -363,17 +363,11 @@ impl Solver {
     fn set_anchor(
         &mut self,
         py: Python<'_>,
-        i: i64,
+        i: Int,
         vertex_or_point: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
         let k = self.inner.n_anchors();
-        if !(0..k as i64).contains(&i) {
-            return Err(value(format!(
-                "i = {i} is not an anchor index: the solver has {k} anchors (0 to {})",
-                k - 1
-            )));
-        }
-        let i = i as usize;
+        let i = i.within("i", 0, k as i128 - 1)? as usize;
         let a = one_anchor(&self.made_from, vertex_or_point)?;
         self.inner.anchors_mut().set(i, a).map_err(lib(py))
     }

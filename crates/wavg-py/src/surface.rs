@@ -199,7 +199,7 @@ impl Surface {
     /// cancelled call returns at once; the abandoned work stops at its next checkpoint in
     /// the background. On any error the surface is unchanged.
     #[pyo3(
-        signature = (landmarks=Int(1000), seed=Int(0), threads=None, progress=None),
+        signature = (landmarks=Int::of(1000), seed=Int::of(0), threads=None, progress=None),
         text_signature = "($self, landmarks=1000, seed=0, threads=None, progress=True)"
     )]
     fn precompute(
@@ -377,7 +377,7 @@ impl Surface {
 
     /// S.spread_anchors(k, seed=0) -> (k,) int64: ``k`` vertices spread over the surface by
     /// farthest-point sampling (a good default anchor set).
-    #[pyo3(signature = (k, seed=Int(0)), text_signature = "($self, k, seed=0)")]
+    #[pyo3(signature = (k, seed=Int::of(0)), text_signature = "($self, k, seed=0)")]
     fn spread_anchors<'py>(
         &self,
         py: Python<'py>,
@@ -403,7 +403,7 @@ impl Surface {
     /// S.sample_points(n, seed=0) -> (faces (n,) int64, bary (n, 3) float64): ``n`` random
     /// surface points, uniform by area and seeded (the points ``wavg bench roundtrip
     /// --seed S`` draws with seed ``S + 1``).
-    #[pyo3(signature = (n, seed=Int(0)), text_signature = "($self, n, seed=0)")]
+    #[pyo3(signature = (n, seed=Int::of(0)), text_signature = "($self, n, seed=0)")]
     fn sample_points<'py>(
         &self,
         py: Python<'py>,
