@@ -150,6 +150,9 @@ def test_copies_keep_the_embedding_the_solver_was_made_with(torus_mesh, anchors)
         out = s.forward(W)
         assert np.array_equal(out.face, ref.face) and np.array_equal(out.xyz, ref.xyz)
     assert not np.array_equal(wavg.Solver(S, anchors).forward(W).xyz, ref.xyz)
+    # Their surfaces are the one the solver was made from (no embedding then).
+    assert not copy.deepcopy(sol).surface.has_embedding
+    assert not pickle.loads(pickle.dumps(sol)).surface.has_embedding
 
 
 def test_integer_and_thread_arguments_are_checked_by_name(surface, solver):

@@ -445,15 +445,15 @@ impl Solver {
         Ok((restore, args))
     }
 
-    fn __deepcopy__(&self, py: Python<'_>, memo: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let copy = py.import("copy")?;
-        let surface = copy
-            .call_method1("deepcopy", (self.surface.bind(py), memo))?
-            .cast_into::<Surface>()
-            .map_err(PyErr::from)?;
+    /// A deep copy's surface is the one the solver was made from, as a pickled copy's.
+    fn __deepcopy__(&self, py: Python<'_>, _memo: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let snapshot = Surface {
+            inner: self.made_from.clone(),
+            polygons: self.surface.borrow(py).polygons.clone(),
+        };
         Ok(Self {
             inner: self.inner.clone(),
-            surface: surface.unbind(),
+            surface: Py::new(py, snapshot)?,
             made_from: self.made_from.clone(),
         })
     }

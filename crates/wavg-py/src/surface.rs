@@ -364,13 +364,19 @@ impl Surface {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let a = ints(ids, "ids", 1, &[], "a (q,) array of integer vertex ids")?;
         let ids = indices(data(&a), self.inner.n_vertices(), "ids")?;
-        let mut faces = Vec::with_capacity(ids.len());
-        let mut bary = Vec::with_capacity(3 * ids.len());
-        for v in ids {
-            let p = self.inner.vertex_point(v).map_err(|e| to_py(py, e))?;
-            faces.push(i64::from(p.face));
-            bary.extend(p.bary);
-        }
+        let s = &self.inner;
+        let (faces, bary) = py
+            .detach_run(|| {
+                let mut faces = Vec::with_capacity(ids.len());
+                let mut bary = Vec::with_capacity(3 * ids.len());
+                for v in ids {
+                    let p = s.vertex_point(v)?;
+                    faces.push(i64::from(p.face));
+                    bary.extend(p.bary);
+                }
+                Ok((faces, bary))
+            })
+            .map_err(|e| to_py(py, e))?;
         let q = faces.len();
         Ok((array(py, faces, &[q])?, array(py, bary, &[q, 3])?))
     }
