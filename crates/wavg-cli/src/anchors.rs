@@ -86,7 +86,7 @@ struct JsonAnchor {
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
-        &[std::path::Path::new(&*args.mesh)],
+        &crate::common::inputs([std::path::Path::new(&*args.mesh)], [&args.embedding]),
         &[("-o", &args.output)],
         args.json,
     )?;

@@ -61,7 +61,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Timed runs of each batch; the best is reported.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, value_parser = crate::common::parse_repeat)]
     pub repeat: usize,
     /// Forward search: the paper's local search (fast), the projector's certified closest
     /// projection, or the exhaustive search.

@@ -44,7 +44,7 @@ pub struct Args {
     #[arg(long, default_value_t = 500, value_parser = crate::common::parse_samples)]
     pub samples: usize,
     /// Timed runs.
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = 50, value_parser = crate::common::parse_repeat)]
     pub repeat: usize,
     /// Worker threads T (default: all cores; at most 4 per CPU, or 64).
     #[arg(long, value_parser = crate::common::parse_threads)]

@@ -166,9 +166,28 @@ pub fn parse_queries(s: &str) -> Result<usize, String> {
     parse_up_to(s, MAX_COUNT, "queries")
 }
 
+/// Parses a `--repeat` value: 1 to 100,000 timed runs.
+pub fn parse_repeat(s: &str) -> Result<usize, String> {
+    match parse_up_to(s, 100_000, "runs")? {
+        0 => Err("at least 1 run is needed".into()),
+        n => Ok(n),
+    }
+}
+
 /// Parses a `--frames` value: at most [`MAX_FRAMES`].
 pub fn parse_frames(s: &str) -> Result<usize, String> {
     parse_up_to(s, MAX_FRAMES, "frames")
+}
+
+/// The input files of a command for [`check_outputs`]: those always given and those
+/// given when present.
+pub fn inputs<'a>(
+    given: impl IntoIterator<Item = &'a Path>,
+    optional: impl IntoIterator<Item = &'a Option<std::path::PathBuf>>,
+) -> Vec<&'a Path> {
+    let mut all: Vec<&Path> = given.into_iter().collect();
+    all.extend(optional.into_iter().flatten().map(|p| p.as_path()));
+    all
 }
 
 /// Checks a command's outputs before any work: each (named by its option, e.g. `-o`)
@@ -193,6 +212,12 @@ pub fn check_outputs(
         if wavg::mesh::io::is_special_destination(path) {
             continue;
         }
+        if path.is_dir() {
+            return Err(CliError::input(format!(
+                "{opt} {}: is a folder; give a file name",
+                path.display()
+            )));
+        }
         let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
         if let Some(dir) = parent
             && !dir.is_dir()
@@ -204,14 +229,14 @@ pub fn check_outputs(
             )));
         }
         for &(other, q) in &outputs[..i] {
-            if q == path || same_file(q, path) {
+            if same_file(q, path) {
                 return Err(CliError::input(format!(
                     "{other} and {opt} name the same file {}",
                     path.display()
                 )));
             }
         }
-        if let Some(input) = inputs.iter().find(|&&q| q == path || same_file(q, path)) {
+        if let Some(input) = inputs.iter().find(|&&q| same_file(q, path)) {
             return Err(CliError::input(format!(
                 "{opt} {} is an input of this command ({}): write to another file",
                 path.display(),
@@ -238,10 +263,32 @@ pub fn require_extension(path: &Path, ext: &str, what: &str) -> Result<(), CliEr
     )))
 }
 
-/// Whether two paths name the same existing file (after resolving links and `..`).
+/// Whether two paths name the same file, existing or about to be written: the same
+/// path after resolving links, `.` and `..` (a missing file by its folder), or on Unix
+/// one file under two names (hard links).
 pub fn same_file(a: &Path, b: &Path) -> bool {
-    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
+    if resolved(a).is_some_and(|p| Some(p) == resolved(b)) {
+        return true;
     }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return x.is_file() && x.dev() == y.dev() && x.ino() == y.ino();
+        }
+    }
+    false
+}
+
+/// `path` made absolute with links, `.` and `..` resolved; a file that does not exist
+/// yet by its folder's resolved path and its name (`None` without such a folder).
+fn resolved(path: &Path) -> Option<std::path::PathBuf> {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return Some(p);
+    }
+    let name = path.file_name()?;
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
+    std::fs::canonicalize(dir.unwrap_or(Path::new(".")))
+        .ok()
+        .map(|d| d.join(name))
 }

@@ -82,9 +82,21 @@ struct JsonReport<'a> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
+    // The .mtl and checkerboard written beside the OBJ are outputs too.
+    let (mtl, checker) = decal_material::side_files(&args.output);
+    let mut outputs = vec![("-o", args.output.as_path())];
+    if args.output != std::path::Path::new("-") {
+        outputs.push(("its .mtl", mtl.as_path()));
+        if args.texture.is_none() {
+            outputs.push(("its checkerboard", checker.as_path()));
+        }
+    }
     crate::common::check_outputs(
-        &[std::path::Path::new(&*args.mesh), &args.anchors, &args.uv],
-        &[("-o", &args.output)],
+        &crate::common::inputs(
+            [std::path::Path::new(&*args.mesh), &args.anchors, &args.uv],
+            [&args.embedding, &args.texture],
+        ),
+        &outputs,
         args.json,
     )?;
     crate::common::require_extension(

@@ -39,6 +39,19 @@ impl Material {
     }
 }
 
+/// The `.mtl` and the checkerboard image written beside the OBJ `obj`: `STEM.mtl` and
+/// `STEM_checker.png`.
+pub fn side_files(obj: &Path) -> (PathBuf, PathBuf) {
+    let dir = obj.parent().unwrap_or(Path::new(""));
+    let stem = obj
+        .file_stem()
+        .map_or_else(|| "decal".into(), |s| s.to_string_lossy().into_owned());
+    (
+        dir.join(format!("{stem}.mtl")),
+        dir.join(format!("{stem}_checker.png")),
+    )
+}
+
 /// Writes `STEM.mtl` beside `obj` naming `texture` (checked by [`check_texture`]), or a
 /// checkerboard `STEM_checker.png` written beside it when there is none. Nothing is
 /// written for standard output (`-`).
@@ -47,21 +60,18 @@ pub fn write(obj: &Path, texture: Option<&Path>) -> Result<Option<Material>, Cli
         return Ok(None);
     }
     let dir = obj.parent().unwrap_or(Path::new(""));
-    let stem = obj
-        .file_stem()
-        .map_or_else(|| "decal".into(), |s| s.to_string_lossy().into_owned());
+    let (mtl, checker) = side_files(obj);
     let texture_arg = texture;
     let texture = match texture {
         Some(t) => t.to_path_buf(),
         None => {
-            let t = dir.join(format!("{stem}_checker.png"));
+            let t = checker;
             let board = crate::demo_pictures::decal_board().map_err(CliError::failure)?;
             crate::render::write_png(&t, &board)?;
             t
         }
     };
     let generated = texture_arg.is_none();
-    let mtl = dir.join(format!("{stem}.mtl"));
     let name = relative_to(&texture, dir);
     let material = Material {
         mtl,

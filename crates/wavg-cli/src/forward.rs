@@ -55,7 +55,14 @@ pub struct Args {
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
-        &[&args.weights, std::path::Path::new(&*args.problem.mesh)],
+        &crate::common::inputs(
+            [
+                args.weights.as_path(),
+                std::path::Path::new(&*args.problem.mesh),
+                &args.problem.anchors,
+            ],
+            [&args.problem.embedding],
+        ),
         &[("-o", &args.problem.output)],
         false,
     )?;

@@ -53,7 +53,14 @@ pub struct Args {
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
-        &[&args.points, std::path::Path::new(&*args.problem.mesh)],
+        &crate::common::inputs(
+            [
+                args.points.as_path(),
+                std::path::Path::new(&*args.problem.mesh),
+                &args.problem.anchors,
+            ],
+            [&args.problem.embedding],
+        ),
         &[("-o", &args.problem.output)],
         false,
     )?;

@@ -115,8 +115,9 @@ pub fn command() -> clap::Command {
 }
 
 /// Makes a report printed to a closed pipe (`wavg info M | head -1`) end the process
-/// quietly with status 0, as `-o -` does, instead of a panic: `println!` panics when its
-/// stream is gone, and the reader has taken all it wanted.
+/// quietly with status 0, as `-o -` does, instead of a panic (`println!` panics when its
+/// stream is gone, and the reader has taken all it wanted); any other failure to print
+/// (`> /dev/full`) ends it with one line and status 1.
 fn quiet_on_closed_pipe() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
@@ -126,8 +127,14 @@ fn quiet_on_closed_pipe() {
             .map(String::as_str)
             .or_else(|| info.payload().downcast_ref::<&str>().copied())
             .unwrap_or("");
-        if msg.starts_with("failed printing to std") && msg.contains("Broken pipe") {
-            std::process::exit(0);
+        if msg.starts_with("failed printing to std") {
+            if msg.contains("Broken pipe") {
+                std::process::exit(0);
+            }
+            // Another write error (a full disk): one line, if stderr still takes it.
+            use std::io::Write;
+            let _ = writeln!(std::io::stderr(), "wavg: {msg}");
+            std::process::exit(1);
         }
         default(info);
     }));

@@ -54,7 +54,6 @@ struct JsonReport<'a> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    crate::common::check_outputs(&[], &[("-o", &args.output)], args.json)?;
     if args.frames == 0 || args.frames > 100_000 {
         return Err(CliError::input("--frames must be between 1 and 100000"));
     }

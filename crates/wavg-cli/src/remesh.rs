@@ -77,7 +77,10 @@ pub struct Args {
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
-        &[std::path::Path::new(&*args.mesh), &args.base],
+        &crate::common::inputs(
+            [std::path::Path::new(&*args.mesh), &args.base],
+            [&args.embedding],
+        ),
         &[("-o", &args.output)],
         args.json,
     )?;

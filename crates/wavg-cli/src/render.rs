@@ -163,11 +163,12 @@ pub fn write_png(path: &Path, img: &Image) -> Result<(), CliError> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    crate::common::check_outputs(
-        &[std::path::Path::new(&*args.mesh)],
-        &[("-o", &args.output)],
-        args.json,
-    )?;
+    let mut inputs = crate::common::inputs(
+        [std::path::Path::new(&*args.mesh)],
+        [&args.points, &args.texture, &args.scalar],
+    );
+    inputs.extend(args.curve.iter().map(|p| p.as_path()));
+    crate::common::check_outputs(&inputs, &[("-o", &args.output)], args.json)?;
     let (width, height) = parse_size(&args.size, "--size")?;
     let view = args
         .view

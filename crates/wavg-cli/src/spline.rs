@@ -78,7 +78,10 @@ pub(crate) const CHUNK: usize = 256;
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
-        &[std::path::Path::new(&*args.mesh), &args.control],
+        &crate::common::inputs(
+            [std::path::Path::new(&*args.mesh), &args.control],
+            [&args.embedding],
+        ),
         &[("-o", &args.output)],
         args.json,
     )?;

@@ -96,3 +96,69 @@ fn bad_outputs_are_refused_before_any_work() {
     );
     assert!(!dir.path().join("r.obj").exists() && !dir.path().join("m.wavg").exists());
 }
+
+/// Outputs that name an input another way: a file not yet written under two spellings,
+/// the anchors or the embedding, a hard link, a folder; a symbolic link is written
+/// through, never replaced.
+#[test]
+fn outputs_named_another_way() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let mesh = d("m.obj");
+    let torus = wavg(&["subdivide", "builtin:torus", "--levels", "0", "-o", &mesh]);
+    assert!(torus.status.success());
+    let anchors = d("a.txt");
+    std::fs::write(&anchors, "v 0\nv 300\nv 600\n").unwrap();
+    let weights = d("w.txt");
+    std::fs::write(&weights, "0.2 0.3 0.5\n").unwrap();
+    let forward = |out: &str| {
+        wavg(&[
+            "forward",
+            &mesh,
+            "--embedding",
+            "none",
+            "--anchors",
+            &anchors,
+            "--weights",
+            &weights,
+            "-o",
+            out,
+        ])
+    };
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let twice = format!("{}/../r.obj", sub.display());
+    refused(
+        &["repair", &mesh, "-o", &d("r.obj"), "--map", &twice],
+        "name the same file",
+    );
+    for out in [anchors.clone(), d("sub")] {
+        let r = forward(&out);
+        assert_eq!(
+            r.status.code(),
+            Some(2),
+            "{out}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+    }
+    #[cfg(unix)]
+    {
+        let hard = d("hard.txt");
+        std::fs::hard_link(&weights, &hard).unwrap();
+        assert_eq!(forward(&hard).status.code(), Some(2));
+        let (target, link) = (d("t.txt"), d("link.txt"));
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        assert!(forward(&link).status.success());
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read_to_string(&target).unwrap().lines().count(), 1);
+    }
+    assert_eq!(
+        std::fs::read_to_string(&anchors).unwrap(),
+        "v 0\nv 300\nv 600\n"
+    );
+}

@@ -183,3 +183,23 @@ fn a_report_to_a_closed_pipe_is_no_failure() {
     let stderr = exits_zero(&cmd);
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// A report that cannot be printed for another reason (a full disk): one line, status 1.
+#[test]
+fn a_report_to_a_full_disk_is_a_failure_without_a_panic() {
+    if !std::path::Path::new("/dev/full").exists() {
+        eprintln!("skipped: no /dev/full");
+        return;
+    }
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_wavg"))
+        .args(["info", "builtin:torus"])
+        .stdout(std::fs::File::create("/dev/full").unwrap())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        !stderr.contains("panicked") && stderr.lines().count() == 1,
+        "{stderr}"
+    );
+}

@@ -19,6 +19,8 @@ impl BaseMesh {
     /// assert_eq!(b.faces, vec![vec![0, 1, 2, 3]]);
     /// ```
     pub fn from_obj_str(text: &str) -> Result<Self, RemeshError> {
+        // A UTF-8 byte order mark opening the file (some editors write one).
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut out = BaseMesh::default();
         for (k, line) in text.lines().enumerate() {
             let bad = |message: String| RemeshError::Parse {

@@ -10,9 +10,15 @@ use crate::common::one_line;
 
 use super::PointSpec;
 
-/// Reads a whole text file, mapping failures to exit status 2.
+/// Reads a whole text file, mapping failures to exit status 2; a UTF-8 byte order mark
+/// opening it (some editors write one) is dropped.
 pub fn read_text(path: &Path) -> Result<String, CliError> {
-    std::fs::read_to_string(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))
+    let mut text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
+    Ok(text)
 }
 
 /// Writes `body`'s output to `path` atomically (`wavg::mesh::io::write_atomic`: a

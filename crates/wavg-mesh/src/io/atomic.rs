@@ -23,6 +23,10 @@ pub fn write_atomic(
     path: &Path,
     body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
+    // A symbolic link is written through: the file it names is replaced, not the link
+    // (`-o /dev/stdout` redirected to a file must not replace `/dev/stdout`).
+    let target = link_target(path);
+    let path = target.as_deref().unwrap_or(path);
     if is_special_destination(path) {
         let file = std::fs::OpenOptions::new().write(true).open(path)?;
         let mut w = std::io::BufWriter::new(file);
@@ -55,9 +59,52 @@ pub fn write_atomic(
     Ok(())
 }
 
+/// What the symbolic link `path` points to, resolved through every link (for a dangling
+/// link, the path its last link names); `None` when `path` is not a link.
+fn link_target(path: &Path) -> Option<PathBuf> {
+    if !std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        return None;
+    }
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return Some(p);
+    }
+    let mut p = path.to_path_buf();
+    // A chain of links to a missing file: follow the names (a bounded number of them).
+    for _ in 0..40 {
+        let Ok(next) = std::fs::read_link(&p) else {
+            break;
+        };
+        p = match p.parent() {
+            Some(dir) if next.is_relative() => dir.join(next),
+            _ => next,
+        };
+    }
+    Some(p)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A link is written through: the file it names gets the content, the link stays (also
+    /// when that file does not exist yet).
+    #[cfg(unix)]
+    #[test]
+    fn a_symbolic_link_is_written_through() {
+        let dir = tempfile::tempdir().unwrap();
+        let (file, link) = (dir.path().join("f.txt"), dir.path().join("l.txt"));
+        std::os::unix::fs::symlink("f.txt", &link).unwrap();
+        for text in [&b"dangling"[..], b"existing"] {
+            write_atomic(&link, |w| w.write_all(text)).unwrap();
+            assert!(
+                std::fs::symlink_metadata(&link)
+                    .unwrap()
+                    .file_type()
+                    .is_symlink()
+            );
+            assert_eq!(std::fs::read(&file).unwrap(), text);
+        }
+    }
 
     #[test]
     fn writes_whole_file_or_nothing() {
