@@ -54,18 +54,7 @@ pub struct Args {
 /// Runs the command: the weights stream through in chunks (parsed, checked, solved and
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
-    crate::common::check_outputs(
-        &crate::common::inputs(
-            [
-                args.weights.as_path(),
-                std::path::Path::new(&*args.problem.mesh),
-                &args.problem.anchors,
-            ],
-            [&args.problem.embedding],
-        ),
-        &[("-o", &args.problem.output)],
-        false,
-    )?;
+    args.problem.check_output(&args.weights)?;
     let solver = textio::load_solver(&args.problem)?;
     let normalization = if args.normalize {
         Normalization::Normalize

@@ -52,18 +52,7 @@ pub struct Args {
 /// Runs the command: the points stream through in chunks (parsed, resolved, solved and
 /// written in parallel), so files of any length use bounded memory.
 pub fn run(args: Args) -> Result<(), CliError> {
-    crate::common::check_outputs(
-        &crate::common::inputs(
-            [
-                args.points.as_path(),
-                std::path::Path::new(&*args.problem.mesh),
-                &args.problem.anchors,
-            ],
-            [&args.problem.embedding],
-        ),
-        &[("-o", &args.problem.output)],
-        false,
-    )?;
+    args.problem.check_output(&args.points)?;
     let mut solver = textio::load_solver(&args.problem)?;
     solver
         .set_gamma(args.gamma)

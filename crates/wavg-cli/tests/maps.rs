@@ -73,6 +73,34 @@ fn correspond_a_surface_onto_itself() {
 
 /// `wavg decal --json` on `builtin:icosphere` with these anchors and (u, v) lines, into
 /// `dir/d.obj`: the JSON object, its keys and the output path.
+/// Runs `wavg decal` on `builtin:icosphere` with `anchors` and `uv` (file texts written
+/// to `dir`) into `dir/d.obj`, with `extra` arguments; the output and the OBJ's path.
+fn decal_run(
+    dir: &Path,
+    anchors: &str,
+    uv: &str,
+    extra: &[&str],
+) -> (std::process::Output, PathBuf) {
+    let (a, u) = (dir.join("a.txt"), dir.join("uv.txt"));
+    std::fs::write(&a, anchors).unwrap();
+    std::fs::write(&u, uv).unwrap();
+    let out = dir.join("d.obj");
+    let mut args = vec![
+        "decal".to_owned(),
+        "--mesh".into(),
+        "builtin:icosphere".into(),
+        "--anchors".into(),
+        s(&a),
+        "--uv".into(),
+        s(&u),
+        "-o".into(),
+        s(&out),
+    ];
+    args.extend(extra.iter().map(|x| x.to_string()));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    (wavg(&args), out)
+}
+
 fn decal_json(
     dir: &Path,
     anchors: &str,
@@ -82,22 +110,8 @@ fn decal_json(
     Vec<String>,
     PathBuf,
 ) {
-    let (a, u) = (dir.join("a.txt"), dir.join("uv.txt"));
-    std::fs::write(&a, anchors).unwrap();
-    std::fs::write(&u, uv).unwrap();
-    let out = dir.join("d.obj");
-    let r = wavg_ok(&[
-        "decal",
-        "--mesh",
-        "builtin:icosphere",
-        "--anchors",
-        &s(&a),
-        "--uv",
-        &s(&u),
-        "-o",
-        &s(&out),
-        "--json",
-    ]);
+    let (r, out) = decal_run(dir, anchors, uv, &["--json"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let (o, keys) = json_object(&r);
     (o, keys, out)
 }
@@ -107,22 +121,13 @@ fn decal_json(
 #[test]
 fn a_decal_that_fails_leaves_no_file() {
     let dir = tempfile::tempdir().unwrap();
-    let (a, u) = (dir.path().join("a.txt"), dir.path().join("uv.txt"));
-    std::fs::write(&a, "v 0\nv 1\nv 2\nv 3\n").unwrap();
-    std::fs::write(&u, "0 0\n1 0\n0 1\n1 1\n").unwrap();
     std::fs::create_dir(dir.path().join("d.mtl")).unwrap();
-    let out = dir.path().join("d.obj");
-    let r = wavg(&[
-        "decal",
-        "--mesh",
-        "builtin:icosphere",
-        "--anchors",
-        &s(&a),
-        "--uv",
-        &s(&u),
-        "-o",
-        &s(&out),
-    ]);
+    let (r, out) = decal_run(
+        dir.path(),
+        "v 0\nv 1\nv 2\nv 3\n",
+        "0 0\n1 0\n0 1\n1 1\n",
+        &[],
+    );
     assert!(!r.status.success());
     assert!(!out.exists() && !dir.path().join("d_checker.png").exists());
 }

@@ -35,6 +35,21 @@ pub struct ProblemArgs {
     pub threads: Option<usize>,
 }
 
+impl ProblemArgs {
+    /// [`crate::common::check_outputs`] for `-o`, with the query file `queries` among the
+    /// inputs.
+    pub fn check_output(&self, queries: &Path) -> Result<(), CliError> {
+        crate::common::check_outputs(
+            &crate::common::inputs(
+                [queries, Path::new(&*self.mesh), &self.anchors],
+                [&self.embedding],
+            ),
+            &[("-o", &self.output)],
+            false,
+        )
+    }
+}
+
 /// The `--embedding` value that asks for the mesh's 3-D positions as the embedding.
 pub const NO_EMBEDDING: &str = "none";
 
