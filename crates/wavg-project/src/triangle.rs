@@ -386,7 +386,9 @@ struct System {
 impl System {
     #[inline(always)]
     fn new(d: &TriData, frames: [&Frame32; 3], corners: [&Vec8; 3], y: &Vec8) -> Self {
-        // a[i][j]: T_i (v_{i+1+j} - v_i); h[i] = T_i (y - v_i).
+        // a[i][j]: T_i (v_{i+1+j} - v_i); h[i] = T_i (y - v_i). The six corner differences
+        // are three edges `e_i = v_{i+1} - v_i` and their negations (exact in floating
+        // point): `v_{i+2} - v_i = -e_{i+2}`.
         let mut a = [[[0.0f64; 2]; 2]; 3];
         let mut h = [[0.0f64; 2]; 3];
         let yv: &[f64; 8] = &y.data.0[0];
@@ -395,22 +397,25 @@ impl System {
             &corners[1].data.0[0],
             &corners[2].data.0[0],
         ];
+        let edge = [0, 1, 2].map(|i| {
+            let (p, q) = (cv[i], cv[(i + 1) % 3]);
+            std::array::from_fn::<f64, 8, _>(|c| q[c] - p[c])
+        });
         for i in 0..3 {
             let f = frames[i];
-            let (k1, k2) = ((i + 1) % 3, (i + 2) % 3);
+            let (e1, e2) = (&edge[i], &edge[(i + 2) % 3]);
             let mut acc = [0.0f64; 6];
             for c in 0..8 {
                 let (t0, t1) = (f[c] as f64, f[8 + c] as f64);
-                let o = cv[i][c];
-                let (d1, d2, dy) = (cv[k1][c] - o, cv[k2][c] - o, yv[c] - o);
-                acc[0] += t0 * d1;
-                acc[1] += t1 * d1;
-                acc[2] += t0 * d2;
-                acc[3] += t1 * d2;
+                let dy = yv[c] - cv[i][c];
+                acc[0] += t0 * e1[c];
+                acc[1] += t1 * e1[c];
+                acc[2] += t0 * e2[c];
+                acc[3] += t1 * e2[c];
                 acc[4] += t0 * dy;
                 acc[5] += t1 * dy;
             }
-            a[i] = [[acc[0], acc[1]], [acc[2], acc[3]]];
+            a[i] = [[acc[0], acc[1]], [-acc[2], -acc[3]]];
             h[i] = [acc[4], acc[5]];
         }
         let mut q = [[0.0f64; 2]; 6];
@@ -533,15 +538,84 @@ impl System {
 }
 
 /// [`coefficients`] with derivatives along `(xi_0, xi_1)` on the plane `sum xi = 1`
-/// (`d/du = d/dxi_0 - d/dxi_2`, `d/dv = d/dxi_1 - d/dxi_2`).
+/// (`d/du = d/dxi_0 - d/dxi_2`, `d/dv = d/dxi_1 - d/dxi_2`), computed directly: Newton's
+/// method needs only these two, once per iteration.
 #[inline(always)]
 fn coefficients_reduced(x: &[f64; 3]) -> ([f64; 6], [[f64; 2]; 6]) {
-    let (c, dc) = coefficients(x);
-    let mut r = [[0.0; 2]; 6];
-    for e in 0..6 {
-        r[e] = [dc[e][0] - dc[e][2], dc[e][1] - dc[e][2]];
+    let s = x[0] * x[1] + x[1] * x[2] + x[2] * x[0];
+    if s >= S_MIN {
+        return reduced_regular(x, s);
     }
-    (c, r)
+    reduced_at_vertex(x)
+}
+
+/// [`coefficients_reduced`] at a vertex, as in `coefficients`: the limit values, the
+/// derivatives just inside.
+#[cold]
+#[inline(never)]
+fn reduced_at_vertex(x: &[f64; 3]) -> ([f64; 6], [[f64; 2]; 6]) {
+    let v = corner_of(x);
+    let inner = x.map(|x| (1.0 - 1e-6) * x + 1e-6 / 3.0);
+    let si = inner[0] * inner[1] + inner[1] * inner[2] + inner[2] * inner[0];
+    let (_, dc) = reduced_regular(&inner, si);
+    (vertex_limit(v), dc)
+}
+
+/// The corner a point with `S` ~ 0 sits at: its largest barycentric.
+#[inline(always)]
+fn corner_of(xi: &[f64; 3]) -> usize {
+    if xi[0] >= xi[1] && xi[0] >= xi[2] {
+        0
+    } else if xi[1] >= xi[2] {
+        1
+    } else {
+        2
+    }
+}
+
+/// The coefficients' limit at corner `v`: half on each of its two terms (the first of
+/// edge `v`, the second of edge `v - 1`), so `Psi` spans the corner's frame.
+#[inline(always)]
+fn vertex_limit(v: usize) -> [f64; 6] {
+    let mut c = [0.0; 6];
+    c[2 * v] = 0.5;
+    c[2 * ((v + 2) % 3) + 1] = 0.5;
+    c
+}
+
+/// [`coefficients_reduced`] away from the corners. With `a = xi_k`, `b = xi_l` the
+/// numerators are `n1 = a^2 b + P/2`, `n2 = a b^2 + P/2`; their reduced derivatives add
+/// `dP/2` to the terms of `a` and `b` along `u` and `v`, and `c' = (n' - c S') / S`.
+#[inline(always)]
+fn reduced_regular(x: &[f64; 3], s: f64) -> ([f64; 6], [[f64; 2]; 6]) {
+    let (x0, x1, x2) = (x[0], x[1], x[2]);
+    let inv = 1.0 / s;
+    let hp = 0.5 * (x0 * x1 * x2);
+    let (hpu, hpv) = (0.5 * (x1 * (x2 - x0)), 0.5 * (x0 * (x2 - x1)));
+    let (su, sv) = (x2 - x0, x2 - x1);
+    let mut c = [0.0; 6];
+    let mut dc = [[0.0; 2]; 6];
+    let mut term = |e: usize, n: f64, nu: f64, nv: f64| {
+        let ce = n * inv;
+        c[e] = ce;
+        dc[e] = [(nu - ce * su) * inv, (nv - ce * sv) * inv];
+    };
+    // k = 0: a = xi_0 (along u), b = xi_1 (along v).
+    let (a, b) = (x0, x1);
+    let (ab2, aa, bb) = (2.0 * a * b, a * a, b * b);
+    term(0, aa * b + hp, hpu + ab2, hpv + aa);
+    term(1, a * bb + hp, hpu + bb, hpv + ab2);
+    // k = 1: a = xi_1 (along v), b = xi_2 (against both).
+    let (a, b) = (x1, x2);
+    let (ab2, aa, bb) = (2.0 * a * b, a * a, b * b);
+    term(2, aa * b + hp, hpu - aa, hpv + (ab2 - aa));
+    term(3, a * bb + hp, hpu - ab2, hpv + (bb - ab2));
+    // k = 2: a = xi_2 (against both), b = xi_0 (along u).
+    let (a, b) = (x2, x0);
+    let (ab2, aa, bb) = (2.0 * a * b, a * a, b * b);
+    term(4, aa * b + hp, hpu + (aa - ab2), hpv - ab2);
+    term(5, a * bb + hp, hpu + (ab2 - bb), hpv - bb);
+    (c, dc)
 }
 
 /// Clamps negative barycentrics to zero and rescales to sum 1 (`None` if nothing is left).
@@ -571,21 +645,11 @@ pub(crate) fn coefficients(xi: &[f64; 3]) -> ([f64; 6], [[f64; 3]; 6]) {
     if s >= S_MIN {
         return coefficients_regular(xi, s);
     }
-    let v = if xi[0] >= xi[1] && xi[0] >= xi[2] {
-        0
-    } else if xi[1] >= xi[2] {
-        1
-    } else {
-        2
-    };
+    let v = corner_of(xi);
     let inner = xi.map(|x| (1.0 - 1e-6) * x + 1e-6 / 3.0);
     let si = inner[0] * inner[1] + inner[1] * inner[2] + inner[2] * inner[0];
     let (_, dc) = coefficients_regular(&inner, si);
-    let mut c = [0.0; 6];
-    // Corner v's terms: c_first of edge v and c_second of edge v-1.
-    c[2 * v] = 0.5;
-    c[2 * ((v + 2) % 3) + 1] = 0.5;
-    (c, dc)
+    (vertex_limit(v), dc)
 }
 
 #[inline(always)]
@@ -687,6 +751,43 @@ mod tests {
             for w in e.windows(2) {
                 prop_assert!(w[1] <= w[0] + 1e-9 * (1.0 + w[0]), "{e:?}");
             }
+        }
+    }
+
+    /// The direct reduced derivatives are those of [`coefficients`], differenced.
+    fn check_reduced(xi: [f64; 3]) {
+        let (c, dc) = coefficients(&xi);
+        let (cr, dr) = coefficients_reduced(&xi);
+        let scale = 1.0 + dc.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        for e in 0..6 {
+            assert!((c[e] - cr[e]).abs() <= 1e-14, "{xi:?} {e}");
+            let want = [dc[e][0] - dc[e][2], dc[e][1] - dc[e][2]];
+            for m in 0..2 {
+                let d = (want[m] - dr[e][m]).abs();
+                assert!(d <= 1e-12 * scale, "{xi:?} {e} {m}: {want:?} {:?}", dr[e]);
+            }
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn reduced_coefficients_match_the_full_ones(xi in bary()) {
+            check_reduced(xi);
+        }
+    }
+
+    #[test]
+    fn reduced_coefficients_match_on_edges_and_near_corners() {
+        for xi in [
+            [0.3, 0.7, 0.0],
+            [0.0, 0.4, 0.6],
+            [0.5, 0.0, 0.5],
+            [1.0 - 2e-7, 1e-7, 1e-7],
+            [1e-9, 1.0 - 2e-9, 1e-9],
+            [0.0, 0.0, 1.0],
+            [1.0 / 3.0; 3],
+        ] {
+            check_reduced(xi);
         }
     }
 
