@@ -4,7 +4,7 @@
 //! independent, so the results never depend on the parallelism.
 
 use wavg_mesh::SurfacePoint;
-use wavg_project::Par;
+use wavg_project::{Par, Vec8};
 
 use crate::error::SolveError;
 use crate::kernel::InverseScratch;
@@ -130,7 +130,8 @@ impl Solver {
     }
 
     /// Forward problem for a sequence of nearby queries (e.g. samples along a curve):
-    /// each query warm-starts from the previous answer. For parallelism the sequence is cut
+    /// each query warm-starts from the previous answer, heading for the extrapolation of
+    /// the two previous answers (see [`Solver::forward_aimed`]). For parallelism the sequence is cut
     /// into chunks of `chunk` queries (independent of the thread count, so the results are
     /// too); the first query of each chunk starts cold (or from `opts.warm_start`).
     pub fn forward_batch_warm<W: AsRef<[f64]> + Sync>(
@@ -158,11 +159,20 @@ impl Solver {
         out.clear();
         par.map_chunks(weights, chunk, out, |c| {
             let mut o = *opts;
+            // The last two answers, extrapolated: where the next warm start heads (see
+            // `Solver::forward_aimed`).
+            let mut last: [Option<Vec8>; 2] = [None, None];
+            let emb = self.projector().embedded();
             c.iter()
                 .map(|w| {
-                    let r = self.forward(w.as_ref(), &o);
+                    let aim = match last {
+                        [Some(a), Some(b)] => Some(b * 2.0 - a),
+                        _ => None,
+                    };
+                    let r = self.forward_aimed(w.as_ref(), &o, aim.as_ref());
                     if let Ok(r) = &r {
                         o.warm_start = Some(r.point);
+                        last = [last[1], Some(emb.point(&r.point))];
                     }
                     r
                 })

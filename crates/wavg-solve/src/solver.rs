@@ -86,6 +86,9 @@ pub(crate) struct Prepared {
     start: Start,
     /// The warm start's face, tried first by the fast search.
     hint: Option<FaceId>,
+    /// Where the walk over faces from `hint` heads (see [`Projector::project_aimed`]);
+    /// `None`: the average itself.
+    pub(crate) aim: Option<Vec8>,
 }
 
 /// The index of the highest of (finite, validated) `weights`, ties to the lowest index:
@@ -246,7 +249,24 @@ impl Solver {
         weights: &[f64],
         opts: &ForwardOptions,
     ) -> Result<ForwardResult, SolveError> {
-        let prepared = self.prepare(weights, opts)?;
+        self.forward_aimed(weights, opts, None)
+    }
+
+    /// [`Solver::forward`] whose warm start heads for the face under `aim` (a point of
+    /// R^8 near where the answer is expected) before Newton's method, instead of the face
+    /// under the average: along a curve the answer trails the face under the average, and
+    /// the extrapolation of the two previous answers, `2 p1 - p0`, usually lies over its
+    /// face (what [`Solver::forward_batch_warm`] passes). Only the route of the search
+    /// changes, and only with `opts.warm_start` in [`SearchMode::Fast`]; a non-finite or
+    /// missing `aim` heads for the average.
+    pub fn forward_aimed(
+        &self,
+        weights: &[f64],
+        opts: &ForwardOptions,
+        aim: Option<&Vec8>,
+    ) -> Result<ForwardResult, SolveError> {
+        let mut prepared = self.prepare(weights, opts)?;
+        prepared.aim = aim.copied();
         self.forward_prepared(&prepared, opts)
     }
 
@@ -285,6 +305,7 @@ impl Solver {
             ybar: *ybar,
             start,
             hint,
+            aim: None,
         };
         self.forward_prepared(&prepared, opts)
     }
@@ -314,7 +335,12 @@ impl Solver {
                 }
             }
         };
-        Ok(Prepared { ybar, start, hint })
+        Ok(Prepared {
+            ybar,
+            start,
+            hint,
+            aim: None,
+        })
     }
 
     /// The search part of [`Solver::forward`], from a prepared average and start.
@@ -327,6 +353,7 @@ impl Solver {
             ybar,
             mut start,
             hint,
+            aim,
         } = *prepared;
         let mesh = self.mesh();
         if let Start::HighestWeight { anchor, vertex } = start {
@@ -344,7 +371,7 @@ impl Solver {
             | Start::Located { vertex: v, .. } => match opts.mode {
                 SearchMode::Fast => {
                     self.projector
-                        .project_with(&ybar, v, hint, SearchGoal::FirstHit)
+                        .project_aimed(&ybar, v, hint, aim.as_ref(), SearchGoal::FirstHit)
                 }
                 _ => self.projector.project(&ybar, v),
             },

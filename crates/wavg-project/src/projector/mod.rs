@@ -389,6 +389,37 @@ impl Projector {
         hint: Option<FaceId>,
         goal: SearchGoal,
     ) -> Result<Projection, ProjectError> {
+        self.project_aimed(y, start, hint, None, goal)
+    }
+
+    /// [`Projector::project_with`] whose walk over faces from the `hint` face heads for the
+    /// face under `aim` rather than under `y` (Newton's method still solves for `y`). Along
+    /// a curve the projection trails the face under the query by an offset that changes
+    /// little from one sample to the next: with the previous sample's query `y0` and
+    /// projection `p0` (in R^8), `aim = p0 + (y - y0)` usually lies over the face holding
+    /// the new projection, so the first Newton solve there finds it. A non-finite `aim`
+    /// is ignored.
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
+    /// use wavg_project::{EmbeddedMesh, Projector, SearchGoal};
+    /// let m = Arc::new(ValidMesh::new(procedural::icosphere(3)).unwrap());
+    /// let emb = Arc::new(EmbeddedMesh::from_positions(m));
+    /// let p = Projector::new(emb.clone()).unwrap();
+    /// let on = emb.point(&SurfacePoint::new(40, [0.2, 0.3, 0.5]));
+    /// let y = on * 1.01;
+    /// let aimed = p.project_aimed(&y, 0, Some(40), Some(&on), SearchGoal::FirstHit).unwrap();
+    /// assert_eq!(aimed.point.face, 40);
+    /// ```
+    pub fn project_aimed(
+        &self,
+        y: &Vec8,
+        start: VertexId,
+        hint: Option<FaceId>,
+        aim: Option<&Vec8>,
+        goal: SearchGoal,
+    ) -> Result<Projection, ProjectError> {
         if !y.iter().all(|v| v.is_finite()) {
             return Err(ProjectError::NonFiniteQuery);
         }
@@ -405,7 +436,8 @@ impl Projector {
                     n_faces: self.faces.len(),
                 });
             }
-            match self.face_walk(y, f) {
+            let aim = aim.filter(|a| a.iter().all(|v| v.is_finite())).unwrap_or(y);
+            match self.face_walk(y, f, aim) {
                 Some(b) if goal == SearchGoal::FirstHit => {
                     return Ok(Self::finish(b, ProjectionPath::Local));
                 }

@@ -387,13 +387,13 @@ impl Projector {
     /// to it is likely not the one the walk would find (a query far off a curved surface
     /// can have several); the full search decides then, as it does when no face within
     /// the steps lies under the query.
-    pub(super) fn face_walk(&self, y: &Vec8, mut f: FaceId) -> Option<Best> {
+    pub(super) fn face_walk(&self, y: &Vec8, mut f: FaceId, aim: &Vec8) -> Option<Best> {
         let topo = self.emb.mesh().topology();
         let mut prev = NONE;
         // Newton's method is worth trying only on a face the query is over (or beside).
         for step in 0..=HINT_STEPS {
             let [a, b, c] = self.corners(f);
-            let (e1, e2, r) = (b - a, c - a, y - a);
+            let (e1, e2, r) = (b - a, c - a, aim - a);
             let (aa, ab, bb, d, e) = (
                 e1.dot(&e1),
                 e1.dot(&e2),
@@ -479,6 +479,28 @@ mod tests {
             }
         }
         assert!(walked > 100, "only {walked} queries needed a walk");
+    }
+
+    /// The warm start's walk over faces heads for its aim: aimed at the query it finds the
+    /// query's face from a neighbour; aimed at a point far across the mesh it runs out of
+    /// steps before any Newton solve (and the full search decides).
+    #[test]
+    fn the_face_walk_heads_for_its_aim() {
+        let mesh = Arc::new(ValidMesh::new(procedural::grid(30, 30, 1.0, 1.0)).unwrap());
+        let emb = Arc::new(EmbeddedMesh::from_positions(mesh.clone()));
+        let p = Projector::new(emb.clone()).unwrap();
+        let topo = mesh.topology();
+        let far = emb.point(&SurfacePoint::new(0, [0.2, 0.3, 0.5]));
+        let mut checked = 0;
+        for f in (mesh.n_faces() as FaceId / 2)..(mesh.n_faces() as FaceId / 2 + 40) {
+            let y = emb.point(&SurfacePoint::new(f, [0.3, 0.3, 0.4]));
+            for g in topo.face_neighbors(f).into_iter().filter(|&g| g != NONE) {
+                assert_eq!(p.face_walk(&y, g, &y).map(|b| b.face), Some(f));
+                assert!(p.face_walk(&y, g, &far).is_none(), "face {f} from {g}");
+                checked += 1;
+            }
+        }
+        assert!(checked >= 100);
     }
 
     #[test]
