@@ -20,7 +20,8 @@ Maps every source vertex onto the target as `wavg correspond` does (same options
 the vertices that fail the validity test harmonically from the valid ones (each the average
 of its neighbours, the valid ones fixed), and writes --frames OBJ files DIR/frame_000.obj ...
 with the source's faces, blending linearly from the source positions (first frame) to the
-mapped ones (last frame). The folder is created if needed; nothing is written on error.
+mapped ones (last frame). The folder is created if needed; nothing is written on error (a
+frame that cannot be written removes the frames written before it).
 --json prints one object: frames, valid_fraction, seconds (map and fill, precomputation
 excluded), plus the per-reason counts and the output folder.")]
 pub struct Args {
@@ -70,11 +71,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .map_err(|e| CliError::failure(format!("{}: {}", args.map.pair.source, one_line(&e))))?;
     let frames = morph_frames(&mesh.positions, &mapped, args.frames);
     let seconds = c.seconds + t.elapsed().as_secs_f64();
+    let created = !args.output.exists();
     std::fs::create_dir_all(&args.output)
         .map_err(|e| CliError::failure(format!("{}: {e}", args.output.display())))?;
+    let mut written = Vec::with_capacity(frames.len());
     for (k, f) in frames.iter().enumerate() {
         let path = args.output.join(format!("frame_{k:03}.obj"));
-        textio::write_atomic(&path, |w: &mut dyn Write| {
+        let r = textio::write_atomic(&path, |w: &mut dyn Write| {
             for p in f {
                 write!(w, "v ")?;
                 write_numbers(w, p.iter().copied())?;
@@ -85,7 +88,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
                 writeln!(w, "f {a} {b} {c}")?;
             }
             Ok(())
-        })?;
+        });
+        if let Err(e) = r {
+            // Nothing half-written: the frames of this run go, and the folder if this run
+            // made it.
+            for p in &written {
+                let _ = std::fs::remove_file(p);
+            }
+            if created {
+                let _ = std::fs::remove_dir(&args.output);
+            }
+            return Err(e);
+        }
+        written.push(path);
     }
     if args.json {
         let j = serde_json::to_value(JsonReport {

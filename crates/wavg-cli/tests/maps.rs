@@ -203,6 +203,40 @@ fn morph_writes_the_frames() {
     assert!(!out.join("frame_004.obj").exists());
 }
 
+/// A frame that cannot be written (its name is taken by a folder) fails the command and
+/// takes the frames written before it along: nothing half-written.
+#[test]
+fn morph_removes_its_frames_when_one_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = s(&sphere_anchors(dir.path()));
+    let out = dir.path().join("frames");
+    std::fs::create_dir_all(out.join("frame_002.obj")).unwrap();
+    let r = wavg(&[
+        "morph",
+        "--source",
+        "builtin:icosphere",
+        "--target",
+        "builtin:icosphere",
+        "--source-anchors",
+        &a,
+        "--target-anchors",
+        &a,
+        "--frames",
+        "4",
+        "-o",
+        &s(&out),
+    ]);
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("frame_002.obj"), "{err}");
+    let mut left: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["frame_002.obj"]);
+}
+
 #[test]
 fn a_pose_pair_maps_close_to_its_ground_truth() {
     let Some(f0) = wavg_testdata::require_data_file(

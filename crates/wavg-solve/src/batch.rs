@@ -4,8 +4,9 @@
 //! independent, so the results never depend on the parallelism.
 
 use wavg_mesh::SurfacePoint;
-use wavg_project::{Par, Vec8};
+use wavg_project::Par;
 
+use crate::aim::CurveAim;
 use crate::error::SolveError;
 use crate::kernel::InverseScratch;
 use crate::solver::{ForwardOptions, ForwardResult, Prepared, Solver};
@@ -130,8 +131,8 @@ impl Solver {
     }
 
     /// Forward problem for a sequence of nearby queries (e.g. samples along a curve):
-    /// each query warm-starts from the previous answer, heading for the extrapolation of
-    /// the two previous answers (see [`Solver::forward_aimed`]). For parallelism the sequence is cut
+    /// each query warm-starts from the previous answer and heads where [`CurveAim`]
+    /// says. For parallelism the sequence is cut
     /// into chunks of `chunk` queries (independent of the thread count, so the results are
     /// too); the first query of each chunk starts cold (or from `opts.warm_start`).
     pub fn forward_batch_warm<W: AsRef<[f64]> + Sync>(
@@ -159,20 +160,15 @@ impl Solver {
         out.clear();
         par.map_chunks(weights, chunk, out, |c| {
             let mut o = *opts;
-            // The last two answers, extrapolated: where the next warm start heads (see
-            // `Solver::forward_aimed`).
-            let mut last: [Option<Vec8>; 2] = [None, None];
-            let emb = self.projector().embedded();
+            let mut aim = CurveAim::default();
             c.iter()
                 .map(|w| {
-                    let aim = match last {
-                        [Some(a), Some(b)] => Some(b * 2.0 - a),
-                        _ => None,
-                    };
-                    let r = self.forward_aimed(w.as_ref(), &o, aim.as_ref());
+                    let mut prepared = self.prepare(w.as_ref(), &o)?;
+                    prepared.aim = aim.aim();
+                    let r = self.forward_prepared(&prepared, &o);
                     if let Ok(r) = &r {
                         o.warm_start = Some(r.point);
-                        last = [last[1], Some(emb.point(&r.point))];
+                        aim.record(self, &r.point);
                     }
                     r
                 })

@@ -34,6 +34,7 @@
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
 
+mod aim;
 mod anchors;
 mod batch;
 mod error;
@@ -49,6 +50,7 @@ mod verified;
 mod weights;
 
 // The solver and its problems.
+pub use aim::CurveAim;
 pub use batch::{BatchWeights, ForwardScratch};
 pub use solver::{ForwardOptions, ForwardResult, SearchMode, Solver, Start};
 pub use verified::{DEFAULT_TOLERANCE, PENALTY_LADDER, RoundTrip, Verified};

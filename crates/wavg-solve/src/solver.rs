@@ -255,8 +255,9 @@ impl Solver {
     /// [`Solver::forward`] whose warm start heads for the face under `aim` (a point of
     /// R^8 near where the answer is expected) before Newton's method, instead of the face
     /// under the average: along a curve the answer trails the face under the average, and
-    /// the extrapolation of the two previous answers, `2 p1 - p0`, usually lies over its
-    /// face (what [`Solver::forward_batch_warm`] passes). Only the route of the search
+    /// the extrapolation of the two previous answers usually lies over its face (see
+    /// [`CurveAim`](crate::CurveAim), what [`Solver::forward_batch_warm`] passes). Only
+    /// the route of the search
     /// changes, and only with `opts.warm_start` in [`SearchMode::Fast`]; a non-finite or
     /// missing `aim` heads for the average.
     pub fn forward_aimed(

@@ -10,8 +10,8 @@ use wavg_mesh::geometry::mean_edge_length;
 use wavg_mesh::{SurfacePoint, ValidMesh, procedural};
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
 use wavg_solve::{
-    Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, ForwardScratch, Normalization, Par,
-    ProjectionPath, Projector, SearchGoal, SearchMode, SolveError, Solver, Start, Vec8,
+    Anchor, BatchWeights, CurveAim, EmbeddedMesh, ForwardOptions, ForwardScratch, Normalization,
+    Par, ProjectionPath, Projector, SearchGoal, SearchMode, SolveError, Solver, Start, Vec8,
 };
 
 /// Inverse then forward on `n` random points; returns the fraction back within 1e-3 mean
@@ -323,14 +323,12 @@ fn batches_equal_sequential_for_any_thread_count() {
     let mut seq_warm = Vec::new();
     for c in weights.chunks(50) {
         let mut o = opts;
-        // Heading for the extrapolation of the two previous answers.
-        let (mut p0, mut p1) = (None, None);
+        let mut aim = CurveAim::default();
         for w in c {
-            let aim = p0.zip(p1).map(|(a, b): (Vec8, Vec8)| b * 2.0 - a);
-            let r = s.forward_aimed(w, &o, aim.as_ref());
+            let r = s.forward_aimed(w, &o, aim.aim().as_ref());
             if let Ok(r) = &r {
                 o.warm_start = Some(r.point);
-                (p0, p1) = (p1, Some(s.projector().embedded().point(&r.point)));
+                aim.record(&s, &r.point);
             }
             seq_warm.push(r);
         }
