@@ -30,8 +30,9 @@ pub enum SolveError {
         /// The accepted deviation from 1.
         tolerance: f64,
     },
-    /// Normalisation was requested but the weights sum to (almost) zero.
-    #[error("weights sum to {}: cannot normalise", short(*.sum))]
+    /// Normalisation was requested but the weights sum to (almost) zero for their size
+    /// (at most 1e-12 of the sum of their magnitudes), or overflow.
+    #[error("{}", zero_sum(*.sum))]
     ZeroWeightSum {
         /// The sum.
         sum: f64,
@@ -110,6 +111,19 @@ impl SolveError {
 
 /// `x` for a message: plain decimals between 1e-4 and 1e6, else scientific notation (a sum
 /// of 1e-320 would otherwise print 320 digits).
+/// The message of [`SolveError::ZeroWeightSum`].
+fn zero_sum(sum: f64) -> String {
+    if sum.is_finite() {
+        format!(
+            "weights sum to {}, (almost) zero for their size (at most 1e-12 of the sum of \
+             their magnitudes): cannot normalise",
+            short(sum)
+        )
+    } else {
+        format!("the weights' sum overflows ({sum}): cannot normalise")
+    }
+}
+
 fn short(x: f64) -> String {
     if x == 0.0 || (1e-4..1e6).contains(&x.abs()) || !x.is_finite() {
         format!("{x}")

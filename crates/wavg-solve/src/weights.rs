@@ -116,6 +116,11 @@ mod tests {
             validate_weights(&[1.0, -1.0], 2, Normalize),
             Err(SolveError::ZeroWeightSum { .. })
         ));
+        // A sum lost to cancellation and an overflowing one say so.
+        let e = validate_weights(&[1e200, -1e200, 1.0], 3, Normalize).unwrap_err();
+        assert!(e.to_string().contains("zero for their size"), "{e}");
+        let e = validate_weights(&[1e308, 1e308, -1e308], 3, Normalize).unwrap_err();
+        assert!(e.to_string().contains("overflows"), "{e}");
         assert_eq!(validate_weights(&[], 0, Reject), Err(SolveError::NoAnchors));
         assert_eq!(validate_weights(&[2.0, 2.0], 2, Normalize), Ok(0.25));
         assert_eq!(validate_weights(&[-1.0, 2.0], 2, Reject), Ok(1.0));
