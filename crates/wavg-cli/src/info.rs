@@ -77,6 +77,16 @@ fn yes_no(b: bool) -> &'static str {
     if b { "yes" } else { "no" }
 }
 
+/// A coordinate with six decimals, in scientific notation where that would print more
+/// than 16 digits before the point or only zeros.
+fn coordinate(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs()) {
+        format!("{x:.6}")
+    } else {
+        format!("{x:.6e}")
+    }
+}
+
 /// The human-readable report.
 pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, s: &MeshInfo) -> String {
     use std::fmt::Write;
@@ -112,11 +122,21 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, s: &MeshIn
     };
     let _ = writeln!(o, "texture coordinates:  {uv}");
     if let Some(b) = &s.bounding_box {
+        let [x0, y0, z0, x1, y1, z1, d] = [
+            b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2], b.diagonal,
+        ]
+        .map(coordinate);
         let _ = writeln!(
             o,
-            "bounding box:         [{:.6}, {:.6}, {:.6}] .. [{:.6}, {:.6}, {:.6}] (diagonal {:.6})",
-            b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2], b.diagonal
+            "bounding box:         [{x0}, {y0}, {z0}] .. [{x1}, {y1}, {z1}] (diagonal {d})"
         );
+        if !b.diagonal.is_finite() {
+            let _ = writeln!(
+                o,
+                "note:                 the coordinates are too large to square (beyond about \
+                 1e154): scale the mesh down"
+            );
+        }
     }
     if s.valid && s.components > 1 {
         let _ = writeln!(

@@ -222,3 +222,20 @@ fn shared_data_good_bad_and_unparseable() {
     let err = String::from_utf8(out.stderr).unwrap();
     assert!(err.contains("truncated.off:7:"), "{err}");
 }
+
+/// Coordinates too large to square print in scientific notation, with a note saying so.
+#[test]
+fn huge_coordinates_print_short_with_a_note() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("big.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 1e200 0 0\nv 0 1e200 0\nv 0 0 1e200\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    )
+    .unwrap();
+    let out = wavg(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("1.000000e200, 1.000000e200"), "{text}");
+    assert!(text.contains("too large to square"), "{text}");
+    assert!(text.lines().all(|l| l.len() < 300), "{text}");
+}
