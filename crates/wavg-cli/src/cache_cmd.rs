@@ -33,10 +33,17 @@ pub fn run(cmd: Command) -> Result<(), CliError> {
             let list: Vec<serde_json::Value> = entries
                 .iter()
                 .map(|(key, bytes, meta)| {
+                    // An entry whose description is missing or damaged has the same keys,
+                    // null.
                     let mut v = meta
                         .as_ref()
                         .and_then(|m| serde_json::to_value(m).ok())
-                        .unwrap_or_else(|| serde_json::json!({}));
+                        .unwrap_or_else(|| {
+                            serde_json::json!({
+                                "mesh": null, "vertices": null, "faces": null,
+                                "landmarks": null, "seconds": null, "created": null,
+                            })
+                        });
                     v["key"] = key.clone().into();
                     v["bytes"] = (*bytes).into();
                     v

@@ -108,6 +108,29 @@ fn second_run_reuses_the_embedding_and_gives_the_same_curve() {
     );
     assert_eq!(std::fs::read(&file).unwrap(), bytes);
 
+    // An entry whose description is damaged is listed with the same keys, null.
+    let good = entries(&cache);
+    std::fs::write(file.with_extension("json"), "{").unwrap();
+    let listed = entries(&cache);
+    assert_eq!(listed.len(), 1);
+    let keys = |v: &serde_json::Value| {
+        let mut k: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
+        k.sort();
+        k
+    };
+    assert_eq!(keys(&listed[0]), keys(&good[0]));
+    for k in [
+        "mesh",
+        "vertices",
+        "faces",
+        "landmarks",
+        "seconds",
+        "created",
+    ] {
+        assert!(listed[0][k].is_null(), "{k}: {}", listed[0]);
+    }
+    assert_eq!(listed[0]["bytes"], bytes.len());
+
     let cleared = run(&cache, &["cache", "clear"]);
     assert!(String::from_utf8_lossy(&cleared.stdout).contains("removed 1 cached"));
     assert!(entries(&cache).is_empty());
