@@ -133,7 +133,9 @@ typedef struct wavg_precompute_options {
 // `false` to cancel (the call then returns `WAVG_STATUS_CANCELLED` soon after and changes
 // nothing). It may be called from any of the library's threads, but never by two at
 // once; it must not call back into the library on the same surface, and must not throw
-// (C++) or longjmp.
+// (C++) or longjmp. Stages overlap, so their reports interleave: the quality check's
+// exact distances run alongside the decimation, the least-squares factorisation alongside
+// the geodesics; every stage that runs ends with a report of 1.
 typedef bool (*wavg_progress_fn)(enum wavg_stage stage, double fraction, void *user_data);
 
 #ifdef __cplusplus

@@ -77,6 +77,8 @@ impl From<wavg::Stage> for wavg_stage {
 /// `false` to cancel (the call then returns `WAVG_STATUS_CANCELLED` soon after and changes
 /// nothing). It may be called from any of the library's threads, but never by two at
 /// once; it must not call back into the library on the same surface, and must not throw
-/// (C++) or longjmp.
+/// (C++) or longjmp. Stages overlap, so their reports interleave: the quality check's
+/// exact distances run alongside the decimation, the least-squares factorisation alongside
+/// the geodesics; every stage that runs ends with a report of 1.
 pub type wavg_progress_fn =
     Option<unsafe extern "C" fn(stage: wavg_stage, fraction: f64, user_data: *mut c_void) -> bool>;
