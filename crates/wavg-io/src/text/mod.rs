@@ -205,7 +205,8 @@ fn point_line(line: usize, t: &[&str]) -> Result<PointSpec, LineError> {
         ("v", n) => err(format!("'v' takes 1 value (VERTEX), got {}", n - 1)),
         ("f", n) => err(format!("'f' takes 4 values (FACE B0 B1 B2), got {}", n - 1)),
         (other, _) => err(format!(
-            "expected 'v VERTEX' or 'f FACE B0 B1 B2', found '{other}'"
+            "expected 'v VERTEX' or 'f FACE B0 B1 B2', found {}",
+            shown(other)
         )),
     }
 }
@@ -220,10 +221,31 @@ impl fmt::Display for WeightNo {
     }
 }
 
+/// A token quoted for a message, its invisible characters (controls, zero-width ones, a
+/// byte-order mark) escaped, so `'\u{feff}v'` does not read as `'v'`; a byte-order mark
+/// gets a word on where it likely came from.
+fn shown(tok: &str) -> String {
+    let invisible =
+        |c: char| c.is_control() || matches!(c, '\u{feff}' | '\u{200b}'..='\u{200f}' | '\u{2060}');
+    let mut s = String::from("'");
+    for c in tok.chars() {
+        if invisible(c) {
+            s.extend(c.escape_unicode());
+        } else {
+            s.push(c);
+        }
+    }
+    s.push('\'');
+    if tok.contains('\u{feff}') {
+        s.push_str(" (a byte-order mark inside the file: files joined with cat?)");
+    }
+    s
+}
+
 fn number(tok: &str, line: usize, what: impl fmt::Display) -> Result<f64, LineError> {
     let x: f64 = tok.parse().map_err(|_| LineError {
         line,
-        message: format!("{what}: '{tok}' is not a number"),
+        message: format!("{what}: {} is not a number", shown(tok)),
     })?;
     if !x.is_finite() {
         return Err(LineError {
@@ -237,7 +259,7 @@ fn number(tok: &str, line: usize, what: impl fmt::Display) -> Result<f64, LineEr
 fn index(tok: &str, line: usize, what: &str) -> Result<u64, LineError> {
     tok.parse().map_err(|_| LineError {
         line,
-        message: format!("{what}: '{tok}' is not a non-negative integer"),
+        message: format!("{what}: {} is not a non-negative integer", shown(tok)),
     })
 }
 
@@ -411,7 +433,18 @@ mod tests {
         let w = parse_weights("\u{feff}0.5 0.5\n", 1).unwrap();
         assert_eq!(w, vec![(1, vec![0.5, 0.5])]);
         assert!(parse_points("\u{feff}v 3\n", 7).is_err());
-        assert!(parse_points("v 3\n\u{feff}v 4\n", 1).is_err());
+        // Elsewhere the message shows the mark and says where it likely came from.
+        let e = parse_points("v 3\n\u{feff}v 4\n", 1).unwrap_err();
+        assert!(e.message.contains(r"'\u{feff}v'"), "{}", e.message);
+        assert!(e.message.contains("byte-order mark"), "{}", e.message);
+        let e = parse_weights("0.5 0.5\n\u{feff}0.2 0.8\n", 1).unwrap_err();
+        assert!(
+            e.message.contains(r"'\u{feff}0.2' (a byte-order mark"),
+            "{}",
+            e.message
+        );
+        let e = parse_weights("0.5 0.5\n0.2\u{200b} 0.8\n", 1).unwrap_err();
+        assert!(e.message.contains(r"'0.2\u{200b}'"), "{}", e.message);
     }
 
     #[test]
