@@ -214,7 +214,7 @@ impl Solver {
         let n = self.n_anchors();
         weights.n = n;
         weights.data.resize(points.len() * n.max(1), 0.0);
-        let mut prepared = Vec::new();
+        let mut prepared = Vec::with_capacity(points.len());
         weights.status.clear();
         for (status, p) in self.inverse_rows_then(
             points,
