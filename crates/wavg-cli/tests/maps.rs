@@ -1,4 +1,4 @@
-//! `wavg correspond`, `wavg decal` and `wavg morph` run as processes: JSON keys, output
+//! `wavg correspond` and `wavg decal` run as processes (`wavg morph`: `morph.rs`): JSON keys, output
 //! files, the identity map of a surface onto itself, a real pose pair against its ground
 //! truth, and bad input that writes nothing.
 
@@ -170,71 +170,6 @@ fn decal_writes_one_vt_per_vertex() {
     let marked = o["marked"].as_array().unwrap().len();
     let frac = o["valid_fraction"].as_f64().unwrap();
     assert!((frac - (2562 - marked) as f64 / 2562.0).abs() < 1e-12);
-}
-
-#[test]
-fn morph_writes_the_frames() {
-    let dir = tempfile::tempdir().unwrap();
-    let a = s(&sphere_anchors(dir.path()));
-    let out = dir.path().join("frames");
-    let r = wavg_ok(&[
-        "morph",
-        "--source",
-        "builtin:icosphere",
-        "--target",
-        "builtin:icosphere",
-        "--source-anchors",
-        &a,
-        "--target-anchors",
-        &a,
-        "--frames",
-        "4",
-        "-o",
-        &s(&out),
-        "--json",
-    ]);
-    let (o, keys) = json_object(&r);
-    has_keys(&keys, &["frames", "valid_fraction", "seconds"]);
-    assert_eq!(o["frames"], 4);
-    for k in 0..4 {
-        let f = std::fs::read_to_string(out.join(format!("frame_{k:03}.obj"))).unwrap();
-        assert_eq!(f.lines().filter(|l| l.starts_with("v ")).count(), 2562);
-    }
-    assert!(!out.join("frame_004.obj").exists());
-}
-
-/// A frame that cannot be written (its name is taken by a folder) fails the command and
-/// takes the frames written before it along: nothing half-written.
-#[test]
-fn morph_removes_its_frames_when_one_fails() {
-    let dir = tempfile::tempdir().unwrap();
-    let a = s(&sphere_anchors(dir.path()));
-    let out = dir.path().join("frames");
-    std::fs::create_dir_all(out.join("frame_002.obj")).unwrap();
-    let r = wavg(&[
-        "morph",
-        "--source",
-        "builtin:icosphere",
-        "--target",
-        "builtin:icosphere",
-        "--source-anchors",
-        &a,
-        "--target-anchors",
-        &a,
-        "--frames",
-        "4",
-        "-o",
-        &s(&out),
-    ]);
-    assert!(!r.status.success());
-    let err = String::from_utf8_lossy(&r.stderr);
-    assert!(err.contains("frame_002.obj"), "{err}");
-    let mut left: Vec<_> = std::fs::read_dir(&out)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    left.sort();
-    assert_eq!(left, ["frame_002.obj"]);
 }
 
 #[test]
