@@ -45,10 +45,11 @@ impl CurveAim {
     /// Records the next answer, `point`.
     pub fn record(&mut self, solver: &Solver, point: &SurfacePoint) {
         let p = solver.projector().embedded().point(point);
-        self.aiming = match self.last {
-            [Some(a), Some(b)] => (b * 2.0 - a - p).norm() < 0.5 * (b - a).norm(),
-            _ => false,
-        };
+        let step = self.last[0].zip(self.last[1]).map(|(a, b)| (b - a).norm());
+        self.aiming = self
+            .guess()
+            .zip(step)
+            .is_some_and(|(g, step)| (g - p).norm() < 0.5 * step);
         self.last = [self.last[1], Some(p)];
     }
 

@@ -393,12 +393,11 @@ impl Projector {
     }
 
     /// [`Projector::project_with`] whose walk over faces from the `hint` face heads for the
-    /// face under `aim` rather than under `y` (Newton's method still solves for `y`). Along
-    /// a curve the projection trails the face under the query by an offset that changes
-    /// little from one sample to the next: with the previous sample's query `y0` and
-    /// projection `p0` (in R^8), `aim = p0 + (y - y0)` usually lies over the face holding
-    /// the new projection, so the first Newton solve there finds it. A non-finite `aim`
-    /// is ignored.
+    /// face under `aim` rather than under `y` (Newton's method still solves for `y`). Far
+    /// from the surface the projection trails the face under the query; along a curve the
+    /// extrapolation `2 p1 - p0` of the two previous projections (in R^8) usually lies
+    /// over the face holding the new one, so the first Newton solve there finds it
+    /// (`wavg_solve::CurveAim` decides when to aim). A non-finite `aim` is ignored.
     ///
     /// ```
     /// use std::sync::Arc;

@@ -378,15 +378,15 @@ impl Projector {
     }
 
     /// A warm start's face walk: from face `f`, up to [`HINT_STEPS`] steps over faces to
-    /// the one over which the query lies (its Euclidean projection onto the face's plane
-    /// falls inside; each step crosses the edge opposite the most negative barycentric
+    /// the one over which `aim` lies (the query itself unless the caller predicts better;
+    /// its Euclidean projection onto the face's plane falls inside; each step crosses the edge opposite the most negative barycentric
     /// coordinate; a step back to the previous face ends the walk where it is), then that
     /// face and up to [`FACE_WALK`] faces in all that Newton's
     /// method exits into; the first valid projection, if it is at least as close to `y`
     /// as the corners of its face. A projection farther than a point of the surface next
     /// to it is likely not the one the walk would find (a query far off a curved surface
     /// can have several); the full search decides then, as it does when no face within
-    /// the steps lies under the query.
+    /// the steps lies under the aim.
     pub(super) fn face_walk(&self, y: &Vec8, mut f: FaceId, aim: &Vec8) -> Option<Best> {
         let topo = self.emb.mesh().topology();
         let mut prev = NONE;
