@@ -21,6 +21,11 @@ const MAX_CELLS: u32 = 128;
 /// The walk over the cells stops after this many steps (the walk over the vertices goes
 /// on from where it stopped).
 const MAX_CELL_STEPS: usize = 64;
+/// The walk over the cells stops at a vertex within this many cell widths of the query:
+/// a step costs as much as several steps of the walk over the vertices, which covers the
+/// last cell width as well and from closer (armadillo, 93 anchors: 5.7% fewer forward
+/// instructions than walking on to the closest cell, no fewer round trips).
+const NEAR_CELLS: f32 = 1.0;
 
 /// A cell's vertex and a copy of its walk coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -176,16 +181,29 @@ impl StartGrid {
         (idx, d2)
     }
 
+    /// Squared walk distance below which a cell's vertex is near enough to start from
+    /// (see [`NEAR_CELLS`]).
+    #[inline]
+    fn near(&self) -> f32 {
+        let h = NEAR_CELLS / self.inv_cell;
+        h * h
+    }
+
     /// Greedy walk over the cells from the one holding walk point `p`: moves to the
     /// neighbouring cell whose vertex is closest to `p` (squared distance in walk units;
-    /// ties to the first in [`StartGrid::neighbours`]' order) while that improves; returns
-    /// the last cell's vertex and its squared distance.
+    /// ties to the first in [`StartGrid::neighbours`]' order) while that improves and
+    /// the current one lies farther than [`NEAR_CELLS`] from `p`; returns the last cell's
+    /// vertex and its squared distance.
     #[inline]
     pub(super) fn walk(&self, p: &[f32; 8]) -> (VertexId, f32) {
         let dist2 = |cell: &Cell| super::layout::dist2_packed(&cell.c, p);
         let mut c = self.cell_of(p).0;
         let mut v = self.cells[c].v;
         let mut d = dist2(&self.cells[c]);
+        let near = self.near();
+        if d <= near {
+            return (v, d);
+        }
         let [d0, d1, d2] = self.dims.map(|d| d as usize);
         // Index offsets of the 26 neighbours of a cell off the grid's sides, in
         // `neighbours`' order.
@@ -202,6 +220,9 @@ impl StartGrid {
             }
         }
         for _ in 0..MAX_CELL_STEPS {
+            if d <= near {
+                break;
+            }
             let mut next = c;
             let (i, j, k) = (c / (d1 * d2), c / d2 % d1, c % d2);
             let inside = (1..d0.saturating_sub(1)).contains(&i)
@@ -306,6 +327,9 @@ mod tests {
             let mut c = g.cell_of(p).0;
             let (mut v, mut d) = (g.cells[c].v, dist2(&g.cells[c]));
             for _ in 0..MAX_CELL_STEPS {
+                if d <= g.near() {
+                    break;
+                }
                 let mut next = c;
                 for n in g.neighbours(c, true).into_iter().flatten() {
                     let du = dist2(&g.cells[n]);
