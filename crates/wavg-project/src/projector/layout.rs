@@ -84,6 +84,17 @@ pub(super) fn wdist2(a: &[f32; 8], b: &[f32; 8]) -> f32 {
     (s[0] + s[2]) + (s[1] + s[3])
 }
 
+/// Dot product of walk-coordinate vectors, summed in [`wdist2`]'s fixed tree (so it stays
+/// in SIMD registers).
+#[inline(always)]
+pub(super) fn wdot(a: &[f32; 8], b: &[f32; 8]) -> f32 {
+    let mut s = [0.0f32; 4];
+    for k in 0..4 {
+        s[k] = a[k] * b[k] + a[k + 4] * b[k + 4];
+    }
+    (s[0] + s[2]) + (s[1] + s[3])
+}
+
 /// What a query reads of a vertex, in two adjacent cache lines: its embedded point (f64,
 /// for the tangent equations) and its frame (f32).
 #[derive(Clone, Copy, Debug)]

@@ -1,6 +1,7 @@
 //! Ordering: Morton keys that sort a batch so nearby queries run together, and the order
 //! in which the faces around the walk's end are tried (most promising first).
 
+use super::layout::wdot;
 use super::*;
 
 /// Faces around a vertex, most promising for a query first (from
@@ -126,15 +127,9 @@ impl Projector {
                 } else {
                     first
                 };
-                let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
-                for k in 0..8 {
-                    a += cur[k] * cur[k];
-                    b += cur[k] * dy[k];
-                    c += cur[k] * next[k];
-                }
-                ee[j] = a;
-                de[j] = b;
-                ee1[j] = c;
+                ee[j] = wdot(&cur, &cur);
+                de[j] = wdot(&cur, &dy);
+                ee1[j] = wdot(&cur, &next);
                 cur = next;
             }
             // Face j lies between ring[j] and ring[j + 1] (cyclically when interior).
