@@ -130,15 +130,17 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, s: &MeshIn
             o,
             "bounding box:         [{x0}, {y0}, {z0}] .. [{x1}, {y1}, {z1}] (diagonal {d})"
         );
-        if !b.diagonal.is_finite() {
-            let _ = writeln!(
-                o,
-                "note:                 the coordinates are too large to square (beyond about \
-                 1e154): scale the mesh down"
-            );
-        }
     }
-    if s.valid && s.components > 1 {
+    if let Some(why) = &s.out_of_range {
+        let _ = writeln!(o, "note:                 {why}");
+    }
+    if s.valid && s.out_of_range.is_some() {
+        let _ = writeln!(
+            o,
+            "valid:                yes (oriented manifold), but out of range for wavg (see the \
+             note)"
+        );
+    } else if s.valid && s.components > 1 {
         let _ = writeln!(
             o,
             "valid:                yes (oriented manifold); precompute, anchors and the \

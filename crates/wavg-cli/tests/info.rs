@@ -223,9 +223,10 @@ fn shared_data_good_bad_and_unparseable() {
     assert!(err.contains("truncated.off:7:"), "{err}");
 }
 
-/// Coordinates too large to square print in scientific notation, with a note saying so.
+/// Coordinates too large for the computations print in scientific notation, with a note
+/// saying so; the faces are judged by their shape (not zero-area); the JSON says why.
 #[test]
-fn huge_coordinates_print_short_with_a_note() {
+fn coordinates_out_of_range_print_short_with_a_note() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("big.obj");
     std::fs::write(
@@ -236,6 +237,51 @@ fn huge_coordinates_print_short_with_a_note() {
     let out = wavg(&["info", path.to_str().unwrap()]);
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("1.000000e200, 1.000000e200"), "{text}");
-    assert!(text.contains("too large to square"), "{text}");
+    assert!(text.contains("beyond the supported magnitude"), "{text}");
+    assert!(
+        text.contains("valid:                yes (oriented manifold), but out of range"),
+        "{text}"
+    );
     assert!(text.lines().all(|l| l.len() < 300), "{text}");
+    let out = wavg(&["info", "--json", path.to_str().unwrap()]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["valid"], true, "{v}");
+    assert!(
+        v["out_of_range"]
+            .as_str()
+            .unwrap()
+            .contains("scale the mesh down"),
+        "{v}"
+    );
+    let small = dir.path().join("small.obj");
+    std::fs::write(
+        &small,
+        "v 0 0 0\nv 1e-70 0 0\nv 0 1e-70 0\nv 0 0 1e-70\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    )
+    .unwrap();
+    let out = wavg(&["info", "--json", small.to_str().unwrap()]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["valid"], true, "{v}");
+    assert!(
+        v["out_of_range"]
+            .as_str()
+            .unwrap()
+            .contains("scale the mesh up"),
+        "{v}"
+    );
+    let out = wavg(&[
+        "precompute",
+        small.to_str().unwrap(),
+        "-o",
+        dir.path().join("s.wavg").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8(out.stderr)
+            .unwrap()
+            .contains("scale the mesh up")
+    );
+    let out = wavg(&["info", "--json", "builtin:torus"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["out_of_range"].is_null(), "{v}");
 }

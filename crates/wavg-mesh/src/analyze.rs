@@ -239,18 +239,27 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
     }
 }
 
-/// Doubled area small against the longest squared edge (collinear or coincident corners).
+/// Doubled area small against the longest squared edge (collinear or coincident corners),
+/// whatever the scale: the edges are scaled to a largest component of 1 first, so faces
+/// of meshes too large or too small to square are judged by their shape (the
+/// computations refuse such meshes, see [`crate::coordinates_out_of_range`]).
 pub(crate) fn is_degenerate(
     a: nalgebra::Vector3<f64>,
     b: nalgebra::Vector3<f64>,
     c: nalgebra::Vector3<f64>,
 ) -> bool {
     let (e0, e1, e2) = (b - a, c - b, a - c);
+    let m = e0.amax().max(e1.amax()).max(e2.amax());
+    // Below 1e-300 the inverse could overflow; such corners coincide for any purpose.
+    if !(m.is_finite() && m > 1e-300) {
+        return true;
+    }
+    let (e0, e1, e2) = (e0 / m, e1 / m, e2 / m);
     let longest = e0
         .norm_squared()
         .max(e1.norm_squared())
         .max(e2.norm_squared());
-    let twice_area = e0.cross(&(c - a)).norm();
+    let twice_area = e0.cross(&(-e2)).norm();
     // Written so that NaN counts as degenerate.
     let well_shaped = twice_area > ZERO_AREA_RELATIVE_TOLERANCE * longest && longest > 0.0;
     !well_shaped

@@ -78,20 +78,50 @@ pub use error::MeshError;
 /// them down; valid meshes beyond it can still be inspected and repaired.
 pub const MAX_COORDINATE: f64 = 1e37;
 
-/// Why `mesh` is beyond [`MAX_COORDINATE`] (a message that names the remedy), or `None`.
+/// The smallest bounding-box side (the longest of the three) the embedding accepts: its
+/// least-squares mesh weighs vertices by their areas, products of four lengths that must
+/// stay normal double-precision numbers (a sphere of radius 1e-75 still round-trips every
+/// query; at 1e-80 some fail, at 1e-90 the areas underflow). Smaller meshes are refused
+/// with an error that says to scale them up.
+pub const MIN_EXTENT: f64 = 1e-60;
+
+/// Why `mesh` is beyond [`MAX_COORDINATE`] or smaller than [`MIN_EXTENT`] (a message that
+/// names the remedy), or `None`.
 ///
 /// ```
 /// let mut m = wavg_mesh::procedural::icosphere(0);
 /// assert!(wavg_mesh::coordinates_out_of_range(&m).is_none());
 /// m.positions[3].x = -2e38;
 /// assert!(wavg_mesh::coordinates_out_of_range(&m).unwrap().contains("scale the mesh down"));
+/// let mut m = wavg_mesh::procedural::icosphere(0);
+/// for p in &mut m.positions {
+///     *p *= 1e-70;
+/// }
+/// assert!(wavg_mesh::coordinates_out_of_range(&m).unwrap().contains("scale the mesh up"));
 /// ```
 pub fn coordinates_out_of_range(mesh: &TriMesh) -> Option<String> {
     let largest = mesh.positions.iter().map(|p| p.amax()).fold(0.0, f64::max);
-    (largest > MAX_COORDINATE).then(|| {
-        format!(
+    if largest > MAX_COORDINATE {
+        return Some(format!(
             "the mesh's coordinates reach {largest:e}, beyond the supported magnitude of \
              {MAX_COORDINATE:e}: scale the mesh down"
+        ));
+    }
+    let extent = (0..3)
+        .map(|k| {
+            let (lo, hi) = mesh
+                .positions
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                    (l.min(p[k]), h.max(p[k]))
+                });
+            hi - lo
+        })
+        .fold(0.0, f64::max);
+    (extent < MIN_EXTENT).then(|| {
+        format!(
+            "the mesh spans only {extent:e}, below the supported size of {MIN_EXTENT:e}: \
+             scale the mesh up"
         )
     })
 }

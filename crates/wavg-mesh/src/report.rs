@@ -60,6 +60,10 @@ pub struct MeshInfo {
     pub problem_summary: Vec<ProblemGroup>,
     /// What the default repairs would do (`None` for a valid mesh).
     pub repair: Option<RepairPreview>,
+    /// Why the embedding and the solvers would refuse the mesh's size (coordinates beyond
+    /// [`crate::MAX_COORDINATE`] or a span below [`crate::MIN_EXTENT`], whatever its
+    /// validity: [`crate::coordinates_out_of_range`]); `None` within range.
+    pub out_of_range: Option<String>,
 }
 
 impl MeshInfo {
@@ -98,6 +102,7 @@ impl MeshInfo {
                 .map(ProblemGroup::from)
                 .collect(),
             repair: (!valid).then(|| RepairPreview::of(mesh)),
+            out_of_range: crate::coordinates_out_of_range(mesh),
         }
     }
 }

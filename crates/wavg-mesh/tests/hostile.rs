@@ -107,3 +107,43 @@ fn degenerate_meshes_are_invalid() {
         other => panic!("expected invalid, got {other:?}"),
     }
 }
+
+/// Faces are judged by their shape whatever the mesh's scale: a sphere scaled by 1e±200
+/// (whose squared lengths overflow or underflow) is valid, a needle among them is caught
+/// at every scale, and the computations' range check names the remedy.
+#[test]
+fn validity_does_not_depend_on_scale() {
+    use wavg_mesh::{ProblemKind, analyze, coordinates_out_of_range};
+    let sphere = wavg_mesh::procedural::icosphere(3);
+    for (scale, remedy) in [
+        (1e200, Some("down")),
+        (1e-200, Some("up")),
+        (1e30, None),
+        (1e-50, None),
+    ] {
+        let mut m = sphere.clone();
+        for p in &mut m.positions {
+            *p *= scale;
+        }
+        assert!(analyze(&m).report.is_valid(), "scale {scale:e}");
+        let why = coordinates_out_of_range(&m);
+        match remedy {
+            Some(r) => assert!(
+                why.as_deref()
+                    .unwrap()
+                    .contains(&format!("scale the mesh {r}"))
+            ),
+            None => assert!(why.is_none(), "scale {scale:e}: {why:?}"),
+        }
+        // Corner 0 of face 0 moved onto the middle of its opposite edge: a needle.
+        let [a, b, c] = m.triangles[0].map(|i| i as usize);
+        m.positions[a] = (m.positions[b] + m.positions[c]) / 2.0;
+        let report = analyze(&m).report;
+        assert!(
+            report.count(ProblemKind::ZeroAreaFace) >= 1,
+            "scale {scale:e}: {report:?}"
+        );
+        let repaired = wavg_mesh::repair::drop_degenerate_faces(&m);
+        assert!(repaired.mesh.n_faces() < m.n_faces(), "scale {scale:e}");
+    }
+}
