@@ -127,6 +127,33 @@ def test_progress_exception_propagates(torus_mesh):
     assert S.embedding is None
 
 
+def test_load_embedding_during_precompute_is_refused(tmp_path, surface, torus_mesh):
+    # The progress callback runs while the precompute does: what another thread could do
+    # then, it does here, deterministically.
+    other = tmp_path / "other.wavg"
+    surface.save_embedding(other)
+    S = wavg.Surface(*torus_mesh)
+    refused = []
+
+    def meddle(stage, done, total):
+        if not refused:
+            for call in (lambda: S.load_embedding(other), lambda: S.precompute(landmarks=20, progress=False)):
+                with pytest.raises(RuntimeError, match="precompute"):
+                    call()
+                refused.append(call)
+        return True
+    S.precompute(landmarks=30, progress=meddle)
+    assert len(refused) == 2
+    mine = S.embedding.copy()
+    assert not np.array_equal(mine, surface.embedding)  # the precompute's, not the loaded one
+    S.load_embedding(other)  # after it: allowed again
+    assert np.array_equal(S.embedding, surface.embedding)
+    # A cancelled precompute frees the surface too.
+    with pytest.raises(wavg.CancelledError):
+        S.precompute(landmarks=30, progress=lambda *a: False)
+    S.load_embedding(other)
+
+
 def test_precompute_threads_equal(torus_mesh):
     a = wavg.Surface(*torus_mesh)
     b = wavg.Surface(*torus_mesh)

@@ -433,6 +433,7 @@ impl Solver {
         let snapshot = Surface {
             inner: self.made_from.clone(),
             polygons: self.surface.borrow(py).polygons.clone(),
+            busy: Default::default(),
         };
         let args = (
             Py::new(py, snapshot)?,
@@ -450,6 +451,7 @@ impl Solver {
         let snapshot = Surface {
             inner: self.made_from.clone(),
             polygons: self.surface.borrow(py).polygons.clone(),
+            busy: Default::default(),
         };
         Ok(Self {
             inner: self.inner.clone(),

@@ -28,6 +28,41 @@ pub(crate) struct Surface {
     /// every triangle is its own polygon): `render`'s wireframe leaves out the diagonals
     /// that triangulating the file's quads added.
     pub(crate) polygons: std::sync::Arc<Vec<u32>>,
+    /// Set while `precompute` runs (it replaces the embedding when it returns): a second
+    /// precompute or a `load_embedding` meanwhile is refused rather than overwritten.
+    pub(crate) busy: Busy,
+}
+
+/// A flag shared by a surface and its running precompute; copies get their own.
+#[derive(Default)]
+pub(crate) struct Busy(std::sync::Arc<std::sync::atomic::AtomicBool>);
+
+impl Busy {
+    /// Sets the flag until the returned guard drops; an error if it is already set.
+    fn claim(&self) -> PyResult<BusyGuard> {
+        use std::sync::atomic::Ordering;
+        self.0
+            .compare_exchange(false, true, Ordering::AcqRel, Ordering::Acquire)
+            .map_err(|_| {
+                pyo3::exceptions::PyRuntimeError::new_err(
+                    "a precompute is already running on this surface",
+                )
+            })?;
+        Ok(BusyGuard(self.0.clone()))
+    }
+
+    fn is_set(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Acquire)
+    }
+}
+
+/// Clears its [`Busy`] flag when dropped (on every way out of `precompute`).
+struct BusyGuard(std::sync::Arc<std::sync::atomic::AtomicBool>);
+
+impl Drop for BusyGuard {
+    fn drop(&mut self) {
+        self.0.store(false, std::sync::atomic::Ordering::Release);
+    }
 }
 
 /// The most points one `sample_points` call draws (32 bytes each in the answer).
@@ -142,6 +177,7 @@ impl Surface {
         Ok(Self {
             inner,
             polygons: Default::default(),
+            busy: Busy::default(),
         })
     }
 
@@ -169,6 +205,7 @@ impl Surface {
         Ok(Self {
             inner,
             polygons: std::sync::Arc::new(notes.polygon_of),
+            busy: Busy::default(),
         })
     }
 
@@ -197,7 +234,9 @@ impl Surface {
     /// progress stands still) and cancels (``CancelledError``)
     /// by returning ``False``. Ctrl-C stops it within a second (``KeyboardInterrupt``). A
     /// cancelled call returns at once; the abandoned work stops at its next checkpoint in
-    /// the background. On any error the surface is unchanged.
+    /// the background. On any error the surface is unchanged. While it runs, another
+    /// thread's ``precompute`` or ``load_embedding`` of this surface raises
+    /// ``RuntimeError`` (the other methods go on with the current embedding).
     #[pyo3(
         signature = (landmarks=Int::of(1000), seed=Int::of(0), threads=None, progress=None),
         text_signature = "($self, landmarks=1000, seed=0, threads=None, progress=True)"
@@ -229,7 +268,10 @@ impl Surface {
             } else {
                 None
             };
-        let mut s = slf.borrow().inner.clone();
+        let (mut s, _busy) = {
+            let me = slf.borrow();
+            (me.inner.clone(), me.busy.claim()?)
+        };
         let opts = PrecomputeOptions {
             landmarks: landmarks as usize,
             seed,
@@ -254,8 +296,15 @@ impl Surface {
     }
 
     /// S.load_embedding(path): reads a ``.wavg`` embedding computed for this mesh (its
-    /// fingerprint is checked) and uses it from now on.
+    /// fingerprint is checked) and uses it from now on. ``RuntimeError`` while a
+    /// ``precompute`` of this surface runs in another thread.
     fn load_embedding(&mut self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        if self.busy.is_set() {
+            return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "a precompute is running on this surface (it replaces the embedding when it \
+                 returns); load the embedding after it",
+            ));
+        }
         require_file(&path)?;
         let mut s = self.inner.clone();
         py.detach_run(|| s.load_embedding(&path))
@@ -474,6 +523,7 @@ impl Surface {
         Self {
             inner: self.inner.clone(),
             polygons: self.polygons.clone(),
+            busy: Busy::default(),
         }
     }
 
@@ -481,6 +531,7 @@ impl Surface {
         Self {
             inner: self.inner.clone(),
             polygons: self.polygons.clone(),
+            busy: Busy::default(),
         }
     }
 }
