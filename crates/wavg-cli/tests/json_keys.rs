@@ -418,6 +418,7 @@ fn info_json_keys() {
         "problems",
         "problem_summary",
         "repair",
+        "out_of_range",
     ];
     assert_keys(&["info", "--builtin", "torus", "--json"], &keys);
     let dir = tempfile::tempdir().unwrap();
