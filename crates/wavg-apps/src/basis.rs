@@ -161,8 +161,11 @@ fn closed_bspline(p: usize, n: usize, out: &mut [f64]) {
         let t = s as f64 * n as f64 / samples as f64;
         let i = (t.floor() as usize).min(n - 1);
         let b = basis.eval(&knots, p, p as f64 + (t - i as f64));
-        for (k, bk) in b.iter().enumerate() {
-            w[(i + n * p + k - shift) % n] += bk;
+        // Controls (i - shift + k) mod n: one division per sample, then a wrap.
+        let mut c = (i + n * p - shift) % n;
+        for bk in b {
+            w[c] += bk;
+            c = if c + 1 == n { 0 } else { c + 1 };
         }
     }
 }
