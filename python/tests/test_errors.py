@@ -25,6 +25,18 @@ def test_invalid_mesh_lists_problems(torus_mesh):
         wavg.Surface(V2, F)
 
 
+def test_mesh_scale_out_of_range_says_how_to_rescale(torus_mesh):
+    V, F = torus_mesh
+    for scale, word in [(1e-100, "scale the mesh up"), (1e40, "scale the mesh down")]:
+        with pytest.raises(wavg.InvalidArgumentError, match=word):
+            wavg.Surface(V * scale, F)
+    # Within the range, any scale works, the same shape giving the same weights.
+    faces, bary = np.array([0, 7]), np.array([[0.2, 0.3, 0.5], [0.6, 0.2, 0.2]])
+    W = [wavg.Solver(wavg.Surface(V * s, F), [0, 50, 100, 150]).inverse(faces, bary)[0]
+         for s in (1e-50, 1.0, 1e30)]
+    assert np.allclose(W[0], W[1], atol=1e-9) and np.allclose(W[2], W[1], atol=1e-9)
+
+
 @pytest.mark.parametrize("V_bad, F_bad, exc, word", [
     ("shape", None, ValueError, "V"),
     (None, "shape", ValueError, "F"),

@@ -31,6 +31,16 @@ pub enum ProjectError {
         /// Its largest coordinate in magnitude.
         value: f64,
     },
+    /// The embedded mesh spans less than [`wavg_mesh::MIN_EXTENT`], but not zero (its
+    /// squared lengths and areas would leave double precision).
+    #[error(
+        "the embedded mesh spans only {extent:e}, below the supported size of 1e-60: scale \
+         the mesh up"
+    )]
+    TooSmall {
+        /// The longest side of the embedding's bounding box.
+        extent: f64,
+    },
     /// The mesh has no faces to project onto.
     #[error("the mesh has no faces")]
     EmptyMesh,

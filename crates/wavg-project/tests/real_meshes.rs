@@ -158,6 +158,20 @@ fn embedding_errors_are_typed() {
         Projector::new(emb),
         Err(wavg_project::ProjectError::OutOfRange { vertex: 7, value }) if value == 2e37
     ));
+    // Too small for squared lengths: refused, saying to scale the mesh up.
+    let tiny: Vec<_> = (0..n)
+        .map(|v| wavg_project::Vec8::from_fn(|k, _| 1e-62 * ((v * 7 + k) % 5) as f64))
+        .collect();
+    let emb = Arc::new(EmbeddedMesh::new(mesh.clone(), tiny).unwrap());
+    match Projector::new(emb) {
+        Err(e @ wavg_project::ProjectError::TooSmall { extent }) => {
+            assert!(
+                extent < 1e-60 && e.to_string().contains("scale the mesh up"),
+                "{e}"
+            );
+        }
+        other => panic!("expected TooSmall, got {:?}", other.map(|_| ())),
+    }
     let p = Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap();
     let y = wavg_project::Vec8::repeat(f64::INFINITY);
     assert_eq!(

@@ -191,6 +191,11 @@ impl Projector {
             );
         let walk_origin = lo;
         let extent = (hi - lo).max();
+        // (A collapsed embedding, every vertex at one point, is a degenerate case the
+        // frames and searches handle; a tiny one is a mesh to scale.)
+        if extent > 0.0 && extent < wavg_mesh::MIN_EXTENT {
+            return Err(ProjectError::TooSmall { extent });
+        }
         let walk_inv_step = if extent > 0.0 && extent.is_finite() {
             65535.0 / extent
         } else {
