@@ -223,17 +223,32 @@ fn shared_data_good_bad_and_unparseable() {
     assert!(err.contains("truncated.off:7:"), "{err}");
 }
 
+/// A tetrahedron with its corners `scale` from the origin, as an OBJ file in `dir`.
+fn tetrahedron(dir: &std::path::Path, name: &str, scale: &str) -> std::path::PathBuf {
+    let path = dir.join(name);
+    let s = scale;
+    std::fs::write(
+        &path,
+        format!("v 0 0 0\nv {s} 0 0\nv 0 {s} 0\nv 0 0 {s}\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"),
+    )
+    .unwrap();
+    path
+}
+
+/// `info --json` of `path`: valid, and `out_of_range` says `remedy`.
+fn assert_valid_but_out_of_range(path: &std::path::Path, remedy: &str) {
+    let out = wavg(&["info", "--json", path.to_str().unwrap()]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["valid"], true, "{v}");
+    assert!(v["out_of_range"].as_str().unwrap().contains(remedy), "{v}");
+}
+
 /// Coordinates too large for the computations print in scientific notation, with a note
 /// saying so; the faces are judged by their shape (not zero-area); the JSON says why.
 #[test]
 fn coordinates_out_of_range_print_short_with_a_note() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("big.obj");
-    std::fs::write(
-        &path,
-        "v 0 0 0\nv 1e200 0 0\nv 0 1e200 0\nv 0 0 1e200\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
-    )
-    .unwrap();
+    let path = tetrahedron(dir.path(), "big.obj", "1e200");
     let out = wavg(&["info", path.to_str().unwrap()]);
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("1.000000e200, 1.000000e200"), "{text}");
@@ -243,32 +258,9 @@ fn coordinates_out_of_range_print_short_with_a_note() {
         "{text}"
     );
     assert!(text.lines().all(|l| l.len() < 300), "{text}");
-    let out = wavg(&["info", "--json", path.to_str().unwrap()]);
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["valid"], true, "{v}");
-    assert!(
-        v["out_of_range"]
-            .as_str()
-            .unwrap()
-            .contains("scale the mesh down"),
-        "{v}"
-    );
-    let small = dir.path().join("small.obj");
-    std::fs::write(
-        &small,
-        "v 0 0 0\nv 1e-70 0 0\nv 0 1e-70 0\nv 0 0 1e-70\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
-    )
-    .unwrap();
-    let out = wavg(&["info", "--json", small.to_str().unwrap()]);
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["valid"], true, "{v}");
-    assert!(
-        v["out_of_range"]
-            .as_str()
-            .unwrap()
-            .contains("scale the mesh up"),
-        "{v}"
-    );
+    assert_valid_but_out_of_range(&path, "scale the mesh down");
+    let small = tetrahedron(dir.path(), "small.obj", "1e-70");
+    assert_valid_but_out_of_range(&small, "scale the mesh up");
     let out = wavg(&[
         "precompute",
         small.to_str().unwrap(),
