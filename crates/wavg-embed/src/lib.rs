@@ -30,12 +30,14 @@ mod near_field;
 mod ordering;
 mod pipeline;
 mod quality;
+mod scaled;
 mod simd;
 
 // The precomputation and its settings.
 pub use decimate::{Bounds, DecimateOptions, Decimated, decimate, select_landmarks};
 pub use mds::MdsOptions;
-pub use pipeline::{LANDMARK_ASPECT_RATIO, PrecomputeOptions, Report, StageSeconds, precompute};
+pub use pipeline::{LANDMARK_ASPECT_RATIO, PrecomputeOptions, Report, StageSeconds};
+pub use scaled::precompute;
 
 // Its result (saved and loaded by the `file` module).
 pub use embedding::{Embedding, EmbeddingParams};

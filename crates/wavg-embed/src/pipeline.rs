@@ -167,33 +167,15 @@ pub struct Report {
     pub faces: usize,
 }
 
-/// Computes the 8-D embedding of `mesh` (paper Section 3.5).
-///
-/// The mesh must be connected (one component; any genus, boundaries allowed). Progress is
-/// reported per [`crate::Stage`]; when `progress.cancelled()` turns true the computation
-/// stops at the next check and returns [`EmbedError::Cancelled`].
-///
-/// ```
-/// use wavg_embed::{PrecomputeOptions, precompute};
-/// use wavg_embed::NoProgress;
-/// use wavg_mesh::{ValidMesh, procedural};
-/// let mesh = ValidMesh::new(procedural::torus(48, 24, 1.0, 0.4)).unwrap();
-/// let opts = PrecomputeOptions { landmarks: 100, ..Default::default() };
-/// let (emb, report) = precompute(&mesh, &opts, &NoProgress).unwrap();
-/// assert_eq!(emb.coords.len(), mesh.n_vertices());
-/// assert_eq!(report.landmarks, 100);
-/// assert!(report.geodesic_rel_err_p50 < 0.1);
-/// ```
-pub fn precompute(
+/// [`crate::precompute`] on a mesh of moderate scale (see [`crate::scaled`]), its range
+/// already checked.
+pub(crate) fn precompute_unscaled(
     mesh: &ValidMesh,
     opts: &PrecomputeOptions,
     progress: &dyn Progress,
 ) -> Result<(Embedding, Report), EmbedError> {
     let start = Instant::now();
     let n = mesh.n_vertices();
-    if let Some(why) = wavg_mesh::coordinates_out_of_range(mesh) {
-        return Err(EmbedError::InvalidArgument(why));
-    }
     let components = mesh.topology().n_components();
     if components != 1 {
         return Err(EmbedError::InvalidArgument(format!(
@@ -396,7 +378,7 @@ pub fn precompute(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{NoProgress, Stage};
+    use crate::{NoProgress, Stage, precompute};
     use std::sync::Mutex;
     use std::sync::atomic::{AtomicBool, Ordering};
     use wavg_mesh::{TriMesh, procedural};
