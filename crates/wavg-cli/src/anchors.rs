@@ -175,7 +175,9 @@ pub fn warn_if_low(fraction: f64, what: &str, anchors: usize, mesh: &str) -> boo
         return false;
     }
     eprintln!(
-        "wavg: warning: {what}: {:.1}%, below {:.0}%. The likely cause: {anchors} anchors          are too few for this mesh (large gaps between them). The remedy: more anchors,          e.g. `wavg anchors {mesh} --count {} -o anchors.txt`.",
+        "wavg: warning: {what}: {:.1}%, below {:.0}%. The likely cause: {anchors} anchors \
+         are too few for this mesh (large gaps between them). The remedy: more anchors, \
+         e.g. `wavg anchors {mesh} --count {} -o anchors.txt`.",
         fraction * 100.0,
         LOW_FRACTION * 100.0,
         (2 * anchors).max(32)

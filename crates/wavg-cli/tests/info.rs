@@ -259,6 +259,21 @@ fn coordinates_out_of_range_print_short_with_a_note() {
     );
     assert!(text.lines().all(|l| l.len() < 300), "{text}");
     assert_valid_but_out_of_range(&path, "scale the mesh down");
+    let out = wavg(&["info", "--json", path.to_str().unwrap()]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let d = v["bounding_box"]["diagonal"].as_f64().unwrap();
+    assert!((d / (3f64.sqrt() * 1e200) - 1.0).abs() < 1e-12, "{v}");
+    // An unused vertex far away: invalid (repair drops it), so no range verdict yet.
+    let far = dir.path().join("far.obj");
+    std::fs::write(
+        &far,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1e300 0 0\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    )
+    .unwrap();
+    let out = wavg(&["info", "--json", far.to_str().unwrap()]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["valid"], false, "{v}");
+    assert!(v["out_of_range"].is_null(), "{v}");
     let small = tetrahedron(dir.path(), "small.obj", "1e-70");
     assert_valid_but_out_of_range(&small, "scale the mesh up");
     let out = wavg(&[

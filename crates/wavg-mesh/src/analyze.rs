@@ -248,11 +248,15 @@ pub(crate) fn is_degenerate(
     b: nalgebra::Vector3<f64>,
     c: nalgebra::Vector3<f64>,
 ) -> bool {
-    let (e0, e1, e2) = (b - a, c - b, a - c);
-    let m = e0.amax().max(e1.amax()).max(e2.amax());
-    // Below 1e-300 the inverse could overflow; such corners coincide for any purpose.
-    if !(m.is_finite() && m > 1e-300) {
+    let (mut e0, mut e1, mut e2) = (b - a, c - b, a - c);
+    let mut m = e0.amax().max(e1.amax()).max(e2.amax());
+    if !(m.is_finite() && m > 0.0) {
         return true;
+    }
+    if m < 1e-290 {
+        // 1 / m would overflow: scale up by 2^600 first (exact).
+        let up = 2f64.powi(600);
+        (e0, e1, e2, m) = (e0 * up, e1 * up, e2 * up, m * up);
     }
     let (e0, e1, e2) = (e0 / m, e1 / m, e2 / m);
     let longest = e0

@@ -98,15 +98,14 @@ pub const MIN_EXTENT: f64 = 1e-60;
 ///     *p *= 1e-70;
 /// }
 /// assert!(wavg_mesh::coordinates_out_of_range(&m).unwrap().contains("scale the mesh up"));
+/// for p in &mut m.positions {
+///     *p = *p * 1e70 + nalgebra::Vector3::repeat(1e38);
+/// }
+/// let why = wavg_mesh::coordinates_out_of_range(&m).unwrap();
+/// assert!(why.contains("move the mesh towards the origin"), "{why}");
 /// ```
 pub fn coordinates_out_of_range(mesh: &TriMesh) -> Option<String> {
     let largest = mesh.positions.iter().map(|p| p.amax()).fold(0.0, f64::max);
-    if largest > MAX_COORDINATE {
-        return Some(format!(
-            "the mesh's coordinates reach {largest:e}, beyond the supported magnitude of \
-             {MAX_COORDINATE:e}: scale the mesh down"
-        ));
-    }
     let extent = (0..3)
         .map(|k| {
             let (lo, hi) = mesh
@@ -118,6 +117,18 @@ pub fn coordinates_out_of_range(mesh: &TriMesh) -> Option<String> {
             hi - lo
         })
         .fold(0.0, f64::max);
+    if largest > MAX_COORDINATE {
+        // Far from the origin but of moderate size: moving it is the remedy.
+        let remedy = if extent <= MAX_COORDINATE / 8.0 {
+            "move the mesh towards the origin"
+        } else {
+            "scale the mesh down"
+        };
+        return Some(format!(
+            "the mesh's coordinates reach {largest:e}, beyond the supported magnitude of \
+             {MAX_COORDINATE:e}: {remedy}"
+        ));
+    }
     (extent < MIN_EXTENT).then(|| {
         format!(
             "the mesh spans only {extent:e}, below the supported size of {MIN_EXTENT:e}: \

@@ -60,9 +60,11 @@ pub struct MeshInfo {
     pub problem_summary: Vec<ProblemGroup>,
     /// What the default repairs would do (`None` for a valid mesh).
     pub repair: Option<RepairPreview>,
-    /// Why the embedding and the solvers would refuse the mesh's size (coordinates beyond
-    /// [`crate::MAX_COORDINATE`] or a span below [`crate::MIN_EXTENT`], whatever its
-    /// validity: [`crate::coordinates_out_of_range`]); `None` within range.
+    /// Why the embedding and the solvers would refuse the size of this valid mesh
+    /// (coordinates beyond [`crate::MAX_COORDINATE`] or a span below
+    /// [`crate::MIN_EXTENT`]: [`crate::coordinates_out_of_range`]); `None` within range,
+    /// and for an invalid mesh (its repair may change what is in range: an unused far
+    /// vertex goes).
     pub out_of_range: Option<String>,
 }
 
@@ -92,7 +94,16 @@ impl MeshInfo {
             bounding_box: mesh.bounding_box().map(|(lo, hi)| BoundingBox {
                 min: [lo.x, lo.y, lo.z],
                 max: [hi.x, hi.y, hi.z],
-                diagonal: (hi - lo).norm(),
+                // Scaled by the longest side first: no overflow or underflow on the way.
+                diagonal: {
+                    let d = hi - lo;
+                    let m = d.amax();
+                    if m > 0.0 && m.is_finite() {
+                        m * (d / m).norm()
+                    } else {
+                        m
+                    }
+                },
             }),
             problems: analysis.report.lines(),
             problem_summary: analysis
@@ -102,7 +113,9 @@ impl MeshInfo {
                 .map(ProblemGroup::from)
                 .collect(),
             repair: (!valid).then(|| RepairPreview::of(mesh)),
-            out_of_range: crate::coordinates_out_of_range(mesh),
+            out_of_range: valid
+                .then(|| crate::coordinates_out_of_range(mesh))
+                .flatten(),
         }
     }
 }

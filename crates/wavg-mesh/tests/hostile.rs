@@ -109,7 +109,8 @@ fn degenerate_meshes_are_invalid() {
 }
 
 /// Faces are judged by their shape whatever the mesh's scale: a sphere scaled by 1e±200
-/// (whose squared lengths overflow or underflow) is valid, a needle among them is caught
+/// (whose squared lengths overflow or underflow; at 1e-305 even the reciprocal of an
+/// edge overflows) is valid, a needle among them is caught
 /// at every scale, and the computations' range check names the remedy.
 #[test]
 fn validity_does_not_depend_on_scale() {
@@ -118,6 +119,7 @@ fn validity_does_not_depend_on_scale() {
     for (scale, remedy) in [
         (1e200, Some("down")),
         (1e-200, Some("up")),
+        (1e-305, Some("up")),
         (1e30, None),
         (1e-50, None),
     ] {
