@@ -14,7 +14,7 @@ use crate::mds::{MdsOptions, metric_mds};
 use crate::quality::{QualityOptions, QualityPairs};
 use crate::{Embedding, EmbeddingParams};
 
-/// Settings of [`precompute`].
+/// Settings of [`precompute`](crate::precompute).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PrecomputeOptions {
     /// Number of landmarks (paper: 1000). If the mesh has no more vertices than this, every
@@ -129,7 +129,7 @@ pub struct StageSeconds {
     pub quality: f64,
 }
 
-/// What [`precompute`] measured. With the `serde` feature it serialises to the keys of
+/// What [`precompute`](crate::precompute) measured. With the `serde` feature it serialises to the keys of
 /// `wavg precompute --json` (a NaN error, when not measured, becomes `null` in JSON).
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
