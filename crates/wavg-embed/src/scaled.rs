@@ -9,6 +9,7 @@ use wavg_mesh::{MAX_COORDINATE, MIN_EXTENT, TriMesh, ValidMesh};
 
 use crate::embedding::Embedding;
 use crate::error::{EmbedError, Progress};
+use crate::file::MAX_DIM;
 use crate::pipeline::{PrecomputeOptions, Report, precompute_unscaled};
 
 /// Meshes whose bounding box's longest side lies within `2^-SCALE_FREE ..= 2^SCALE_FREE`
@@ -97,17 +98,16 @@ fn check_range(e: &Embedding) -> Result<(), EmbedError> {
              the mesh down"
         )));
     }
-    let extent = (0..e.dim)
-        .map(|k| {
-            let (lo, hi) = e
-                .coords
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), c| {
-                    (l.min(c[k]), h.max(c[k]))
-                });
-            hi - lo
-        })
-        .fold(0.0f64, f64::max);
+    let (lo, hi) = e.coords.iter().fold(
+        ([f64::INFINITY; MAX_DIM], [f64::NEG_INFINITY; MAX_DIM]),
+        |(l, h), c| {
+            (
+                std::array::from_fn(|k| l[k].min(c[k])),
+                std::array::from_fn(|k| h[k].max(c[k])),
+            )
+        },
+    );
+    let extent = (0..MAX_DIM).map(|k| hi[k] - lo[k]).fold(0.0f64, f64::max);
     if extent > 0.0 && extent < MIN_EXTENT {
         return Err(EmbedError::InvalidArgument(format!(
             "the embedding spans only {extent:e}, below the supported size of {MIN_EXTENT:e}: \

@@ -106,17 +106,7 @@ pub const MIN_EXTENT: f64 = 1e-60;
 /// ```
 pub fn coordinates_out_of_range(mesh: &TriMesh) -> Option<String> {
     let largest = mesh.positions.iter().map(|p| p.amax()).fold(0.0, f64::max);
-    let extent = (0..3)
-        .map(|k| {
-            let (lo, hi) = mesh
-                .positions
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
-                    (l.min(p[k]), h.max(p[k]))
-                });
-            hi - lo
-        })
-        .fold(0.0, f64::max);
+    let extent = mesh.bounding_box().map_or(0.0, |(lo, hi)| (hi - lo).amax());
     if largest > MAX_COORDINATE {
         // Far from the origin but of moderate size: moving it is the remedy.
         let remedy = if extent <= MAX_COORDINATE / 8.0 {
