@@ -104,7 +104,13 @@ def test_render_and_png_round_trip(tmp_path, surface, anchors):
     assert not np.array_equal(plain, img)
 
 
-EXAMPLES = sorted((ROOT / "crates" / "wavg-py" / "examples").glob("[a-z]*.py"))
+EXAMPLES = sorted((ROOT / "python" / "examples").glob("[a-z]*.py"))
+
+
+def test_the_examples_are_found():
+    # An empty list would skip every example silently.
+    assert {e.name for e in EXAMPLES} >= {"correspond.py", "decal.py", "remesh.py", "render.py",
+                                          "spline.py", "transfer_texture.py"}
 
 
 @pytest.mark.parametrize("example", EXAMPLES, ids=[e.name for e in EXAMPLES])

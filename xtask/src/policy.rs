@@ -7,8 +7,8 @@ use std::path::Path;
 /// Crates allowed to contain `unsafe` blocks (each keeps them in one module).
 const UNSAFE_ALLOWED: [&str; 2] = ["wavg-project", "wavg-ffi"];
 
-/// `Err` names every crate root (library or binary) under `crates/`, `xtask` and `lab` that
-/// lacks `#![forbid(unsafe_code)]` without being allowed `unsafe`.
+/// `Err` names every crate root (library or binary) under `crates/`, `python` (wavg-py),
+/// `xtask` and `lab` that lacks `#![forbid(unsafe_code)]` without being allowed `unsafe`.
 pub fn check_unsafe(root: &Path) -> Result<(), String> {
     let mut dirs: Vec<_> = std::fs::read_dir(root.join("crates"))
         .map_err(|e| format!("crates: {e}"))?
@@ -16,6 +16,7 @@ pub fn check_unsafe(root: &Path) -> Result<(), String> {
         .map(|e| e.path())
         .filter(|p| p.is_dir())
         .collect();
+    dirs.push(root.join("python"));
     dirs.push(root.join("xtask"));
     dirs.push(root.join("lab"));
     dirs.sort();
@@ -77,6 +78,9 @@ mod tests {
             err.contains("bad/src/main.rs") && !err.contains("good"),
             "{err}"
         );
+        write("python/src/lib.rs", "//! the Python extension\n");
+        let err = check_unsafe(&root).unwrap_err();
+        assert!(err.contains("python/src/lib.rs"), "{err}");
         std::fs::remove_dir_all(&root).unwrap();
     }
 

@@ -6,8 +6,15 @@ use std::path::{Path, PathBuf};
 
 use crate::steps;
 
+/// The Python package's folder (crate, package, tests, `pyproject.toml`), relative to the
+/// repository root.
+const PACKAGE: &str = "python";
+/// The same folder as pip's argument (a bare `python` would name a package on the index).
+const INSTALL: &str = "./python";
 /// The requirements file, relative to the repository root.
 const REQUIREMENTS: &str = "python/requirements-test.txt";
+/// The package's tests, relative to the repository root.
+const TESTS: &str = "python/tests";
 
 /// The virtual environment's folder.
 pub fn venv_dir(root: &Path) -> PathBuf {
@@ -56,7 +63,7 @@ pub fn ensure_venv(root: &Path) -> Result<PathBuf, String> {
 }
 
 /// Builds the `wavg` wheel (abi3, CPython >= 3.10) with the environment's maturin from
-/// `pyproject.toml`, in cargo's dev profile and target directory, so the dependencies the
+/// `python/pyproject.toml`, in cargo's dev profile and target directory, so the dependencies the
 /// workspace build already compiled are reused (only PyO3 and the binding crate compile);
 /// returns the wheel's path (in `target/wheels`, older `wavg-*.whl` there removed first).
 pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
@@ -76,8 +83,11 @@ pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
         py.to_string_lossy(),
         out.to_string_lossy(),
     );
-    steps::command(
-        root,
+    // Run in the package's folder (maturin reads the `pyproject.toml` there), with the
+    // target directory made absolute as seen from the repository root.
+    let target = steps::target_dir(root);
+    steps::command_env(
+        &root.join(PACKAGE),
         &maturin_s,
         &[
             "build",
@@ -88,6 +98,7 @@ pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
             "--out",
             &out_s,
         ],
+        &[("CARGO_TARGET_DIR", &target.to_string_lossy())],
     )?;
     std::fs::read_dir(&out)
         .map_err(|e| format!("{}: {e}", out.display()))?
@@ -101,7 +112,7 @@ pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
         .ok_or_else(|| format!("maturin built no wavg wheel in {}", out.display()))
 }
 
-/// Installs the package as the README says, `pip install .` (PEP 517 through maturin, with
+/// Installs the package as the README says, `pip install ./python` (PEP 517 through maturin, with
 /// build isolation), but in cargo's dev profile and target directory (`MATURIN_PEP517_ARGS`)
 /// so the workspace build's dependencies are reused; then runs `pytest python/tests` there.
 /// pytest's "no tests ran" (exit 5) fails too.
@@ -121,7 +132,7 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
             "--disable-pip-version-check",
             "--force-reinstall",
             "--no-deps",
-            ".",
+            INSTALL,
         ],
         &[
             ("MATURIN_PEP517_ARGS", "--profile dev"),
@@ -134,7 +145,7 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     steps::command_env(
         root,
         &py_s,
-        &["-m", "pytest", "-q", "python/tests"],
+        &["-m", "pytest", "-q", TESTS],
         &[("WAVG_DATA_DIR", &data), ("WAVG_CLI", &wavg_bin)],
     )
     .map_err(|e| format!("{e} (pytest exit 5 means no tests ran)"))

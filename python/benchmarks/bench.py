@@ -1,6 +1,6 @@
 """Targets of the Python package, measured against the CLI in the same run.
 
-    python python/bench.py [--mesh meshes/armadillo.obj.gz] [--anchors 93] [--queries 100000]
+    python python/benchmarks/bench.py [--mesh meshes/armadillo.obj.gz] [--anchors 93] [--queries 100000]
                            [--threads 2] [--wheel target/wheels-release/wavg-*.whl]
 
 Solver.forward / Solver.inverse (paper weights) on the N surface points and K anchors of
@@ -23,11 +23,9 @@ import time
 
 import numpy as np
 
-# The installed package, not its sources beside this script.
-sys.path = [p for p in sys.path if pathlib.Path(p or ".").resolve() != pathlib.Path(__file__).resolve().parent]
-import wavg  # noqa: E402
+import wavg
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def cli_path():

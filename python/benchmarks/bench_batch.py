@@ -1,7 +1,7 @@
 """Benchmarks of wavg.batch (issue targets and the figures of docs/scaling.md).
 
-    python python/bench_batch.py                 # everything (about 10 minutes on 2 cores)
-    python python/bench_batch.py --only engine   # one part: engine, kills, overhead, costs
+    python python/benchmarks/bench_batch.py                 # everything (about 10 minutes on 2 cores)
+    python python/benchmarks/bench_batch.py --only engine   # one part: engine, kills, overhead, costs
 
 * engine: 16 precomputes of 20k-vertex meshes (1000 landmarks, one thread each) on a Dask
   LocalCluster of 2 single-thread worker processes and on a ProcessPoolExecutor(2),
@@ -33,10 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
-# The installed package, not the sources beside this script (they lack the compiled module).
-_HERE = Path(__file__).resolve().parent
-sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != _HERE]
-sys.path.insert(0, str(_HERE / "tests"))
+# The tests' fixtures; `wavg` is the installed package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import batch_fixtures as bf  # noqa: E402
 
 import wavg  # noqa: E402
