@@ -79,7 +79,7 @@ fn usage() -> ExitCode {
          venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
          wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path\n  \
          blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)\n  \
-         web    rebuild web/dist (the page of `wavg serve`) from web/src and npm ci of web/package-lock.json (--check: verify the checked-in copy)",
+         web    vendor three.js for the page of `wavg serve` into web/vendor/three by npm ci of web/package-lock.json (--check: verify the checked-in files)",
         MAX = lines::MAX_LINES
     );
     ExitCode::from(2)

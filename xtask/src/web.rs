@@ -1,15 +1,16 @@
-//! The page of `wavg serve`: `cargo xtask web` rebuilds `web/dist/` (our sources from
-//! `web/src/` and three.js's files from npm, as pinned by `web/package-lock.json`); the
-//! "web assets" check verifies the checked-in copy is what the lock file produces; the
-//! "browser tests" step runs `web/tests` (pytest + Playwright) on Debian's chromium.
+//! The page of `wavg serve`: our sources are `web/src/` (their only copy); `cargo xtask
+//! web` vendors three.js's files into `web/vendor/three/` from npm, as pinned by
+//! `web/package-lock.json`; the "web assets" check verifies the checked-in vendored files
+//! are what the lock file gives; the "browser tests" step runs `web/tests` (pytest +
+//! Playwright) on Debian's chromium.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::{python, steps};
 
 /// three.js files the page serves: path under `node_modules/`, name under
-/// `web/dist/vendor/three/`.
+/// [`VENDORED`].
 const VENDOR: &[(&str, &str)] = &[
     ("three/build/three.module.js", "three.module.js"),
     ("three/build/three.core.js", "three.core.js"),
@@ -20,6 +21,9 @@ const VENDOR: &[(&str, &str)] = &[
     ("three/LICENSE", "LICENSE"),
 ];
 
+/// Where the vendored three.js files are checked in (embedded by wavg-serve's assets.rs).
+const VENDORED: &str = "web/vendor/three";
+
 /// The browser the tests drive (never Playwright's own downloads).
 const CHROMIUM: &str = "/usr/bin/chromium";
 
@@ -28,36 +32,17 @@ fn npm_ci(dir: &Path) -> Result<(), String> {
         .map_err(|e| format!("{e} (npm comes with Debian's `nodejs`/`npm` packages)"))
 }
 
-/// Our sources: every file of `web/src/`.
-fn sources(root: &Path) -> Result<Vec<String>, String> {
-    let dir = root.join("web/src");
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .map_err(|e| format!("{}: {e}", dir.display()))?
-        .filter_map(|e| e.ok())
-        .filter(|e| e.path().is_file())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    Ok(names)
-}
-
-/// `cargo xtask web`: `npm ci` in `web/`, then copies the sources and three.js into
-/// `web/dist/`.
+/// `cargo xtask web`: `npm ci` in `web/`, then copies three.js's files into
+/// `web/vendor/three/`.
 pub fn build(root: &Path) -> Result<(), String> {
     let web = root.join("web");
     npm_ci(&web)?;
-    let dist = web.join("dist");
-    std::fs::create_dir_all(dist.join("vendor/three")).map_err(|e| e.to_string())?;
-    for name in sources(root)? {
-        copy(&web.join("src").join(&name), &dist.join(&name))?;
-    }
+    let vendored = root.join(VENDORED);
+    std::fs::create_dir_all(&vendored).map_err(|e| e.to_string())?;
     for (from, to) in VENDOR {
-        copy(
-            &web.join("node_modules").join(from),
-            &dist.join("vendor/three").join(to),
-        )?;
+        copy(&web.join("node_modules").join(from), &vendored.join(to))?;
     }
-    eprintln!("==> web/dist rebuilt; rebuild wavg to embed it");
+    eprintln!("==> {VENDORED} rebuilt; rebuild wavg to embed it");
     Ok(())
 }
 
@@ -68,7 +53,8 @@ fn copy(from: &Path, to: &Path) -> Result<(), String> {
 }
 
 /// The "web assets" check: `npm ci` from the lock file into a folder under target/, then
-/// byte comparisons of every vendored file and every source with `web/dist/`.
+/// byte comparisons of every vendored file with `web/vendor/three/`, which must hold
+/// nothing else; `web/dist/` (a second copy of the sources) must not exist.
 pub fn check_assets(root: &Path) -> Result<(), String> {
     let web = root.join("web");
     let tmp = steps::target_dir(root).join("web-assets-check");
@@ -78,39 +64,58 @@ pub fn check_assets(root: &Path) -> Result<(), String> {
         copy(&web.join(f), &tmp.join(f))?;
     }
     npm_ci(&tmp)?;
-    let mut pairs: Vec<(std::path::PathBuf, std::path::PathBuf)> = VENDOR
+    let vendored = root.join(VENDORED);
+    let pairs: Vec<(PathBuf, PathBuf)> = VENDOR
         .iter()
-        .map(|(from, to)| {
-            (
-                tmp.join("node_modules").join(from),
-                web.join("dist/vendor/three").join(to),
-            )
-        })
+        .map(|(from, to)| (tmp.join("node_modules").join(from), vendored.join(to)))
         .collect();
-    for name in sources(root)? {
-        pairs.push((web.join("src").join(&name), web.join("dist").join(&name)));
-    }
-    let mut stale = Vec::new();
+    let mut wrong = Vec::new();
     for (want, have) in &pairs {
         let w = std::fs::read(want).map_err(|e| format!("{}: {e}", want.display()))?;
         if std::fs::read(have).ok().as_deref() != Some(w.as_slice()) {
-            stale.push(
-                have.strip_prefix(root)
-                    .unwrap_or(have)
-                    .display()
-                    .to_string(),
-            );
+            wrong.push(format!("{} differs", shown(root, have)));
         }
     }
-    if stale.is_empty() {
-        eprintln!("    {} files of web/dist match", pairs.len());
+    wrong.extend(
+        extra_files(&vendored)?
+            .iter()
+            .map(|p| format!("{} is not one of three's files", shown(root, p))),
+    );
+    if web.join("dist").exists() {
+        wrong.push("web/dist exists (the sources' one copy is web/src)".into());
+    }
+    if wrong.is_empty() {
+        eprintln!("    {} files of {VENDORED} match", pairs.len());
         Ok(())
     } else {
         Err(format!(
-            "web/dist differs from what web/src and the lock file give: {}; run `cargo xtask web`",
-            stale.join(", ")
+            "{}; run `cargo xtask web` (and delete what it does not make)",
+            wrong.join(", ")
         ))
     }
+}
+
+/// `path` relative to `root` for a message.
+fn shown(root: &Path, path: &Path) -> String {
+    path.strip_prefix(root)
+        .unwrap_or(path)
+        .display()
+        .to_string()
+}
+
+/// Files in `dir` other than [`VENDOR`]'s.
+fn extra_files(dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let mut extra: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| {
+            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            !VENDOR.iter().any(|(_, to)| *to == name)
+        })
+        .collect();
+    extra.sort();
+    Ok(extra)
 }
 
 /// The "browser tests" step: chromium (apt-installed when root and missing, else a

@@ -1,16 +1,20 @@
-//! The page's files, embedded at compile time from `web/dist/` (no path from a request
-//! reaches the file system).
+//! The page's files, embedded at compile time: our sources from `web/src/` (their only
+//! copy) and the pinned three.js files from `web/vendor/three/` (checked against
+//! `web/package-lock.json` by `cargo xtask web --check`). No path from a request reaches
+//! the file system.
 
-/// One embedded file: its URL path, content type and bytes.
+/// One embedded file: its URL path, content type and bytes, from `web/$dir/$name`.
 macro_rules! file {
-    ($url:literal, $ty:expr, $rel:literal) => {
+    ($url:literal, $ty:expr, $dir:literal, $name:literal) => {
         (
             $url,
             $ty,
             include_bytes!(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/../../web/dist/",
-                $rel
+                "/../../web/",
+                $dir,
+                "/",
+                $name
             )) as &[u8],
         )
     };
@@ -20,33 +24,42 @@ const JS: &str = "text/javascript; charset=utf-8";
 
 /// Every file the page loads.
 static FILES: &[(&str, &str, &[u8])] = &[
-    file!("/index.html", "text/html; charset=utf-8", "index.html"),
-    file!("/style.css", "text/css; charset=utf-8", "style.css"),
-    file!("/app.js", JS, "app.js"),
-    file!("/api.js", JS, "api.js"),
-    file!("/picking.js", JS, "picking.js"),
-    file!("/modes.js", JS, "modes.js"),
-    file!("/colors.js", JS, "colors.js"),
-    file!("/frame.js", JS, "frame.js"),
+    file!(
+        "/index.html",
+        "text/html; charset=utf-8",
+        "src",
+        "index.html"
+    ),
+    file!("/style.css", "text/css; charset=utf-8", "src", "style.css"),
+    file!("/app.js", JS, "src", "app.js"),
+    file!("/api.js", JS, "src", "api.js"),
+    file!("/picking.js", JS, "src", "picking.js"),
+    file!("/modes.js", JS, "src", "modes.js"),
+    file!("/colors.js", JS, "src", "colors.js"),
+    file!("/frame.js", JS, "src", "frame.js"),
     file!(
         "/vendor/three/three.module.js",
         JS,
-        "vendor/three/three.module.js"
+        "vendor/three",
+        "three.module.js"
     ),
     file!(
         "/vendor/three/three.core.js",
         JS,
-        "vendor/three/three.core.js"
+        "vendor/three",
+        "three.core.js"
     ),
     file!(
         "/vendor/three/OrbitControls.js",
         JS,
-        "vendor/three/OrbitControls.js"
+        "vendor/three",
+        "OrbitControls.js"
     ),
     file!(
         "/vendor/three/LICENSE",
         "text/plain; charset=utf-8",
-        "vendor/three/LICENSE"
+        "vendor/three",
+        "LICENSE"
     ),
 ];
 

@@ -13,7 +13,8 @@ use std::time::{Duration, Instant};
 
 use tiny_http::{Header, Method, Request, Response, Server, StatusCode};
 
-use crate::routes::{Reply, route};
+use crate::reply::Reply;
+use crate::routes::route;
 use crate::{ApiError, App, MAX_BODY, WORKERS};
 
 /// A server answering on its threads.
@@ -130,10 +131,7 @@ fn answer(app: &App, mut request: Request, computing: &Counter) {
         }
         Err(e) => Err(e),
     };
-    let mut reply = reply.unwrap_or_else(|e| {
-        let body = serde_json::json!({ "error": e.message }).to_string();
-        Reply::json(body.into_bytes()).with_status(e.status)
-    });
+    let mut reply = reply.unwrap_or_else(|e| Reply::error(&e));
     if reply.compute_ms.is_some() {
         reply.total_ms = Some(start.elapsed().as_secs_f64() * 1e3);
     }

@@ -1,12 +1,14 @@
-//! The local HTTP server of `wavg serve`: one interactive page (three.js, embedded at
-//! compile time from `web/dist/`) and a JSON/binary API over a [`wavg::Surface`], with the same
-//! semantics and row formats as the command line (routes and bodies: `docs/serve.md`).
+//! The local HTTP server of `wavg serve`: one interactive page (our sources from `web/src/`
+//! and three.js from `web/vendor/three/`, embedded at compile time) and a JSON/binary API
+//! over a [`wavg::Surface`], with the same semantics and row formats as the command line
+//! (routes and bodies: `docs/serve.md`).
 //!
 //! [`App::new`] takes the surface; without an embedding, [`App::precompute_in_background`]
 //! computes one while the server already answers (`GET /api/status` reports the stage;
 //! the computing routes answer 503 until it is done). [`start`] binds and serves on worker
 //! threads, so a slow request never blocks the others; bad requests get a 4xx status with
-//! a message and never stop the server.
+//! a message and never stop the server; a failure of the server's own work gets 500
+//! ([`status_of`] maps the library's error kinds).
 //!
 //! ```no_run
 //! use wavg::Surface;
@@ -24,13 +26,17 @@
 
 mod apps;
 mod assets;
+mod body;
+mod error;
 mod http;
 mod meshbin;
-mod parse;
+mod points;
 mod problems;
+mod reply;
 mod routes;
 mod state;
 
+pub use error::{ApiError, status_of};
 pub use http::{Running, start};
 pub use meshbin::encode_mesh;
 pub use state::{App, Status};
@@ -51,36 +57,3 @@ pub const MAX_ANSWER: usize = 1 << 22;
 pub const MAX_FACES: usize = 1 << 20;
 /// Worker threads answering requests.
 pub const WORKERS: usize = 8;
-
-/// A request the server refuses: its HTTP status and a one-line message (sent as
-/// `{"error": MESSAGE}`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ApiError {
-    /// HTTP status (400, 404, 405, 413, 503, 500).
-    pub status: u16,
-    /// What is wrong, on one line.
-    pub message: String,
-}
-
-impl ApiError {
-    /// 400 Bad Request.
-    pub(crate) fn bad(message: impl Into<String>) -> Self {
-        Self {
-            status: 400,
-            message: message.into(),
-        }
-    }
-
-    /// Any status.
-    pub(crate) fn status(status: u16, message: impl Into<String>) -> Self {
-        Self {
-            status,
-            message: message.into(),
-        }
-    }
-
-    /// A library error: 400 for input errors, 500 otherwise.
-    pub(crate) fn from_lib(e: &dyn std::fmt::Display) -> Self {
-        Self::bad(e.to_string().replace('\n', " "))
-    }
-}

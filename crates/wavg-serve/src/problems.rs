@@ -8,9 +8,9 @@ use wavg::{
     DEFAULT_TOLERANCE, ForwardOptions, ForwardResult, Normalization, RoundTrip, SolveError, Solver,
 };
 
-use crate::parse::{self, Body};
-use crate::routes::Reply;
-use crate::{ApiError, App, MAX_ANSWER, MAX_ROWS, MAX_SAMPLES};
+use crate::body::{self, Anchors};
+use crate::reply::Reply;
+use crate::{ApiError, App, MAX_ANSWER, MAX_SAMPLES, points};
 
 /// Samples evaluated in sequence, warm-started, per parallel chunk (as `wavg spline`).
 const CHUNK: usize = 256;
@@ -39,41 +39,33 @@ struct SplinePoints {
     points: Vec<Option<PointRow>>,
 }
 
-/// 200 with `answer` as JSON.
-fn reply_json(answer: &impl Serialize) -> Result<Reply, ApiError> {
-    serde_json::to_vec(answer)
-        .map(Reply::json)
-        .map_err(|e| ApiError::status(500, format!("the answer could not be written: {e}")))
-}
-
-/// A solver for the field `key`'s anchors (at least `min`).
-fn solver(app: &App, body: &Body, key: &str, min: usize) -> Result<Solver, ApiError> {
+/// A solver for the anchors of the field `key` (at least `min`).
+fn solver(app: &App, list: &Anchors, key: &str, min: usize) -> Result<Solver, ApiError> {
     let surface = app.surface()?;
-    let anchors = parse::anchors(body.required(key)?, key, surface.mesh(), min)?;
-    surface.solver(anchors).map_err(|e| ApiError::from_lib(&e))
+    let anchors = points::anchors(&list.0, key, surface.mesh(), min)?;
+    surface.solver(anchors).map_err(ApiError::lib)
 }
 
 /// `POST /api/forward` `{"anchors": [...], "weights": [[...], ...], "normalize": false}` ->
 /// `{"points": [...]}`. Weight rows must have one finite weight per anchor summing to 1
 /// (or any non-zero sum with `"normalize": true`), as `wavg forward` checks them.
-pub(crate) fn forward(app: &App, body: &Body) -> Result<Reply, ApiError> {
-    let solver = solver(app, body, "anchors", 1)?;
-    let norm = if body.bool_or("normalize", false)? {
+pub(crate) fn forward(app: &App, body: body::Forward) -> Result<Reply, ApiError> {
+    let solver = solver(app, &body.anchors, "anchors", 1)?;
+    let norm = if body.normalize.unwrap_or(false) {
         Normalization::Normalize
     } else {
         Normalization::Reject
     };
-    let rows = parse::array(body.required("weights")?, "weights", MAX_ROWS)?;
     let k = solver.n_anchors();
-    let weights = rows
-        .iter()
+    let weights = body
+        .weights
+        .0
+        .into_iter()
         .enumerate()
-        .map(|(i, r)| {
-            let what = format!("weights[{i}]");
-            let w = parse::numbers(r, &what, k)?;
-            wavg::validate_weights(&w, k, norm)
-                .map_err(|e| ApiError::bad(format!("{what}: {e}")))?;
-            Ok(w)
+        .map(|(i, w)| {
+            wavg::validate_weights(&w.0, k, norm)
+                .map_err(|e| ApiError::lib(e).within(&format!("weights[{i}]")))?;
+            Ok(w.0)
         })
         .collect::<Result<Vec<_>, ApiError>>()?;
     let opts = ForwardOptions {
@@ -81,7 +73,7 @@ pub(crate) fn forward(app: &App, body: &Body) -> Result<Reply, ApiError> {
         ..Default::default()
     };
     let results = solver.forward_batch(&weights, &opts);
-    reply_json(&Points {
+    Reply::serialize(&Points {
         points: results.iter().map(point_row).collect(),
     })
 }
@@ -89,13 +81,14 @@ pub(crate) fn forward(app: &App, body: &Body) -> Result<Reply, ApiError> {
 /// `POST /api/inverse` `{"anchors": [...], "points": [...], "verified": false}` ->
 /// `{"weights": [[...] or null, ...]}` (with `verified`, checked by the forward problem as
 /// `wavg inverse --verified`).
-pub(crate) fn inverse(app: &App, body: &Body) -> Result<Reply, ApiError> {
-    let solver = solver(app, body, "anchors", 1)?;
-    let list = parse::array(body.required("points")?, "points", MAX_ROWS)?;
-    let points = list
+pub(crate) fn inverse(app: &App, body: body::Inverse) -> Result<Reply, ApiError> {
+    let solver = solver(app, &body.anchors, "anchors", 1)?;
+    let points = body
+        .points
+        .0
         .iter()
         .enumerate()
-        .map(|(i, p)| parse::point(p, &format!("points[{i}]"), solver.mesh()))
+        .map(|(i, p)| points::point(p, &format!("points[{i}]"), solver.mesh()))
         .collect::<Result<Vec<_>, _>>()?;
     let k = solver.n_anchors();
     if points.len().saturating_mul(k) > MAX_ANSWER {
@@ -105,7 +98,7 @@ pub(crate) fn inverse(app: &App, body: &Body) -> Result<Reply, ApiError> {
             points.len()
         )));
     }
-    let weights: Vec<Value> = if body.bool_or("verified", false)? {
+    let weights: Vec<Value> = if body.verified.unwrap_or(false) {
         // Points no weights of the ladder bring back have none (`wavg inverse --verified`
         // prints `none not-reached`).
         solver
@@ -129,20 +122,19 @@ pub(crate) fn inverse(app: &App, body: &Body) -> Result<Reply, ApiError> {
 /// `POST /api/spline` `{"control": [...], "degree": 3, "closed": false, "bezier": false,
 /// "samples": 500, "format": "json"}` -> `{"points": [...]}`: the samples of `wavg
 /// spline`; `"format": "text"` answers with its output file instead.
-pub(crate) fn spline(app: &App, body: &Body) -> Result<Reply, ApiError> {
-    let solver = solver(app, body, "control", 2)?;
-    let kind = if body.bool_or("bezier", false)? {
+pub(crate) fn spline(app: &App, body: body::Spline) -> Result<Reply, ApiError> {
+    let solver = solver(app, &body.control, "control", 2)?;
+    let kind = if body.bezier.unwrap_or(false) {
         SplineKind::Bezier
     } else {
         SplineKind::BSpline {
-            degree: body.usize_or("degree", 3, 1, 64)?,
-            closed: body.bool_or("closed", false)?,
+            degree: body::in_range("degree", body.degree, 3, 1, 64)?,
+            closed: body.closed.unwrap_or(false),
         }
     };
-    let samples = body.usize_or("samples", 500, 1, MAX_SAMPLES)?;
-    let text = text_format(body, "text")?;
-    let curve =
-        evaluate_spline(&solver, kind, samples, CHUNK).map_err(|e| ApiError::from_lib(&e))?;
+    let samples = body::in_range("samples", body.samples, 500, 1, MAX_SAMPLES)?;
+    let text = body::text_format(body.format.as_deref(), "text")?;
+    let curve = evaluate_spline(&solver, kind, samples, CHUNK).map_err(ApiError::lib)?;
     if text {
         let mut out = Vec::new();
         for r in &curve.samples {
@@ -162,29 +154,18 @@ pub(crate) fn spline(app: &App, body: &Body) -> Result<Reply, ApiError> {
         }
         return Ok(Reply::text(out));
     }
-    reply_json(&SplinePoints {
+    Reply::serialize(&SplinePoints {
         length: curve.length(),
         points: curve.samples.iter().map(point_row).collect(),
     })
 }
 
-/// Whether `"format"` asks for the command line's file format `name` (else JSON).
-pub(crate) fn text_format(body: &Body, name: &str) -> Result<bool, ApiError> {
-    match body.str("format")? {
-        None | Some("json") => Ok(false),
-        Some(f) if f == name => Ok(true),
-        Some(f) => Err(ApiError::bad(format!(
-            "\"format\" is \"json\" or \"{name}\", not \"{f}\""
-        ))),
-    }
-}
-
 /// `POST /api/distance` `{"source": POINT}` -> `{"distances": [per vertex], "max": D}`: the
 /// Euclidean distance in the 8-D embedding from the source point to every vertex (an
 /// approximation of the geodesic distance).
-pub(crate) fn distance(app: &App, body: &Body) -> Result<Reply, ApiError> {
+pub(crate) fn distance(app: &App, body: body::Distance) -> Result<Reply, ApiError> {
     let surface = app.surface()?;
-    let p = parse::point(body.required("source")?, "source", surface.mesh())?;
+    let p = points::point(&body.source, "source", surface.mesh())?;
     let coords = surface.embedded_coords();
     let tri = surface.mesh().triangles[p.face as usize];
     let at = (0..3).fold(wavg::Vec8::zeros(), |acc, k| {

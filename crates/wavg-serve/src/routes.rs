@@ -1,57 +1,16 @@
 //! Routing: the page's files from memory, the read-only routes (`/api/info`,
 //! `/api/status`, `/api/mesh`) and the computing ones (in [`crate::problems`] and
-//! [`crate::apps`]).
+//! [`crate::apps`], which never import this module), each with its body type.
 
 use std::time::Instant;
 
+use serde::de::DeserializeOwned;
 use serde_json::{Value, json};
 use tiny_http::Method;
 
-use crate::parse::Body;
+use crate::reply::Reply;
 use crate::state::Status;
-use crate::{ApiError, App};
-
-/// An answer: status, content type, body, the time the computation took (its JSON
-/// included) and the time from taking the request to the answer ready to send (sent as a
-/// `Server-Timing: compute;dur=MS, total;dur=MS` header).
-pub(crate) struct Reply {
-    pub(crate) status: u16,
-    pub(crate) content_type: &'static str,
-    pub(crate) body: Vec<u8>,
-    pub(crate) compute_ms: Option<f64>,
-    pub(crate) total_ms: Option<f64>,
-}
-
-impl Reply {
-    /// 200 with a JSON body.
-    pub(crate) fn json(body: Vec<u8>) -> Self {
-        Self {
-            status: 200,
-            content_type: "application/json",
-            body,
-            compute_ms: None,
-            total_ms: None,
-        }
-    }
-
-    /// 200 with a JSON value.
-    pub(crate) fn value(v: &Value) -> Self {
-        Self::json(v.to_string().into_bytes())
-    }
-
-    /// 200 with plain text (the command line's file formats).
-    pub(crate) fn text(body: Vec<u8>) -> Self {
-        Self {
-            content_type: "text/plain; charset=utf-8",
-            ..Self::json(body)
-        }
-    }
-
-    /// The same with another status.
-    pub(crate) fn with_status(self, status: u16) -> Self {
-        Self { status, ..self }
-    }
-}
+use crate::{ApiError, App, apps, body, problems};
 
 /// The API's routes answered on GET (and HEAD).
 const GET_ROUTES: [&str; 3] = ["/api/info", "/api/status", "/api/mesh"];
@@ -67,24 +26,20 @@ fn shown(path: &str) -> String {
 /// Answers `method url` with `body` (empty unless POST).
 pub(crate) fn route(app: &App, method: &Method, url: &str, body: &[u8]) -> Result<Reply, ApiError> {
     let path = url.split(['?', '#']).next().unwrap_or("");
-    let post = |f: fn(&App, &Body) -> Result<Reply, ApiError>| -> Result<Reply, ApiError> {
-        if *method != Method::Post {
-            return Err(ApiError::status(405, format!("{path} takes POST")));
-        }
-        let body = Body::parse(body)?;
-        let t = Instant::now();
-        let mut reply = f(app, &body)?;
-        reply.compute_ms = Some(t.elapsed().as_secs_f64() * 1e3);
-        Ok(reply)
+    let post = Post {
+        app,
+        method,
+        path,
+        body,
     };
     match path {
-        "/api/forward" => post(crate::problems::forward),
-        "/api/inverse" => post(crate::problems::inverse),
-        "/api/spline" => post(crate::problems::spline),
-        "/api/distance" => post(crate::problems::distance),
-        "/api/decal" => post(crate::apps::decal),
-        "/api/remesh" => post(crate::apps::remesh),
-        "/api/cage" => post(crate::apps::cage),
+        "/api/forward" => post.answer(problems::forward),
+        "/api/inverse" => post.answer(problems::inverse),
+        "/api/spline" => post.answer(problems::spline),
+        "/api/distance" => post.answer(problems::distance),
+        "/api/decal" => post.answer(apps::decal),
+        "/api/remesh" => post.answer(apps::remesh),
+        "/api/cage" => post.answer(apps::cage),
         _ if *method != Method::Get && *method != Method::Head => {
             let known = !path.starts_with("/api/") || GET_ROUTES.contains(&path);
             Err(ApiError::status(
@@ -94,20 +49,43 @@ pub(crate) fn route(app: &App, method: &Method, url: &str, body: &[u8]) -> Resul
         }
         "/api/info" => Ok(Reply::value(&info(app))),
         "/api/status" => Ok(Reply::value(&status(app))),
-        "/api/mesh" => Ok(Reply {
-            content_type: "application/octet-stream",
-            ..Reply::json(app.mesh_bytes().to_vec())
-        }),
+        "/api/mesh" => Ok(Reply::bytes(
+            "application/octet-stream",
+            app.mesh_bytes().to_vec(),
+        )),
         _ => match crate::assets::get(path) {
-            Some((content_type, bytes)) => Ok(Reply {
-                content_type,
-                ..Reply::json(bytes.to_vec())
-            }),
+            Some((content_type, bytes)) => Ok(Reply::bytes(content_type, bytes.to_vec())),
             None => Err(ApiError::status(
                 404,
                 format!("no page or route {}", shown(path)),
             )),
         },
+    }
+}
+
+/// A request to a computing route.
+struct Post<'a> {
+    app: &'a App,
+    method: &'a Method,
+    path: &'a str,
+    body: &'a [u8],
+}
+
+impl Post<'_> {
+    /// The answer of `handler` to the body read as `B`, with the time it took; 405 unless
+    /// the method is POST.
+    fn answer<B: DeserializeOwned>(
+        self,
+        handler: fn(&App, B) -> Result<Reply, ApiError>,
+    ) -> Result<Reply, ApiError> {
+        if *self.method != Method::Post {
+            return Err(ApiError::status(405, format!("{} takes POST", self.path)));
+        }
+        let body = body::parse(self.body)?;
+        let t = Instant::now();
+        let mut reply = handler(self.app, body)?;
+        reply.compute_ms = Some(t.elapsed().as_secs_f64() * 1e3);
+        Ok(reply)
     }
 }
 

@@ -346,30 +346,32 @@ fn the_page_and_three_come_from_memory() {
                 .starts_with("text/javascript")
         );
     }
-    // Every file of web/dist is served, with its bytes.
-    let dist = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../web/dist");
-    let mut dirs = vec![dist.clone()];
+    // Every file of web/src (at the root) and of web/vendor (under /vendor) is served,
+    // with its bytes.
+    let web = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../web");
     let mut files = 0;
-    while let Some(dir) = dirs.pop() {
-        for e in std::fs::read_dir(&dir).unwrap() {
-            let path = e.unwrap().path();
-            if path.is_dir() {
-                dirs.push(path);
-                continue;
+    for (folder, prefix) in [("src", ""), ("vendor", "vendor/")] {
+        let top = web.join(folder);
+        let mut dirs = vec![top.clone()];
+        while let Some(dir) = dirs.pop() {
+            for e in std::fs::read_dir(&dir).unwrap() {
+                let path = e.unwrap().path();
+                if path.is_dir() {
+                    dirs.push(path);
+                    continue;
+                }
+                let rel = path.strip_prefix(&top).unwrap().to_str().unwrap();
+                let url = format!("{prefix}{rel}");
+                let a = get(&format!("/{url}"));
+                assert_eq!(a.status, 200, "{url} is in web/{folder} but not served");
+                assert_eq!(a.body, std::fs::read(&path).unwrap(), "{url}");
+                files += 1;
             }
-            let url = path
-                .strip_prefix(&dist)
-                .unwrap()
-                .to_str()
-                .unwrap()
-                .to_owned();
-            let a = get(&format!("/{url}"));
-            assert_eq!(a.status, 200, "{url} is in web/dist but not served");
-            assert_eq!(a.body, std::fs::read(&path).unwrap(), "{url}");
-            files += 1;
         }
     }
-    assert!(files >= 10, "{files} files in web/dist");
+    assert!(files >= 12, "{files} files in web/src and web/vendor");
+    // web/ keeps one copy of each source: no built folder beside them.
+    assert!(!web.join("dist").exists(), "web/dist is back");
     for path in [
         "/../Cargo.toml",
         "/etc/passwd",

@@ -537,3 +537,46 @@ fn slow_clients_do_not_hold_the_server() {
     assert!(t.elapsed().as_secs() < 10, "{:?}", t.elapsed());
     drop(slow);
 }
+
+/// A refusal names the field, the row and what was expected.
+#[test]
+fn refusals_name_the_field_and_what_was_expected() {
+    for (route, body, says) in [
+        (
+            "/api/forward",
+            json!({"anchors": [0, 1], "weights": [[0.5, 0.5], [0.5, "a"]]}),
+            "weights[1][1]: invalid type: string \"a\", expected f64",
+        ),
+        (
+            "/api/forward",
+            json!({"anchors": [0, 1], "weights": [[0.9, 0.5]]}),
+            "weights[0]: ",
+        ),
+        (
+            "/api/inverse",
+            json!({"anchors": [0, 1, 2], "points": [5, [5, 0.2, 0.3]]}),
+            "points[1]: invalid length 3, expected a vertex id or [face, b0, b1, b2]",
+        ),
+        (
+            "/api/inverse",
+            json!({"anchors": [0, 999_999], "points": [5]}),
+            "anchors[1]: ",
+        ),
+        (
+            "/api/spline",
+            json!({"control": [0, 1, 2], "closed": "no"}),
+            "closed: invalid type: string \"no\", expected a boolean",
+        ),
+        (
+            "/api/remesh",
+            json!({"cage": {"vertices": [[0, 0, 0]], "faces": [[0, 1, -2]]}}),
+            "cage.faces[0][2]: invalid value: integer `-2`, expected u32",
+        ),
+        ("/api/distance", json!({}), "missing field `source`"),
+    ] {
+        let a = post(route, &body);
+        assert_eq!(a.status, 400, "{route} {body}");
+        let msg = a.json()["error"].as_str().unwrap().to_owned();
+        assert!(msg.contains(says), "{route} {body}: {msg}");
+    }
+}
