@@ -11,7 +11,7 @@ use crate::{python, steps};
 
 /// The add-on's folder in the repository.
 const SOURCE: &str = "blender/wavg_blender";
-/// The README's headless example.
+/// The headless example of docs/blender.md.
 const EXAMPLE: &str = "blender/examples/headless.py";
 
 /// The headless test script.
@@ -102,7 +102,7 @@ pub fn test(root: &Path) -> Result<(), String> {
     let scripts_s = scripts.to_string_lossy();
     let env = [("BLENDER_USER_SCRIPTS", scripts_s.as_ref())];
     steps::command_env(root, "blender", &args, &env)?;
-    // The README's example, as written there.
+    // The example of docs/blender.md, as written there.
     steps::command_env(
         root,
         "blender",

@@ -5,6 +5,7 @@
 
 mod blender;
 mod cbuild;
+mod cli_docs;
 mod examples;
 mod fuzz;
 mod lab;
@@ -41,6 +42,7 @@ fn main() -> ExitCode {
         Some("man") if args.len() <= 2 => {
             report(man::run(&workspace_root(), args.get(1).map(String::as_str)))
         }
+        Some("cli-docs") if args.len() == 1 => report(cli_docs::run(&workspace_root())),
         Some("blender-addon") if args.len() == 1 => {
             report(blender::build_addon(&workspace_root()).map(|zip| println!("{}", zip.display())))
         }
@@ -62,20 +64,17 @@ fn main() -> ExitCode {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
-         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask venv | cargo xtask wheel | \
+         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask cli-docs | cargo xtask venv | cargo xtask wheel | \
          cargo xtask blender-addon | cargo xtask web [--check]\n\n  \
-         test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
-         (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
-         and wavg-ffi), cargo doc (-D warnings), the examples \
-         (and quickstart.rs as a crate outside the workspace), the C/C++ build (CMake: \
-         libwavg, C tests, examples, OpenMesh harness) and ctest, a {SMOKE_SECONDS} s smoke \
-         run of every fuzz target; a table of step times at the end\n  \
+         test   every check, in CI's order (the steps: docs/development.md), then a table of \
+         step times\n  \
          test --quick   rustfmt check, clippy and the unit tests, for the edit loop\n  \
          fuzz   every fuzz target (or only NAME) for N seconds (default 60) each\n  \
          lab    build the lab (lab/, not a default member), or run its program NAME \
          (lab/src/bin/NAME.rs, release mode) with ARGS\n  \
          lines  the Rust files over {MAX} lines of non-test code (before the first #[cfg(test)])\n  \
          man    man pages of wavg and every subcommand into DIR (default target/man)\n  \
+         cli-docs   write docs/cli.md from the command definitions (help texts and examples)\n  \
          venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
          wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path\n  \
          blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)\n  \

@@ -38,7 +38,11 @@ morph between them.
 --json prints one object: mesh, method, seed, count, anchors (each vertex and position
 [x, y, z]), largest_gap (the largest distance in the embedding from a vertex to its
 nearest anchor, as a fraction of the bounding-box diagonal; 0.08 or less keeps
-about 90% of round trips on real meshes) and diagonal.")]
+about 90% of round trips on real meshes) and diagonal.
+
+The text report gives that largest gap and suggests a count when it is above 0.08: measured
+on pig, armadillo and elephant, a gap of 0.08 or less keeps 92-99% of round trips (3,000
+random points; armadillo: 8 anchors, gap 0.31, 53%; 93 anchors, gap 0.076, 95%).")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,

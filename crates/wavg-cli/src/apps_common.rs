@@ -37,7 +37,7 @@ pub struct PairArgs {
     pub target_embedding: Option<PathBuf>,
     #[command(flatten)]
     pub cache: CacheArg,
-    /// Worker threads (default: all cores; at most 4 per CPU, or 64).
+    /// Worker threads (default: all cores; the limit: docs/limits.md).
     #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
 }

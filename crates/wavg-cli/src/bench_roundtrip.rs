@@ -38,7 +38,9 @@ penalty of the ladder 10, 100, 1000, 10000 that does) and adds verified_inverse_
 verified_negative_weight_fraction (the same protocol on those weights),
 verified_penalized_fraction and verified_not_reached_fraction.
 
-Without --embedding or --precompute the 3-D positions are the embedding.")]
+Without --embedding or --precompute the 3-D positions are the embedding. The protocol is
+also a library function, wavg::round_trip (its RoundTripReport serialises to these keys,
+less mesh, with wavg-solve's serde feature).")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
@@ -54,7 +56,7 @@ pub struct Args {
     /// Number of random query points N.
     #[arg(long, default_value_t = 100_000, value_parser = crate::common::parse_queries)]
     pub queries: usize,
-    /// Worker threads T (default: all cores; at most 4 per CPU, or 64).
+    /// Worker threads T (default: all cores; the limit: docs/limits.md).
     #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
     /// Seed of the anchors and the query points.

@@ -22,7 +22,8 @@ solved on its own by the certified search (the closest valid projection of its a
 no warm start): agree_fraction is the fraction of samples whose curve point lies within
 1e-6 mean edge lengths of that answer (or that both fail),
 max_disagreement the largest distance in mean edge lengths (0 when all agree). Also
-samples, ok_samples, controls, threads, repeat, load (1-minute load average) and mesh.")]
+samples, ok_samples, controls, threads, repeat, load (1-minute load average) and mesh.
+builtin:genus2 (51k vertices, genus 2) is the mesh of the spline figures in BENCHMARKS.md.")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
@@ -46,7 +47,7 @@ pub struct Args {
     /// Timed runs.
     #[arg(long, default_value_t = 50, value_parser = crate::common::parse_repeat)]
     pub repeat: usize,
-    /// Worker threads T (default: all cores; at most 4 per CPU, or 64).
+    /// Worker threads T (default: all cores; the limit: docs/limits.md).
     #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
     /// Print one JSON object instead of text.

@@ -7,8 +7,14 @@ use crate::cache;
 #[derive(clap::Subcommand)]
 pub enum Command {
     /// List the cached embeddings: key, size, mesh, vertices, landmarks, age.
+    #[command(after_long_help = "\
+One line per cached embedding: key, size, vertices, landmarks, the seconds it took, age,
+and the mesh as first named. --json prints dir and entries (each key, bytes, mesh,
+vertices, faces, landmarks, seconds, created; all but key and bytes null for an entry
+whose description is missing or damaged).")]
     List(ListArgs),
     /// Remove every cached embedding.
+    #[command(after_long_help = "Removes every cached embedding and says how much space it freed.")]
     Clear,
 }
 

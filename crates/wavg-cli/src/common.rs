@@ -110,9 +110,7 @@ pub fn cpu_seconds(thread: bool) -> Option<f64> {
     }
 }
 
-/// The largest `--threads` accepted: 4 per CPU this process may use, and at least 64.
-/// Far more threads than cores only add overhead (thousands of them take seconds to start
-/// and to hand work to).
+/// The largest `--threads` accepted: the library's [`wavg::Par::max_threads`].
 pub fn max_threads() -> usize {
     wavg::Par::max_threads()
 }

@@ -10,10 +10,10 @@ use crate::CliError;
 
 /// Arguments of `wavg completions`.
 #[derive(Parser)]
-#[command(after_long_help = "Examples:\n  \
-    wavg completions bash > ~/.local/share/bash-completion/completions/wavg\n  \
-    wavg completions zsh > ~/.zfunc/_wavg   # with fpath+=~/.zfunc before compinit\n  \
-    wavg completions fish > ~/.config/fish/completions/wavg.fish")]
+#[command(
+    after_long_help = "Prints a completion script for bash, zsh or fish to standard \
+    output, generated from the command's own definition."
+)]
 pub struct Args {
     /// The shell to complete in.
     #[arg(value_enum)]

@@ -72,6 +72,14 @@ vertices_per_cpu_s (CPU time of the map, all threads), counts per reason and, wi
 target's bounding-box diagonal, with rejected_correct (images within 2% rejected) and
 accepted_wrong (valid vertices farther than 2%).
 
+Why `local`: `paper` judges the weights, not the image, and on pose pairs most vertices it
+rejects are mapped correctly. A single wrong image spoils all of its own edges but one of
+each neighbour's, so correct neighbours stay; on thin parts (fingers), images a fraction of
+an edge off flip triangles while landing well within 1% of the diagonal, hence the test of
+flips only where the target is smooth at the scale of its edges. stretch is the
+symmetrised L2 stretch of Sander et al. 2001 / Schreiner et al. 2004 over faces with three
+valid corners; stretch_best95 leaves out the worst 5% of them.
+
 Timings: `seconds` is the wall time of the map alone, from starting its worker threads to the
 last validity decision; `vertices_per_s` is source_vertices / seconds. Neither includes
 setup_seconds: reading the meshes, anchors and embeddings (or precomputing them), building

@@ -30,7 +30,8 @@ to 0.08 of the diagonal, reported; --anchors K for K), evaluates a closed cubic 
 the surface through the first 8 of them (or all K) in the order of a short closed tour, and
 runs inverse-then-forward round trips on random surface points with the paper's and the
 verified inverse. Fewer than 90% of round trips leading back is a warning on stderr that
-names the remedy.
+names the remedy (wavg anchors --count); `wavg spline`, `forward`, `inverse` and `bench
+roundtrip` warn the same way. On builtin:bump (2,562 vertices) it takes well under a second.
 
 With --out DIR it writes DIR/mesh.obj, DIR/mesh.wavg, DIR/anchors.txt, DIR/curve.txt
 (FACE B0 B1 B2 X Y Z per sample, as `wavg forward` writes) and DIR/curve.obj (the curve

@@ -14,6 +14,16 @@ use crate::common::one_line;
 /// Arguments.
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("source").required(true).args(["mesh", "mesh_flag", "builtin"])))]
+#[command(after_long_help = "\
+Counts, topology and every validation problem (counts and the first offending indices), and
+whether `wavg repair` would fix them. Succeeds for any file it can parse, valid or not.
+
+--json prints one object with at least vertices, faces, components, boundary_loops, genus
+(null when undefined), manifold (bool), problems (list of strings), plus edges,
+euler_characteristic, oriented, watertight, valid, uv, bounding_box, problem_summary,
+repair and out_of_range: null, or why the embedding and the solvers would refuse this
+valid mesh's size (docs/limits.md), with the remedy. Validity is judged by shape whatever
+the scale; an invalid mesh gets null (repair it first).")]
 pub struct Args {
     /// Mesh file: .obj, .off or .ply, optionally gzip-compressed (.gz), or builtin:NAME
     /// (as the other commands take it).
@@ -21,8 +31,7 @@ pub struct Args {
     /// The same as the positional MESH.
     #[arg(long = "mesh", value_name = "MESH")]
     pub mesh_flag: Option<String>,
-    /// Describe a procedural mesh instead of a file (icosphere, sphere-small, torus, grid,
-    /// bump, noisy-sphere).
+    /// Describe a procedural mesh instead of a file (the names: `wavg --help`).
     #[arg(long, value_name = "NAME")]
     pub builtin: Option<String>,
     /// Print one JSON object instead of text.

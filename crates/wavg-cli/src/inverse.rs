@@ -29,7 +29,16 @@ lambda d_ref |ybar - yhat|^2, d_ref the fourth smallest D_ii). A point that no w
 reach is written as 'none not-reached' (a NaN row in .npy), as the C call
 wavg_inverse_verified returns NO_SOLUTION for it: add anchors near it (wavg anchors
 --count). A summary on standard error counts the penalised and the unreached points and
-lists the latter (counted from 1). About 3-5x slower.";
+lists the latter (counted from 1). About 3-5x slower.
+
+Why points fail to round-trip: the paper's weights make the point a stationary projection
+of the anchors' average; on thin parts covered by few anchors (a pig's ears with 27
+anchors) the average can land nearer another part of the surface, and the forward problem
+then returns that part (about 5% of random points on pig.off with 27 anchors). This is a
+property of the weights, not of the search: `wavg bench roundtrip --search certified`,
+which always returns the closest valid projection, round-trips hardly more points (0.9512
+of them on armadillo with 93 anchors, against 0.9509 with the paper's local search). In
+Rust: Solver::inverse_verified, and for many points Solver::inverse_verified_batch_into.";
 
 /// Arguments.
 #[derive(clap::Args)]

@@ -24,6 +24,26 @@ use crate::common::{load_mesh, one_line};
 
 /// Arguments.
 #[derive(clap::Args)]
+#[command(after_long_help = "\
+Computes the 8-D embedding (1000 landmarks by decimation, keeping coarse triangles round so
+thin parts such as fingers and tails keep landmarks all around; fast-marching geodesics on
+an intermediate mesh of at most 10k vertices with close pairs refined on the full mesh,
+--geodesic-vertices 0 for full resolution; metric MDS; least-squares mesh) and writes the
+.wavg file (format: crates/wavg-embed/FORMAT.md). The mesh must be a valid manifold with
+one component (or pass --largest-component). Progress bars on a terminal only; Ctrl-C
+stops cleanly (exit status 130, nothing written).
+
+A mesh with problems or several pieces: on a mesh that `wavg repair` would fix, precompute
+says so and prints the command. --largest-component renumbers the vertices, so the
+embedding belongs to the repaired mesh, not to the file: --repaired-mesh FIXED.obj saves
+that mesh, and later commands take FIXED.obj with the .wavg file. The same in two steps:
+`wavg repair MESH -o FIXED.obj --largest-component` (it warns when its result still has
+several components), then `wavg precompute FIXED.obj -o FIXED.wavg`.
+
+--json prints one object: seconds (the precomputation, without loading the mesh and
+writing the file: load_seconds, save_seconds), stages (decimate, geodesics, mds, lsmesh,
+quality, in seconds), landmarks, dim, stress, geodesic_rel_err_p50, geodesic_rel_err_p90,
+vertices, faces and a few more.")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
@@ -50,7 +70,7 @@ pub struct Args {
     /// Write the mesh the embedding belongs to (after --largest-component) to this file.
     #[arg(long, value_name = "MESH")]
     pub repaired_mesh: Option<PathBuf>,
-    /// Worker threads (default: all cores; at most 4 per CPU, or 64). The embedding does
+    /// Worker threads (default: all cores; the limit: docs/limits.md). The embedding does
     /// not depend on it.
     #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,

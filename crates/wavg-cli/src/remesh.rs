@@ -35,7 +35,12 @@ time of all threads per frame), frames, max_offsurface
 (largest 3-D distance of an output vertex from the mesh over its bounding-box diagonal),
 roughness (mean umbrella length over mean edge length), problems (forward problems
 solved; also as forward_problems_solved), fallbacks, threads,
-precompute_seconds, plus mesh and base.")]
+precompute_seconds, plus mesh and base.
+
+This is the paper's semiregular remeshing (Section 4.1). Bad bases (empty, out-of-range
+indices, non-manifold, far from the surface, malformed lines) exit with status 2 and write
+nothing. From Rust: wavg::apps::Remesher; from C: wavg_remesher_new, _run, _move_vertex,
+_get.")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
@@ -63,7 +68,7 @@ pub struct Args {
     /// The base vertex dragged by --frames.
     #[arg(long, default_value_t = 0)]
     pub drag: usize,
-    /// Worker threads (default: all cores; at most 4 per CPU, or 64).
+    /// Worker threads (default: all cores; the limit: docs/limits.md).
     #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
     /// Output OBJ file (`-` for standard output; written atomically).

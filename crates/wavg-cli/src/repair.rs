@@ -23,7 +23,8 @@ use crate::common::{load_mesh, one_line};
     vertices. Components are kept unless --largest-component is given.\n\n\
     --map FILE writes one line per output vertex: the 0-based index of the input vertex it \
     came from (after welding, the lowest such index; for a copy made by splitting, the \
-    vertex it copies).\n\n\
+    vertex it copies). --json adds added_vertices (copies made by splitting) to the \
+    counts.\n\n\
     Exit status: 0 when the output is a valid mesh, 1 when problems remain (the output is \
     still written, and the remaining problems are listed), 2 for unreadable input."
 )]

@@ -40,7 +40,11 @@ precompute_s, verified, stride, interpolated_texels.
 --stride N (default 4): texels on every N-th row and column of the atlas are solved exactly;
 a texel between four of them whose source UVs lie close together (one chart, no seam in
 between) takes their bilinear interpolation; every other covered texel is solved exactly.
---stride 1 solves every texel.")]
+--stride 1 solves every texel.
+
+Spot onto itself (same anchors) reproduces its texture with a mean colour error of 0.06 (of
+255) over the covered texels, and onto a stretched, bent copy 3.6 (cargo test -p wavg-apps
+--test transfer).")]
 pub struct Args {
     #[command(flatten)]
     pub pair: PairArgs,

@@ -1,10 +1,10 @@
-//! `docs/cli.md` documents exactly the commands and options the command line has.
+//! `docs/cli.md` is what `cargo xtask cli-docs` writes from the command definitions, and
+//! documents exactly the commands and options the command line has.
 //!
-//! Convention of that file: one `### wavg NAME` heading per command (`### wavg bench load`
-//! for a nested one), and under it one list item per argument, starting with the argument
-//! in backticks: `` - `--mesh MESH`: ... ``, `` - `-o, --output FILE`: ... `` or, for a
-//! positional argument, its value name: `` - `MESH`: ... ``. Prose may mention any option
-//! anywhere; only those list items count. `--help` and `--version` are left out.
+//! Convention of that file: one `## wavg NAME` heading per command (`## wavg bench load`
+//! for a nested one), and under it the command's `--help` text, whose `Arguments:` list
+//! names each positional argument (`  [MESH]`) and whose `Options:` list each option
+//! (`  -o, --output <OUTPUT>`, `      --json`). `--help` and `--version` are left out.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -47,10 +47,11 @@ fn walk(cmd: &clap::Command, path: &str, out: &mut Documented) {
 fn from_markdown(text: &str) -> Documented {
     let mut out = Documented::new();
     let mut current: Option<String> = None;
+    let mut section = "";
     for line in text.lines() {
         if line.starts_with('#') {
             current = line
-                .strip_prefix("### ")
+                .strip_prefix("## ")
                 .filter(|h| h.starts_with("wavg "))
                 .map(|h| h.trim().to_string());
             if let Some(c) = &current {
@@ -61,23 +62,36 @@ fn from_markdown(text: &str) -> Documented {
             }
             continue;
         }
-        let (Some(cmd), Some(item)) = (&current, line.strip_prefix("- `")) else {
+        let Some(cmd) = &current else { continue };
+        if line.is_empty() {
             continue;
-        };
-        let spec = &item[..item.find('`').expect("a closing backtick")];
-        let args = out.get_mut(cmd).unwrap();
-        let mut tokens = spec.split([' ', ',']).filter(|t| !t.is_empty());
-        let first = tokens.next().expect("an argument");
-        let is_positional = first
-            .chars()
-            .all(|c| c.is_ascii_uppercase() || c == '_' || c == '.');
-        if is_positional {
-            args.insert(first.to_string());
         }
-        for t in std::iter::once(first).chain(tokens) {
-            if t.starts_with('-') {
-                args.insert(t.to_string());
+        if !line.starts_with(' ') {
+            section = if line.ends_with(':') { line } else { "" };
+            continue;
+        }
+        let indent = line.len() - line.trim_start().len();
+        let item = line.trim();
+        let args = out.get_mut(cmd).unwrap();
+        match section {
+            "Arguments:" if indent == 2 => {
+                let name = item
+                    .split_whitespace()
+                    .next()
+                    .unwrap()
+                    .trim_end_matches("...")
+                    .trim_matches(['[', ']', '<', '>']);
+                args.insert(name.to_string());
             }
+            "Options:" if indent <= 6 && item.starts_with('-') => {
+                let spec = item.split("  ").next().unwrap();
+                for t in spec.split([' ', ',']).filter(|t| t.starts_with('-')) {
+                    if !["-h", "--help", "-V", "--version"].contains(&t) {
+                        args.insert(t.to_string());
+                    }
+                }
+            }
+            _ => {}
         }
     }
     out
@@ -88,7 +102,7 @@ fn differences(clap: &Documented, docs: &Documented) -> Vec<String> {
     let mut out = Vec::new();
     for (cmd, args) in clap {
         match docs.get(cmd) {
-            None => out.push(format!("`### {cmd}` is missing from docs/cli.md")),
+            None => out.push(format!("`## {cmd}` is missing from docs/cli.md")),
             Some(documented) => {
                 for a in args.difference(documented) {
                     out.push(format!("{cmd}: `{a}` is not documented in docs/cli.md"));
@@ -102,7 +116,7 @@ fn differences(clap: &Documented, docs: &Documented) -> Vec<String> {
         }
     }
     for cmd in docs.keys().filter(|c| !clap.contains_key(*c)) {
-        out.push(format!("docs/cli.md has `### {cmd}`, which is no command"));
+        out.push(format!("docs/cli.md has `## {cmd}`, which is no command"));
     }
     out
 }
@@ -122,15 +136,35 @@ fn docs_cli_md_lists_every_command_and_option_and_no_other() {
 #[test]
 fn a_missing_an_extra_and_an_unknown_entry_are_each_reported() {
     let clap = from_clap();
-    let text = "### wavg info\n- `MESH`: a mesh\n- `--builtin NAME`: x\n- `--jsn`: typo\n\
-                ### wavg frobnicate\n- `--x`: y\n";
+    let text = "## wavg info\n```text\nArguments:\n  [MESH]\n          a mesh\n\nOptions:\n      \
+                --mesh <MESH>\n      --builtin <NAME>\n          x\n      --jsn\n          typo\n\
+                \nProse: --json is mentioned here only.\n  --json indented prose\n```\n\
+                ## wavg frobnicate\n```text\nOptions:\n      --x\n```\n";
     let diff = differences(&clap, &from_markdown(text));
     let has = |s: &str| diff.iter().any(|d| d.contains(s));
     assert!(has("wavg info: `--json` is not documented"), "{diff:?}");
     assert!(has("lists `--jsn`"), "{diff:?}");
-    assert!(
-        has("`### wavg frobnicate`, which is no command"),
-        "{diff:?}"
-    );
-    assert!(has("`### wavg demo` is missing"), "{diff:?}");
+    assert!(has("`## wavg frobnicate`, which is no command"), "{diff:?}");
+    assert!(has("`## wavg demo` is missing"), "{diff:?}");
+}
+
+#[test]
+fn docs_cli_md_is_what_cargo_xtask_cli_docs_writes() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/cli.md");
+    let text = std::fs::read_to_string(path).expect("docs/cli.md");
+    let generated = wavg_cli::cli_docs::markdown();
+    if text != generated {
+        let line = text
+            .lines()
+            .zip(generated.lines())
+            .position(|(a, b)| a != b)
+            .map_or(text.lines().count().min(generated.lines().count()), |i| i)
+            + 1;
+        panic!(
+            "docs/cli.md differs from the command definitions (first at line {line}: {:?} \
+             instead of {:?}): run `cargo xtask cli-docs`",
+            text.lines().nth(line - 1),
+            generated.lines().nth(line - 1)
+        );
+    }
 }

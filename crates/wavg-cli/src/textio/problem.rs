@@ -30,7 +30,7 @@ pub struct ProblemArgs {
     /// Output file ('-' for stdout).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Worker threads (default: all cores; at most 4 per CPU, or 64).
+    /// Worker threads (default: all cores; the limit: docs/limits.md).
     #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
 }
