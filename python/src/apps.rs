@@ -4,7 +4,7 @@
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
 
-use crate::args::DetachRun;
+use crate::pool::DetachRun;
 use wavg::apps::{
     CorrespondOptions, Image, SplineKind, TransferOptions, ValidityTest, correspond_vertices,
     decal_vertices, evaluate_spline,
@@ -42,7 +42,7 @@ fn solver_for(
             "{name} must hold at least one anchor; got none"
         )));
     }
-    s.solver(a).map_err(|e| to_py(py, e))
+    py.detach_run(|| s.solver(a)).map_err(|e| to_py(py, e))
 }
 
 /// spline(S, control, samples=200, degree=3, closed=False, bezier=False, threads=None) -> Points

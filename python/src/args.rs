@@ -154,57 +154,6 @@ pub(crate) fn finite(values: &[f64], what: &str) -> PyResult<()> {
     }
 }
 
-/// The process that imported the module (see [`run`]).
-static IMPORT_PID: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
-
-/// A thread pool of this process when it was forked after the import.
-static CHILD_POOL: std::sync::Mutex<Option<(u32, std::sync::Arc<rayon::ThreadPool>)>> =
-    std::sync::Mutex::new(None);
-
-/// Records the importing process, once.
-pub(crate) fn remember_pid() {
-    IMPORT_PID.get_or_init(std::process::id);
-}
-
-/// Runs `f`, the library's work of one call. In a child forked after the import
-/// (`multiprocessing`'s fork start method), the threads of rayon's global pool and of the
-/// pools cached per thread did not survive the fork: `f` then runs on a pool made in this
-/// process (its threads start with empty caches), so every pool `f` asks for is alive.
-pub(crate) fn run<T: Send>(f: impl FnOnce() -> T + Send) -> T {
-    let pid = std::process::id();
-    if IMPORT_PID.get().is_none_or(|&p| p == pid) {
-        return f();
-    }
-    let pool = {
-        let mut slot = CHILD_POOL.lock().unwrap_or_else(|e| e.into_inner());
-        match slot.as_ref() {
-            Some((p, pool)) if *p == pid => Some(pool.clone()),
-            _ => {
-                let n = std::thread::available_parallelism().map_or(1, |n| n.get());
-                let built = rayon::ThreadPoolBuilder::new().num_threads(n).build().ok();
-                *slot = built.map(|b| (pid, std::sync::Arc::new(b)));
-                slot.as_ref().map(|(_, p)| p.clone())
-            }
-        }
-    };
-    match pool {
-        Some(pool) => pool.install(f),
-        None => f(),
-    }
-}
-
-/// [`Python::detach`] for the library's work: without the GIL, through [`run`].
-pub(crate) trait DetachRun {
-    /// Runs `f` without the GIL, on live threads.
-    fn detach_run<T: Send>(self, f: impl FnOnce() -> T + Send) -> T;
-}
-
-impl DetachRun for Python<'_> {
-    fn detach_run<T: Send>(self, f: impl FnOnce() -> T + Send) -> T {
-        self.detach(|| run(f))
-    }
-}
-
 /// A thread count: `None` is all cores (the current rayon pool), 1 the calling thread, at
 /// most [`wavg::Par::max_threads`].
 pub(crate) fn par(threads: Option<Int>) -> PyResult<wavg::Par> {

@@ -7,9 +7,9 @@ use numpy::{PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use wavg::apps::{Image, MAX_SIDE};
 
-use crate::args::DetachRun;
 use crate::args::{Int, array};
 use crate::errors::{png, raise, require_file, type_error, value};
+use crate::pool::DetachRun;
 
 /// An image argument: an `(H, W, 3)` or `(H, W, 4)` uint8 array (or a PNG path).
 pub(crate) fn image_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Image> {

@@ -3,8 +3,9 @@
 //! (exceptions, named tuples, the progress bar).
 //!
 //! Every call that loops over arrays releases the GIL and runs on the library's own
-//! thread pools; arguments are checked before any work, and a query without an answer is
-//! a row of the `ok`/`valid` mask, never an exception.
+//! thread pools (in a process forked after the import, on a pool of its own: see
+//! `pool`); arguments are checked before any work, and a query without an answer is a row
+//! of the `ok`/`valid` mask, never an exception. `__version__` is the crate's version.
 
 #![forbid(unsafe_code)]
 
@@ -13,6 +14,7 @@ mod args;
 mod errors;
 mod image;
 mod json;
+mod pool;
 mod progress;
 mod remesh;
 mod render;
@@ -23,7 +25,7 @@ use std::path::PathBuf;
 
 use pyo3::prelude::*;
 
-use crate::args::DetachRun;
+use crate::pool::DetachRun;
 
 /// read_mesh(path) -> (V (n, 3) float64, F (m, 3) int64)
 ///
@@ -44,7 +46,8 @@ fn read_mesh<'py>(
 /// The module.
 #[pymodule]
 fn _wavg(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    args::remember_pid();
+    pool::remember_pid();
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<surface::Surface>()?;
     m.add_class::<solver::Solver>()?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;

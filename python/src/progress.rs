@@ -112,7 +112,7 @@ pub(crate) fn watch<T: Send + 'static>(
     let s = Arc::clone(&shared);
     let handle = std::thread::Builder::new()
         .name("wavg-watched".into())
-        .spawn(move || crate::args::run(|| work(&s)))
+        .spawn(move || crate::pool::run(|| work(&s)))
         .map_err(|e| PyRuntimeError::new_err(format!("wavg: cannot start a thread: {e}")))?;
     let mut shown = 0;
     let mut first = true;

@@ -4,7 +4,7 @@
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
 
-use crate::args::DetachRun;
+use crate::pool::DetachRun;
 use wavg::Vector3;
 use wavg::apps::BaseMesh;
 
@@ -93,10 +93,12 @@ impl Remesher {
         if p.len() != 3 || !p.iter().all(|x| x.is_finite()) {
             return Err(value("xyz must be 3 finite coordinates"));
         }
-        let (sp, _) = self.inner.closest_point(&Vector3::new(p[0], p[1], p[2]));
-        self.inner
-            .move_base_vertex(i as usize, sp)
-            .map_err(|e| remesh(py, &e))
+        let inner = &mut self.inner;
+        py.detach_run(|| {
+            let (sp, _) = inner.closest_point(&Vector3::new(p[0], p[1], p[2]));
+            inner.move_base_vertex(i as usize, sp)
+        })
+        .map_err(|e| remesh(py, &e))
     }
 
     /// Vertices of the last ``run()``, ``(N, 3)`` float64 (None before the first).

@@ -3,7 +3,7 @@
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
 
-use crate::args::DetachRun;
+use crate::pool::DetachRun;
 use wavg::Vector3;
 use wavg::apps::{Colouring, Overlays, RenderOptions, View};
 

@@ -4,7 +4,7 @@
 use numpy::{PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use crate::args::DetachRun;
+use crate::pool::DetachRun;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyList, PyTuple};
 use wavg::{Anchor, ForwardOptions, ForwardResult, SolveError, SurfacePoint};
@@ -265,7 +265,7 @@ impl Solver {
         if a.is_empty() {
             return Err(value("anchors must hold at least one anchor; got none"));
         }
-        let inner = s.solver(a).map_err(|e| to_py(py, e))?;
+        let inner = py.detach_run(|| s.solver(a)).map_err(|e| to_py(py, e))?;
         Ok(Self {
             inner,
             surface: surface.unbind(),
@@ -297,9 +297,9 @@ impl Solver {
     /// Generalised barycentric weights of surface points ``faces (q,) int``, ``bary (q, 3)
     /// float``. With ``verified`` (default) the weights are checked by the forward problem
     /// (the paper's where they return to the point, else an offset-penalised solution that
-    /// does); ``ok`` is False where none returns (the paper's weights are then given) or
-    /// where there are no weights (a NaN row). Without ``verified``, the paper's weights;
-    /// ``ok`` False only for NaN rows. Parallel without the GIL (``threads``: None = all
+    /// does); where none returns, or there are no weights, ``ok`` is False and the row is
+    /// NaN (as ``wavg inverse --verified`` prints ``none not-reached``). Without
+    /// ``verified``, the paper's weights; ``ok`` False only for NaN rows. Parallel without the GIL (``threads``: None = all
     /// cores). ``out``: a writable C-contiguous ``(q, k) float64`` array to fill and return
     /// as ``W`` (saves allocating and first touching a new one in repeated calls).
     #[pyo3(signature = (faces, bary, verified=true, threads=None, out=None))]
@@ -337,21 +337,22 @@ impl Solver {
                     &mut trips,
                     par,
                 )?;
+                // As `wavg inverse --verified` (`none not-reached`) and the C ABI: weights
+                // that do not return to their point are none.
+                let mut ok = Vec::with_capacity(q);
                 for (i, row) in rows.chunks_exact_mut(k.max(1)).enumerate().take(q) {
-                    match batch.get(i) {
-                        Ok(r) => row.copy_from_slice(r),
-                        Err(_) => row.fill(f64::NAN),
+                    match (batch.get(i), &trips[i]) {
+                        (Ok(r), Ok(wavg::RoundTrip::Paper | wavg::RoundTrip::Penalized(_))) => {
+                            row.copy_from_slice(r);
+                            ok.push(true);
+                        }
+                        _ => {
+                            row.fill(f64::NAN);
+                            ok.push(false);
+                        }
                     }
                 }
-                Ok(trips
-                    .iter()
-                    .map(|t| {
-                        matches!(
-                            t,
-                            Ok(wavg::RoundTrip::Paper | wavg::RoundTrip::Penalized(_))
-                        )
-                    })
-                    .collect())
+                Ok(ok)
             })
             .map_err(lib(py))?;
         drop(rw);
@@ -493,7 +494,7 @@ pub(crate) fn _restore_solver(
             }
         })
         .collect();
-    let mut inner = s.solver(a).map_err(|e| to_py(py, e))?;
+    let mut inner = py.detach_run(|| s.solver(a)).map_err(|e| to_py(py, e))?;
     inner.set_gamma(gamma).map_err(lib(py))?;
     Ok(Solver {
         inner,

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
 
-use crate::args::DetachRun;
+use crate::pool::DetachRun;
 use pyo3::types::{PyBytes, PyTuple};
 use wavg::mesh::TexCoords;
 use wavg::{PrecomputeOptions, TriMesh, Vector3};
@@ -151,12 +151,13 @@ pub(crate) fn mesh_from(
 }
 
 /// Embedding bytes (the `.wavg` format) of a surface, when it has one.
-fn embedding_bytes(s: &wavg::Surface) -> PyResult<Option<Vec<u8>>> {
-    Python::attach(|py| {
+fn embedding_bytes(py: Python<'_>, s: &wavg::Surface) -> PyResult<Option<Vec<u8>>> {
+    py.detach_run(|| {
         s.embedding()
-            .map(|e| wavg::embed::file::encode(e, s.mesh().mesh()).map_err(lib(py)))
+            .map(|e| wavg::embed::file::encode(e, s.mesh().mesh()))
             .transpose()
     })
+    .map_err(lib(py))
 }
 
 #[pymethods]
@@ -499,7 +500,7 @@ impl Surface {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let (v, f) = mesh_arrays(py, self.inner.mesh().mesh())?;
         let uv = self.uv(py)?;
-        let emb = embedding_bytes(&self.inner)?.map(|b| PyBytes::new(py, &b));
+        let emb = embedding_bytes(py, &self.inner)?.map(|b| PyBytes::new(py, &b));
         let restore = py.import("wavg._wavg")?.getattr("_restore_surface")?;
         // The file's polygons, so that a wireframe still leaves out triangulation edges.
         let polygons = (!self.polygons.is_empty()).then(|| self.polygons.to_vec());
@@ -559,13 +560,16 @@ pub(crate) fn _restore_surface(
         s.polygons = std::sync::Arc::new(p);
     }
     if let Some(bytes) = embedding {
-        let e = wavg::embed::file::decode(
-            bytes,
-            s.inner.mesh().mesh(),
-            std::path::Path::new("<pickle>"),
-        )
-        .map_err(lib(py))?;
-        s.inner.set_embedding(e).map_err(|e| to_py(py, e))?;
+        let inner = &mut s.inner;
+        py.detach_run(|| -> wavg::Result<()> {
+            let e = wavg::embed::file::decode(
+                bytes,
+                inner.mesh().mesh(),
+                std::path::Path::new("<pickle>"),
+            )?;
+            inner.set_embedding(e)
+        })
+        .map_err(|e| to_py(py, e))?;
     }
     Ok(s)
 }

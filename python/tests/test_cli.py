@@ -61,6 +61,26 @@ def test_forward_and_inverse_equal_cli(files, cli, torus_mesh, anchors):
         assert np.array_equal(cli_w, Wpy), f"verified={verified}"
 
 
+def test_verified_inverse_without_weights_as_the_cli(files, cli, surface):
+    # Where the CLI prints `none not-reached`, the package gives a NaN row and ok False.
+    three = surface.spread_anchors(3, seed=0)
+    S = wavg.Surface.open(files / "t.obj", embedding=files / "t.wavg")
+    faces, bary = S.vertex_points(np.arange(S.vertex_count))
+    _anchor_file(files / "a3.txt", three)
+    (files / "v.txt").write_text("".join(f"v {i}\n" for i in range(S.vertex_count)))
+    subprocess.run([cli, "inverse", "--mesh", str(files / "t.obj"), "--embedding",
+                    str(files / "t.wavg"), "--anchors", str(files / "a3.txt"), "--points",
+                    str(files / "v.txt"), "--verified", "-o", str(files / "iw3.txt")],
+                   check=True, capture_output=True)
+    lines = (files / "iw3.txt").read_text().splitlines()
+    W, ok = wavg.Solver(S, three).inverse(faces, bary)
+    none = np.array([line.startswith("none") for line in lines])
+    assert none.any() and np.array_equal(none, ~ok)
+    assert np.isnan(W[none]).all()
+    cli_w = np.array([[float(x) for x in line.split()] for line in lines if not line.startswith("none")])
+    assert np.array_equal(cli_w, W[ok])
+
+
 def test_correspond_report_keys_and_map_equal_cli(files, cli, anchors):
     S = wavg.Surface.open(files / "t.obj", embedding=files / "t.wavg")
     _anchor_file(files / "a.txt", anchors)

@@ -1,7 +1,9 @@
 """Whole-process behaviour: no leak over large batches, Ctrl-C stops a precompute,
-`import wavg` stays light."""
+`import wavg` stays light, `wavg.__version__` is the crate's."""
 
+import importlib.metadata
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -33,6 +35,13 @@ def test_forward_batches_do_not_leak(surface):
     # After warm-up the resident size stays flat (a leak of the 10^6 results would add
     # about 60 MB per repetition).
     assert max(rss[5:]) - rss[4] < 40, rss
+
+
+def test_version_is_the_workspace_version():
+    cargo = (ROOT / "Cargo.toml").read_text()
+    want = re.search(r'^\[workspace\.package\]$[^\[]*?^version = "([^"]+)"$', cargo, re.M).group(1)
+    assert wavg.__version__ == want
+    assert wavg._wavg.__version__ == want == importlib.metadata.version("wavg")
 
 
 IMPORT_ONLY = "import sys, time; t = time.perf_counter(); import wavg; print(time.perf_counter() - t); print('dask' in sys.modules)"

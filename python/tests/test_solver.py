@@ -87,6 +87,19 @@ def test_inverse_paper_weights(solver, surface):
     assert np.allclose(W[ok].sum(axis=1), 1.0)
 
 
+def test_verified_inverse_rows_not_ok_are_nan(surface):
+    # Three anchors do not reach most of a torus: those rows have no weights (NaN rows,
+    # as `wavg inverse --verified` prints `none not-reached`), though the paper's weights
+    # exist there.
+    sol = wavg.Solver(surface, surface.spread_anchors(3, seed=0))
+    faces, bary = surface.sample_points(2000, seed=1)
+    W, ok = sol.inverse(faces, bary)
+    assert 0 < (~ok).sum() < len(ok)
+    assert np.isnan(W[~ok]).all() and np.isfinite(W[ok]).all()
+    paper, paper_ok = sol.inverse(faces, bary, verified=False)
+    assert paper_ok.all() and np.isfinite(paper[~ok]).all()
+
+
 def test_inverse_into_out(solver, surface):
     faces, bary = surface.vertex_points(np.arange(0, surface.vertex_count, 5))
     k, q = solver.anchor_count, len(faces)

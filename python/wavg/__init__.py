@@ -17,7 +17,7 @@ from ._errors import (
     WavgIOError,
 )
 from ._types import Correspondence, Points
-from ._wavg import Solver, Surface, read_mesh
+from ._wavg import Solver, Surface, __version__, read_mesh
 from . import _wavg
 
 __all__ = [
@@ -72,7 +72,8 @@ def barycentric_weights(V, F, anchors, faces, bary, threads=None):
 
     One-off inverse problem on the mesh ``V (n, 3)``, ``F (m, 3)``: precomputes its
     embedding and returns the verified generalised barycentric weights of the surface
-    points ``faces (q,)``, ``bary (q, 3)`` with respect to ``anchors``.
+    points ``faces (q,)``, ``bary (q, 3)`` with respect to ``anchors`` (NaN rows where
+    ``ok`` is False).
     """
     surface = Surface(V, F)
     surface.precompute(progress=False, threads=threads)
