@@ -13,6 +13,7 @@ mod man;
 mod policy;
 mod python;
 mod sancov;
+mod sandbox;
 mod steps;
 mod web;
 

@@ -6,6 +6,7 @@
 use std::path::Path;
 use std::process::Command;
 
+use crate::sandbox::Sandbox;
 use crate::{python, steps};
 
 /// three.js files the page serves: path under `node_modules/`, name under
@@ -115,7 +116,8 @@ pub fn check_assets(root: &Path) -> Result<(), String> {
 
 /// The "browser tests" step: chromium (apt-installed when root and missing, else a
 /// SKIPPED message), then `pytest web/tests` with the environment's python against the
-/// dev build's `wavg`.
+/// dev build's `wavg`, in a [`Sandbox`] (the browser's profile is Playwright's temporary
+/// one; whatever chromium keeps in the home goes to the sandbox's).
 pub fn browser_tests(root: &Path, data_dir: &Path) -> Result<(), String> {
     if !Path::new(CHROMIUM).exists() {
         let root_user = Command::new("id")
@@ -153,7 +155,7 @@ pub fn browser_tests(root: &Path, data_dir: &Path) -> Result<(), String> {
         wavg.to_string_lossy().into_owned(),
         data_dir.to_string_lossy().into_owned(),
     );
-    steps::command_env(
+    Sandbox::new(root, "browser")?.run(
         root,
         &py,
         &["-m", "pytest", "-q", "web/tests"],
