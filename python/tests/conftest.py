@@ -37,6 +37,15 @@ def write_obj(path, V, F):
             f.write("f {} {} {}\n".format(*(int(x) + 1 for x in t)))
 
 
+@pytest.fixture(scope="session", autouse=True)
+def own_cache(tmp_path_factory):
+    """The CLI's embedding cache: $WAVG_CACHE_DIR when set, else a temporary folder (never
+    the user's ~/.cache/wavg)."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("WAVG_CACHE_DIR", os.environ.get("WAVG_CACHE_DIR") or str(tmp_path_factory.mktemp("cache")))
+        yield
+
+
 @pytest.fixture(scope="session")
 def torus_mesh():
     return torus()

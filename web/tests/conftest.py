@@ -1,5 +1,6 @@
 """Fixtures of the browser tests: a `wavg serve` process and Debian's chromium driven by
-Playwright (never Playwright's own browsers).
+Playwright (never Playwright's own browsers), on a temporary profile (Playwright's
+`launch`, never the user's; `test_profile.py` checks it).
 
 Environment: WAVG_BIN (the `wavg` binary; default target/debug/wavg of this repository),
 WAVG_SERVE_MESH (default builtin:torus), WAVG_BENCH_MESH (a ~100k-face mesh for the

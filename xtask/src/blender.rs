@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use crate::sandbox::{self, Sandbox};
 use crate::{python, steps};
 
 /// The add-on's folder in the repository.
@@ -69,18 +70,82 @@ fn copy_sources(from: &Path, to: &Path) -> Result<(), String> {
 }
 
 /// The `blender` step: the headless tests, or `SKIPPED` when Blender is missing and cannot
-/// be installed here (not root, or no apt-get).
+/// be installed here (not root, or no apt-get). Every Blender it starts runs in a
+/// [`Sandbox`] whose home holds a decoy `wavg_blender` in the user's add-ons and
+/// extensions folders; the step fails if a test loads it or anything under the home's
+/// Blender folder changes.
 pub fn test(root: &Path) -> Result<(), String> {
-    if !ensure_packages()? {
+    let sandbox = Sandbox::new(root, "blender")?;
+    let Some(version) = ensure_packages(&sandbox)? else {
         eprintln!(
             "SKIPPED blender (not installed): `sudo apt-get install {}` to run the add-on's tests",
             PACKAGES.join(" ")
         );
         return Ok(());
-    }
+    };
     let zip = build_addon(root)?;
-    let target = steps::target_dir(root);
-    let scripts = target.join("blender-user-scripts");
+    let user = plant_decoy(&sandbox.home(), &version)?;
+    let before = sandbox::snapshot(&user)?;
+    run_tests(root, &sandbox, &zip)?;
+    let changed = sandbox::differences(&before, &sandbox::snapshot(&user)?);
+    if changed.is_empty() {
+        eprintln!(
+            "    {} ({} entries, the decoy add-on among them) unchanged",
+            user.display(),
+            before.len()
+        );
+        Ok(())
+    } else {
+        Err(format!(
+            "the tests changed the user's Blender folder {}: {}",
+            user.display(),
+            changed
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    }
+}
+
+/// A `wavg_blender` that fails on import, with a `bl_info` and a manifest so that Blender
+/// lists it as an add-on and as an extension.
+const DECOY_INIT: &str = "bl_info = {\"name\": \"wavg (decoy)\", \"blender\": (3, 4, 0), \"category\": \"Object\"}\n\
+raise ImportError(\"the decoy wavg_blender of the user's own Blender was loaded\")\n";
+const DECOY_MANIFEST: &str = "schema_version = \"1.0.0\"\nid = \"wavg_blender\"\n\
+version = \"0.0.1\"\nname = \"wavg (decoy)\"\ntagline = \"A decoy\"\nmaintainer = \"tests\"\n\
+type = \"add-on\"\nblender_version_min = \"4.2.0\"\nlicense = [\"SPDX:MIT\"]\n";
+
+/// Puts a decoy `wavg_blender` where Blender `version` (`"3.4"`) finds the user's own
+/// add-ons and extensions under `home` (as the issue's user had installed the add-on), and
+/// returns the user's Blender folder (`home/.config/blender`).
+fn plant_decoy(home: &Path, version: &str) -> Result<PathBuf, String> {
+    let user = home.join(".config").join("blender");
+    let base = user.join(version);
+    let files = [
+        (
+            base.join("scripts/addons/wavg_blender/__init__.py"),
+            DECOY_INIT,
+        ),
+        (
+            base.join("extensions/user_default/wavg_blender/__init__.py"),
+            DECOY_INIT,
+        ),
+        (
+            base.join("extensions/user_default/wavg_blender/blender_manifest.toml"),
+            DECOY_MANIFEST,
+        ),
+    ];
+    for (path, text) in files {
+        let dir = path.parent().unwrap_or(home);
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    Ok(user)
+}
+
+/// The headless tests, the README's example and the window test, each Blender in `sandbox`.
+fn run_tests(root: &Path, sandbox: &Sandbox, zip: &Path) -> Result<(), String> {
     let zip_s = zip.to_string_lossy();
     let mut args = vec![
         "-b",
@@ -94,16 +159,14 @@ pub fn test(root: &Path) -> Result<(), String> {
         &zip_s,
     ];
     // The CLI of the tests' build, to compare the decal with `wavg decal`.
-    let cli = target.join("debug").join("wavg");
+    let cli = steps::target_dir(root).join("debug").join("wavg");
     let cli_s = cli.to_string_lossy();
     if cli.is_file() {
         args.extend(["--wavg-cli", &cli_s]);
     }
-    let scripts_s = scripts.to_string_lossy();
-    let env = [("BLENDER_USER_SCRIPTS", scripts_s.as_ref())];
-    steps::command_env(root, "blender", &args, &env)?;
+    sandbox.run(root, "blender", &args, &[])?;
     // The example of docs/blender.md, as written there.
-    steps::command_env(
+    sandbox.run(
         root,
         "blender",
         &[
@@ -116,7 +179,7 @@ pub fn test(root: &Path) -> Result<(), String> {
             "--",
             &zip_s,
         ],
-        &env,
+        &[],
     )?;
     if !runs("xvfb-run", &["--help"]) {
         eprintln!("SKIPPED blender window test (xvfb-run not installed)");
@@ -135,7 +198,7 @@ pub fn test(root: &Path) -> Result<(), String> {
         "--zip",
         &zip_s,
     ];
-    steps::command_env(root, "xvfb-run", &ui, &env)
+    sandbox.run(root, "xvfb-run", &ui, &[])
 }
 
 fn runs(program: &str, args: &[&str]) -> bool {
@@ -154,13 +217,30 @@ fn installed(package: &str) -> bool {
         })
 }
 
-fn blender_runs() -> bool {
-    runs("blender", &["-b", "--factory-startup", "--version"])
+/// The running Blender's `major.minor` (from `blender --version`, started in `sandbox`),
+/// or `None` when it does not start.
+fn blender_version(sandbox: &Sandbox) -> Option<String> {
+    let mut cmd = Command::new("blender");
+    sandbox.apply(&mut cmd);
+    let out = cmd
+        .args(["-b", "--factory-startup", "--version"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let full = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("Blender "))?
+        .split_whitespace()
+        .next()?;
+    let mut parts = full.split('.');
+    Some(format!("{}.{}", parts.next()?, parts.next()?))
 }
 
-/// True when Blender (with NumPy) is there, after installing the missing packages with
-/// apt-get when root; false when Blender is missing and cannot be installed here.
-fn ensure_packages() -> Result<bool, String> {
+/// Blender's `major.minor` when Blender (with NumPy) is there, after installing the missing
+/// packages with apt-get when root; `None` when Blender is missing and cannot be installed
+/// here.
+fn ensure_packages(sandbox: &Sandbox) -> Result<Option<String>, String> {
     let missing: Vec<&str> = PACKAGES.iter().copied().filter(|p| !installed(p)).collect();
     let root_user = Command::new("id")
         .arg("-u")
@@ -186,5 +266,5 @@ fn ensure_packages() -> Result<bool, String> {
     }
     // Debian's Blender runs on the system Python, which needs python3-numpy; other builds
     // (blender.org's) carry their own Python and NumPy.
-    Ok(blender_runs() && (installed("python3-numpy") || !installed("blender")))
+    Ok(blender_version(sandbox).filter(|_| installed("python3-numpy") || !installed("blender")))
 }

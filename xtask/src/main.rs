@@ -14,6 +14,7 @@ mod man;
 mod policy;
 mod python;
 mod sancov;
+mod sandbox;
 mod steps;
 mod web;
 
@@ -46,6 +47,7 @@ fn main() -> ExitCode {
         Some("blender-addon") if args.len() == 1 => {
             report(blender::build_addon(&workspace_root()).map(|zip| println!("{}", zip.display())))
         }
+        Some("blender") if args.len() == 1 => report(blender::test(&workspace_root())),
         Some("web") => match args.get(1).map(String::as_str) {
             None => report(web::build(&workspace_root())),
             Some("--check") => report(web::check_assets(&workspace_root())),
@@ -65,7 +67,7 @@ fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
          cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask cli-docs | cargo xtask venv | cargo xtask wheel | \
-         cargo xtask blender-addon | cargo xtask web [--check]\n\n  \
+         cargo xtask blender-addon | cargo xtask blender | cargo xtask web [--check]\n\n  \
          test   every check, in CI's order (the steps: docs/development.md), then a table of \
          step times\n  \
          test --quick   rustfmt check, clippy and the unit tests, for the edit loop\n  \
@@ -78,6 +80,7 @@ fn usage() -> ExitCode {
          venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
          wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path\n  \
          blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)\n  \
+         blender   the blender step of `test` alone: the add-on's tests in Blender, with a temporary home holding a decoy add-on\n  \
          web    vendor three.js for the page of `wavg serve` into web/vendor/three by npm ci of web/package-lock.json (--check: verify the checked-in files)",
         MAX = lines::MAX_LINES
     );

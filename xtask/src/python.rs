@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::sandbox::Sandbox;
 use crate::steps;
 
 /// The Python package's folder (crate, package, tests, `pyproject.toml`), relative to the
@@ -114,7 +115,8 @@ pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
 
 /// Installs the package as the README says, `pip install ./python` (PEP 517 through maturin, with
 /// build isolation), but in cargo's dev profile and target directory (`MATURIN_PEP517_ARGS`)
-/// so the workspace build's dependencies are reused; then runs `pytest python/tests` there.
+/// so the workspace build's dependencies are reused; then runs `pytest python/tests` there,
+/// in a [`Sandbox`].
 /// pytest's "no tests ran" (exit 5) fails too.
 pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     let py = ensure_venv(root)?;
@@ -142,13 +144,14 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     let data = data_dir.to_string_lossy();
     let wavg_bin = steps::target_dir(root).join("debug").join("wavg");
     let wavg_bin = wavg_bin.to_string_lossy();
-    steps::command_env(
-        root,
-        &py_s,
-        &["-m", "pytest", "-q", TESTS],
-        &[("WAVG_DATA_DIR", &data), ("WAVG_CLI", &wavg_bin)],
-    )
-    .map_err(|e| format!("{e} (pytest exit 5 means no tests ran)"))
+    Sandbox::new(root, "python")?
+        .run(
+            root,
+            &py_s,
+            &["-m", "pytest", "-q", TESTS],
+            &[("WAVG_DATA_DIR", &data), ("WAVG_CLI", &wavg_bin)],
+        )
+        .map_err(|e| format!("{e} (pytest exit 5 means no tests ran)"))
 }
 
 /// The `python` code blocks of `README.md` and `docs/`, run by the CLI's `docs_blocks` test

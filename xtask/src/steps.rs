@@ -73,10 +73,14 @@ pub fn command_env(
     env: &[(&str, &str)],
 ) -> Result<(), String> {
     eprintln!("    {program} {}", args.join(" "));
-    let status = Command::new(program)
-        .args(args)
-        .envs(env.iter().copied())
-        .current_dir(dir)
+    let mut cmd = Command::new(program);
+    cmd.args(args).envs(env.iter().copied()).current_dir(dir);
+    run(program, args, &mut cmd)
+}
+
+/// Runs `cmd` (`program args`, for the messages); `Err` says how it ended.
+pub fn run(program: &str, args: &[&str], cmd: &mut Command) -> Result<(), String> {
+    let status = cmd
         .status()
         .map_err(|e| format!("could not start {program}: {e}"))?;
     if status.success() {

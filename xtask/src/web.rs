@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use crate::sandbox::Sandbox;
 use crate::{python, steps};
 
 /// three.js files the page serves: path under `node_modules/`, name under
@@ -120,7 +121,8 @@ fn extra_files(dir: &Path) -> Result<Vec<PathBuf>, String> {
 
 /// The "browser tests" step: chromium (apt-installed when root and missing, else a
 /// SKIPPED message), then `pytest web/tests` with the environment's python against the
-/// dev build's `wavg`.
+/// dev build's `wavg`, in a [`Sandbox`] (the browser's profile is Playwright's temporary
+/// one; whatever chromium keeps in the home goes to the sandbox's).
 pub fn browser_tests(root: &Path, data_dir: &Path) -> Result<(), String> {
     if !Path::new(CHROMIUM).exists() {
         let root_user = Command::new("id")
@@ -158,7 +160,7 @@ pub fn browser_tests(root: &Path, data_dir: &Path) -> Result<(), String> {
         wavg.to_string_lossy().into_owned(),
         data_dir.to_string_lossy().into_owned(),
     );
-    steps::command_env(
+    Sandbox::new(root, "browser")?.run(
         root,
         &py,
         &["-m", "pytest", "-q", "web/tests"],

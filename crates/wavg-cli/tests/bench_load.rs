@@ -1,6 +1,6 @@
 //! `wavg bench load` as a process: JSON figures on a small file, exit 2 on bad input.
 
-use std::process::Command;
+mod common;
 
 use wavg::mesh::{io, procedural};
 
@@ -9,7 +9,7 @@ fn bench_load_reports_every_stage() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("s.off.gz");
     io::save(&path, &procedural::icosphere(3)).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
+    let out = common::wavg_command()
         .args([
             "bench",
             "load",
@@ -40,7 +40,7 @@ fn bench_load_reports_every_stage() {
 
     let bad = dir.path().join("t.off");
     std::fs::write(&bad, "OFF\n3 1 0\n0 0 0\n").unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
+    let out = common::wavg_command()
         .args(["bench", "load", "--mesh", bad.to_str().unwrap()])
         .output()
         .unwrap();

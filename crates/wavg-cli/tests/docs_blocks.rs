@@ -280,7 +280,7 @@ const TIMEOUT: [&str; 2] = ["--kill-after=10", "300"];
 
 /// A fresh folder for one block: `work/` (the current folder) holding the fixtures,
 /// `shared/data` beside it pointing at the data folder (so `../shared/data` works as in a
-/// clone), a private `HOME` and the tests' embedding cache.
+/// clone), a private `HOME` (and XDG folders in it) and the tests' embedding cache.
 struct Sandbox {
     root: tempfile::TempDir,
     work: PathBuf,
@@ -320,6 +320,9 @@ impl Sandbox {
         c.current_dir(&self.work)
             .env("PATH", path)
             .env("HOME", self.root.path().join("home"))
+            .env("XDG_CONFIG_HOME", self.root.path().join("home/.config"))
+            .env("XDG_CACHE_HOME", self.root.path().join("home/.cache"))
+            .env("XDG_DATA_HOME", self.root.path().join("home/.local/share"))
             .env("WAVG_CACHE_DIR", common::cache_dir());
         c
     }

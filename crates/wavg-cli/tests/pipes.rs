@@ -94,6 +94,7 @@ fn a_reader_that_stops_early_is_no_failure() {
 fn exits_zero(cmd: &str) -> String {
     let out = std::process::Command::new("bash")
         .args(["-c", cmd])
+        .env("WAVG_CACHE_DIR", common::cache_dir())
         .output()
         .unwrap();
     let (stdout, stderr) = (
@@ -124,7 +125,7 @@ fn a_piped_query_file_read_twice_gives_every_answer() {
     let file = dir.path().join("w.txt");
     std::fs::write(&file, &text).unwrap();
     let forward = |weights: &str, out: &str| {
-        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_wavg"));
+        let mut c = common::wavg_command();
         c.args([
             "forward",
             "--mesh",
@@ -191,7 +192,7 @@ fn a_report_to_a_full_disk_is_a_failure_without_a_panic() {
         eprintln!("skipped: no /dev/full");
         return;
     }
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_wavg"))
+    let out = common::wavg_command()
         .args(["info", "builtin:torus"])
         .stdout(std::fs::File::create("/dev/full").unwrap())
         .output()

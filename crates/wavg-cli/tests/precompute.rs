@@ -190,7 +190,7 @@ fn interrupt_stops_cleanly_without_output() {
     // Full-resolution geodesics on a 41k-vertex sphere: several seconds of work.
     let mesh_path = write(dir.path(), "sphere.off", &procedural::icosphere(6));
     let out_path = dir.path().join("sphere.wavg");
-    let child = Command::new(env!("CARGO_BIN_EXE_wavg"))
+    let child = common::wavg_command()
         .args(["precompute", &mesh_path, "-o", out_path.to_str().unwrap()])
         .args(["--geodesic-vertices", "0"])
         .stderr(std::process::Stdio::piped())

@@ -151,6 +151,7 @@ fn other_hosts_get_a_warning_and_bad_meshes_fail() {
     assert!(err.contains("warning") && err.contains("0.0.0.0"), "{err}");
     let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
         .args(["serve", "no-such-mesh.obj", "--port", "0"])
+        .env("WAVG_CACHE_DIR", cache_dir("bad-mesh"))
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));

@@ -8,14 +8,17 @@ pub fn cache_dir() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("wavg-cache")
 }
 
+/// The `wavg` program with the tests' embedding cache ([`cache_dir`]): shared by them,
+/// never the user's.
+pub fn wavg_command() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_wavg"));
+    c.env("WAVG_CACHE_DIR", cache_dir());
+    c
+}
+
 /// Runs `wavg ARGS`.
 pub fn wavg(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .args(args)
-        // The embedding cache of the tests: shared by them, never the user's.
-        .env("WAVG_CACHE_DIR", cache_dir())
-        .output()
-        .expect("run wavg")
+    wavg_command().args(args).output().expect("run wavg")
 }
 
 /// Runs `wavg ARGS` and asserts success (showing its standard error otherwise).
