@@ -66,7 +66,7 @@ fn usage() -> ExitCode {
          cargo xtask blender-addon | cargo xtask web [--check]\n\n  \
          test   rustfmt check, clippy (-D warnings), cargo test --workspace, the source policy \
          (no file over {MAX} lines of non-test code, forbid(unsafe_code) outside wavg-project \
-         and wavg-ffi), cargo doc (-D warnings), the examples \
+         and wavg-ffi, modules with submodules as name/mod.rs), cargo doc (-D warnings), the examples \
          (and quickstart.rs as a crate outside the workspace), the C/C++ build (CMake: \
          libwavg, C tests, examples, OpenMesh harness) and ctest, a {SMOKE_SECONDS} s smoke \
          run of every fuzz target; a table of step times at the end\n  \
@@ -163,10 +163,14 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         steps::cargo_workspace(root, &["test"], &[])
     }) && log.run(
         &format!(
-            "source policy (files over {} lines, forbid(unsafe_code))",
+            "source policy (files over {} lines, forbid(unsafe_code), module style)",
             lines::MAX_LINES
         ),
-        || lines::run(root).and_then(|()| policy::check_unsafe(root)),
+        || {
+            lines::run(root)
+                .and_then(|()| policy::check_unsafe(root))
+                .and_then(|()| policy::check_module_style(root))
+        },
     ) && log.run("docs (cargo doc, warnings as errors)", || {
         steps::command_env(
             root,
