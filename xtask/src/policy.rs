@@ -8,7 +8,7 @@ use std::path::Path;
 use crate::lines::rust_files;
 
 /// The folders whose Rust files follow the one module style (all of the workspace's).
-const STYLE_DIRS: [&str; 4] = ["crates", "xtask", "lab", "fuzz"];
+const STYLE_DIRS: [&str; 5] = ["crates", "python", "xtask", "lab", "fuzz"];
 
 /// Crates allowed to contain `unsafe` blocks (each keeps them in one module).
 const UNSAFE_ALLOWED: [&str; 2] = ["wavg-project", "wavg-ffi"];
