@@ -10,8 +10,8 @@ use wavg_mesh::{
 #[test]
 fn old_names_are_the_new_types() {
     let mut m = procedural::icosphere(0);
-    let first = m.faces[0];
-    m.faces.push(first);
+    let first = m.triangles[0];
+    m.triangles.push(first);
     let a = analyze(&m);
     let p: &Problem = &a.report.problems[0];
     let d: &Defect = p;
