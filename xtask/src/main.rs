@@ -165,10 +165,14 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         steps::cargo_workspace(root, &["test"], &[])
     }) && log.run(
         &format!(
-            "source policy (files over {} lines, forbid(unsafe_code))",
+            "source policy (files over {} lines, forbid(unsafe_code), module style)",
             lines::MAX_LINES
         ),
-        || lines::run(root).and_then(|()| policy::check_unsafe(root)),
+        || {
+            lines::run(root)
+                .and_then(|()| policy::check_unsafe(root))
+                .and_then(|()| policy::check_module_style(root))
+        },
     ) && log.run("docs (cargo doc, warnings as errors)", || {
         steps::command_env(
             root,

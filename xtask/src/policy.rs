@@ -1,8 +1,14 @@
 //! Source policy checked by `cargo xtask test`: `unsafe` code only in the crates that need
 //! it (SIMD and prefetch hints in `wavg-project`, the C ABI in `wavg-ffi`); every other
-//! crate root says `#![forbid(unsafe_code)]`.
+//! crate root says `#![forbid(unsafe_code)]`. One module style: a module with submodules
+//! is `name/mod.rs`, never `name.rs` beside a `name/` folder.
 
 use std::path::Path;
+
+use crate::lines::rust_files;
+
+/// The folders whose Rust files follow the one module style (all of the workspace's).
+const STYLE_DIRS: [&str; 5] = ["crates", "python", "xtask", "lab", "fuzz"];
 
 /// Crates allowed to contain `unsafe` blocks (each keeps them in one module).
 const UNSAFE_ALLOWED: [&str; 2] = ["wavg-project", "wavg-ffi"];
@@ -50,6 +56,40 @@ pub fn check_unsafe(root: &Path) -> Result<(), String> {
     }
 }
 
+/// `Err` names every `name.rs` under [`STYLE_DIRS`] that sits beside a folder `name/`
+/// holding Rust files: the workspace writes such a module as `name/mod.rs` (the style most
+/// of its modules had, and the one `tests/common/mod.rs` needs anyway).
+pub fn check_module_style(root: &Path) -> Result<(), String> {
+    let mut files = Vec::new();
+    for dir in STYLE_DIRS {
+        let dir = root.join(dir);
+        if dir.is_dir() {
+            rust_files(&dir, &mut files)?;
+        }
+    }
+    let mut mixed: Vec<String> = files
+        .iter()
+        .filter(|f| {
+            let sub = f.with_extension("");
+            files.iter().any(|g| g.parent() == Some(sub.as_path()))
+        })
+        .map(|f| f.strip_prefix(root).unwrap_or(f).display().to_string())
+        .collect();
+    mixed.sort();
+    if mixed.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "modules with submodules are written `name/mod.rs`; move {}",
+            mixed
+                .iter()
+                .map(|f| format!("{f} to {}/mod.rs", f.trim_end_matches(".rs")))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -85,8 +125,37 @@ mod tests {
     }
 
     #[test]
+    fn a_module_file_beside_its_folder_is_named() {
+        let root = std::env::temp_dir().join(format!("xtask-style-{}", std::process::id()));
+        let write = |rel: &str| {
+            let p = root.join(rel);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, "//! x\n").unwrap();
+        };
+        write("crates/a/src/lib.rs");
+        write("crates/a/src/one/mod.rs");
+        write("crates/a/src/one/leaf.rs");
+        write("crates/a/tests/common/mod.rs");
+        write("crates/a/src/data.rs");
+        write("crates/a/src/data/table.txt");
+        write("xtask/src/main.rs");
+        assert_eq!(check_module_style(&root), Ok(()));
+        write("crates/a/src/two.rs");
+        write("crates/a/src/two/leaf.rs");
+        let err = check_module_style(&root).unwrap_err();
+        assert!(
+            err.contains("crates/a/src/two.rs to crates/a/src/two/mod.rs")
+                && !err.contains("one")
+                && !err.contains("data"),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
     fn this_workspace_follows_the_policy() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
         assert_eq!(check_unsafe(root), Ok(()));
+        assert_eq!(check_module_style(root), Ok(()));
     }
 }

@@ -203,26 +203,26 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, s: &MeshIn
 
 #[cfg(test)]
 mod tests {
-    use wavg::ProblemKind;
+    use wavg::DefectKind;
 
     /// The `kind` keys of `problem_summary` are a contract with JSON consumers.
     #[test]
     fn problem_kinds_serialise_to_their_stable_keys() {
         let keys = [
-            (ProblemKind::Empty, "empty"),
-            (ProblemKind::IndexOutOfRange, "index_out_of_range"),
-            (ProblemKind::NonFiniteCoordinate, "non_finite_coordinate"),
-            (ProblemKind::RepeatedIndex, "repeated_index"),
-            (ProblemKind::ZeroAreaFace, "zero_area_face"),
-            (ProblemKind::DuplicateFace, "duplicate_face"),
-            (ProblemKind::NonManifoldEdge, "non_manifold_edge"),
-            (ProblemKind::NonManifoldVertex, "non_manifold_vertex"),
+            (DefectKind::Empty, "empty"),
+            (DefectKind::IndexOutOfRange, "index_out_of_range"),
+            (DefectKind::NonFiniteCoordinate, "non_finite_coordinate"),
+            (DefectKind::RepeatedIndex, "repeated_index"),
+            (DefectKind::ZeroAreaFace, "zero_area_face"),
+            (DefectKind::DuplicateFace, "duplicate_face"),
+            (DefectKind::NonManifoldEdge, "non_manifold_edge"),
+            (DefectKind::NonManifoldVertex, "non_manifold_vertex"),
             (
-                ProblemKind::InconsistentOrientation,
+                DefectKind::InconsistentOrientation,
                 "inconsistent_orientation",
             ),
-            (ProblemKind::UnreferencedVertex, "unreferenced_vertex"),
-            (ProblemKind::InvalidTexCoords, "invalid_tex_coords"),
+            (DefectKind::UnreferencedVertex, "unreferenced_vertex"),
+            (DefectKind::InvalidTexCoords, "invalid_tex_coords"),
         ];
         for (kind, key) in keys {
             assert_eq!(serde_json::to_value(kind).unwrap(), key);

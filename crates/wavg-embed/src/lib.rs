@@ -24,10 +24,7 @@ mod error;
 pub mod file;
 mod geodesic;
 mod lsmesh;
-mod lsmesh_two_level;
 mod mds;
-mod near_field;
-mod ordering;
 mod pipeline;
 mod quality;
 mod scaled;
@@ -56,8 +53,8 @@ pub use error::{EmbedError, NoProgress, Progress, Stage};
 #[doc(hidden)]
 pub mod internal {
     pub use crate::decimate::decimate_with_snapshots;
+    pub use crate::geodesic::near_field::NEAR_FIELD_EDGES;
     pub use crate::lsmesh::{bilaplacian, least_squares_mesh};
     pub use crate::mds::{MdsResult, classical_mds, metric_mds, relative_stress, smacof};
-    pub use crate::near_field::NEAR_FIELD_EDGES;
     pub use crate::quality::{Quality, QualityOptions, QualityPairs, geodesic_quality, percentile};
 }

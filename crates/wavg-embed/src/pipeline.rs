@@ -9,7 +9,7 @@ use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
 use crate::geodesic::{FastMarching, GeodesicOptions, landmark_distances};
 use crate::lsmesh::LsMeshSolver;
-use crate::lsmesh_two_level::{CgOptions, LsMeshExtension, TwoLevelLsMesh};
+use crate::lsmesh::two_level::{CgOptions, LsMeshExtension, TwoLevelLsMesh};
 use crate::mds::{MdsOptions, metric_mds};
 use crate::quality::{QualityOptions, QualityPairs};
 use crate::{Embedding, EmbeddingParams};

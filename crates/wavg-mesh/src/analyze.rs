@@ -1,10 +1,10 @@
-//! One pass over a raw mesh: every validation problem, the statistics `wavg info` prints,
+//! One pass over a raw mesh: every validation defect, the statistics `wavg info` prints,
 //! and (when the mesh is valid) its topology.
 
 use rayon::prelude::*;
 
+use crate::defect::{Defect, ValidationReport};
 use crate::mesh::TriMesh;
-use crate::problem::{Problem, ValidationReport};
 use crate::topology::{self, Topology};
 
 /// Faces whose doubled area is below this fraction of their longest squared edge are
@@ -42,13 +42,13 @@ pub struct MeshStats {
 pub struct Analysis {
     /// Counts.
     pub stats: MeshStats,
-    /// Every problem found.
+    /// Every defect found.
     pub report: ValidationReport,
     /// The topology, present exactly when the report is valid.
     pub topology: Option<Topology>,
 }
 
-/// Checks a raw mesh for every problem in [`Problem`] and computes its statistics.
+/// Checks a raw mesh for every defect in [`Defect`] and computes its statistics.
 /// Never panics, whatever the input.
 ///
 /// ```
@@ -60,23 +60,23 @@ pub struct Analysis {
 pub fn analyze(mesh: &TriMesh) -> Analysis {
     let nv = mesh.n_vertices();
     let nf = mesh.n_faces();
-    let mut problems = Vec::new();
+    let mut defects = Vec::new();
     if nv == 0 || nf == 0 {
-        problems.push(Problem::Empty {
+        defects.push(Defect::Empty {
             vertices: nv,
             faces: nf,
         });
     }
     for (v, p) in mesh.positions.iter().enumerate() {
         if !p.iter().all(|c| c.is_finite()) {
-            problems.push(Problem::NonFiniteCoordinate { vertex: v as u32 });
+            defects.push(Defect::NonFiniteCoordinate { vertex: v as u32 });
         }
     }
     // Faces usable for combinatorics: indices in range and distinct.
     let mut usable = vec![true; nf];
     for (f, t) in mesh.triangles.iter().enumerate() {
         if let Some(&bad) = t.iter().find(|&&i| i as usize >= nv) {
-            problems.push(Problem::IndexOutOfRange {
+            defects.push(Defect::IndexOutOfRange {
                 face: f as u32,
                 index: bad,
                 vertex_count: nv,
@@ -86,7 +86,7 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
     }
     for (f, t) in mesh.triangles.iter().enumerate() {
         if usable[f] && (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
-            problems.push(Problem::RepeatedIndex { face: f as u32 });
+            defects.push(Defect::RepeatedIndex { face: f as u32 });
             usable[f] = false;
         }
     }
@@ -94,7 +94,7 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
         if ok {
             let [a, b, c] = mesh.corners(f);
             if [a, b, c].iter().all(|p| p.iter().all(|x| x.is_finite())) && is_degenerate(a, b, c) {
-                problems.push(Problem::ZeroAreaFace { face: f as u32 });
+                defects.push(Defect::ZeroAreaFace { face: f as u32 });
             }
         }
     }
@@ -120,7 +120,7 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
             run.sort_unstable();
             for w in run.windows(2) {
                 if w[0].0 == w[1].0 {
-                    problems.push(Problem::DuplicateFace {
+                    defects.push(Defect::DuplicateFace {
                         face: w[1].1,
                         first: w[0].1,
                     });
@@ -139,7 +139,7 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
         let (a, b) = edges.key_vertices(g.start);
         if hs.len() > 2 {
             edge_manifold = false;
-            problems.push(Problem::NonManifoldEdge {
+            defects.push(Defect::NonManifoldEdge {
                 a,
                 b,
                 faces: hs.len(),
@@ -150,7 +150,7 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
             let dir = |h: u32| mesh.triangles[(h / 3) as usize][(h % 3) as usize];
             if dir(hs[0]) == dir(hs[1]) {
                 oriented = false;
-                problems.push(Problem::InconsistentOrientation {
+                defects.push(Defect::InconsistentOrientation {
                     face_a: fa,
                     face_b: fb,
                     a,
@@ -162,7 +162,7 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
     let adj = edges.manifold_adjacency(nf);
     let incidence = topology::VertexFaces::build(nv, &mesh.triangles, &usable);
     let mut vertex_manifold = true;
-    // Fans per vertex (0 for an unreferenced vertex), in parallel; the problems are then
+    // Fans per vertex (0 for an unreferenced vertex), in parallel; the defects are then
     // listed in vertex order.
     let fans: Vec<usize> = (0..nv)
         .into_par_iter()
@@ -183,29 +183,29 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
     let mut referenced = 0usize;
     for (v, &fans) in fans.iter().enumerate() {
         if fans == 0 {
-            problems.push(Problem::UnreferencedVertex { vertex: v as u32 });
+            defects.push(Defect::UnreferencedVertex { vertex: v as u32 });
             continue;
         }
         referenced += 1;
         if fans > 1 {
             vertex_manifold = false;
-            problems.push(Problem::NonManifoldVertex {
+            defects.push(Defect::NonManifoldVertex {
                 vertex: v as u32,
                 fans,
             });
         }
     }
     if let Some(uv) = &mesh.uv {
-        check_uv(mesh, uv, &mut problems);
+        check_uv(mesh, uv, &mut defects);
     }
-    problems.sort_by_key(|p| p.kind());
+    defects.sort_by_key(|p| p.kind());
 
     let manifold = edge_manifold
         && vertex_manifold
-        && !problems.iter().any(|p| {
+        && !defects.iter().any(|p| {
             matches!(
                 p,
-                Problem::IndexOutOfRange { .. } | Problem::RepeatedIndex { .. }
+                Defect::IndexOutOfRange { .. } | Defect::RepeatedIndex { .. }
             )
         });
     let comps = topology::face_components(nv, &mesh.triangles, &usable);
@@ -228,7 +228,7 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
         euler_characteristic: chi,
         genus,
     };
-    let report = ValidationReport { problems };
+    let report = ValidationReport { problems: defects };
     let topology = report
         .is_valid()
         .then(|| Topology::from_parts(mesh, adj, incidence, comps, genus.unwrap_or(0), chi));
@@ -269,9 +269,9 @@ pub(crate) fn is_degenerate(
     !well_shaped
 }
 
-fn check_uv(mesh: &TriMesh, uv: &crate::mesh::TexCoords, problems: &mut Vec<Problem>) {
+fn check_uv(mesh: &TriMesh, uv: &crate::mesh::TexCoords, defects: &mut Vec<Defect>) {
     if uv.faces.len() != mesh.triangles.len() {
-        problems.push(Problem::InvalidTexCoords {
+        defects.push(Defect::InvalidTexCoords {
             face: uv.faces.len().min(mesh.triangles.len()) as u32,
             reason: format!(
                 "{} texture faces for {} triangles",
@@ -283,7 +283,7 @@ fn check_uv(mesh: &TriMesh, uv: &crate::mesh::TexCoords, problems: &mut Vec<Prob
     }
     for (f, t) in uv.faces.iter().enumerate() {
         if let Some(&i) = t.iter().find(|&&i| i as usize >= uv.coords.len()) {
-            problems.push(Problem::InvalidTexCoords {
+            defects.push(Defect::InvalidTexCoords {
                 face: f as u32,
                 reason: format!("uv index {i} out of range ({} uvs)", uv.coords.len()),
             });
@@ -291,7 +291,7 @@ fn check_uv(mesh: &TriMesh, uv: &crate::mesh::TexCoords, problems: &mut Vec<Prob
             .iter()
             .any(|&i| !uv.coords[i as usize].iter().all(|c| c.is_finite()))
         {
-            problems.push(Problem::InvalidTexCoords {
+            defects.push(Defect::InvalidTexCoords {
                 face: f as u32,
                 reason: "non-finite uv".into(),
             });

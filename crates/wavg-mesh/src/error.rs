@@ -2,12 +2,12 @@
 
 use std::path::PathBuf;
 
-use crate::problem::ValidationReport;
+use crate::defect::ValidationReport;
 
 /// Everything that can go wrong loading, validating or repairing a mesh.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    /// The mesh failed validation; the report lists every problem.
+    /// The mesh failed validation; the report lists every defect.
     #[error("{0}")]
     Invalid(Box<ValidationReport>),
     /// Reading or writing a file failed.

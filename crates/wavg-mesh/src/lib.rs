@@ -1,7 +1,7 @@
 //! Triangle meshes for wavg: storage, connectivity, validation, repair, I/O and geometry.
 //!
 //! The flow is: load or generate a [`TriMesh`] (any file can be parsed into one, however
-//! broken), [`analyze()`] it to see its problems and statistics, optionally [`repair`] it, then
+//! broken), [`analyze()`] it to see its defects and statistics, optionally [`repair`] it, then
 //! make a [`ValidMesh`] (oriented manifold plus [`Topology`]), the only type later stages take.
 //!
 //! ```
@@ -33,12 +33,12 @@
 #![forbid(unsafe_code)]
 
 mod analyze;
+mod defect;
 mod error;
 pub mod geometry;
 pub mod io;
 mod mesh;
 mod point;
-mod problem;
 pub mod procedural;
 pub mod repair;
 mod report;
@@ -55,11 +55,24 @@ pub use valid::ValidMesh;
 
 // Diagnostics.
 pub use analyze::{Analysis, MeshStats, ZERO_AREA_RELATIVE_TOLERANCE, analyze};
-pub use problem::{Problem, ProblemKind, ProblemSummary, ValidationReport};
+pub use defect::{Defect, DefectKind, DefectSummary, ValidationReport};
+
+/// Renamed to [`Defect`] ("problem" names the paper's forward and inverse problems).
+#[deprecated(note = "renamed to `Defect`")]
+pub type Problem = Defect;
+/// Renamed to [`DefectKind`].
+#[deprecated(note = "renamed to `DefectKind`")]
+pub type ProblemKind = DefectKind;
+/// Renamed to [`DefectSummary`].
+#[deprecated(note = "renamed to `DefectSummary`")]
+pub type ProblemSummary = DefectSummary;
+/// Renamed to [`DefectGroup`].
+#[deprecated(note = "renamed to `DefectGroup`")]
+pub type ProblemGroup = DefectGroup;
 
 // Reports for people and programs (with the `serde` feature, serialisable).
 pub use report::{
-    BoundingBox, MeshInfo, ProblemGroup, RepairPreview, RepairReport, SubdivisionReport,
+    BoundingBox, DefectGroup, MeshInfo, RepairPreview, RepairReport, SubdivisionReport,
 };
 
 // Points on the surface.

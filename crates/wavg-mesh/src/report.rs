@@ -3,13 +3,13 @@
 //! ([`RepairReport`]) and `wavg subdivide --json` ([`SubdivisionReport`]): the field names.
 
 use crate::analyze::{Analysis, analyze};
+use crate::defect::{DefectKind, DefectSummary};
 use crate::io::format::LoadNotes;
 use crate::mesh::TriMesh;
-use crate::problem::{ProblemKind, ProblemSummary};
 use crate::repair::repair_all;
 use crate::repair::types::{RepairOptions, Repaired};
 
-/// Counts, topology, bounding box and problems of a mesh, valid or not, and what the
+/// Counts, topology, bounding box and defects of a mesh, valid or not, and what the
 /// default repairs would do to it.
 ///
 /// ```
@@ -48,16 +48,16 @@ pub struct MeshInfo {
     pub oriented: bool,
     /// Whether there is no boundary.
     pub watertight: bool,
-    /// Whether no problem was found (an oriented manifold wavg can use).
+    /// Whether no defect was found (an oriented manifold wavg can use).
     pub valid: bool,
     /// Whether the mesh has texture coordinates.
     pub uv: bool,
     /// Bounding box (`None` without vertices).
     pub bounding_box: Option<BoundingBox>,
-    /// One line per kind of problem ([`crate::ValidationReport::lines`]).
+    /// One line per kind of defect ([`crate::ValidationReport::lines`]).
     pub problems: Vec<String>,
-    /// The problems by kind.
-    pub problem_summary: Vec<ProblemGroup>,
+    /// The defects by kind.
+    pub problem_summary: Vec<DefectGroup>,
     /// What the default repairs would do (`None` for a valid mesh).
     pub repair: Option<RepairPreview>,
     /// Why the embedding and the solvers would refuse the size of this valid mesh
@@ -110,7 +110,7 @@ impl MeshInfo {
                 .report
                 .summary()
                 .iter()
-                .map(ProblemGroup::from)
+                .map(DefectGroup::from)
                 .collect(),
             repair: (!valid).then(|| RepairPreview::of(mesh)),
             out_of_range: valid
@@ -132,24 +132,24 @@ pub struct BoundingBox {
     pub diagonal: f64,
 }
 
-/// One kind of problem: [`ProblemSummary`] in words.
+/// One kind of defect: [`DefectSummary`] in words.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct ProblemGroup {
+pub struct DefectGroup {
     /// The kind (in JSON its snake_case name, e.g. `non_manifold_edge`).
-    pub kind: ProblemKind,
-    /// [`ProblemKind::describe`].
+    pub kind: DefectKind,
+    /// [`DefectKind::describe`].
     pub description: &'static str,
-    /// How many problems of this kind.
+    /// How many defects of this kind.
     pub count: usize,
     /// The first few, as sentences.
     pub examples: Vec<String>,
-    /// [`ProblemKind::remedy`].
+    /// [`DefectKind::remedy`].
     pub remedy: Option<&'static str>,
 }
 
-impl From<&ProblemSummary> for ProblemGroup {
-    fn from(p: &ProblemSummary) -> Self {
+impl From<&DefectSummary> for DefectGroup {
+    fn from(p: &DefectSummary) -> Self {
         Self {
             kind: p.kind,
             description: p.kind.describe(),
@@ -174,7 +174,7 @@ pub struct RepairPreview {
     pub added_vertices: usize,
     /// Faces removed.
     pub removed_faces: usize,
-    /// The problems left, one `"COUNT DESCRIPTION"` per kind (empty when `fixes_all`).
+    /// The defects left, one `"COUNT DESCRIPTION"` per kind (empty when `fixes_all`).
     pub remaining_problems: Vec<String>,
     /// Connected components after repair. Not serialised.
     #[cfg_attr(feature = "serde", serde(skip))]
@@ -203,7 +203,7 @@ impl RepairPreview {
     }
 }
 
-/// What a repair did: the counts before and after, and the problems left.
+/// What a repair did: the counts before and after, and the defects left.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct RepairReport {
@@ -225,7 +225,7 @@ pub struct RepairReport {
     pub components: usize,
     /// Whether the output is valid.
     pub valid: bool,
-    /// The problems left, one line per kind ([`crate::ValidationReport::lines`]).
+    /// The defects left, one line per kind ([`crate::ValidationReport::lines`]).
     pub problems: Vec<String>,
 }
 

@@ -25,7 +25,7 @@ pub struct ValidMesh {
 }
 
 impl ValidMesh {
-    /// Validates `mesh`; the error lists every problem found.
+    /// Validates `mesh`; the error lists every defect found.
     pub fn new(mesh: TriMesh) -> Result<Self, MeshError> {
         let a = analyze(&mesh);
         match a.topology {

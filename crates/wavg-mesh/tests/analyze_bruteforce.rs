@@ -4,7 +4,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
-use wavg_mesh::{Problem, ProblemKind, TriMesh, ValidMesh, analyze};
+use wavg_mesh::{Defect, DefectKind, TriMesh, ValidMesh, analyze};
 
 fn find(p: &mut Vec<usize>, x: usize) -> usize {
     if p[x] != x {
@@ -68,7 +68,7 @@ proptest! {
             }
         }
         let mut got: Vec<(u32, u32)> = a.report.problems.iter().filter_map(|p| match p {
-            Problem::DuplicateFace { face, first } => Some((*face, *first)),
+            Defect::DuplicateFace { face, first } => Some((*face, *first)),
             _ => None,
         }).collect();
         got.sort();
@@ -85,12 +85,12 @@ proptest! {
         }
         prop_assert_eq!(a.stats.edges, edges.len());
         let nm = edges.values().filter(|h| h.len() > 2).count();
-        prop_assert_eq!(a.report.count(ProblemKind::NonManifoldEdge), nm);
+        prop_assert_eq!(a.report.count(DefectKind::NonManifoldEdge), nm);
         let flips = edges.values().filter(|h| h.len() == 2 && h[0] == h[1]).count();
-        prop_assert_eq!(a.report.count(ProblemKind::InconsistentOrientation), flips);
+        prop_assert_eq!(a.report.count(DefectKind::InconsistentOrientation), flips);
         // Referenced vertices, Euler characteristic, components.
         let referenced: BTreeSet<usize> = usable.iter().flat_map(|&f| faces[f].map(|i| i as usize)).collect();
-        prop_assert_eq!(a.report.count(ProblemKind::UnreferencedVertex), nv - referenced.len());
+        prop_assert_eq!(a.report.count(DefectKind::UnreferencedVertex), nv - referenced.len());
         prop_assert_eq!(
             a.stats.euler_characteristic,
             referenced.len() as i64 - edges.len() as i64 + usable.len() as i64
@@ -136,7 +136,7 @@ proptest! {
                 pinched += 1;
             }
         }
-        prop_assert_eq!(a.report.count(ProblemKind::NonManifoldVertex), pinched);
+        prop_assert_eq!(a.report.count(DefectKind::NonManifoldVertex), pinched);
         // Valid exactly when no problem; then the topology agrees with the counts.
         prop_assert_eq!(a.topology.is_some(), a.report.is_valid());
         if a.report.is_valid() {

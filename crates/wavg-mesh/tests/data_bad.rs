@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use wavg_mesh::ProblemKind::{self, *};
+use wavg_mesh::DefectKind::{self, *};
 use wavg_mesh::{MeshError, ValidMesh, analyze, io};
 use wavg_mesh::{RepairOptions, repair};
 use wavg_testdata as data;
@@ -18,7 +18,7 @@ enum Expect {
         tris: usize,
         loops: usize,
         chi: Option<i64>,
-        problems: &'static [(ProblemKind, Option<usize>)],
+        problems: &'static [(DefectKind, Option<usize>)],
         /// `repair_all` with default options yields a valid mesh.
         repairable: bool,
     },
@@ -38,7 +38,7 @@ const fn report(
     tris: usize,
     loops: usize,
     chi: Option<i64>,
-    problems: &'static [(ProblemKind, Option<usize>)],
+    problems: &'static [(DefectKind, Option<usize>)],
     repairable: bool,
 ) -> Expect {
     Report {
@@ -169,8 +169,8 @@ fn every_bad_file_is_diagnosed_and_repairable_ones_are_repaired() {
                 if let Some(chi) = chi {
                     assert_eq!(a.stats.euler_characteristic, *chi, "{name}: chi");
                 }
-                let kinds: Vec<ProblemKind> = a.report.summary().iter().map(|s| s.kind).collect();
-                let expected: Vec<ProblemKind> = problems.iter().map(|p| p.0).collect();
+                let kinds: Vec<DefectKind> = a.report.summary().iter().map(|s| s.kind).collect();
+                let expected: Vec<DefectKind> = problems.iter().map(|p| p.0).collect();
                 assert_eq!(kinds, expected, "{name}: {}", a.report);
                 for (kind, count) in problems.iter() {
                     if let Some(c) = count {

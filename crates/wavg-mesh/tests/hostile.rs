@@ -114,7 +114,7 @@ fn degenerate_meshes_are_invalid() {
 /// at every scale, and the computations' range check names the remedy.
 #[test]
 fn validity_does_not_depend_on_scale() {
-    use wavg_mesh::{ProblemKind, analyze, coordinates_out_of_range};
+    use wavg_mesh::{DefectKind, analyze, coordinates_out_of_range};
     let sphere = wavg_mesh::procedural::icosphere(3);
     for (scale, remedy) in [
         (1e200, Some("down")),
@@ -142,7 +142,7 @@ fn validity_does_not_depend_on_scale() {
         m.positions[a] = (m.positions[b] + m.positions[c]) / 2.0;
         let report = analyze(&m).report;
         assert!(
-            report.count(ProblemKind::ZeroAreaFace) >= 1,
+            report.count(DefectKind::ZeroAreaFace) >= 1,
             "scale {scale:e}: {report:?}"
         );
         let repaired = wavg_mesh::repair::drop_degenerate_faces(&m);

@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use proptest::prelude::*;
+use wavg_mesh::{DefectKind, MeshError, TriMesh, analyze};
 use wavg_mesh::{Format, LoadNotes, io};
-use wavg_mesh::{MeshError, ProblemKind, TriMesh, analyze};
 
 fn parse(text: &str, format: Format) -> Result<(TriMesh, LoadNotes), MeshError> {
     io::parse_bytes(text.as_bytes(), format, Path::new("t"))
@@ -66,7 +66,7 @@ f 1 3 4
     let (m, n) = parse(&format!("{SQUARE}f 1 2\nf 1 2 5\nv 0 0 1\n"), Format::Obj).unwrap();
     assert_eq!((n.skipped_faces, m.n_faces(), m.n_vertices()), (1, 1, 5));
     assert_eq!(m.triangles, vec![[0, 1, 4]]);
-    assert_eq!(analyze(&m).report.count(ProblemKind::IndexOutOfRange), 0);
+    assert_eq!(analyze(&m).report.count(DefectKind::IndexOutOfRange), 0);
 }
 
 #[test]
@@ -118,7 +118,7 @@ fn byte_order_mark_and_crlf_are_accepted() {
 fn obj_out_of_range_is_kept_for_validation() {
     let (m, _) = parse(&format!("{SQUARE}f 1 2 9\n"), Format::Obj).unwrap();
     assert_eq!(m.triangles, vec![[0, 1, 8]]);
-    assert_eq!(analyze(&m).report.count(ProblemKind::IndexOutOfRange), 1);
+    assert_eq!(analyze(&m).report.count(DefectKind::IndexOutOfRange), 1);
 }
 
 #[test]
@@ -163,7 +163,7 @@ fn off_variants() {
     .unwrap();
     assert_eq!(m.n_vertices(), 3);
     let (m, _) = parse("OFF\n0 0 0\n", Format::Off).unwrap();
-    assert_eq!(analyze(&m).report.count(ProblemKind::Empty), 1);
+    assert_eq!(analyze(&m).report.count(DefectKind::Empty), 1);
 }
 
 #[test]

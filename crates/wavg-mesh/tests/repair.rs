@@ -2,7 +2,7 @@
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
-use wavg_mesh::{NONE, ProblemKind, TexCoords, TriMesh, ValidMesh, analyze, procedural};
+use wavg_mesh::{DefectKind, NONE, TexCoords, TriMesh, ValidMesh, analyze, procedural};
 use wavg_mesh::{RepairOptions, Repaired, repair};
 
 /// Every position is the original's, the two vertex maps are consistent, and every face
@@ -129,11 +129,11 @@ fn degenerate_duplicate_and_unreferenced_are_removed() {
     m.positions.push(Vector3::new(5.0, 5.0, 5.0)); // unreferenced
     let a0 = analyze(&m);
     for k in [
-        ProblemKind::RepeatedIndex,
-        ProblemKind::IndexOutOfRange,
-        ProblemKind::DuplicateFace,
-        ProblemKind::ZeroAreaFace,
-        ProblemKind::UnreferencedVertex,
+        DefectKind::RepeatedIndex,
+        DefectKind::IndexOutOfRange,
+        DefectKind::DuplicateFace,
+        DefectKind::ZeroAreaFace,
+        DefectKind::UnreferencedVertex,
     ] {
         assert!(a0.report.count(k) > 0, "{k:?} not detected");
     }
@@ -168,7 +168,7 @@ fn unreferenced_drop_keeps_out_of_range_indices_out_of_range() {
     assert_eq!(r.mesh.n_vertices(), 12);
     assert!(r.mesh.triangles.last().unwrap()[2] >= 12);
     assert_eq!(
-        analyze(&r.mesh).report.count(ProblemKind::IndexOutOfRange),
+        analyze(&r.mesh).report.count(DefectKind::IndexOutOfRange),
         1
     );
 }
@@ -256,30 +256,30 @@ proptest! {
 fn remedies_named_by_problem_kinds_are_real() {
     let base = procedural::icosphere(1);
     let n = base.n_vertices() as u32;
-    let mut cases: Vec<(TriMesh, ProblemKind)> = Vec::new();
+    let mut cases: Vec<(TriMesh, DefectKind)> = Vec::new();
     let mut m = base.clone();
     m.triangles.push([0, 0, 1]);
-    cases.push((m, ProblemKind::RepeatedIndex));
+    cases.push((m, DefectKind::RepeatedIndex));
     let mut m = base.clone();
     m.triangles.push([0, 1, n + 3]);
-    cases.push((m, ProblemKind::IndexOutOfRange));
+    cases.push((m, DefectKind::IndexOutOfRange));
     let mut m = base.clone();
     m.positions[5] = Vector3::new(f64::NAN, 0.0, 0.0);
-    cases.push((m, ProblemKind::NonFiniteCoordinate));
+    cases.push((m, DefectKind::NonFiniteCoordinate));
     let mut m = base.clone();
     m.triangles.push(m.triangles[4]); // also makes 3 non-manifold edges
-    cases.push((m, ProblemKind::DuplicateFace));
+    cases.push((m, DefectKind::DuplicateFace));
     let mut m = base.clone();
     m.positions.push(Vector3::zeros());
-    cases.push((m, ProblemKind::UnreferencedVertex));
+    cases.push((m, DefectKind::UnreferencedVertex));
     let mut m = base.clone();
     let mid = (m.positions[0] + m.positions[11]) / 2.0;
     m.positions.push(mid);
     m.triangles.push([0, 11, n]);
-    cases.push((m, ProblemKind::ZeroAreaFace));
+    cases.push((m, DefectKind::ZeroAreaFace));
     let mut m = base.clone();
     m.triangles[3].swap(0, 1);
-    cases.push((m, ProblemKind::InconsistentOrientation));
+    cases.push((m, DefectKind::InconsistentOrientation));
     // Two spheres glued at one vertex, and along one edge.
     let (mut pinch, mut fin) = (base.clone(), base.clone());
     for (m, shared) in [(&mut pinch, 1), (&mut fin, 2)] {
@@ -301,8 +301,8 @@ fn remedies_named_by_problem_kinds_are_real() {
         m.triangles
             .extend(base.triangles.iter().map(|t| t.map(glue)));
     }
-    cases.push((pinch, ProblemKind::NonManifoldVertex));
-    cases.push((fin, ProblemKind::NonManifoldEdge));
+    cases.push((pinch, DefectKind::NonManifoldVertex));
+    cases.push((fin, DefectKind::NonManifoldEdge));
     for (m, kind) in cases {
         let a = analyze(&m);
         assert!(a.report.count(kind) > 0, "{kind:?}: {}", a.report);
@@ -403,7 +403,7 @@ fn faces_are_oriented_consistently() {
     let r = repair::repair_all(&moebius, &RepairOptions::default());
     check_maps(&moebius, &r);
     let a = analyze(&r.mesh);
-    assert!(a.report.count(ProblemKind::InconsistentOrientation) > 0);
+    assert!(a.report.count(DefectKind::InconsistentOrientation) > 0);
 }
 
 /// A Moebius strip of `n` quads (two triangles each), one half twist.

@@ -72,8 +72,11 @@ pub use wavg_solve::{DEFAULT_GAMMA, DEFAULT_TOLERANCE, resolve_anchor, validate_
 // Reports and options of the mesh tools (inspection, repair, subdivision, decimation) and
 // texture coordinates.
 pub use wavg_embed::DecimateOptions;
+/// Renamed to [`DefectKind`] ("problem" names the paper's forward and inverse problems).
+#[allow(deprecated)]
+pub use wavg_mesh::ProblemKind;
 pub use wavg_mesh::{
-    LoadNotes, MeshInfo, ProblemKind, RepairOptions, RepairReport, SubdivisionReport, TexCoords,
+    DefectKind, LoadNotes, MeshInfo, RepairOptions, RepairReport, SubdivisionReport, TexCoords,
 };
 
 /// Seeded sampling of surface points and anchor vertices, as the benchmarks and the demo

@@ -242,3 +242,11 @@ fn solvers_and_one_offs_agree() {
     let e = s.solver([s.n_vertices() as u32]).err().unwrap();
     assert_eq!(e.kind(), ErrorKind::InvalidArgument);
 }
+
+/// The facade's old name for a defect kind still names the same type (deprecated).
+#[test]
+#[allow(deprecated)]
+fn problem_kind_is_the_deprecated_name_of_defect_kind() {
+    let k: wavg::ProblemKind = wavg::DefectKind::ZeroAreaFace;
+    assert_eq!(k, wavg::mesh::DefectKind::ZeroAreaFace);
+}

@@ -44,7 +44,7 @@ pub struct FastMarching {
     pub(super) n: usize,
     pub(super) offsets: Vec<u32>,
     pub(super) entries: Vec<Entry>,
-    /// Exact distances near a source, by unfolding ([`crate::near_field`]).
+    /// Exact distances near a source, by unfolding ([`super::near_field`]).
     pub(super) near: NearField,
     /// Number of obtuse corners, and how many of them were split by unfolding.
     pub(super) obtuse: (usize, usize),
@@ -222,7 +222,7 @@ impl FastMarching {
     }
 
     /// This fast marching with its exact near field reaching `edges` mean edge lengths
-    /// from each source instead of [`NEAR_FIELD_EDGES`](crate::near_field::NEAR_FIELD_EDGES)
+    /// from each source instead of [`NEAR_FIELD_EDGES`](super::near_field::NEAR_FIELD_EDGES)
     /// (0 turns it off). A wider near field costs more per run (3-5x the plain fast
     /// marching at 16 edge lengths on real meshes, 1.1-1.5x at 8) and is exact further out.
     ///

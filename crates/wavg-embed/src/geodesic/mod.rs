@@ -44,9 +44,9 @@
 //! full-resolution fast marching are in `BENCHMARKS.md`.
 //!
 //! **Near the source** the front is strongly curved and a plane wave fits it worst, so each
-//! run starts with exact polyhedral distances within [`crate::near_field::NEAR_FIELD_EDGES`]
+//! run starts with exact polyhedral distances within [`near_field::NEAR_FIELD_EDGES`]
 //! mean edge lengths of the source (windows of Chen & Han with pseudo-sources at saddle
-//! vertices and Xin & Wang's pruning, [`crate::near_field`]; the radius is a parameter,
+//! vertices and Xin & Wang's pruning, [`near_field`]; the radius is a parameter,
 //! [`FastMarching::with_near_field_edges`]). It makes close pairs nearly exact and the
 //! landmark matrix far more symmetric for a little more time per run; the figures are in
 //! `BENCHMARKS.md`.
@@ -62,14 +62,15 @@ use wavg_mesh::{NONE, ValidMesh};
 
 use crate::decimate::{DecimateOptions, Decimated, decimate};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
-use crate::near_field::{NearField, NearScratch};
 
 mod fast_marching;
 mod heap;
 mod landmarks;
+pub(crate) mod near_field;
 mod unfold;
 
 use fast_marching::*;
+use near_field::{NearField, NearScratch};
 use unfold::*;
 
 pub(crate) use fast_marching::{DEFAULT_GEODESIC_VERTICES, MAX_UNFOLD_STEPS};

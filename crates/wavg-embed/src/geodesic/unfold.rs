@@ -35,7 +35,7 @@ pub(super) fn unfold(
         if w == x {
             return None;
         }
-        let w2 = crate::near_field::place(
+        let w2 = super::near_field::place(
             &p2,
             &r2,
             (pos[w as usize] - pos[p as usize]).norm(),

@@ -1,7 +1,9 @@
 //! The exclusion test before Newton's method: a proof, cheaper than a solve, that a
 //! triangle holds no projection of the query.
 
-use super::*;
+use super::newton::System;
+use super::{CLAMP_RESIDUAL, Frame32, TriData};
+use crate::Vec8;
 
 impl TriData {
     /// [`TriData::solve_or_exit`], but `Err(None)` without Newton's method when the

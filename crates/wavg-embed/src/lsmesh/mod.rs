@@ -20,6 +20,9 @@ use wavg_mesh::{TriMesh, ValidMesh, geometry};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
 
+mod ordering;
+pub(crate) mod two_level;
+
 /// The bi-Laplacian `A = L M⁻¹ L` of a mesh (n x n, symmetric positive semidefinite,
 /// constants in its kernel).
 pub fn bilaplacian(mesh: &TriMesh) -> Result<SparseColMat<usize, f64>, EmbedError> {
@@ -90,11 +93,8 @@ fn fill_reducing_symbolic(
     if a.ncols() < nested_dissection_min {
         return Ok(amd);
     }
-    let (forward, inverse) = crate::ordering::nested_dissection(
-        a.symbolic().col_ptr(),
-        a.symbolic().row_idx(),
-        positions,
-    );
+    let (forward, inverse) =
+        ordering::nested_dissection(a.symbolic().col_ptr(), a.symbolic().row_idx(), positions);
     let perm = faer::perm::PermRef::new_checked(&forward, &inverse, a.ncols());
     let nd = symbolic(SymmetricOrdering::Custom(perm))?;
     Ok(if nd.len_val() < amd.len_val() {

@@ -19,10 +19,10 @@ use faer::sparse::SparseColMat;
 use rayon::prelude::*;
 use wavg_mesh::{ValidMesh, geometry};
 
+use super::LsMeshSolver;
 use crate::decimate::Decimated;
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
-use crate::lsmesh::LsMeshSolver;
 
 type Row = [f64; MAX_DIM];
 

@@ -1,4 +1,8 @@
-//! Typed validation problems and the report that groups them.
+//! Typed validation defects and the report that groups them.
+//!
+//! "Defect" names what is wrong with a mesh; "problem" is kept for the paper's forward and
+//! inverse problems. Field names and JSON keys (`problems`, `problem_summary`,
+//! `remaining_problems`) keep their old spelling: they are a stable interface.
 
 use std::fmt;
 
@@ -6,7 +10,7 @@ use crate::mesh::{FaceId, VertexId};
 
 /// One thing wrong with a mesh, naming the offending index.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum Problem {
+pub enum Defect {
     /// The mesh has no vertices or no faces.
     #[error("the mesh is empty ({vertices} vertices, {faces} faces)")]
     Empty {
@@ -97,7 +101,7 @@ pub enum Problem {
     },
 }
 
-/// The kinds of [`Problem`], for grouping and counting. With the `serde` feature a kind
+/// The kinds of [`Defect`], for grouping and counting. With the `serde` feature a kind
 /// serialises to its stable snake_case name (`non_manifold_edge`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[cfg_attr(
@@ -105,32 +109,32 @@ pub enum Problem {
     derive(serde::Serialize),
     serde(rename_all = "snake_case")
 )]
-pub enum ProblemKind {
-    /// [`Problem::Empty`]
+pub enum DefectKind {
+    /// [`Defect::Empty`]
     Empty,
-    /// [`Problem::IndexOutOfRange`]
+    /// [`Defect::IndexOutOfRange`]
     IndexOutOfRange,
-    /// [`Problem::NonFiniteCoordinate`]
+    /// [`Defect::NonFiniteCoordinate`]
     NonFiniteCoordinate,
-    /// [`Problem::RepeatedIndex`]
+    /// [`Defect::RepeatedIndex`]
     RepeatedIndex,
-    /// [`Problem::ZeroAreaFace`]
+    /// [`Defect::ZeroAreaFace`]
     ZeroAreaFace,
-    /// [`Problem::DuplicateFace`]
+    /// [`Defect::DuplicateFace`]
     DuplicateFace,
-    /// [`Problem::NonManifoldEdge`]
+    /// [`Defect::NonManifoldEdge`]
     NonManifoldEdge,
-    /// [`Problem::NonManifoldVertex`]
+    /// [`Defect::NonManifoldVertex`]
     NonManifoldVertex,
-    /// [`Problem::InconsistentOrientation`]
+    /// [`Defect::InconsistentOrientation`]
     InconsistentOrientation,
-    /// [`Problem::UnreferencedVertex`]
+    /// [`Defect::UnreferencedVertex`]
     UnreferencedVertex,
-    /// [`Problem::InvalidTexCoords`]
+    /// [`Defect::InvalidTexCoords`]
     InvalidTexCoords,
 }
 
-impl ProblemKind {
+impl DefectKind {
     /// Short human-readable name, e.g. "non-manifold edges".
     pub fn describe(self) -> &'static str {
         match self {
@@ -169,26 +173,26 @@ impl ProblemKind {
     }
 }
 
-impl Problem {
-    /// The kind of this problem.
-    pub fn kind(&self) -> ProblemKind {
+impl Defect {
+    /// The kind of this defect.
+    pub fn kind(&self) -> DefectKind {
         match self {
-            Self::Empty { .. } => ProblemKind::Empty,
-            Self::IndexOutOfRange { .. } => ProblemKind::IndexOutOfRange,
-            Self::NonFiniteCoordinate { .. } => ProblemKind::NonFiniteCoordinate,
-            Self::RepeatedIndex { .. } => ProblemKind::RepeatedIndex,
-            Self::ZeroAreaFace { .. } => ProblemKind::ZeroAreaFace,
-            Self::DuplicateFace { .. } => ProblemKind::DuplicateFace,
-            Self::NonManifoldEdge { .. } => ProblemKind::NonManifoldEdge,
-            Self::NonManifoldVertex { .. } => ProblemKind::NonManifoldVertex,
-            Self::InconsistentOrientation { .. } => ProblemKind::InconsistentOrientation,
-            Self::UnreferencedVertex { .. } => ProblemKind::UnreferencedVertex,
-            Self::InvalidTexCoords { .. } => ProblemKind::InvalidTexCoords,
+            Self::Empty { .. } => DefectKind::Empty,
+            Self::IndexOutOfRange { .. } => DefectKind::IndexOutOfRange,
+            Self::NonFiniteCoordinate { .. } => DefectKind::NonFiniteCoordinate,
+            Self::RepeatedIndex { .. } => DefectKind::RepeatedIndex,
+            Self::ZeroAreaFace { .. } => DefectKind::ZeroAreaFace,
+            Self::DuplicateFace { .. } => DefectKind::DuplicateFace,
+            Self::NonManifoldEdge { .. } => DefectKind::NonManifoldEdge,
+            Self::NonManifoldVertex { .. } => DefectKind::NonManifoldVertex,
+            Self::InconsistentOrientation { .. } => DefectKind::InconsistentOrientation,
+            Self::UnreferencedVertex { .. } => DefectKind::UnreferencedVertex,
+            Self::InvalidTexCoords { .. } => DefectKind::InvalidTexCoords,
         }
     }
 }
 
-/// All problems found in a mesh. Empty means the mesh is a valid oriented manifold.
+/// All defects found in a mesh. Empty means the mesh is a valid oriented manifold.
 ///
 /// ```
 /// use wavg_mesh::{analyze, procedural};
@@ -197,35 +201,36 @@ impl Problem {
 /// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ValidationReport {
-    /// Every problem, grouped by kind in [`ProblemKind`] order, ascending index within a kind.
-    pub problems: Vec<Problem>,
+    /// Every defect, grouped by kind in [`DefectKind`] order, ascending index within a kind
+    /// (the field keeps its name, a stable interface).
+    pub problems: Vec<Defect>,
 }
 
-/// Count and first examples of one kind of problem.
+/// Count and first examples of one kind of defect.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ProblemSummary {
+pub struct DefectSummary {
     /// The kind.
-    pub kind: ProblemKind,
-    /// How many problems of this kind.
+    pub kind: DefectKind,
+    /// How many defects of this kind.
     pub count: usize,
     /// The first few (at most 5).
-    pub examples: Vec<Problem>,
+    pub examples: Vec<Defect>,
 }
 
 impl ValidationReport {
-    /// True when no problem was found.
+    /// True when no defect was found.
     pub fn is_valid(&self) -> bool {
         self.problems.is_empty()
     }
 
-    /// Number of problems of one kind.
-    pub fn count(&self, kind: ProblemKind) -> usize {
+    /// Number of defects of one kind.
+    pub fn count(&self, kind: DefectKind) -> usize {
         self.problems.iter().filter(|p| p.kind() == kind).count()
     }
 
-    /// Problems grouped by kind, with counts and the first five examples.
-    pub fn summary(&self) -> Vec<ProblemSummary> {
-        let mut out: Vec<ProblemSummary> = Vec::new();
+    /// Defects grouped by kind, with counts and the first five examples.
+    pub fn summary(&self) -> Vec<DefectSummary> {
+        let mut out: Vec<DefectSummary> = Vec::new();
         for p in &self.problems {
             match out.iter_mut().find(|s| s.kind == p.kind()) {
                 Some(s) => {
@@ -234,7 +239,7 @@ impl ValidationReport {
                         s.examples.push(p.clone());
                     }
                 }
-                None => out.push(ProblemSummary {
+                None => out.push(DefectSummary {
                     kind: p.kind(),
                     count: 1,
                     examples: vec![p.clone()],
