@@ -32,14 +32,12 @@ fn reports_the_file_and_its_stages() {
 #[test]
 fn invalid_meshes_are_measured_and_bad_files_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let open = dir.path().join("open.obj");
-    std::fs::write(
-        &open,
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 2 2\n",
-    )
-    .unwrap();
-    let r = load_bench(&open, 1).unwrap();
-    assert_eq!((r.vertices, r.faces), (4, 3));
+    // Three triangles on one edge: not a manifold.
+    let fan = dir.path().join("fan.obj");
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
+    std::fs::write(&fan, text).unwrap();
+    let r = load_bench(&fan, 1).unwrap();
+    assert_eq!((r.vertices, r.faces), (5, 3));
     assert!(!r.valid, "{r:?}");
     assert!(load_bench(&dir.path().join("missing.obj"), 1).is_err());
     let junk = dir.path().join("junk.off");
