@@ -1,9 +1,8 @@
 //! `wavg bench load`: how long reading, parsing, and validating + building the topology
-//! of a mesh take (best of N runs each), in release builds.
+//! of a mesh take (best of N runs each), in release builds (the protocol is
+//! [`wavg_bench::load_bench`]'s; this prints its report).
 
-use std::time::Instant;
-
-use wavg::mesh::{analyze, io};
+use wavg_bench::{LoadBenchReport, load_bench};
 
 use crate::CliError;
 use crate::common::one_line;
@@ -23,92 +22,43 @@ pub struct Args {
     pub json: bool,
 }
 
-/// Best times in seconds of each stage and of a whole run.
-struct Times {
-    read: f64,
-    parse: f64,
-    analyze: f64,
-    total: f64,
-}
-
 /// The `--json` object (printed through `serde_json::Value`, so keys come out sorted): the
-/// mesh's counts and the best [`Times`], measured here (no library report holds them).
+/// protocol's report and the mesh argument.
 #[derive(serde::Serialize)]
-struct JsonReport {
-    mesh: String,
-    vertices: usize,
-    faces: usize,
-    bytes: usize,
-    repeat: u32,
-    valid: bool,
-    topology_built: bool,
-    read_s: f64,
-    parse_s: f64,
-    validate_topology_s: f64,
-    total_s: f64,
+struct JsonReport<'a> {
+    mesh: &'a str,
+    #[serde(flatten)]
+    report: &'a LoadBenchReport,
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let mut best = Times {
-        read: f64::INFINITY,
-        parse: f64::INFINITY,
-        analyze: f64::INFINITY,
-        total: f64::INFINITY,
-    };
-    let mut facts = None;
-    for _ in 0..args.repeat {
-        let t0 = Instant::now();
-        let (format, bytes) =
-            io::read_file(args.mesh.as_ref()).map_err(|e| CliError::input(one_line(&e)))?;
-        let t1 = Instant::now();
-        let (mesh, _) = io::parse_bytes(&bytes, format, args.mesh.as_ref())
-            .map_err(|e| CliError::input(one_line(&e)))?;
-        let t2 = Instant::now();
-        let a = analyze(&mesh);
-        let t3 = Instant::now();
-        best.read = best.read.min((t1 - t0).as_secs_f64());
-        best.parse = best.parse.min((t2 - t1).as_secs_f64());
-        best.analyze = best.analyze.min((t3 - t2).as_secs_f64());
-        best.total = best.total.min((t3 - t0).as_secs_f64());
-        facts = Some((
-            mesh.n_vertices(),
-            mesh.n_faces(),
-            bytes.len(),
-            a.report.is_valid(),
-            a.topology.is_some(),
-        ));
-        drop((a, mesh, bytes));
-    }
-    let (nv, nf, nbytes, valid, topo) = facts.expect("repeat >= 1");
+    let r =
+        load_bench(args.mesh.as_ref(), args.repeat).map_err(|e| CliError::input(one_line(&e)))?;
     if args.json {
         let j = serde_json::to_value(JsonReport {
-            mesh: args.mesh.to_string(),
-            vertices: nv,
-            faces: nf,
-            bytes: nbytes,
-            repeat: args.repeat,
-            valid,
-            topology_built: topo,
-            read_s: best.read,
-            parse_s: best.parse,
-            validate_topology_s: best.analyze,
-            total_s: best.total,
+            mesh: &args.mesh,
+            report: &r,
         })
         .map_err(CliError::failure)?;
         println!("{j}");
     } else {
         println!(
-            "{}: {nv} vertices, {nf} faces, {:.1} MB uncompressed, valid: {}",
+            "{}: {} vertices, {} faces, {:.1} MB uncompressed, valid: {}",
             args.mesh,
-            nbytes as f64 / 1e6,
-            if valid { "yes" } else { "no" }
+            r.vertices,
+            r.faces,
+            r.bytes as f64 / 1e6,
+            if r.valid { "yes" } else { "no" }
         );
-        println!("stage (best of {})          time", args.repeat);
-        println!("read + decompress       {:>8.1} ms", best.read * 1e3);
-        println!("parse                   {:>8.1} ms", best.parse * 1e3);
-        println!("validate + topology     {:>8.1} ms", best.analyze * 1e3);
-        println!("total (best run)        {:>8.1} ms", best.total * 1e3);
+        println!("stage (best of {})          time", r.repeat);
+        println!("read + decompress       {:>8.1} ms", r.read_s * 1e3);
+        println!("parse                   {:>8.1} ms", r.parse_s * 1e3);
+        println!(
+            "validate + topology     {:>8.1} ms",
+            r.validate_topology_s * 1e3
+        );
+        println!("total (best run)        {:>8.1} ms", r.total_s * 1e3);
     }
     Ok(())
 }

@@ -1,9 +1,10 @@
 //! `wavg bench project`: Phong projection speed and accuracy on random surface points
-//! (the protocol is [`wavg::projection_bench`]'s; this prints its report).
+//! (the protocol is [`wavg_bench::projection_bench`]'s; this prints its report).
 
 use std::path::PathBuf;
 
-use wavg::{ProjectionBenchOptions, ProjectionBenchReport, SolveError, projection_bench};
+use wavg::SolveError;
+use wavg_bench::{ProjectionBenchOptions, ProjectionBenchReport, projection_bench};
 
 use crate::CliError;
 use crate::common::load_valid;

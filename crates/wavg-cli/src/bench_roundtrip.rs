@@ -1,4 +1,4 @@
-//! `wavg bench roundtrip`: the paper's Table 1 protocol ([`wavg::round_trip`]).
+//! `wavg bench roundtrip`: the paper's Table 1 protocol ([`wavg_bench::round_trip`]).
 //!
 //! K anchors by farthest-point sampling (edge-graph distance, seeded) and the solver are set
 //! up here; the library samples N surface points uniform by area (seed + 1), times the
@@ -10,7 +10,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 use wavg::sampling::{FpsMetric, farthest_point_vertices};
-use wavg::{Anchor, RoundTripOptions, RoundTripReport, SearchMode, SolveError, Solver};
+use wavg::{Anchor, SearchMode, SolveError, Solver};
+use wavg_bench::{RoundTripOptions, RoundTripReport, load_average};
 
 use crate::CliError;
 use crate::common::{load_valid, one_line};
@@ -39,8 +40,8 @@ verified_negative_weight_fraction (the same protocol on those weights),
 verified_penalized_fraction and verified_not_reached_fraction.
 
 Without --embedding or --precompute the 3-D positions are the embedding. The protocol is
-also a library function, wavg::round_trip (its RoundTripReport serialises to these keys,
-less mesh, with wavg-solve's serde feature).")]
+the function wavg_bench::round_trip of the workspace's wavg-bench crate, outside the
+library (its RoundTripReport serialises to these keys, less mesh).")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
@@ -96,14 +97,6 @@ struct JsonReport<'a> {
     mesh: &'a str,
 }
 
-/// The 1-minute load average (Linux), to judge how busy the machine was.
-pub(crate) fn load_average() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()
-        .and_then(|s| s.split_whitespace().next().map(str::to_string))
-        .unwrap_or_else(|| "unknown".into())
-}
-
 /// The process CPU-time clock of the report's CPU figures.
 fn process_cpu_seconds() -> Option<f64> {
     crate::common::cpu_seconds(false)
@@ -145,7 +138,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         verified: args.verified,
         cpu_clock: Some(process_cpu_seconds),
     };
-    let report = textio::with_threads(Some(threads), || wavg::round_trip(&solver, &opts))?
+    let report = textio::with_threads(Some(threads), || wavg_bench::round_trip(&solver, &opts))?
         .map_err(|e| match e {
             SolveError::InvalidParameter(_) => CliError::input(one_line(&e)),
             e => CliError::failure(one_line(&e)),

@@ -1,12 +1,11 @@
-//! `wavg bench spline`: time per sample of a curve on the surface ([`evaluate_spline`],
-//! the same call as `wavg spline`), best of repeated runs, with the samples checked
-//! against the closest valid projection of each sample's average.
-
-use std::time::Instant;
+//! `wavg bench spline`: time per sample of a curve on the surface, best of repeated runs,
+//! with the samples checked against the closest valid projection of each sample's average
+//! (the protocol is [`wavg_bench::spline_bench`]'s; this prints its report).
 
 use serde::Serialize;
-use wavg::apps::{SplineKind, evaluate_spline, spline_weights_flat};
-use wavg::{ForwardOptions, SearchMode, SolveError};
+use wavg::SolveError;
+use wavg::apps::SplineKind;
+use wavg_bench::{SplineBenchOptions, SplineBenchReport, load_average, spline_bench};
 
 use crate::CliError;
 use crate::common::one_line;
@@ -55,20 +54,13 @@ pub struct Args {
     pub json: bool,
 }
 
-/// The report (`--json` keys).
+/// The `--json` object: the protocol's report between the mesh argument and the load
+/// average.
 #[derive(Serialize)]
-struct Report<'a> {
+struct JsonReport<'a> {
     mesh: &'a str,
-    controls: usize,
-    samples: usize,
-    ok_samples: usize,
-    threads: usize,
-    repeat: usize,
-    us_per_sample: f64,
-    us_per_sample_median: f64,
-    cpu_us_per_sample: Option<f64>,
-    agree_fraction: f64,
-    max_disagreement: f64,
+    #[serde(flatten)]
+    report: &'a SplineBenchReport,
     load: String,
 }
 
@@ -90,68 +82,28 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let bad =
         |e: SolveError| CliError::input(format!("{}: {}", args.control.display(), one_line(&e)));
     let threads = args.threads.unwrap_or_else(rayon::current_num_threads);
-    let (times, curve, cpu) = textio::with_threads(Some(threads), || {
-        let cpu0 = crate::common::cpu_seconds(false);
-        let mut times = Vec::with_capacity(args.repeat);
-        let mut curve = None;
-        for _ in 0..args.repeat {
-            let t = Instant::now();
-            let c = evaluate_spline(&solver, kind, args.samples, crate::spline::CHUNK);
-            times.push(t.elapsed().as_secs_f64());
-            curve = Some(c);
-        }
-        let cpu = crate::common::cpu_seconds(false)
-            .zip(cpu0)
-            .map(|(b, a)| b - a);
-        (times, curve, cpu)
-    })?;
-    let curve = curve.expect("repeat >= 1").map_err(bad)?;
-    // The reference: every sample on its own, the closest valid projection.
-    let flat = spline_weights_flat(kind, solver.n_anchors(), args.samples).map_err(bad)?;
-    let mel = solver.mean_edge_length();
-    let closest = ForwardOptions {
-        mode: SearchMode::Certified,
-        ..ForwardOptions::default()
-    };
-    let mut agree = 0usize;
-    let mut worst = 0.0f64;
-    for (w, got) in flat.chunks_exact(solver.n_anchors()).zip(&curve.samples) {
-        let want = solver.forward(w, &closest);
-        match (got, want) {
-            (Ok(a), Ok(b)) => {
-                let d = (a.position - b.position).norm() / mel;
-                worst = worst.max(d);
-                agree += usize::from(d <= 1e-6);
-            }
-            (Err(_), Err(_)) => agree += 1,
-            _ => worst = f64::INFINITY,
-        }
-    }
-    let mut sorted = times.clone();
-    sorted.sort_by(f64::total_cmp);
-    let n = args.samples as f64;
-    let report = Report {
-        mesh: &args.mesh,
-        controls: solver.n_anchors(),
+    let opts = SplineBenchOptions {
+        kind,
         samples: args.samples,
-        ok_samples: curve.ok_samples(),
-        threads,
         repeat: args.repeat,
-        us_per_sample: sorted[0] / n * 1e6,
-        us_per_sample_median: sorted[sorted.len() / 2] / n * 1e6,
-        cpu_us_per_sample: cpu.map(|c| c / (n * args.repeat as f64) * 1e6),
-        agree_fraction: agree as f64 / n,
-        max_disagreement: worst,
-        load: crate::bench_roundtrip::load_average(),
+        chunk: crate::spline::CHUNK,
+        cpu_clock: Some(|| crate::common::cpu_seconds(false)),
+    };
+    let report =
+        textio::with_threads(Some(threads), || spline_bench(&solver, &opts))?.map_err(bad)?;
+    let json = JsonReport {
+        mesh: &args.mesh,
+        report: &report,
+        load: load_average(),
     };
     if args.json {
-        let s = serde_json::to_string(&report).map_err(CliError::failure)?;
+        let s = serde_json::to_string(&json).map_err(CliError::failure)?;
         println!("{s}");
     } else {
         println!(
             "{}: {} of {} samples, {:.3} us per sample (median {:.3}, CPU {:.3}) on {} threads; \
              {:.5} agree with the closest projections (worst {:.3e} mean edges); load {}",
-            report.mesh,
+            json.mesh,
             report.ok_samples,
             report.samples,
             report.us_per_sample,
@@ -160,7 +112,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             report.threads,
             report.agree_fraction,
             report.max_disagreement,
-            report.load
+            json.load
         );
     }
     Ok(())

@@ -10,10 +10,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use wavg::DEFAULT_TOLERANCE;
-use wavg::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
-use wavg::{Anchor, EmbeddedMesh, ForwardOptions, Solver, Vec8};
-use wavg::{SurfacePoint, ValidMesh};
+use wavg::sampling::{FpsMetric, farthest_point_vertices};
+use wavg::{Anchor, EmbeddedMesh, ForwardOptions, SolveError, Solver, ValidMesh, Vec8};
+use wavg_bench::{RoundTripOptions, round_trip};
 
 use crate::CliError;
 use crate::anchors::{GOOD_GAP, closed_tour, largest_gap, spread_to_good_gap};
@@ -79,11 +78,11 @@ pub struct Args {
     pub json: bool,
 }
 
-/// The `--json` object (printed through `serde_json::Value`, so keys come out sorted). Its
-/// own figures rather than the library's reports flattened: the demo times its own
-/// batches, and the keys of `wavg::embed::Report`, `wavg::apps::CurveReport` and
-/// `wavg::RoundTripReport` are not these (`curve_points`, not `samples`; no stage
-/// times).
+/// The `--json` object (printed through `serde_json::Value`, so keys come out sorted). A
+/// selection of the reports' figures under the demo's own keys rather than the reports
+/// flattened: the keys of `wavg::embed::Report`, `wavg::apps::CurveReport` and
+/// `wavg_bench::RoundTripReport` are not these (`curve_points`, not `samples`;
+/// `roundtrip_queries`, not `queries`; no stage times).
 #[derive(serde::Serialize)]
 struct JsonReport<'a> {
     mesh: &'a str,
@@ -228,32 +227,30 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let curve_us = t0.elapsed().as_secs_f64() / args.samples as f64 * 1e6;
     let curve_ok = curve.iter().filter(|r| r.is_ok()).count();
 
-    // Round trips.
-    let points = uniform_surface_points(&mesh, args.queries, args.seed.wrapping_add(1))
-        .map_err(|e| CliError::input(one_line(&e)))?;
-    let t0 = Instant::now();
-    let inv = solver.inverse_batch(&points);
-    let inverse_us = t0.elapsed().as_secs_f64() / points.len() as f64 * 1e6;
-    let rows: Vec<&[f64]> = inv.iter().map(|r| r.unwrap_or(&[])).collect();
-    let t0 = Instant::now();
-    let fwd = solver.forward_batch(&rows, &ForwardOptions::default());
-    let forward_us = t0.elapsed().as_secs_f64() / points.len() as f64 * 1e6;
-    let tol = DEFAULT_TOLERANCE * solver.mean_edge_length();
-    let back = |p: &SurfacePoint, r: &Result<wavg::ForwardResult, _>| {
-        r.as_ref()
-            .is_ok_and(|r| (r.position - p.position(&mesh)).norm() <= tol)
-    };
-    let ok = points.iter().zip(&fwd).filter(|(p, r)| back(p, r)).count();
-    let verified = solver.inverse_verified_batch(&points, DEFAULT_TOLERANCE);
-    let vrows: Vec<&[f64]> = verified
-        .iter()
-        .map(|r| r.as_ref().map_or(&[][..], |v| &v.weights[..]))
-        .collect();
-    let vfwd = solver.forward_batch(&vrows, &ForwardOptions::default());
-    let vok = points.iter().zip(&vfwd).filter(|(p, r)| back(p, r)).count();
-    let n = points.len() as f64;
+    // Round trips: the Table 1 protocol, once, with the paper's and the verified inverse.
+    let trips = round_trip(
+        &solver,
+        &RoundTripOptions {
+            queries: args.queries,
+            seed: args.seed.wrapping_add(1),
+            repeat: 1,
+            verified: true,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| match e {
+        SolveError::InvalidParameter(_) => CliError::input(one_line(&e)),
+        e => CliError::failure(one_line(&e)),
+    })?;
+    let (ok, vok) = (
+        trips.roundtrip_ok_fraction,
+        trips
+            .verified
+            .as_ref()
+            .map_or(0.0, |v| v.verified_roundtrip_ok_fraction),
+    );
     let warned = crate::anchors::warn_if_low(
-        ok as f64 / n,
+        ok,
         "round trips that lead back to their point",
         anchor_ids.len(),
         mesh_name,
@@ -305,11 +302,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
             curve_points: args.samples,
             curve_ok,
             curve_us,
-            roundtrip_queries: points.len(),
-            inverse_us,
-            forward_us,
-            roundtrip_ok_fraction: ok as f64 / n,
-            verified_roundtrip_ok_fraction: vok as f64 / n,
+            roundtrip_queries: trips.queries,
+            inverse_us: trips.inverse_us,
+            forward_us: trips.forward_us,
+            roundtrip_ok_fraction: ok,
+            verified_roundtrip_ok_fraction: vok,
             pictures: pictures
                 .as_ref()
                 .map(|p| p.written.iter().map(|p| p.display().to_string()).collect()),
@@ -336,11 +333,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         args.samples
     );
     println!(
-        "round trips    {} random points: inverse {inverse_us:.2} us, forward {forward_us:.2} \
-         us; back to the point: paper {:.4}, verified {:.4}",
-        points.len(),
-        ok as f64 / n,
-        vok as f64 / n
+        "round trips    {} random points: inverse {:.2} us, forward {:.2} us; back to the \
+         point: paper {ok:.4}, verified {vok:.4}",
+        trips.queries, trips.inverse_us, trips.forward_us
     );
     match &args.out {
         Some(d) => {

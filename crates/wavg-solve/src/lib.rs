@@ -9,10 +9,8 @@
 //!
 //! Also: [`AnchorSet`] (editable anchor sets), [`resolve_anchor`] and [`check_point`]
 //! (validating user locations), [`validate_weights`], [`inverse_weights`] (the inverse
-//! problem's kernel on its own), [`sampling`] (seeded anchors and query points for
-//! benchmarks and tests), [`round_trip`] (the paper's Table 1 round-trip protocol) and
-//! [`projection_bench`] (the projection benchmark); their reports serialise with the
-//! `serde` feature.
+//! problem's kernel on its own) and [`sampling`] (seeded anchors and query points). The
+//! benchmark protocols that measure all this live outside the library, in `wavg-bench`.
 //!
 //! ```
 //! use std::sync::Arc;
@@ -41,8 +39,6 @@ mod error;
 mod kernel;
 mod penalty;
 mod points;
-pub mod projbench;
-pub mod roundtrip;
 pub mod sampling;
 mod simd;
 mod solver;
@@ -62,14 +58,6 @@ pub use points::{
     Anchor, BARY_TOLERANCE, check_point, nearest_corner, resolve_anchor, vertex_point,
 };
 pub use weights::{Normalization, WEIGHT_SUM_TOLERANCE, validate_weights};
-
-// The Table 1 round-trip protocol.
-pub use roundtrip::{
-    RoundTripOptions, RoundTripReport, VerifiedRoundTripReport, round_trip, round_trip_at,
-};
-
-// The projection benchmark protocol.
-pub use projbench::{ProjectionBenchOptions, ProjectionBenchReport, projection_bench};
 
 // The embedded mesh and projector the solver works on.
 pub use wavg_project::{

@@ -52,10 +52,6 @@ pub use wavg_solve::{
     Anchor, BatchWeights, ForwardOptions, ForwardResult, ForwardScratch, Normalization, Par,
     ProjectionPath, RoundTrip, SearchGoal, SearchMode, Solver, Verified,
 };
-pub use wavg_solve::{RoundTripOptions, RoundTripReport, VerifiedRoundTripReport, round_trip};
-
-// The projection benchmark protocol, beside the round trip's.
-pub use wavg_solve::{ProjectionBenchOptions, ProjectionBenchReport, projection_bench};
 
 // The layers' own errors, for callers that tell failures apart before they become an
 // [`Error`].
@@ -79,8 +75,8 @@ pub use wavg_mesh::{
     DefectKind, LoadNotes, MeshInfo, RepairOptions, RepairReport, SubdivisionReport, TexCoords,
 };
 
-/// Seeded sampling of surface points and anchor vertices, as the benchmarks and the demo
-/// draw them.
+/// Seeded sampling of surface points and anchor vertices, as the benchmarks (`wavg-bench`,
+/// outside the library) and the demo draw them.
 pub use wavg_solve::sampling;
 
 pub use wavg_apps as apps;

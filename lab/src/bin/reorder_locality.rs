@@ -8,10 +8,11 @@ use std::path::Path;
 use std::sync::Arc;
 
 use nalgebra::Vector3;
+use wavg_bench::RoundTripOptions;
 use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh};
 use wavg_project::{EmbeddedMesh, Projector, Vec8};
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
-use wavg_solve::{Anchor, RoundTripOptions, Solver};
+use wavg_solve::{Anchor, Solver};
 
 /// Interleaves the low 21 bits of `x` with two zero bits between each.
 fn spread(mut x: u64) -> u64 {
@@ -94,7 +95,7 @@ fn main() {
     for round in 0..2 {
         for (name, s, pts) in [("stored", &s0, &points), ("morton", &s1, &points1)] {
             let r = pool
-                .install(|| wavg_solve::round_trip_at(s, pts, &opts))
+                .install(|| wavg_bench::round_trip_at(s, pts, &opts))
                 .unwrap();
             println!(
                 "round {round} {name:7} forward_us {:.3} forward_warm_us {:.3} inverse_us {:.3} ok {:.5}",

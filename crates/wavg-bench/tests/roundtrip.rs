@@ -4,14 +4,16 @@
 use std::sync::Arc;
 
 use proptest::prelude::*;
-use wavg_mesh::geometry::mean_edge_length;
-use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, procedural};
-use wavg_solve::roundtrip::{NEGATIVE_WEIGHT, ROUND_TRIP_TOLERANCE};
-use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
-use wavg_solve::{
-    Anchor, EmbeddedMesh, ForwardOptions, Projector, RoundTripOptions, RoundTripReport, SolveError,
-    Solver, round_trip, round_trip_at, vertex_point,
+use wavg::mesh::geometry::mean_edge_length;
+use wavg::mesh::procedural;
+use wavg::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
+use wavg::solve::vertex_point;
+use wavg::{
+    Anchor, EmbeddedMesh, ForwardOptions, Projector, SolveError, Solver, SurfacePoint, TriMesh,
+    ValidMesh,
 };
+use wavg_bench::roundtrip::{NEGATIVE_WEIGHT, ROUND_TRIP_TOLERANCE};
+use wavg_bench::{RoundTripOptions, RoundTripReport, round_trip, round_trip_at};
 
 fn solver_on(mesh: TriMesh, k: usize) -> Solver {
     let mesh = Arc::new(ValidMesh::new(mesh).unwrap());
@@ -171,7 +173,6 @@ fn bad_input_is_an_error() {
 }
 
 /// The JSON keys are those of `wavg bench roundtrip --json` (less the mesh argument).
-#[cfg(feature = "serde")]
 #[test]
 fn serialises_to_the_documented_keys() {
     let solver = solver_on(procedural::icosphere(2), 12);

@@ -19,8 +19,8 @@
 //!
 //! ```
 //! use std::sync::Arc;
-//! use wavg_mesh::{ValidMesh, procedural};
-//! use wavg_solve::{EmbeddedMesh, ProjectionBenchOptions, projection_bench};
+//! use wavg::{EmbeddedMesh, ValidMesh, mesh::procedural};
+//! use wavg_bench::{ProjectionBenchOptions, projection_bench};
 //!
 //! let mesh = Arc::new(ValidMesh::new(procedural::icosphere(2)).unwrap());
 //! let emb = Arc::new(EmbeddedMesh::from_positions(mesh));
@@ -35,12 +35,15 @@ use std::time::Instant;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use wavg_mesh::geometry::face_normal;
-use wavg_mesh::{RingSearch, SurfacePoint, VertexId};
-use wavg_project::{ProjectError, ProjectScratch, Projection};
+use wavg::mesh::RingSearch;
+use wavg::mesh::geometry::face_normal;
+use wavg::project::{ProjectError, ProjectScratch, Projection};
+use wavg::sampling::uniform_surface_points;
+use wavg::{
+    EmbeddedMesh, Par, ProjectionPath, Projector, SolveError, SurfacePoint, Vec8, VertexId,
+};
 
-use crate::sampling::uniform_surface_points;
-use crate::{EmbeddedMesh, Par, ProjectionPath, Projector, SolveError, Vec8};
+use crate::timing::CpuClock;
 
 /// Timed passes over the queries (the fastest is reported).
 pub const REPEATS: usize = 3;
@@ -63,7 +66,7 @@ pub struct ProjectionBenchOptions {
     pub offset_along_normal: bool,
     /// The calling thread's CPU-time clock in seconds (the standard library has none);
     /// without one the CPU figures are wall time.
-    pub thread_cpu_clock: Option<fn() -> Option<f64>>,
+    pub thread_cpu_clock: Option<CpuClock>,
     /// Threads of the brute-force comparison (the timed passes run on the calling thread).
     pub par: Par,
 }
@@ -81,11 +84,9 @@ impl Default for ProjectionBenchOptions {
 }
 
 /// Speed and accuracy of [`Projector`] on random surface points, and of the global
-/// search on the queries that needed it. Times are microseconds per query. With the
-/// `serde` feature it serialises to the keys of `wavg bench project --json` (the field
-/// names); the fields marked "not serialised" are the extra figures of its text output.
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+/// search on the queries that needed it. Times are microseconds per query. It serialises
+/// to the keys of `wavg bench project --json` (the field names); the fields marked "not serialised" are the extra figures of its text output.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ProjectionBenchReport {
     /// Vertices of the mesh.
     pub vertices: usize,
@@ -100,37 +101,37 @@ pub struct ProjectionBenchReport {
     /// Projecting points on the surface: CPU microseconds per query.
     pub onsurface_us: f64,
     /// Projecting points on the surface: wall microseconds per query. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub onsurface_wall_us: f64,
     /// The same points, one `project` call at a time: CPU microseconds per query. Not
     /// serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub single_us: f64,
     /// One `project` call at a time: wall microseconds per query. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub single_wall_us: f64,
     /// Whether the batch and the one-at-a-time answers are the same (they must be). Not
     /// serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub batch_agrees: bool,
     /// Fraction of the points on the surface that project back to themselves.
     pub onsurface_self_fraction: f64,
     /// Answers to the points on the surface by path: local (certified or not), fallback,
     /// none. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub onsurface_paths: [usize; 3],
     /// Projecting points offset from the surface: CPU microseconds per query.
     pub offset_us: f64,
     /// Projecting offset points: wall microseconds per query. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub offset_wall_us: f64,
     /// Fraction of the offset points checked whose answer equals the brute-force search's.
     pub offset_bruteforce_agree_fraction: f64,
     /// Offset points compared with the brute-force search. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub bruteforce_checked: usize,
     /// Answers to the offset points by path, as `onsurface_paths`. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub offset_paths: [usize; 3],
     /// Fraction of the points on the surface that needed the global search.
     pub onsurface_fallback_fraction: f64,
@@ -140,7 +141,7 @@ pub struct ProjectionBenchReport {
     /// none did).
     pub fallback_us: Option<f64>,
     /// Queries that needed the global search (both kinds). Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub fallback_queries: usize,
 }
 
@@ -254,7 +255,7 @@ fn timed(
     ys: &[Vec8],
     starts: &[VertexId],
     batch: bool,
-    clock: Option<fn() -> Option<f64>>,
+    clock: Option<CpuClock>,
 ) -> (Vec<Answer>, Timing) {
     let mut out = Vec::with_capacity(ys.len());
     let mut scratch = ProjectScratch::default();

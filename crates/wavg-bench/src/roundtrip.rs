@@ -8,17 +8,18 @@
 //! the threads, as in the paper), best of [`RoundTripOptions::repeat`] runs. The same
 //! forward problems are also run in spatial (Morton) order, each warm-started from the
 //! previous answer. Optionally the verified inverse ([`Solver::inverse_verified`]) runs
-//! through the same protocol.
+//! through the same protocol. The verified inverse's own round-trip check is algorithm and
+//! stays in the library; this is its measurement.
 //!
 //! ```
 //! use std::sync::Arc;
-//! use wavg_mesh::{ValidMesh, procedural};
-//! use wavg_solve::{Anchor, EmbeddedMesh, Projector, RoundTripOptions, Solver, round_trip};
+//! use wavg::{Anchor, EmbeddedMesh, Projector, Solver, ValidMesh, mesh::procedural};
+//! use wavg_bench::{RoundTripOptions, round_trip};
 //!
 //! let mesh = Arc::new(ValidMesh::new(procedural::icosphere(2)).unwrap());
 //! let proj = Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh))).unwrap());
-//! let anchors = wavg_solve::sampling::farthest_point_vertices(
-//!     proj.embedded().mesh(), 12, 0, wavg_solve::sampling::FpsMetric::EdgeGraph).unwrap();
+//! let anchors = wavg::sampling::farthest_point_vertices(
+//!     proj.embedded().mesh(), 12, 0, wavg::sampling::FpsMetric::EdgeGraph).unwrap();
 //! let solver = Solver::new(proj, anchors.into_iter().map(Anchor::Vertex)).unwrap();
 //! let opts = RoundTripOptions { queries: 50, repeat: 1, ..Default::default() };
 //! let report = round_trip(&solver, &opts).unwrap();
@@ -26,16 +27,15 @@
 //! assert!(report.roundtrip_ok_fraction > 0.9);
 //! ```
 
-use std::time::Instant;
-
-use wavg_mesh::SurfacePoint;
-use wavg_mesh::geometry::mean_edge_length;
-
-use crate::sampling::{spatial_order, uniform_surface_points};
-use crate::{
-    BatchWeights, ForwardOptions, ForwardResult, ProjectionPath, RoundTrip, SearchMode, SolveError,
-    Solver,
+use wavg::mesh::geometry::mean_edge_length;
+use wavg::sampling::{spatial_order, uniform_surface_points};
+use wavg::solve::check_point;
+use wavg::{
+    BatchWeights, ForwardOptions, ForwardResult, Par, ProjectionPath, RoundTrip, SearchMode,
+    SolveError, Solver, SurfacePoint,
 };
+
+use crate::timing::{CpuClock, best_of, with_cpu};
 
 /// A forward result within this many mean edge lengths of the original point counts as a
 /// successful round trip (the paper's Table 1 threshold).
@@ -60,7 +60,7 @@ pub struct RoundTripOptions {
     pub verified: bool,
     /// A process CPU-time clock in seconds (the standard library has none); when given, the
     /// report's CPU figures are filled in.
-    pub cpu_clock: Option<fn() -> Option<f64>>,
+    pub cpu_clock: Option<CpuClock>,
 }
 
 impl Default for RoundTripOptions {
@@ -76,11 +76,10 @@ impl Default for RoundTripOptions {
     }
 }
 
-/// What the protocol measured. With the `serde` feature it serialises to the keys of
-/// `wavg bench roundtrip --json` (the field names); the fields marked "not serialised" are
+/// What the protocol measured. It serialises to the keys of `wavg bench roundtrip --json`
+/// (the field names); the fields marked "not serialised" are
 /// the extra figures of its text output.
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct RoundTripReport {
     /// Inverse problem: wall microseconds per query (batch time / queries, best run).
     pub inverse_us: f64,
@@ -90,18 +89,18 @@ pub struct RoundTripReport {
     pub forward_warm_us: f64,
     /// Inverse problem: CPU microseconds per query, mean over the runs, summed over
     /// threads; `None` without a CPU clock. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub inverse_cpu_us: Option<f64>,
     /// Forward problem: CPU microseconds per query, as `inverse_cpu_us`. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub forward_cpu_us: Option<f64>,
     /// Warm-started forward problem: CPU microseconds per query. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub forward_warm_cpu_us: Option<f64>,
     /// Fraction of queries whose round trip is ok (a failed inverse or forward is not).
     pub roundtrip_ok_fraction: f64,
     /// The same fraction for the warm-started forward problems. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub roundtrip_warm_ok_fraction: f64,
     /// Median round-trip distance in mean edge lengths (infinite when more than half
     /// failed; `null` in JSON).
@@ -111,17 +110,17 @@ pub struct RoundTripReport {
     /// Fraction of queries whose weights have some weight below [`NEGATIVE_WEIGHT`].
     pub negative_weight_fraction: f64,
     /// Forward answers found by the local search (certified or not). Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub forward_local: usize,
     /// Forward answers found by the certified fallback. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub forward_fallback: usize,
     /// Forward problems without an answer, including those of failed inverses. Not
     /// serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub forward_failed: usize,
     /// Inverse problems without an answer. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub inverse_failed: usize,
     /// Vertices of the mesh.
     pub vertices: usize,
@@ -134,19 +133,15 @@ pub struct RoundTripReport {
     /// Threads of the rayon pool the batches ran on.
     pub threads: usize,
     /// Timed runs of each batch. Not serialised.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    #[serde(skip)]
     pub repeat: usize,
     /// The verified inverse's figures, when requested.
-    #[cfg_attr(
-        feature = "serde",
-        serde(flatten, skip_serializing_if = "Option::is_none")
-    )]
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub verified: Option<VerifiedRoundTripReport>,
 }
 
 /// The verified inverse through the protocol (its weights, then the same forward problem).
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct VerifiedRoundTripReport {
     /// Verified inverse: wall microseconds per query, its forward checks included.
     pub verified_inverse_us: f64,
@@ -185,7 +180,7 @@ pub fn round_trip_at(
         ));
     }
     for p in points {
-        crate::check_point(solver.mesh(), p)?;
+        check_point(solver.mesh(), p)?;
     }
     let mesh = solver.mesh();
     let n = points.len();
@@ -199,20 +194,20 @@ pub fn round_trip_at(
 
     // The result buffers are reused across the repeats, as an application would.
     let mut weights = BatchWeights::default();
-    let ((t_inv, ()), cpu_inv) = with_cpu(opts, || {
+    let ((t_inv, ()), cpu_inv) = with_cpu(opts.cpu_clock, || {
         best_of(repeat, || {
             // `Par::Rayon` always starts.
-            let _ = solver.inverse_batch_into(points, &mut weights, wavg_project::Par::Rayon);
+            let _ = solver.inverse_batch_into(points, &mut weights, Par::Rayon);
         })
     });
     // Failed inverses get a placeholder that fails validation, so forward reports it.
     let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
-    let ((t_fwd, fwd), cpu_fwd) = with_cpu(opts, || {
+    let ((t_fwd, fwd), cpu_fwd) = with_cpu(opts.cpu_clock, || {
         best_of(repeat, || solver.forward_batch(&rows, &fwd_opts))
     });
     let order = spatial_order(&points.iter().map(|p| p.position(mesh)).collect::<Vec<_>>());
     let ordered: Vec<&[f64]> = order.iter().map(|&i| rows[i]).collect();
-    let ((t_warm, warm), cpu_warm) = with_cpu(opts, || {
+    let ((t_warm, warm), cpu_warm) = with_cpu(opts.cpu_clock, || {
         best_of(repeat, || {
             solver.forward_batch_warm(&ordered, &fwd_opts, WARM_CHUNK)
         })
@@ -289,7 +284,7 @@ fn verified_round_trip(
             ROUND_TRIP_TOLERANCE,
             &mut weights,
             &mut trips,
-            wavg_project::Par::Rayon,
+            Par::Rayon,
         );
     });
     let rows: Vec<&[f64]> = weights.iter().map(|r| r.unwrap_or(&[])).collect();
@@ -317,28 +312,6 @@ fn verified_round_trip(
         verified_penalized_fraction: fraction(&|_, t| matches!(t, RoundTrip::Penalized(_))),
         verified_not_reached_fraction: fraction(&|_, t| t == RoundTrip::NotReached),
     }
-}
-
-/// Best wall time in seconds of `repeat` runs of `f`, and the last result.
-fn best_of<T>(repeat: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let t = Instant::now();
-    let mut out = f();
-    let mut best = t.elapsed().as_secs_f64();
-    for _ in 1..repeat {
-        let t = Instant::now();
-        out = f();
-        best = best.min(t.elapsed().as_secs_f64());
-    }
-    (best, out)
-}
-
-/// Runs `f` and returns its result with the CPU seconds it used, when there is a clock.
-fn with_cpu<T>(opts: &RoundTripOptions, f: impl FnOnce() -> T) -> (T, Option<f64>) {
-    let clock = opts.cpu_clock;
-    let c0 = clock.and_then(|c| c());
-    let r = f();
-    let c1 = clock.and_then(|c| c());
-    (r, c0.zip(c1).map(|(a, b)| b - a))
 }
 
 /// Value at quantile `q` of sorted, non-empty `xs` (nearest rank).
