@@ -9,7 +9,7 @@ use wavg::apps::{Image, MAX_SIDE};
 
 use crate::args::DetachRun;
 use crate::args::{Int, array};
-use crate::errors::{png, raise, require_file, type_error, value};
+use crate::errors::{lib, raise, require_file, type_error, value};
 
 /// An image argument: an `(H, W, 3)` or `(H, W, 4)` uint8 array (or a PNG path).
 pub(crate) fn image_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Image> {
@@ -18,7 +18,7 @@ pub(crate) fn image_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Image> {
         require_file(&path)?;
         return py
             .detach_run(|| Image::read_png(&path))
-            .map_err(|e| png(py, &e));
+            .map_err(lib(py));
     }
     let expected = "an (H, W, 3) or (H, W, 4) uint8 image array (or a PNG path)";
     let np = crate::args::numpy(py)?;
@@ -111,6 +111,6 @@ pub(crate) fn read_png<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'p
     require_file(&path)?;
     let img = py
         .detach_run(|| Image::read_png(&path))
-        .map_err(|e| png(py, &e))?;
+        .map_err(lib(py))?;
     to_array(py, &img)
 }

@@ -6,7 +6,6 @@ use std::time::Instant;
 use wavg::mesh::{analyze, io};
 
 use crate::CliError;
-use crate::common::one_line;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -60,10 +59,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
     for _ in 0..args.repeat {
         let t0 = Instant::now();
         let (format, bytes) =
-            io::read_file(args.mesh.as_ref()).map_err(|e| CliError::input(one_line(&e)))?;
+            io::read_file(args.mesh.as_ref())?;
         let t1 = Instant::now();
-        let (mesh, _) = io::parse_bytes(&bytes, format, args.mesh.as_ref())
-            .map_err(|e| CliError::input(one_line(&e)))?;
+        let (mesh, _) = io::parse_bytes(&bytes, format, args.mesh.as_ref())?;
         let t2 = Instant::now();
         let a = analyze(&mesh);
         let t3 = Instant::now();

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use wavg::{ProjectionBenchOptions, ProjectionBenchReport, SolveError, projection_bench};
+use wavg::{ProjectionBenchOptions, ProjectionBenchReport, projection_bench};
 
 use crate::CliError;
 use crate::common::load_valid;
@@ -57,10 +57,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         thread_cpu_clock: Some(|| crate::common::cpu_seconds(true)),
         ..Default::default()
     };
-    let r = projection_bench(emb, &opts).map_err(|e| match e {
-        SolveError::Project(e) => CliError::failure(e),
-        e => CliError::failure(e),
-    })?;
+    let r = projection_bench(emb, &opts)?;
     if !r.batch_agrees {
         return Err(CliError::failure(
             "project_batch and project disagree (a bug: please report it)",

@@ -6,10 +6,10 @@ use std::time::Instant;
 
 use serde::Serialize;
 use wavg::apps::{SplineKind, evaluate_spline, spline_weights_flat};
-use wavg::{ForwardOptions, SearchMode, SolveError};
+use wavg::{ForwardOptions, SearchMode};
 
 use crate::CliError;
-use crate::common::one_line;
+use crate::error::Context;
 use crate::textio;
 
 /// Arguments.
@@ -87,8 +87,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &args.control,
         args.cache,
     )?;
-    let bad =
-        |e: SolveError| CliError::input(format!("{}: {}", args.control.display(), one_line(&e)));
     let threads = args.threads.unwrap_or_else(rayon::current_num_threads);
     let (times, curve, cpu) = textio::with_threads(Some(threads), || {
         let cpu0 = crate::common::cpu_seconds(false);
@@ -105,9 +103,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .map(|(b, a)| b - a);
         (times, curve, cpu)
     })?;
-    let curve = curve.expect("repeat >= 1").map_err(bad)?;
+    let curve = curve.expect("repeat >= 1").context(args.control.display())?;
     // The reference: every sample on its own, the closest valid projection.
-    let flat = spline_weights_flat(kind, solver.n_anchors(), args.samples).map_err(bad)?;
+    let flat =
+        spline_weights_flat(kind, solver.n_anchors(), args.samples).context(args.control.display())?;
     let mel = solver.mean_edge_length();
     let closest = ForwardOptions {
         mode: SearchMode::Certified,

@@ -14,7 +14,6 @@ use wavg::{Anchor, Solver, Surface};
 
 use crate::CliError;
 use crate::apps_common::{PairArgs, embed, mesh_and_anchors};
-use crate::common::one_line;
 use crate::textio::{self, write_numbers};
 
 /// The validity test, on the command line.
@@ -155,7 +154,7 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
         a.pair.cache,
     )?;
     let solver = |s: &Surface, l: Vec<Anchor>| -> Result<Solver, CliError> {
-        s.solver(l).map_err(|e| CliError::input(one_line(&e)))
+        Ok(s.solver(l)?)
     };
     let (ss, ts) = (solver(&source, sa)?, solver(&target, ta)?);
     let setup_seconds = t0.elapsed().as_secs_f64();
@@ -170,8 +169,7 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
     };
     let t = Instant::now();
     let cpu0 = crate::common::cpu_seconds(false);
-    let map = textio::with_threads(a.pair.threads, || correspond_vertices(&ss, &ts, &opts))?
-        .map_err(|e| CliError::input(one_line(&e)))?;
+    let map = textio::with_threads(a.pair.threads, || correspond_vertices(&ss, &ts, &opts))??;
     Ok(Computed {
         source,
         target,

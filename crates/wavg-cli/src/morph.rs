@@ -9,7 +9,7 @@ use std::time::Instant;
 use wavg::apps::{MorphReport, ReasonCounts, harmonic_fill, morph_frames};
 
 use crate::CliError;
-use crate::common::one_line;
+use crate::error::Context;
 use crate::correspond::{MapArgs, compute};
 use crate::textio::{self, write_numbers};
 
@@ -68,7 +68,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let t = Instant::now();
     let mesh = c.source.mesh();
     let mapped = harmonic_fill(mesh, &c.map.valid_positions())
-        .map_err(|e| CliError::failure(format!("{}: {}", args.map.pair.source, one_line(&e))))?;
+        .context(&args.map.pair.source)?;
     let frames = morph_frames(&mesh.positions, &mapped, args.frames);
     let seconds = c.seconds + t.elapsed().as_secs_f64();
     let created = !args.output.exists();
