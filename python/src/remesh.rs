@@ -94,9 +94,7 @@ impl Remesher {
             return Err(value("xyz must be 3 finite coordinates"));
         }
         let (sp, _) = self.inner.closest_point(&Vector3::new(p[0], p[1], p[2]));
-        self.inner
-            .move_base_vertex(i as usize, sp)
-            .map_err(lib(py))
+        self.inner.move_base_vertex(i as usize, sp).map_err(lib(py))
     }
 
     /// Vertices of the last ``run()``, ``(N, 3)`` float64 (None before the first).

@@ -118,9 +118,7 @@ pub fn embed(
     cache: CacheArg,
 ) -> Result<Surface, CliError> {
     let e = match embedding {
-        Some(path) => {
-            wavg::embed::file::load(path, &mesh)?
-        }
+        Some(path) => wavg::embed::file::load(path, &mesh)?,
         None => crate::cache::embedding(&mesh, name, cache.no_cache)?,
     };
     surface_of(mesh, e)

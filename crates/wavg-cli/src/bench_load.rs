@@ -58,8 +58,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut facts = None;
     for _ in 0..args.repeat {
         let t0 = Instant::now();
-        let (format, bytes) =
-            io::read_file(args.mesh.as_ref())?;
+        let (format, bytes) = io::read_file(args.mesh.as_ref())?;
         let t1 = Instant::now();
         let (mesh, _) = io::parse_bytes(&bytes, format, args.mesh.as_ref())?;
         let t2 = Instant::now();

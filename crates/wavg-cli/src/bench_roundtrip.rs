@@ -130,8 +130,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let t0 = Instant::now();
     let proj = textio::build_projector(emb)?;
     let t_proj = t0.elapsed().as_secs_f64();
-    let anchors = farthest_point_vertices(&mesh, args.anchors, args.seed, FpsMetric::EdgeGraph)
-        ?;
+    let anchors = farthest_point_vertices(&mesh, args.anchors, args.seed, FpsMetric::EdgeGraph)?;
     let solver = Solver::new(proj, anchors.into_iter().map(Anchor::Vertex))?;
     let opts = RoundTripOptions {
         queries: args.queries,

@@ -103,10 +103,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .map(|(b, a)| b - a);
         (times, curve, cpu)
     })?;
-    let curve = curve.expect("repeat >= 1").context(args.control.display())?;
+    let curve = curve
+        .expect("repeat >= 1")
+        .context(args.control.display())?;
     // The reference: every sample on its own, the closest valid projection.
-    let flat =
-        spline_weights_flat(kind, solver.n_anchors(), args.samples).context(args.control.display())?;
+    let flat = spline_weights_flat(kind, solver.n_anchors(), args.samples)
+        .context(args.control.display())?;
     let mel = solver.mean_edge_length();
     let closest = ForwardOptions {
         mode: SearchMode::Certified,

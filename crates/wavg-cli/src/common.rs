@@ -88,7 +88,6 @@ pub fn step(name: &str, since: Instant) -> Instant {
     now
 }
 
-
 /// CPU time consumed so far by the calling thread (`thread`) or by the whole process (all
 /// threads), in seconds, from the POSIX CPU-time clocks (nanosecond resolution, unlike
 /// tick-based counters). `None` where they are unavailable.

@@ -92,9 +92,7 @@ pub fn write(obj: &Path, texture: Option<&Path>) -> Result<Option<Material>, Cli
 
 /// Refuses a `--texture` that is not a readable PNG (before anything is computed).
 pub fn check_texture(texture: &Path) -> Result<(), CliError> {
-    Image::read_png(texture)
-        .map(drop)
-        .context("--texture")
+    Image::read_png(texture).map(drop).context("--texture")
 }
 
 /// How a `.mtl` in `dir` names `file`: its file name when it is in `dir`, else its

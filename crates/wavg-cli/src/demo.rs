@@ -126,8 +126,7 @@ fn spline_weights(order: &[usize], samples: usize) -> Result<Vec<Vec<f64>>, CliE
         degree: 3,
         closed: true,
     };
-    let rows = wavg::apps::spline_weights(kind, order.len(), samples)
-        ?;
+    let rows = wavg::apps::spline_weights(kind, order.len(), samples)?;
     Ok(rows
         .into_iter()
         .map(|row| {
@@ -360,9 +359,8 @@ fn write_outputs(
     anchors: &[u32],
     curve: &[Result<wavg::ForwardResult, wavg::SolveError>],
 ) -> Result<(), CliError> {
-    std::fs::create_dir_all(dir).map_err(|e| {
-        CliError::failure(format!("{}: cannot create: {e}", dir.display()))
-    })?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::failure(format!("{}: cannot create: {e}", dir.display())))?;
     wavg::mesh::io::save(&dir.join("mesh.obj"), mesh)?;
     wavg::embed::file::save(&dir.join("mesh.wavg"), emb, mesh)?;
     textio::write_atomic(&dir.join("anchors.txt"), |w: &mut dyn Write| {

@@ -127,7 +127,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     let _ = write!(out, "{} ", p.face);
                     text::push_numbers(out, p.bary.into_iter().chain(r.position.iter().copied()));
                 }
-                Err(e) => out.extend_from_slice(format!("none {}", crate::common::reason(e)).as_bytes()),
+                Err(e) => {
+                    out.extend_from_slice(format!("none {}", crate::common::reason(e)).as_bytes())
+                }
             },
             |r, row| match r {
                 Ok(r) => {

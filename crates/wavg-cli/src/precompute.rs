@@ -148,8 +148,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         crate::textio::with_threads(args.threads, || embed::precompute(&mesh, &opts, &bars))?;
     bars.clear();
     let (embedding, report) = result.map_err(|e| match e {
-        EmbedError::Cancelled => CliError::from(e)
-            .with_message(format!("interrupted; {} was not written", args.output.display())),
+        EmbedError::Cancelled => CliError::from(e).with_message(format!(
+            "interrupted; {} was not written",
+            args.output.display()
+        )),
         e => CliError::from(e).context(&args.mesh),
     })?;
 

@@ -216,7 +216,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         Colouring::Scalars(_) => format!(" with {}", args.scalar.as_ref().expect("set").display()),
         Colouring::Plain => String::new(),
     };
-    let img = render(&mesh, &colouring, &overlays, &opts).context(format_args!("{}{file}", args.mesh))?;
+    let img =
+        render(&mesh, &colouring, &overlays, &opts).context(format_args!("{}{file}", args.mesh))?;
     write_png(&args.output, &img)?;
     let seconds = t.elapsed().as_secs_f64();
     if args.json {

@@ -109,8 +109,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         args.cache,
     )?;
     let t = Instant::now();
-    let curve = evaluate_spline(&solver, kind, args.samples, CHUNK)
-        .context(args.control.display())?;
+    let curve =
+        evaluate_spline(&solver, kind, args.samples, CHUNK).context(args.control.display())?;
     let seconds = t.elapsed().as_secs_f64();
     let t = crate::common::step("spline", t);
     textio::write_atomic(&args.output, |w: &mut dyn Write| {

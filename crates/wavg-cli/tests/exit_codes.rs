@@ -23,7 +23,14 @@ fn library_input_errors_exit_2() {
     let junk = junk.to_str().unwrap();
     // A corrupt embedding file (the embedding layer's error).
     let (code, err) = failed(&[
-        "anchors", "builtin:torus", "--count", "4", "--embedding", junk, "-o", "-",
+        "anchors",
+        "builtin:torus",
+        "--count",
+        "4",
+        "--embedding",
+        junk,
+        "-o",
+        "-",
     ]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("junk.wavg"), "{err}");

@@ -93,8 +93,7 @@ pub unsafe extern "C" fn wavg_remesher_new(
         } else {
             wavg::apps::DEFAULT_MAX_BASE_DISTANCE
         };
-        let remesher = Remesher::with_max_distance(s.inner.projector().clone(), &base, max)
-?;
+        let remesher = Remesher::with_max_distance(s.inner.projector().clone(), &base, max)?;
         *out = Box::into_raw(Box::new(wavg_remesher {
             remesher,
             last: None,
@@ -122,10 +121,7 @@ pub unsafe extern "C" fn wavg_remesher_run(
     guard(|| {
         // SAFETY: per this function's contract.
         let r = unsafe { handle_mut(remesher, "remesher")? };
-        let out = r
-            .remesher
-            .remesh(levels as usize, smooth as usize)
-?;
+        let out = r.remesher.remesh(levels as usize, smooth as usize)?;
         r.last = Some(out);
         Ok(())
     })

@@ -5,9 +5,9 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
-use wavg::{ErrorKind, Par};
 use wavg::SolveError;
 use wavg::{BatchWeights, ForwardOptions, RoundTrip, Solver, SurfacePoint};
+use wavg::{ErrorKind, Par};
 
 use crate::boundary::{
     Failure, Outcome, guard, guard_value, handle, handle_mut, optional, product, slice, slice_mut,

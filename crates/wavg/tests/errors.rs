@@ -44,7 +44,10 @@ fn every_kind_is_listed_once_and_classed() {
 #[test]
 fn mesh_errors_are_classed() {
     let dir = tempfile::tempdir().unwrap();
-    assert_eq!(kind(io::load(&dir.path().join("missing.obj")).unwrap_err()), ErrorKind::Io);
+    assert_eq!(
+        kind(io::load(&dir.path().join("missing.obj")).unwrap_err()),
+        ErrorKind::Io
+    );
     let bad = dir.path().join("bad.obj");
     std::fs::write(&bad, "f 1 2 x\n").unwrap();
     assert_eq!(kind(io::load(&bad).unwrap_err()), ErrorKind::Io);
@@ -59,7 +62,10 @@ fn mesh_errors_are_classed() {
     let mut m: TriMesh = procedural::icosphere(0);
     m.faces[0] = [0, 0, 1];
     assert_eq!(kind(ValidMesh::new(m).unwrap_err()), ErrorKind::InvalidMesh);
-    assert_eq!(kind(procedural::builtin("nope").unwrap_err()), ErrorKind::InvalidArgument);
+    assert_eq!(
+        kind(procedural::builtin("nope").unwrap_err()),
+        ErrorKind::InvalidArgument
+    );
 }
 
 #[test]
@@ -67,28 +73,55 @@ fn embed_errors_are_classed() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = procedural::icosphere(1);
     let missing = dir.path().join("missing.wavg");
-    assert_eq!(kind(wavg::embed::file::load(&missing, &mesh).unwrap_err()), ErrorKind::Io);
+    assert_eq!(
+        kind(wavg::embed::file::load(&missing, &mesh).unwrap_err()),
+        ErrorKind::Io
+    );
     let junk = dir.path().join("junk.wavg");
     std::fs::write(&junk, b"not an embedding").unwrap();
-    assert_eq!(kind(wavg::embed::file::load(&junk, &mesh).unwrap_err()), ErrorKind::Io);
+    assert_eq!(
+        kind(wavg::embed::file::load(&junk, &mesh).unwrap_err()),
+        ErrorKind::Io
+    );
     let path = PathBuf::from("x.wavg");
     let io_err = || std::io::Error::other("disk full");
-    assert_eq!(kind(EmbedError::Write { path, source: io_err() }), ErrorKind::Write);
+    assert_eq!(
+        kind(EmbedError::Write {
+            path,
+            source: io_err()
+        }),
+        ErrorKind::Write
+    );
     assert_eq!(kind(EmbedError::Cancelled), ErrorKind::Cancelled);
-    assert_eq!(kind(EmbedError::Numerical("x".into())), ErrorKind::InvalidMesh);
-    assert_eq!(kind(EmbedError::InvalidArgument("x".into())), ErrorKind::InvalidArgument);
+    assert_eq!(
+        kind(EmbedError::Numerical("x".into())),
+        ErrorKind::InvalidMesh
+    );
+    assert_eq!(
+        kind(EmbedError::InvalidArgument("x".into())),
+        ErrorKind::InvalidArgument
+    );
 }
 
 #[test]
 fn projection_and_solver_errors_are_classed() {
     assert_eq!(kind(ProjectError::NoProjection), ErrorKind::NoSolution);
     assert_eq!(kind(ProjectError::EmptyMesh), ErrorKind::InvalidMesh);
-    assert_eq!(kind(ProjectError::NonFiniteQuery), ErrorKind::InvalidArgument);
-    assert_eq!(kind(ProjectError::ThreadPool("no threads".into())), ErrorKind::Internal);
+    assert_eq!(
+        kind(ProjectError::NonFiniteQuery),
+        ErrorKind::InvalidArgument
+    );
+    assert_eq!(
+        kind(ProjectError::ThreadPool("no threads".into())),
+        ErrorKind::Internal
+    );
     assert_eq!(kind(SolveError::NoWeightedAverage), ErrorKind::NoSolution);
     assert_eq!(kind(SolveError::DegenerateAnchors), ErrorKind::NoSolution);
     assert_eq!(
-        kind(SolveError::WeightCount { expected: 3, got: 2 }),
+        kind(SolveError::WeightCount {
+            expected: 3,
+            got: 2
+        }),
         ErrorKind::InvalidArgument
     );
     assert_eq!(
@@ -103,9 +136,18 @@ fn projection_and_solver_errors_are_classed() {
 
 #[test]
 fn application_and_remesher_errors_are_classed() {
-    assert_eq!(kind(AppError::Image("x.png: not a PNG".into())), ErrorKind::Io);
-    assert_eq!(kind(AppError::Input("no UVs".into())), ErrorKind::InvalidArgument);
-    assert_eq!(kind(AppError::Solve(SolveError::NoWeightedAverage)), ErrorKind::NoSolution);
+    assert_eq!(
+        kind(AppError::Image("x.png: not a PNG".into())),
+        ErrorKind::Io
+    );
+    assert_eq!(
+        kind(AppError::Input("no UVs".into())),
+        ErrorKind::InvalidArgument
+    );
+    assert_eq!(
+        kind(AppError::Solve(SolveError::NoWeightedAverage)),
+        ErrorKind::NoSolution
+    );
     assert_eq!(
         kind(wavg::apps::Image::read_png(std::path::Path::new("/no/such.png")).unwrap_err()),
         ErrorKind::Io
@@ -122,9 +164,19 @@ fn application_and_remesher_errors_are_classed() {
     let e = fin.validate().unwrap_err();
     assert!(matches!(e, RemeshError::NonManifold { .. }), "{e:?}");
     assert_eq!(kind(e), ErrorKind::InvalidMesh);
-    assert_eq!(kind(RemeshError::InvalidParameter("x".into())), ErrorKind::InvalidArgument);
-    let solve = |source| RemeshError::Solve { stage: "level 1".into(), vertex: 0, source };
-    assert_eq!(kind(solve(SolveError::NoWeightedAverage)), ErrorKind::NoSolution);
+    assert_eq!(
+        kind(RemeshError::InvalidParameter("x".into())),
+        ErrorKind::InvalidArgument
+    );
+    let solve = |source| RemeshError::Solve {
+        stage: "level 1".into(),
+        vertex: 0,
+        source,
+    };
+    assert_eq!(
+        kind(solve(SolveError::NoWeightedAverage)),
+        ErrorKind::NoSolution
+    );
     assert_eq!(
         kind(solve(SolveError::FaceOutOfRange { face: 9, count: 1 })),
         ErrorKind::InvalidArgument

@@ -64,8 +64,7 @@ pub fn load_embedded(
     };
     let e = wavg::embed::file::load(path, &mesh)?;
     let coords: Vec<Vec8> = e.coords.iter().map(|c| Vec8::from(*c)).collect();
-    let emb = EmbeddedMesh::new(mesh, coords)
-        .context(path.display())?;
+    let emb = EmbeddedMesh::new(mesh, coords).context(path.display())?;
     Ok(Arc::new(emb))
 }
 
@@ -126,8 +125,7 @@ pub fn load_solver(args: &ProblemArgs) -> Result<Solver, CliError> {
         None => {
             let e = crate::cache::embedding(&mesh, &args.mesh, args.cache.no_cache)?;
             let coords: Vec<Vec8> = e.coords.iter().map(|c| Vec8::from(*c)).collect();
-            let emb =
-                EmbeddedMesh::new(mesh, coords)?;
+            let emb = EmbeddedMesh::new(mesh, coords)?;
             Arc::new(emb)
         }
     };
