@@ -60,7 +60,7 @@ fn mesh_errors_are_classed() {
     assert!(matches!(e, MeshError::Write { .. }), "{e:?}");
     assert_eq!(kind(e), ErrorKind::Write);
     let mut m: TriMesh = procedural::icosphere(0);
-    m.faces[0] = [0, 0, 1];
+    m.triangles[0] = [0, 0, 1];
     assert_eq!(kind(ValidMesh::new(m).unwrap_err()), ErrorKind::InvalidMesh);
     assert_eq!(
         kind(procedural::builtin("nope").unwrap_err()),
