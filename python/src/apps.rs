@@ -11,7 +11,7 @@ use wavg::apps::{
 };
 
 use crate::args::{Int, array, data, finite, par, reals};
-use crate::errors::{app, lib, to_py, value};
+use crate::errors::{lib, to_py, value};
 use crate::solver::{anchors, named_tuple, points_tuple};
 use crate::surface::Surface;
 use crate::{image, remesh, render};
@@ -315,6 +315,6 @@ fn transfer_texture<'py>(
             par.install(|| wavg::apps::transfer_texture(&ss, &texture, &ts, &opts, &|_, _| {}))
         })
         .map_err(lib(py))?
-        .map_err(|e| app(py, &e))?;
+        .map_err(lib(py))?;
     image::to_array(py, &out.image)
 }

@@ -22,11 +22,13 @@ pub(crate) fn raise(py: Python<'_>, name: &str, message: String) -> PyErr {
     make().unwrap_or_else(|e| e)
 }
 
-/// The Python exception for a library error: `InvalidMeshError` (with `.problems`),
-/// `InvalidArgumentError` (a `ValueError`), `WavgIOError` (an `OSError`),
-/// `NoSolutionError`, `CancelledError`; all derive from `WavgError`.
+/// The Python exception for a library error, the one table from error kinds to classes:
+/// `InvalidMeshError` (with `.problems`), `InvalidArgumentError` (a `ValueError`),
+/// `WavgIOError` (an `OSError`, for failed reads and writes), `NoSolutionError`,
+/// `CancelledError`, and `WavgError` itself (the base of them all) for a failure of the
+/// library on valid input.
 pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
-    let message = one_line(&e);
+    let message = e.message();
     match e.kind() {
         ErrorKind::InvalidMesh => {
             let err = raise(py, "InvalidMeshError", message);
@@ -34,7 +36,7 @@ pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
                 Error::Mesh(MeshError::Invalid(report)) => {
                     report.problems.iter().map(ToString::to_string).collect()
                 }
-                other => vec![one_line(other)],
+                other => vec![other.message()],
             };
             if let Ok(list) = PyList::new(py, problems) {
                 let _ = err.value(py).setattr("problems", list);
@@ -42,9 +44,10 @@ pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
             err
         }
         ErrorKind::InvalidArgument => raise(py, "InvalidArgumentError", message),
-        ErrorKind::Io => raise(py, "WavgIOError", message),
+        ErrorKind::Io | ErrorKind::Write => raise(py, "WavgIOError", message),
         ErrorKind::NoSolution => raise(py, "NoSolutionError", message),
         ErrorKind::Cancelled => raise(py, "CancelledError", message),
+        ErrorKind::Internal => raise(py, "WavgError", message),
     }
 }
 
@@ -55,21 +58,6 @@ pub(crate) fn cancelled(py: Python<'_>) -> PyErr {
         "CancelledError",
         "cancelled by the progress callback".into(),
     )
-}
-
-/// The error and its causes on one line.
-pub(crate) fn one_line(e: &dyn std::error::Error) -> String {
-    let mut s = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let c_s = c.to_string();
-        if !s.contains(&c_s) {
-            s.push_str(": ");
-            s.push_str(&c_s);
-        }
-        cause = c.source();
-    }
-    s.replace('\n', "; ")
 }
 
 /// Converts any library error (of the facade or a layer) to the Python exception.
@@ -99,30 +87,4 @@ pub(crate) fn require_file(path: &Path) -> PyResult<()> {
             path.to_string_lossy().into_owned(),
         )))
     }
-}
-
-/// The Python exception for an error reading, decoding or encoding a PNG image:
-/// `WavgIOError` (an `OSError`), as for meshes and embeddings.
-pub(crate) fn png(py: Python<'_>, e: &wavg::apps::AppError) -> PyErr {
-    match e {
-        wavg::apps::AppError::Image(m) => raise(py, "WavgIOError", m.clone()),
-        e => app(py, e),
-    }
-}
-
-/// The Python exception for an application's error (the message with its causes).
-pub(crate) fn app(py: Python<'_>, e: &wavg::apps::AppError) -> PyErr {
-    raise(py, "InvalidArgumentError", one_line(e))
-}
-
-/// The Python exception for a remeshing error.
-pub(crate) fn remesh(py: Python<'_>, e: &wavg::apps::RemeshError) -> PyErr {
-    let class = if e.is_invalid_mesh() {
-        "InvalidMeshError"
-    } else if e.is_no_solution() {
-        "NoSolutionError"
-    } else {
-        "InvalidArgumentError"
-    };
-    raise(py, class, one_line(e))
 }

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use wavg::apps::{Image, MAX_SIDE};
 
 use crate::args::{Int, array};
-use crate::errors::{png, raise, require_file, type_error, value};
+use crate::errors::{lib, raise, require_file, type_error, value};
 use crate::pool::DetachRun;
 
 /// An image argument: an `(H, W, 3)` or `(H, W, 4)` uint8 array (or a PNG path).
@@ -16,9 +16,7 @@ pub(crate) fn image_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Image> {
     let py = obj.py();
     if let Ok(path) = obj.extract::<PathBuf>() {
         require_file(&path)?;
-        return py
-            .detach_run(|| Image::read_png(&path))
-            .map_err(|e| png(py, &e));
+        return py.detach_run(|| Image::read_png(&path)).map_err(lib(py));
     }
     let expected = "an (H, W, 3) or (H, W, 4) uint8 image array (or a PNG path)";
     let np = crate::args::numpy(py)?;
@@ -109,8 +107,6 @@ pub(crate) fn save_png(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>) 
 #[pyfunction]
 pub(crate) fn read_png<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
     require_file(&path)?;
-    let img = py
-        .detach_run(|| Image::read_png(&path))
-        .map_err(|e| png(py, &e))?;
+    let img = py.detach_run(|| Image::read_png(&path)).map_err(lib(py))?;
     to_array(py, &img)
 }

@@ -9,7 +9,7 @@ use wavg::Vector3;
 use wavg::apps::BaseMesh;
 
 use crate::args::{Int, array, data, ints, reals};
-use crate::errors::{remesh, value};
+use crate::errors::{lib, value};
 use crate::surface::Surface;
 
 /// Semiregular remeshing: ``Remesher(S, base_V, base_F, levels=2, smooth=3)``.
@@ -63,7 +63,7 @@ impl Remesher {
         let projector = S.inner.projector().clone();
         let inner = py
             .detach_run(|| wavg::apps::Remesher::new(projector, &base))
-            .map_err(|e| remesh(py, &e))?;
+            .map_err(lib(py))?;
         Ok(Self {
             inner,
             levels: levels as usize,
@@ -78,7 +78,7 @@ impl Remesher {
         let inner = &mut self.inner;
         let r = py
             .detach_run(|| inner.remesh(levels, smooth))
-            .map_err(|e| remesh(py, &e))?;
+            .map_err(lib(py))?;
         self.result = Some(r);
         Ok((self.vertices(py)?, self.faces(py)?))
     }
@@ -98,7 +98,7 @@ impl Remesher {
             let (sp, _) = inner.closest_point(&Vector3::new(p[0], p[1], p[2]));
             inner.move_base_vertex(i as usize, sp)
         })
-        .map_err(|e| remesh(py, &e))
+        .map_err(lib(py))
     }
 
     /// Vertices of the last ``run()``, ``(N, 3)`` float64 (None before the first).

@@ -8,7 +8,7 @@ use wavg::Vector3;
 use wavg::apps::{Colouring, Overlays, RenderOptions, View};
 
 use crate::args::{Int, data, reals};
-use crate::errors::{app, value};
+use crate::errors::{lib, value};
 use crate::image::{image_arg, size_arg, to_array};
 use crate::surface::Surface;
 
@@ -126,6 +126,6 @@ pub(crate) fn render<'py>(
     };
     let img = py
         .detach_run(|| wavg::apps::render(mesh.mesh(), &colouring, &overlays, &opts))
-        .map_err(|e| app(py, &e))?;
+        .map_err(lib(py))?;
     to_array(py, &img)
 }

@@ -9,7 +9,7 @@ use wavg::sampling::{FpsMetric, farthest_point_vertices};
 use wavg::{ValidMesh, Vec8, VertexId};
 
 use crate::CliError;
-use crate::common::{load_valid, one_line};
+use crate::common::load_valid;
 use crate::textio;
 
 /// How the anchors are chosen.
@@ -105,8 +105,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let coords = embedded_coords(&mesh, &args)?;
     let anchors = match args.method {
         Method::Fps => {
-            farthest_point_vertices(&mesh, args.count, args.seed, FpsMetric::Embedding(&coords))
-                .map_err(|e| CliError::input(one_line(&e)))?
+            farthest_point_vertices(&mesh, args.count, args.seed, FpsMetric::Embedding(&coords))?
         }
         Method::Random => {
             let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(args.seed);
@@ -202,7 +201,7 @@ pub fn suggested_count(count: usize, gap: f64) -> usize {
 /// The embedding's coordinates: `--embedding`'s file or the cache's.
 fn embedded_coords(mesh: &std::sync::Arc<ValidMesh>, args: &Args) -> Result<Vec<Vec8>, CliError> {
     let e = match &args.embedding {
-        Some(p) => wavg::embed::file::load(p, mesh).map_err(|e| CliError::input(one_line(&e)))?,
+        Some(p) => wavg::embed::file::load(p, mesh)?,
         None => crate::cache::embedding(mesh, &args.mesh, args.cache.no_cache)?,
     };
     Ok(e.coords.iter().map(|c| Vec8::from(*c)).collect())
@@ -219,8 +218,7 @@ pub fn spread_to_good_gap(
     max: usize,
 ) -> Result<(Vec<VertexId>, f64), CliError> {
     let max = max.min(mesh.n_vertices()).max(1);
-    let first = farthest_point_vertices(mesh, 1, seed, FpsMetric::Embedding(coords))
-        .map_err(|e| CliError::input(one_line(&e)))?[0];
+    let first = farthest_point_vertices(mesh, 1, seed, FpsMetric::Embedding(coords))?[0];
     let diagonal = mesh.bounding_box_diagonal().max(f64::MIN_POSITIVE);
     let mut dist = vec![f64::INFINITY; coords.len()];
     let (mut out, mut next) = (Vec::new(), first);

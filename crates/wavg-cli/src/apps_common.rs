@@ -9,7 +9,7 @@ use wavg::{Anchor, Embedding, Solver, Surface, ValidMesh};
 
 use crate::CliError;
 use crate::cache::CacheArg;
-use crate::common::{load_mesh, one_line, validate};
+use crate::common::{load_mesh, validate};
 use crate::textio::{located, read_points, spec_anchor};
 
 /// Flags of the commands that relate two surfaces through anchors paired line by line
@@ -57,9 +57,7 @@ pub fn solver_for(
         None => embed(valid, embedding, mesh, cache)?,
     };
     let t = std::time::Instant::now();
-    let solver = surface
-        .solver(list)
-        .map_err(|e| CliError::input(one_line(&e)));
+    let solver = surface.solver(list).map_err(CliError::from);
     crate::common::step("solver", t);
     solver
 }
@@ -120,9 +118,7 @@ pub fn embed(
     cache: CacheArg,
 ) -> Result<Surface, CliError> {
     let e = match embedding {
-        Some(path) => {
-            wavg::embed::file::load(path, &mesh).map_err(|e| CliError::input(one_line(&e)))?
-        }
+        Some(path) => wavg::embed::file::load(path, &mesh)?,
         None => crate::cache::embedding(&mesh, name, cache.no_cache)?,
     };
     surface_of(mesh, e)
@@ -131,8 +127,7 @@ pub fn embed(
 /// The surface on `mesh` with the embedding `e` (its projector built here).
 fn surface_of(mesh: Arc<ValidMesh>, e: Embedding) -> Result<Surface, CliError> {
     let t = std::time::Instant::now();
-    let s =
-        Surface::from_valid_with_embedding(mesh, e).map_err(|e| CliError::failure(one_line(&e)));
+    let s = Surface::from_valid_with_embedding(mesh, e).map_err(CliError::from);
     crate::common::step("projector (embedded mesh, BVH)", t);
     s
 }

@@ -5,7 +5,6 @@
 use wavg_bench::{LoadBenchReport, load_bench};
 
 use crate::CliError;
-use crate::common::one_line;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -34,7 +33,7 @@ struct JsonReport<'a> {
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     let r =
-        load_bench(args.mesh.as_ref(), args.repeat).map_err(|e| CliError::input(one_line(&e)))?;
+        load_bench(args.mesh.as_ref(), args.repeat)?;
     if args.json {
         let j = serde_json::to_value(JsonReport {
             mesh: &args.mesh,

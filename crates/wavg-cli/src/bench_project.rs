@@ -3,7 +3,6 @@
 
 use std::path::PathBuf;
 
-use wavg::SolveError;
 use wavg_bench::{ProjectionBenchOptions, ProjectionBenchReport, projection_bench};
 
 use crate::CliError;
@@ -58,10 +57,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         thread_cpu_clock: Some(|| crate::common::cpu_seconds(true)),
         ..Default::default()
     };
-    let r = projection_bench(emb, &opts).map_err(|e| match e {
-        SolveError::Project(e) => CliError::failure(e),
-        e => CliError::failure(e),
-    })?;
+    let r = projection_bench(emb, &opts)?;
     if !r.batch_agrees {
         return Err(CliError::failure(
             "project_batch and project disagree (a bug: please report it)",

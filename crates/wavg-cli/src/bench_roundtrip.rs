@@ -10,11 +10,12 @@ use std::time::Instant;
 
 use serde::Serialize;
 use wavg::sampling::{FpsMetric, farthest_point_vertices};
-use wavg::{Anchor, SearchMode, SolveError, Solver};
+use wavg::{Anchor, SearchMode, Solver};
 use wavg_bench::{RoundTripOptions, RoundTripReport, load_average};
 
 use crate::CliError;
-use crate::common::{load_valid, one_line};
+use crate::common::load_valid;
+use crate::error::Context;
 use crate::textio;
 
 /// Arguments.
@@ -122,10 +123,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let t0 = Instant::now();
     let proj = textio::build_projector(emb)?;
     let t_proj = t0.elapsed().as_secs_f64();
-    let anchors = farthest_point_vertices(&mesh, args.anchors, args.seed, FpsMetric::EdgeGraph)
-        .map_err(|e| CliError::input(one_line(&e)))?;
-    let solver = Solver::new(proj, anchors.into_iter().map(Anchor::Vertex))
-        .map_err(|e| CliError::failure(one_line(&e)))?;
+    let anchors = farthest_point_vertices(&mesh, args.anchors, args.seed, FpsMetric::EdgeGraph)?;
+    let solver = Solver::new(proj, anchors.into_iter().map(Anchor::Vertex))?;
     let opts = RoundTripOptions {
         queries: args.queries,
         seed: args.seed.wrapping_add(1),
@@ -138,11 +137,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         verified: args.verified,
         cpu_clock: Some(process_cpu_seconds),
     };
-    let report = textio::with_threads(Some(threads), || wavg_bench::round_trip(&solver, &opts))?
-        .map_err(|e| match e {
-            SolveError::InvalidParameter(_) => CliError::input(one_line(&e)),
-            e => CliError::failure(one_line(&e)),
-        })?;
+    let report = textio::with_threads(Some(threads), || wavg_bench::round_trip(&solver, &opts))??;
     crate::anchors::warn_if_low(
         report.roundtrip_ok_fraction,
         "round trips that lead back to their point",
@@ -228,10 +223,9 @@ fn precompute_embedding(
     mesh: &std::sync::Arc<wavg::ValidMesh>,
 ) -> Result<std::sync::Arc<wavg::EmbeddedMesh>, CliError> {
     let opts = wavg::PrecomputeOptions::default();
-    let (emb, _) = wavg::embed::precompute(mesh, &opts, &wavg::NoProgress)
-        .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))?;
+    let (emb, _) = wavg::embed::precompute(mesh, &opts, &wavg::NoProgress).context("precompute")?;
     let coords = emb.coords.iter().map(|c| wavg::Vec8::from(*c)).collect();
     wavg::EmbeddedMesh::new(mesh.clone(), coords)
         .map(std::sync::Arc::new)
-        .map_err(|e| CliError::failure(format!("precompute: {}", one_line(&e))))
+        .context("precompute")
 }

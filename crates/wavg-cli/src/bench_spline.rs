@@ -3,12 +3,11 @@
 //! (the protocol is [`wavg_bench::spline_bench`]'s; this prints its report).
 
 use serde::Serialize;
-use wavg::SolveError;
 use wavg::apps::SplineKind;
 use wavg_bench::{SplineBenchOptions, SplineBenchReport, load_average, spline_bench};
 
 use crate::CliError;
-use crate::common::one_line;
+use crate::error::Context;
 use crate::textio;
 
 /// Arguments.
@@ -79,8 +78,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &args.control,
         args.cache,
     )?;
-    let bad =
-        |e: SolveError| CliError::input(format!("{}: {}", args.control.display(), one_line(&e)));
     let threads = args.threads.unwrap_or_else(rayon::current_num_threads);
     let opts = SplineBenchOptions {
         kind,
@@ -90,7 +87,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         cpu_clock: Some(|| crate::common::cpu_seconds(false)),
     };
     let report =
-        textio::with_threads(Some(threads), || spline_bench(&solver, &opts))?.map_err(bad)?;
+        textio::with_threads(Some(threads), || spline_bench(&solver, &opts))?
+            .context(args.control.display())?;
     let json = JsonReport {
         mesh: &args.mesh,
         report: &report,

@@ -19,7 +19,7 @@ use wavg::embed::file::{FNV_OFFSET, fnv1a64, mesh_hash};
 use wavg::{Embedding, PrecomputeOptions, TriMesh, ValidMesh};
 
 use crate::CliError;
-use crate::common::one_line;
+use crate::error::Context;
 use crate::precompute::Bars;
 
 /// The `--no-cache` flag of the commands that use the cache.
@@ -101,7 +101,7 @@ pub fn embedding(mesh: &ValidMesh, name: &str, no_cache: bool) -> Result<Embeddi
             Err(e) => eprintln!(
                 "wavg: the cached embedding {} cannot be used ({}); computing it again",
                 path.display(),
-                one_line(&e)
+                wavg::Error::from(e).message()
             ),
         }
     }
@@ -180,7 +180,7 @@ fn compute(
     let t = Instant::now();
     let r = crate::textio::with_threads(None, || wavg::embed::precompute(mesh, opts, &bars))?;
     bars.clear();
-    let (emb, _) = r.map_err(|e| CliError::failure(format!("{name}: {}", one_line(&e))))?;
+    let (emb, _) = r.context(name)?;
     Ok((emb, t.elapsed().as_secs_f64()))
 }
 
@@ -196,7 +196,7 @@ fn store(
 ) -> Result<(), String> {
     std::fs::create_dir_all(folder).map_err(|e| e.to_string())?;
     wavg::embed::file::save(&folder.join(format!("{key}.wavg")), emb, mesh)
-        .map_err(|e| one_line(&e))?;
+        .map_err(|e| wavg::Error::from(e).message())?;
     let meta = Meta {
         mesh: name.to_string(),
         vertices: mesh.n_vertices(),

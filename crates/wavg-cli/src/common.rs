@@ -18,8 +18,8 @@ pub const BUILTIN_PREFIX: &str = "builtin:";
 /// message names the file and, for parse errors, the line.
 pub fn load_mesh(path_or_builtin: &str) -> Result<TriMesh, CliError> {
     match path_or_builtin.strip_prefix(BUILTIN_PREFIX) {
-        Some(name) => procedural::builtin(name).map_err(CliError::input),
-        None => io::load(Path::new(path_or_builtin)).map_err(|e| CliError::input(one_line(&e))),
+        Some(name) => Ok(procedural::builtin(name)?),
+        None => Ok(io::load(Path::new(path_or_builtin))?),
     }
 }
 
@@ -28,8 +28,7 @@ pub fn load_mesh(path_or_builtin: &str) -> Result<TriMesh, CliError> {
 pub fn load_mesh_notes(path_or_builtin: &str) -> Result<(TriMesh, wavg::LoadNotes), CliError> {
     match path_or_builtin.strip_prefix(BUILTIN_PREFIX) {
         Some(_) => Ok((load_mesh(path_or_builtin)?, Default::default())),
-        None => io::load_with_notes(Path::new(path_or_builtin))
-            .map_err(|e| CliError::input(one_line(&e))),
+        None => Ok(io::load_with_notes(Path::new(path_or_builtin))?),
     }
 }
 
@@ -53,6 +52,7 @@ pub fn validate(path_or_builtin: &str, mesh: TriMesh) -> Result<Arc<ValidMesh>, 
             Ok(Arc::new(m))
         }
         Err(MeshError::Invalid(report)) => {
+            let n = report.problems.len();
             eprintln!("{path_or_builtin}: the mesh is not a valid oriented manifold:");
             for line in report.lines() {
                 eprintln!("  {line}");
@@ -62,14 +62,19 @@ pub fn validate(path_or_builtin: &str, mesh: TriMesh) -> Result<Arc<ValidMesh>, 
                  degenerate/duplicate faces, unreferenced vertices and extra components can \
                  be removed with `wavg repair {path_or_builtin} -o FIXED.obj [--largest-component]`"
             );
-            Err(CliError::input(format!(
-                "{path_or_builtin}: invalid mesh ({} problem{})",
-                report.problems.len(),
-                if report.problems.len() == 1 { "" } else { "s" }
+            let e = CliError::from(MeshError::Invalid(report));
+            Err(e.with_message(format!(
+                "{path_or_builtin}: invalid mesh ({n} problem{})",
+                if n == 1 { "" } else { "s" }
             )))
         }
-        Err(e) => Err(CliError::input(one_line(&e))),
+        Err(e) => Err(e.into()),
     }
+}
+
+/// A per-sample solver error as the one-line reason of a `none` output line.
+pub fn reason(e: &wavg::SolveError) -> String {
+    wavg::Error::from(e.clone()).message()
 }
 
 /// With `WAVG_STEP_TIMES` set (to anything), prints `step NAME MS` on stderr, the
@@ -81,11 +86,6 @@ pub fn step(name: &str, since: Instant) -> Instant {
         eprintln!("step {name} {:.1}", (now - since).as_secs_f64() * 1e3);
     }
     now
-}
-
-/// An error's message on one line (the CLI prints exactly one line per failure).
-pub fn one_line(e: &dyn std::fmt::Display) -> String {
-    e.to_string().replace('\n', " ")
 }
 
 /// CPU time consumed so far by the calling thread (`thread`) or by the whole process (all

@@ -14,7 +14,7 @@ use wavg::{Anchor, Solver, Surface};
 
 use crate::CliError;
 use crate::apps_common::{PairArgs, embed, mesh_and_anchors};
-use crate::common::one_line;
+use crate::error::Context;
 use crate::textio::{self, write_numbers};
 
 /// The validity test, on the command line.
@@ -154,9 +154,7 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
         &a.pair.target,
         a.pair.cache,
     )?;
-    let solver = |s: &Surface, l: Vec<Anchor>| -> Result<Solver, CliError> {
-        s.solver(l).map_err(|e| CliError::input(one_line(&e)))
-    };
+    let solver = |s: &Surface, l: Vec<Anchor>| -> Result<Solver, CliError> { Ok(s.solver(l)?) };
     let (ss, ts) = (solver(&source, sa)?, solver(&target, ta)?);
     let setup_seconds = t0.elapsed().as_secs_f64();
     let opts = CorrespondOptions {
@@ -170,8 +168,7 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
     };
     let t = Instant::now();
     let cpu0 = crate::common::cpu_seconds(false);
-    let map = textio::with_threads(a.pair.threads, || correspond_vertices(&ss, &ts, &opts))?
-        .map_err(|e| CliError::input(one_line(&e)))?;
+    let map = textio::with_threads(a.pair.threads, || correspond_vertices(&ss, &ts, &opts))??;
     Ok(Computed {
         source,
         target,
@@ -189,7 +186,7 @@ pub fn compute(a: &MapArgs) -> Result<Computed, CliError> {
 fn ground_truth(c: &Computed) -> Result<GroundTruthErrors, CliError> {
     c.map
         .ground_truth_errors(c.source.mesh(), c.target.mesh())
-        .map_err(|e| CliError::input(format!("--ground-truth: {e}")))
+        .context("--ground-truth")
 }
 
 /// The `--json` object: the map's [`Distortion`] with the CLI's counts and timings

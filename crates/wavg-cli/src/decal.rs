@@ -9,7 +9,6 @@ use wavg::apps::{DecalReport, decal_vertices, untextured_faces, write_decal_obj}
 
 use crate::CliError;
 use crate::apps_common::{embed, mesh_and_anchors};
-use crate::common::one_line;
 use crate::decal_material;
 use crate::textio::{self, located};
 
@@ -137,12 +136,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )));
     }
     let surface = embed(mesh, args.embedding.as_deref(), &args.mesh, args.cache)?;
-    let solver = surface
-        .solver(anchors)
-        .map_err(|e| CliError::input(one_line(&e)))?;
+    let solver = surface.solver(anchors)?;
     let t = Instant::now();
-    let decal = decal_vertices(&solver, &uv, args.max_negative)
-        .map_err(|e| CliError::input(one_line(&e)))?;
+    let decal = decal_vertices(&solver, &uv, args.max_negative)?;
     let seconds = t.elapsed().as_secs_f64();
     let mesh = surface.mesh();
     let material = decal_material::write(&args.output, args.texture.as_deref())?;

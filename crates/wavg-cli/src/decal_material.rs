@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use wavg::apps::{DECAL_MATERIAL as TEXTURED, Image, PLAIN_MATERIAL as PLAIN};
 
 use crate::CliError;
-use crate::common::one_line;
+use crate::error::Context;
 use crate::textio;
 
 /// What was written beside the OBJ.
@@ -92,9 +92,7 @@ pub fn write(obj: &Path, texture: Option<&Path>) -> Result<Option<Material>, Cli
 
 /// Refuses a `--texture` that is not a readable PNG (before anything is computed).
 pub fn check_texture(texture: &Path) -> Result<(), CliError> {
-    Image::read_png(texture)
-        .map(drop)
-        .map_err(|e| CliError::input(format!("--texture: {}", one_line(&e))))
+    Image::read_png(texture).map(drop).context("--texture")
 }
 
 /// How a `.mtl` in `dir` names `file`: its file name when it is in `dir`, else its

@@ -11,12 +11,13 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use wavg::sampling::{FpsMetric, farthest_point_vertices};
-use wavg::{Anchor, EmbeddedMesh, ForwardOptions, SolveError, Solver, ValidMesh, Vec8};
+use wavg::{Anchor, EmbeddedMesh, ForwardOptions, Solver, ValidMesh, Vec8};
 use wavg_bench::{RoundTripOptions, round_trip};
 
 use crate::CliError;
 use crate::anchors::{GOOD_GAP, closed_tour, largest_gap, spread_to_good_gap};
-use crate::common::{load_valid, one_line};
+use crate::common::load_valid;
+use crate::error::Context;
 use crate::textio::{self, write_numbers};
 
 /// Arguments.
@@ -124,8 +125,7 @@ fn spline_weights(order: &[usize], samples: usize) -> Result<Vec<Vec<f64>>, CliE
         degree: 3,
         closed: true,
     };
-    let rows = wavg::apps::spline_weights(kind, order.len(), samples)
-        .map_err(|e| CliError::input(e.to_string()))?;
+    let rows = wavg::apps::spline_weights(kind, order.len(), samples)?;
     Ok(rows
         .into_iter()
         .map(|row| {
@@ -174,24 +174,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ..Default::default()
     };
     let (emb, _) =
-        wavg::embed::precompute(&mesh, &opts, &wavg::NoProgress).map_err(|e| match e {
-            // The mesh or the arguments do not suit (exit status 2, as `wavg precompute`).
-            wavg::EmbedError::InvalidArgument(m) => CliError::input(format!("precompute: {m}")),
-            e => CliError::failure(format!("precompute: {}", one_line(&e))),
-        })?;
+        wavg::embed::precompute(&mesh, &opts, &wavg::NoProgress).context("precompute")?;
     let precompute_s = t0.elapsed().as_secs_f64();
     let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
-    let embedded = EmbeddedMesh::new(mesh.clone(), coords)
-        .map(Arc::new)
-        .map_err(|e| CliError::failure(one_line(&e)))?;
+    let embedded = EmbeddedMesh::new(mesh.clone(), coords).map(Arc::new)?;
     let proj = textio::build_projector(embedded)?;
     let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
     // The anchors: as many as asked, else enough for a small gap between them; the spline's
     // control points are all of them when asked for, else the first (most spread) 8.
     let (anchor_ids, gap) = match args.anchors {
         Some(k) => {
-            let ids = farthest_point_vertices(&mesh, k, args.seed, FpsMetric::Embedding(&coords))
-                .map_err(|e| CliError::input(one_line(&e)))?;
+            let ids = farthest_point_vertices(&mesh, k, args.seed, FpsMetric::Embedding(&coords))?;
             let gap = largest_gap(&coords, &ids) / mesh.bounding_box_diagonal();
             (ids, gap)
         }
@@ -202,8 +195,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         None => anchor_ids[..DEFAULT_CONTROLS.min(anchor_ids.len())].to_vec(),
     };
     let solver_for = |ids: &[u32]| {
-        Solver::new(proj.clone(), ids.iter().map(|&v| Anchor::Vertex(v)))
-            .map_err(|e| CliError::failure(one_line(&e)))
+        Solver::new(proj.clone(), ids.iter().map(|&v| Anchor::Vertex(v))).map_err(CliError::from)
     };
     let (solver, spline_solver) = (solver_for(&anchor_ids)?, solver_for(&controls)?);
     say(&format!(
@@ -237,11 +229,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             verified: true,
             ..Default::default()
         },
-    )
-    .map_err(|e| match e {
-        SolveError::InvalidParameter(_) => CliError::input(one_line(&e)),
-        e => CliError::failure(one_line(&e)),
-    })?;
+    )?;
     let (ok, vok) = (
         trips.roundtrip_ok_fraction,
         trips
@@ -363,13 +351,10 @@ fn write_outputs(
     anchors: &[u32],
     curve: &[Result<wavg::ForwardResult, wavg::SolveError>],
 ) -> Result<(), CliError> {
-    let fail = |what: &str, e: &dyn std::fmt::Display| {
-        CliError::failure(format!("{}: {what}: {e}", dir.display()))
-    };
-    std::fs::create_dir_all(dir).map_err(|e| fail("cannot create", &e))?;
-    wavg::mesh::io::save(&dir.join("mesh.obj"), mesh).map_err(|e| fail("mesh.obj", &e))?;
-    wavg::embed::file::save(&dir.join("mesh.wavg"), emb, mesh)
-        .map_err(|e| fail("mesh.wavg", &e))?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::failure(format!("{}: cannot create: {e}", dir.display())))?;
+    wavg::mesh::io::save(&dir.join("mesh.obj"), mesh)?;
+    wavg::embed::file::save(&dir.join("mesh.wavg"), emb, mesh)?;
     textio::write_atomic(&dir.join("anchors.txt"), |w: &mut dyn Write| {
         anchors.iter().try_for_each(|v| writeln!(w, "v {v}"))
     })?;
@@ -380,7 +365,7 @@ fn write_outputs(
                     write!(w, "{} ", r.point.face)?;
                     write_numbers(w, r.point.bary.iter().chain(r.position.iter()).copied())?;
                 }
-                Err(e) => write!(w, "none {}", one_line(e))?,
+                Err(e) => write!(w, "none {}", crate::common::reason(e))?,
             }
             writeln!(w)?;
         }

@@ -128,7 +128,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     text::push_numbers(out, p.bary.into_iter().chain(r.position.iter().copied()));
                 }
                 Err(e) => {
-                    out.extend_from_slice(format!("none {}", crate::common::one_line(e)).as_bytes())
+                    out.extend_from_slice(format!("none {}", crate::common::reason(e)).as_bytes())
                 }
             },
             |r, row| match r {

@@ -9,7 +9,6 @@ use wavg::mesh::{analyze, procedural};
 use wavg::{MeshInfo, TriMesh};
 
 use crate::CliError;
-use crate::common::one_line;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -49,12 +48,11 @@ pub fn run(mut args: Args) -> Result<(), CliError> {
     });
     let (name, mesh, notes) = match (&args.mesh, builtin) {
         (_, Some(b)) => {
-            let m = procedural::builtin(b).map_err(CliError::input)?;
+            let m = procedural::builtin(b)?;
             (format!("builtin:{b}"), m, None)
         }
         (Some(path), None) => {
-            let (m, n) = io::load_with_notes(std::path::Path::new(path))
-                .map_err(|e| CliError::input(one_line(&e)))?;
+            let (m, n) = io::load_with_notes(std::path::Path::new(path))?;
             (path.clone(), m, Some(n))
         }
         (None, None) => return Err(CliError::input("give a mesh file or --builtin NAME")),

@@ -170,7 +170,7 @@ const NOT_REACHED: &str = "none not-reached";
 
 /// `none REASON` for a point without weights.
 fn none(out: &mut Vec<u8>, e: &wavg::SolveError) {
-    out.extend_from_slice(format!("none {}", crate::common::one_line(e)).as_bytes());
+    out.extend_from_slice(format!("none {}", crate::common::reason(e)).as_bytes());
 }
 
 /// What `--verified` reports on standard error: penalised points and points no weights

@@ -154,7 +154,8 @@ fn root_long_help() -> String {
          the\nsolvers' outputs are plain text or NumPy arrays: docs/formats.md. What the readers \
          accept,\nthe limits on options and how outputs are written: docs/limits.md.\n\n\
          Exit status: 0 success; 2 unreadable or malformed input (one line on stderr naming the \
-         file\nand line); 1 any other failure.",
+         file\nand line); 130 interrupted (Ctrl-C); 1 any other failure (an output that cannot \
+         be\nwritten, a question without an answer, a failure of wavg itself).",
         names.join(", ")
     )
 }

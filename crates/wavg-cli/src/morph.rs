@@ -9,8 +9,8 @@ use std::time::Instant;
 use wavg::apps::{MorphReport, ReasonCounts, harmonic_fill, morph_frames};
 
 use crate::CliError;
-use crate::common::one_line;
 use crate::correspond::{MapArgs, compute};
+use crate::error::Context;
 use crate::textio::{self, write_numbers};
 
 /// Arguments.
@@ -67,8 +67,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let c = compute(&args.map)?;
     let t = Instant::now();
     let mesh = c.source.mesh();
-    let mapped = harmonic_fill(mesh, &c.map.valid_positions())
-        .map_err(|e| CliError::failure(format!("{}: {}", args.map.pair.source, one_line(&e))))?;
+    let mapped = harmonic_fill(mesh, &c.map.valid_positions()).context(&args.map.pair.source)?;
     let frames = morph_frames(&mesh.positions, &mapped, args.frames);
     let seconds = c.seconds + t.elapsed().as_secs_f64();
     let created = !args.output.exists();

@@ -20,7 +20,7 @@ use wavg::mesh::repair;
 use wavg::{EmbedError, MeshError, PrecomputeOptions, Progress, Report, Stage, ValidMesh};
 
 use crate::CliError;
-use crate::common::{load_mesh, one_line};
+use crate::common::load_mesh;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -131,7 +131,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let mesh = validate(&args.mesh, mesh)?;
     if let Some(path) = &args.repaired_mesh {
-        wavg::mesh::io::save(path, &mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+        wavg::mesh::io::save(path, &mesh)?;
     }
     let load_seconds = t_load.elapsed().as_secs_f64();
 
@@ -148,17 +148,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         crate::textio::with_threads(args.threads, || embed::precompute(&mesh, &opts, &bars))?;
     bars.clear();
     let (embedding, report) = result.map_err(|e| match e {
-        EmbedError::InvalidArgument(m) => CliError::input(format!("{}: {m}", args.mesh)),
-        EmbedError::Cancelled => CliError {
-            code: 130,
-            message: format!("interrupted; {} was not written", args.output.display()),
-        },
-        e => CliError::failure(format!("{}: {}", args.mesh, one_line(&e))),
+        EmbedError::Cancelled => CliError::from(e).with_message(format!(
+            "interrupted; {} was not written",
+            args.output.display()
+        )),
+        e => CliError::from(e).context(&args.mesh),
     })?;
 
     let t_save = Instant::now();
-    embed::file::save(&args.output, &embedding, &mesh)
-        .map_err(|e| CliError::failure(one_line(&e)))?;
+    embed::file::save(&args.output, &embedding, &mesh)?;
     let save_seconds = t_save.elapsed().as_secs_f64();
 
     let s = &report.stages;
@@ -284,12 +282,13 @@ fn validate(name: &str, mesh: wavg::TriMesh) -> Result<ValidMesh, CliError> {
                      largest"
                 ));
             }
-            Err(CliError::input(format!(
+            let message = format!(
                 "{name}: not a valid oriented manifold mesh: {} ({hint})",
                 report.lines().join("; ")
-            )))
+            );
+            Err(CliError::from(MeshError::Invalid(report)).with_message(message))
         }
-        Err(e) => Err(CliError::input(one_line(&e))),
+        Err(e) => Err(e.into()),
     }
 }
 

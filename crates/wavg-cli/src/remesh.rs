@@ -10,7 +10,8 @@ use wavg::apps::{BaseMesh, RemeshReport, Remesher, polygons_to_obj};
 use wavg::{Surface, Vector3};
 
 use crate::CliError;
-use crate::common::{load_valid, one_line};
+use crate::common::load_valid;
+use crate::error::Context;
 use crate::textio;
 
 /// Arguments.
@@ -91,10 +92,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     )?;
     let text = std::fs::read_to_string(&args.base)
         .map_err(|e| CliError::input(format!("{}: {e}", args.base.display())))?;
-    let base = BaseMesh::from_obj_str(&text)
-        .map_err(|e| CliError::input(format!("{}: {}", args.base.display(), one_line(&e))))?;
-    base.validate()
-        .map_err(|e| CliError::input(format!("{}: {}", args.base.display(), one_line(&e))))?;
+    let base = BaseMesh::from_obj_str(&text).context(args.base.display())?;
+    base.validate().context(args.base.display())?;
     if args.levels > wavg::apps::MAX_LEVELS {
         return Err(CliError::input(format!(
             "--levels is at most {}",
@@ -116,15 +115,10 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
     let t = Instant::now();
     let surface = surface_for(&args)?;
     let precompute_seconds = args.embedding.is_none().then(|| t.elapsed().as_secs_f64());
-    let bad_base = |e: &dyn std::fmt::Display| {
-        CliError::input(format!("{}: {}", args.base.display(), one_line(e)))
-    };
     let mut r = Remesher::with_max_distance(surface.projector().clone(), &base, args.max_distance)
-        .map_err(|e| bad_base(&e))?;
+        .context(args.base.display())?;
     let t = Instant::now();
-    let out = r
-        .remesh(args.levels, args.smooth)
-        .map_err(|e| CliError::failure(one_line(&e)))?;
+    let out = r.remesh(args.levels, args.smooth)?;
     let seconds = t.elapsed().as_secs_f64();
     let drag = drag_frames(&mut r, &base, &args)?;
     let warm = drag.median;
@@ -206,7 +200,7 @@ fn drag_frames(r: &mut Remesher, base: &BaseMesh, args: &Args) -> Result<Drag, C
         let c = crate::common::cpu_seconds(false);
         r.move_base_vertex(args.drag, p)
             .and_then(|()| r.remesh(args.levels, args.smooth))
-            .map_err(|e| CliError::failure(format!("dragged frame {}: {}", k + 1, one_line(&e))))?;
+            .context(format_args!("dragged frame {}", k + 1))?;
         times.push(t.elapsed().as_secs_f64());
         if let (Some(a), Some(b)) = (c, crate::common::cpu_seconds(false)) {
             cpu += b - a;

@@ -10,7 +10,8 @@ use wavg::Vector3;
 use wavg::apps::{Colouring, Image, Overlays, RenderOptions, RenderReport, View, render};
 
 use crate::CliError;
-use crate::common::{load_mesh_notes, one_line};
+use crate::common::load_mesh_notes;
+use crate::error::Context;
 use crate::textio::{self, read_points, read_text, resolve_points};
 
 /// Arguments.
@@ -196,7 +197,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         overlays.points = pts.iter().map(|q| q.position(&mesh)).collect();
     }
     let texture = args.texture.as_deref().map(Image::read_png).transpose();
-    let texture = texture.map_err(|e| CliError::input(one_line(&e)))?;
+    let texture = texture?;
     let scalars = args.scalar.as_deref().map(read_scalars).transpose()?;
     let colouring = match (&texture, &scalars) {
         (Some(t), _) => Colouring::Texture(t),
@@ -210,19 +211,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         wireframe: args.wireframe,
         ..Default::default()
     };
-    let what = |e: &dyn std::fmt::Display| {
-        let file = match colouring {
-            Colouring::Texture(_) => {
-                format!(" with {}", args.texture.as_ref().expect("set").display())
-            }
-            Colouring::Scalars(_) => {
-                format!(" with {}", args.scalar.as_ref().expect("set").display())
-            }
-            Colouring::Plain => String::new(),
-        };
-        CliError::input(format!("{}{file}: {}", args.mesh, one_line(e)))
+    let file = match colouring {
+        Colouring::Texture(_) => format!(" with {}", args.texture.as_ref().expect("set").display()),
+        Colouring::Scalars(_) => format!(" with {}", args.scalar.as_ref().expect("set").display()),
+        Colouring::Plain => String::new(),
     };
-    let img = render(&mesh, &colouring, &overlays, &opts).map_err(|e| what(&e))?;
+    let img =
+        render(&mesh, &colouring, &overlays, &opts).context(format_args!("{}{file}", args.mesh))?;
     write_png(&args.output, &img)?;
     let seconds = t.elapsed().as_secs_f64();
     if args.json {

@@ -9,7 +9,7 @@ use wavg::mesh::{analyze, io};
 use wavg::{RepairOptions, RepairReport};
 
 use crate::CliError;
-use crate::common::{load_mesh, one_line};
+use crate::common::load_mesh;
 
 /// Arguments of `wavg repair`.
 #[derive(clap::Args)]
@@ -71,7 +71,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )));
     }
     // The output's format, from its extension, before any work.
-    wavg::mesh::Format::from_path(&args.output).map_err(|e| CliError::input(one_line(&e)))?;
+    wavg::mesh::Format::from_path(&args.output)?;
     let mesh = load_mesh(&args.mesh)?;
     let options = RepairOptions {
         weld: (!args.no_weld).then_some(args.weld),
@@ -83,7 +83,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let r = repair_all(&mesh, &options);
     let after = analyze(&r.mesh);
     // Written atomically (a temporary file beside it, renamed on success).
-    io::save(&args.output, &r.mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    io::save(&args.output, &r.mesh)?;
     if let Some(map) = &args.map {
         let mut text = String::with_capacity(r.vertex_map.len() * 7);
         for v in &r.vertex_map {

@@ -12,7 +12,7 @@ use std::time::Instant;
 use wavg::Surface;
 
 use crate::CliError;
-use crate::common::{load_valid, one_line};
+use crate::common::load_valid;
 use crate::precompute::Bars;
 
 /// Arguments.
@@ -61,11 +61,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .embedding
         .clone()
         .or_else(|| crate::cache::existing(&mesh, args.cache.no_cache));
-    let mut surface = Surface::from_valid(mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    let mut surface = Surface::from_valid(mesh)?;
     if let Some(path) = &embedding {
-        surface
-            .load_embedding(path)
-            .map_err(|e| CliError::input(one_line(&e)))?;
+        surface.load_embedding(path)?;
     }
     let (n, m) = (surface.n_vertices(), surface.n_faces());
     let app = wavg_serve::App::new(surface);

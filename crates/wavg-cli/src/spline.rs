@@ -8,7 +8,7 @@ use std::time::Instant;
 use wavg::apps::{CurveReport, SplineKind, evaluate_spline};
 
 use crate::CliError;
-use crate::common::one_line;
+use crate::error::Context;
 use crate::textio::{self, write_numbers};
 
 /// Arguments.
@@ -109,8 +109,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         args.cache,
     )?;
     let t = Instant::now();
-    let curve = evaluate_spline(&solver, kind, args.samples, CHUNK)
-        .map_err(|e| CliError::input(format!("{}: {}", args.control.display(), one_line(&e))))?;
+    let curve =
+        evaluate_spline(&solver, kind, args.samples, CHUNK).context(args.control.display())?;
     let seconds = t.elapsed().as_secs_f64();
     let t = crate::common::step("spline", t);
     textio::write_atomic(&args.output, |w: &mut dyn Write| {
@@ -123,7 +123,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
                         r.point.bary.into_iter().chain(r.position.iter().copied()),
                     )?;
                 }
-                Err(e) => write!(w, "none {}", one_line(e))?,
+                Err(e) => write!(w, "none {}", crate::common::reason(e))?,
             }
             writeln!(w)?;
         }

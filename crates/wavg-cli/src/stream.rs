@@ -20,6 +20,7 @@ use wavg::npy::{NpyReader, NpyWriter};
 use wavg::text::{LineChunks, LineError};
 
 use crate::CliError;
+use crate::error::Context;
 use crate::textio::{located, write_atomic};
 
 /// Rows read, computed and written per round.
@@ -210,8 +211,7 @@ impl Source {
             // A small buffer for the header: the values' reads, larger, then go past it
             // straight into their blocks.
             let reader = BufReader::with_capacity(NPY_HEADER_BUFFER, file);
-            let reader = NpyReader::new(reader)
-                .map_err(|e| CliError::input(format!("{}: {e}", input.display())))?;
+            let reader = NpyReader::new(reader).context(input.display())?;
             if reader.cols() == 0 && reader.rows() > 0 {
                 return Err(CliError::input(format!(
                     "{}: the array's {} rows hold no values (shape ({}, 0))",
@@ -241,7 +241,7 @@ impl Source {
                 let mut values = spare.unwrap_or_default();
                 let n = reader
                     .read_rows_over(&mut values, READ_ROWS)
-                    .map_err(|e| io(&e))?;
+                    .context(input.display())?;
                 let first = *done + 1;
                 *done += n;
                 Ok((n > 0).then(|| Raw::Npy {

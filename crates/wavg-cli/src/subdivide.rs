@@ -9,7 +9,7 @@ use wavg::mesh::subdivide::loop_subdivide;
 use wavg::{SubdivisionReport, ValidMesh};
 
 use crate::CliError;
-use crate::common::{load_valid, one_line};
+use crate::common::load_valid;
 
 /// Arguments of `wavg subdivide`.
 #[derive(clap::Args)]
@@ -45,11 +45,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (nv0, nf0) = (input.n_vertices(), input.n_faces());
     let mut mesh = std::sync::Arc::unwrap_or_clone(input);
     for _ in 0..args.levels {
-        let next = loop_subdivide(&mesh).map_err(|e| CliError::failure(one_line(&e)))?;
-        mesh = ValidMesh::new(next).map_err(|e| CliError::failure(one_line(&e)))?;
+        let next = loop_subdivide(&mesh)?;
+        mesh = ValidMesh::new(next)?;
     }
     let seconds = t.elapsed().as_secs_f64();
-    io::save(&args.output, &mesh).map_err(|e| CliError::failure(one_line(&e)))?;
+    io::save(&args.output, &mesh)?;
     let report = SubdivisionReport {
         input_vertices: nv0,
         input_faces: nf0,

@@ -10,7 +10,8 @@ use wavg::apps::{Image, TextureTransfer, TransferOptions, check_uv, transfer_tex
 
 use crate::CliError;
 use crate::apps_common::{PairArgs, solver_for};
-use crate::common::{load_mesh, one_line};
+use crate::common::load_mesh;
+use crate::error::Context;
 use crate::render::{parse_size, write_png};
 use crate::textio::read_points;
 
@@ -110,10 +111,9 @@ fn run_inner(args: Args) -> Result<(), CliError> {
     }
     for (mesh, what) in [(&args.pair.source, "source"), (&args.pair.target, "target")] {
         let m = load_mesh(mesh)?;
-        check_uv(&m, what).map_err(|e| CliError::input(format!("{mesh}: {e}")))?;
+        check_uv(&m, what).context(mesh)?;
     }
-    let texture =
-        Image::read_png(&args.source_texture).map_err(|e| CliError::input(one_line(&e)))?;
+    let texture = Image::read_png(&args.source_texture)?;
     if args.stride == 0 {
         return Err(CliError::input("--stride must be at least 1"));
     }
@@ -160,8 +160,7 @@ fn run_inner(args: Args) -> Result<(), CliError> {
     let out = transfer_texture(&source, &texture, &target, &opts, &|done, all| {
         bar.set_length(all as u64);
         bar.set_position(done as u64);
-    })
-    .map_err(|e| CliError::input(one_line(&e)))?;
+    })?;
     let seconds = t.elapsed().as_secs_f64();
     bar.finish_and_clear();
     write_png(&args.output, &out.image)?;

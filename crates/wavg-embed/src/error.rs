@@ -14,9 +14,17 @@ pub enum EmbedError {
     /// A numerical step failed (for example a factorisation).
     #[error("numerical failure: {0}")]
     Numerical(String),
-    /// Reading or writing a file failed.
+    /// Reading a file failed.
     #[error("{path}: {source}")]
     Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// Writing a file failed (a missing folder, no permission, a full disk).
+    #[error("{path}: {source}")]
+    Write {
         /// The file.
         path: PathBuf,
         /// The underlying error.

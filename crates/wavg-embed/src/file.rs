@@ -329,7 +329,7 @@ pub fn decode(bytes: &[u8], mesh: &TriMesh, path: &Path) -> Result<Embedding, Em
 /// ```
 pub fn save(path: &Path, emb: &Embedding, mesh: &TriMesh) -> Result<(), EmbedError> {
     let bytes = encode(emb, mesh)?;
-    wavg_mesh::io::write_atomic(path, |w| w.write_all(&bytes)).map_err(|source| EmbedError::Io {
+    wavg_mesh::io::write_atomic(path, |w| w.write_all(&bytes)).map_err(|source| EmbedError::Write {
         path: path.to_path_buf(),
         source,
     })

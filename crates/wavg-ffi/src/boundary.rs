@@ -26,14 +26,17 @@ impl Failure {
     }
 }
 
-/// The status of an error kind.
-pub(crate) fn status_of(kind: ErrorKind) -> wavg_status {
+/// The status of an error kind: the C ABI's one table from the library's error kinds
+/// (a failed write is `WAVG_STATUS_IO` like a failed read; a failure of the library on
+/// valid input is `WAVG_STATUS_PANIC`, the internal-error status).
+pub(crate) const fn status_of(kind: ErrorKind) -> wavg_status {
     match kind {
         ErrorKind::InvalidArgument => wavg_status::WAVG_STATUS_INVALID_ARGUMENT,
         ErrorKind::InvalidMesh => wavg_status::WAVG_STATUS_INVALID_MESH,
-        ErrorKind::Io => wavg_status::WAVG_STATUS_IO,
+        ErrorKind::Io | ErrorKind::Write => wavg_status::WAVG_STATUS_IO,
         ErrorKind::NoSolution => wavg_status::WAVG_STATUS_NO_SOLUTION,
         ErrorKind::Cancelled => wavg_status::WAVG_STATUS_CANCELLED,
+        ErrorKind::Internal => wavg_status::WAVG_STATUS_PANIC,
     }
 }
 
@@ -41,10 +44,29 @@ impl From<wavg::Error> for Failure {
     fn from(e: wavg::Error) -> Self {
         Self {
             status: status_of(e.kind()),
-            message: e.to_string(),
+            message: e.message(),
         }
     }
 }
+
+/// Errors of the layers and applications convert through [`wavg::Error`].
+macro_rules! via_facade {
+    ($($t:ty),*) => {$(
+        impl From<$t> for Failure {
+            fn from(e: $t) -> Self {
+                wavg::Error::from(e).into()
+            }
+        }
+    )*};
+}
+
+via_facade!(
+    wavg::MeshError,
+    wavg::EmbedError,
+    wavg::SolveError,
+    wavg::apps::AppError,
+    wavg::apps::RemeshError
+);
 
 pub(crate) type Outcome = Result<(), Failure>;
 

@@ -12,7 +12,7 @@ use crate::solver::{wavg_solver, write_image};
 use crate::types::{wavg_point, wavg_status};
 
 /// The status of an answered point that fails the validity test.
-const REJECTED: wavg_status = wavg_status::WAVG_STATUS_NO_SOLUTION;
+const REJECTED: wavg_status = crate::boundary::status_of(wavg::ErrorKind::NoSolution);
 
 /// Writes per-point statuses and returns the first failure (with a message), or Ok.
 fn finish(
@@ -59,7 +59,7 @@ unsafe fn queries(points: *const wavg_point, n: usize) -> Result<Vec<SurfacePoin
 
 fn solve_failure(e: &wavg::SolveError) -> (wavg_status, String) {
     let e = wavg::Error::from(e.clone());
-    (crate::boundary::status_of(e.kind()), e.to_string())
+    (crate::boundary::status_of(e.kind()), e.message())
 }
 
 /// Maps `n` points of the source surface onto the target: the inverse problem on

@@ -4,7 +4,7 @@
 
 use wavg::SurfacePoint;
 use wavg::Vector3;
-use wavg::apps::{BaseMesh, RemeshError, RemeshResult, Remesher};
+use wavg::apps::{BaseMesh, RemeshResult, Remesher};
 
 use crate::boundary::optional;
 use crate::boundary::{Failure, guard, guard_value, handle, handle_mut, product, slice};
@@ -22,20 +22,6 @@ use crate::types::{wavg_point, wavg_status};
 pub struct wavg_remesher {
     remesher: Remesher,
     last: Option<RemeshResult>,
-}
-
-fn failure(e: RemeshError) -> Failure {
-    let status = if e.is_invalid_mesh() {
-        wavg_status::WAVG_STATUS_INVALID_MESH
-    } else if e.is_no_solution() {
-        wavg_status::WAVG_STATUS_NO_SOLUTION
-    } else {
-        wavg_status::WAVG_STATUS_INVALID_ARGUMENT
-    };
-    Failure {
-        status,
-        message: e.to_string(),
-    }
 }
 
 /// Makes a remesher for a base mesh of `n_base` vertices (`base_xyz`: `3 * n_base`
@@ -107,8 +93,7 @@ pub unsafe extern "C" fn wavg_remesher_new(
         } else {
             wavg::apps::DEFAULT_MAX_BASE_DISTANCE
         };
-        let remesher = Remesher::with_max_distance(s.inner.projector().clone(), &base, max)
-            .map_err(failure)?;
+        let remesher = Remesher::with_max_distance(s.inner.projector().clone(), &base, max)?;
         *out = Box::into_raw(Box::new(wavg_remesher {
             remesher,
             last: None,
@@ -136,10 +121,7 @@ pub unsafe extern "C" fn wavg_remesher_run(
     guard(|| {
         // SAFETY: per this function's contract.
         let r = unsafe { handle_mut(remesher, "remesher")? };
-        let out = r
-            .remesher
-            .remesh(levels as usize, smooth as usize)
-            .map_err(failure)?;
+        let out = r.remesher.remesh(levels as usize, smooth as usize)?;
         r.last = Some(out);
         Ok(())
     })
@@ -162,7 +144,7 @@ pub unsafe extern "C" fn wavg_remesher_move_vertex(
         let r = unsafe { handle_mut(remesher, "remesher")? };
         r.remesher
             .move_base_vertex(index, SurfacePoint::new(point.face, point.bary))
-            .map_err(|e| Failure::arg(e.to_string()))
+            .map_err(Failure::from)
     })
 }
 

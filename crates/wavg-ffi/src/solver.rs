@@ -5,9 +5,9 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
-use wavg::Par;
 use wavg::SolveError;
 use wavg::{BatchWeights, ForwardOptions, RoundTrip, Solver, SurfacePoint};
+use wavg::{ErrorKind, Par};
 
 use crate::boundary::{
     Failure, Outcome, guard, guard_value, handle, handle_mut, optional, product, slice, slice_mut,
@@ -142,7 +142,7 @@ impl Statuses<'_> {
                 if self.first.is_none() {
                     self.first = Some(Failure {
                         status,
-                        message: format!("query {i}: {e}"),
+                        message: format!("query {i}: {}", e.message()),
                     });
                 }
                 status
@@ -158,14 +158,12 @@ impl Statuses<'_> {
             "query {i}: the point is not reached as a weighted average of these anchors \
              (add anchors near it)"
         );
+        let status = status_of(ErrorKind::NoSolution);
         if self.first.is_none() {
-            self.first = Some(Failure {
-                status: wavg_status::WAVG_STATUS_NO_SOLUTION,
-                message,
-            });
+            self.first = Some(Failure { status, message });
         }
         if let Some(out) = self.out.as_deref_mut() {
-            out[i] = wavg_status::WAVG_STATUS_NO_SOLUTION;
+            out[i] = status;
         }
     }
 

@@ -1,7 +1,7 @@
 //! Texture transfer through the C ABI, over RGBA8 buffers and UV arrays.
 
 use wavg::TexCoords;
-use wavg::apps::{AppError, Image, TransferOptions, transfer_texture_with_uv};
+use wavg::apps::{Image, TransferOptions, transfer_texture_with_uv};
 
 use crate::boundary::{Failure, guard, handle, product, slice, slice_mut};
 use crate::solver::wavg_solver;
@@ -125,13 +125,7 @@ pub unsafe extern "C" fn wavg_transfer_texture(
         // Check the output pointer before the work.
         // SAFETY: per this function's contract.
         let out = unsafe { slice_mut(out_rgba, product(n_out, 4, "output size")?, "out_rgba")? };
-        let r =
-            transfer_texture_with_uv(s, &suv, &image, t, &tuv, &opts, &|_, _| {}).map_err(|e| {
-                match e {
-                    AppError::Solve(e) => Failure::from(wavg::Error::from(e)),
-                    other => Failure::arg(other.to_string()),
-                }
-            })?;
+        let r = transfer_texture_with_uv(s, &suv, &image, t, &tuv, &opts, &|_, _| {})?;
         out.copy_from_slice(r.image.pixels.as_flattened());
         // SAFETY: per this function's contract (NULL or one writable element each).
         unsafe {

@@ -10,9 +10,17 @@ pub enum MeshError {
     /// The mesh failed validation; the report lists every defect.
     #[error("{0}")]
     Invalid(Box<ValidationReport>),
-    /// Reading or writing a file failed.
+    /// Reading a file failed.
     #[error("{path}: {source}")]
     Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// Writing a file failed (a missing folder, no permission, a full disk).
+    #[error("{path}: {source}")]
+    Write {
         /// The file.
         path: PathBuf,
         /// The underlying error.

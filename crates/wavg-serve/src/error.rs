@@ -21,6 +21,7 @@ pub fn status_of(kind: ErrorKind) -> u16 {
         ErrorKind::InvalidArgument | ErrorKind::InvalidMesh | ErrorKind::NoSolution => 400,
         // No request names a file, and nothing cancels a request.
         ErrorKind::Io | ErrorKind::Cancelled => 500,
+        ErrorKind::Write | ErrorKind::Internal => 500,
     }
 }
 

@@ -1,12 +1,15 @@
-//! The facade's error type: every failure of the lower crates, with a coarse kind that
-//! callers (and the C ABI's status codes) can branch on.
+//! The facade's error type: every failure the library reports (the layers', the
+//! applications' and the remesher's), with a coarse kind that every front end maps to its
+//! own form in one table (exit code, C status, Python exception class, HTTP status).
 
+use wavg_apps::{AppError, RemeshError};
 use wavg_embed::EmbedError;
+use wavg_io::npy::NpyError;
 use wavg_mesh::MeshError;
 use wavg_project::ProjectError;
 use wavg_solve::SolveError;
 
-/// Anything [`crate::Surface`] and the one-off functions can fail with.
+/// Anything [`crate::Surface`], the one-off functions and the applications can fail with.
 ///
 /// Its `Debug` form is the message and the kind, so a `main` that returns
 /// `Result<(), wavg::Error>` and fails through `?` prints a readable line:
@@ -18,7 +21,7 @@ use wavg_solve::SolveError;
 /// ```
 #[derive(thiserror::Error)]
 pub enum Error {
-    /// Loading, validating or repairing a mesh failed.
+    /// Loading, validating, repairing or writing a mesh failed.
     #[error(transparent)]
     Mesh(#[from] MeshError),
     /// Computing, reading or writing an embedding failed.
@@ -34,49 +37,168 @@ pub enum Error {
     /// the embedding); the message says how to fix it.
     #[error("{0}")]
     Unsuitable(String),
+    /// A picture application (renderer, texture transfer, decals, maps) refused its inputs
+    /// or an image could not be read or written.
+    #[error(transparent)]
+    App(#[from] AppError),
+    /// Semiregular remeshing refused its base mesh or parameters, or an average failed.
+    #[error(transparent)]
+    Remesh(#[from] RemeshError),
+    /// A NumPy `.npy` array could not be read.
+    #[error(transparent)]
+    Npy(#[from] NpyError),
 }
 
 impl std::fmt::Debug for Error {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{self} ({:?})", self.kind())
+        write!(f, "{} ({:?})", self.message(), self.kind())
     }
 }
 
-/// Coarse classes of [`Error`], stable enough to map to exit codes or C status codes.
+/// Coarse classes of [`Error`], stable enough to map to exit codes, C statuses, Python
+/// exception classes and HTTP statuses. Each kind is either the caller's fault (bad input:
+/// exit status 2, HTTP 4xx) or not (exit status 1, HTTP 5xx): see
+/// [`ErrorKind::is_callers_fault`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ErrorKind {
-    /// A parameter or input value is out of range or malformed.
+    /// A parameter or input value is out of range or malformed. The caller's fault.
     InvalidArgument,
-    /// The mesh is not a valid oriented manifold (or not suitable, e.g. disconnected).
+    /// The mesh is not a valid oriented manifold, or not suitable for the operation (e.g.
+    /// disconnected, or beyond what the numerics handle). The caller's fault.
     InvalidMesh,
-    /// A file could not be read, parsed or written.
+    /// A file the caller named could not be read or parsed (missing, unreadable, corrupt,
+    /// an unsupported format, made for another mesh). The caller's fault.
     Io,
-    /// The question is well-formed but has no answer (no valid projection).
+    /// The question is well-formed but has no answer (no valid projection). The caller's:
+    /// asking a question without an answer is the input's property, not a failure of ours.
     NoSolution,
-    /// The caller cancelled the computation.
+    /// The caller cancelled the computation. The caller's (its own choice).
     Cancelled,
+    /// A file could not be written (a missing folder, no permission, a full disk). Not the
+    /// caller's input: the environment failed the library.
+    Write,
+    /// The library failed on valid input (threads could not start, a bug). Not the
+    /// caller's fault.
+    Internal,
+}
+
+impl ErrorKind {
+    /// Every kind, for front ends and tests that go through all of them.
+    pub const ALL: [ErrorKind; 7] = [
+        ErrorKind::InvalidArgument,
+        ErrorKind::InvalidMesh,
+        ErrorKind::Io,
+        ErrorKind::NoSolution,
+        ErrorKind::Cancelled,
+        ErrorKind::Write,
+        ErrorKind::Internal,
+    ];
+
+    /// True when the caller's input or choice caused the error (a front end answers with
+    /// its "bad input" form: exit status 2, HTTP 4xx); false when the environment or the
+    /// library failed (exit status 1, HTTP 5xx).
+    pub fn is_callers_fault(self) -> bool {
+        match self {
+            ErrorKind::InvalidArgument
+            | ErrorKind::InvalidMesh
+            | ErrorKind::Io
+            | ErrorKind::NoSolution
+            | ErrorKind::Cancelled => true,
+            ErrorKind::Write | ErrorKind::Internal => false,
+        }
+    }
 }
 
 impl Error {
     /// The class of this error.
     pub fn kind(&self) -> ErrorKind {
         match self {
-            Error::Mesh(MeshError::Invalid(_) | MeshError::Repair(_)) => ErrorKind::InvalidMesh,
-            Error::Mesh(MeshError::InvalidArgument(_)) => ErrorKind::InvalidArgument,
-            Error::Mesh(
-                MeshError::Io { .. } | MeshError::Parse { .. } | MeshError::Unsupported { .. },
-            ) => ErrorKind::Io,
-            Error::Embed(EmbedError::Cancelled) => ErrorKind::Cancelled,
-            Error::Embed(EmbedError::InvalidArgument(_)) => ErrorKind::InvalidArgument,
-            Error::Embed(EmbedError::Numerical(_)) => ErrorKind::InvalidMesh,
-            Error::Embed(_) => ErrorKind::Io,
-            Error::Project(ProjectError::NoProjection) => ErrorKind::NoSolution,
-            Error::Project(ProjectError::EmptyMesh) => ErrorKind::InvalidMesh,
-            Error::Project(_) => ErrorKind::InvalidArgument,
-            Error::Solve(e) if e.is_no_solution() => ErrorKind::NoSolution,
-            Error::Solve(_) => ErrorKind::InvalidArgument,
+            Error::Mesh(e) => mesh_kind(e),
+            Error::Embed(e) => embed_kind(e),
+            Error::Project(e) => project_kind(e),
+            Error::Solve(e) => solve_kind(e),
             Error::Unsuitable(_) => ErrorKind::InvalidMesh,
+            Error::App(AppError::Image(_)) => ErrorKind::Io,
+            Error::App(AppError::Input(_)) => ErrorKind::InvalidArgument,
+            Error::App(AppError::Solve(e)) => solve_kind(e),
+            Error::Remesh(e) => remesh_kind(e),
+            Error::Npy(_) => ErrorKind::Io,
         }
+    }
+
+    /// The message on one line: the error, then each cause its text does not already
+    /// contain, newlines replaced by `"; "` (for a terminal line, a C string, an HTTP
+    /// body).
+    pub fn message(&self) -> String {
+        use std::error::Error as _;
+        let mut s = self.to_string();
+        let mut cause = self.source();
+        while let Some(c) = cause {
+            let text = c.to_string();
+            if !s.contains(&text) {
+                s.push_str(": ");
+                s.push_str(&text);
+            }
+            cause = c.source();
+        }
+        s.trim_end().replace('\n', "; ")
+    }
+}
+
+fn mesh_kind(e: &MeshError) -> ErrorKind {
+    match e {
+        MeshError::Invalid(_) | MeshError::Repair(_) => ErrorKind::InvalidMesh,
+        MeshError::InvalidArgument(_) => ErrorKind::InvalidArgument,
+        MeshError::Io { .. } | MeshError::Parse { .. } | MeshError::Unsupported { .. } => {
+            ErrorKind::Io
+        }
+        MeshError::Write { .. } => ErrorKind::Write,
+    }
+}
+
+fn embed_kind(e: &EmbedError) -> ErrorKind {
+    match e {
+        EmbedError::Cancelled => ErrorKind::Cancelled,
+        EmbedError::InvalidArgument(_) => ErrorKind::InvalidArgument,
+        // A valid mesh whose geometry defeats a factorisation or an eigen-solver.
+        EmbedError::Numerical(_) => ErrorKind::InvalidMesh,
+        EmbedError::Io { .. }
+        | EmbedError::BadFile { .. }
+        | EmbedError::UnsupportedVersion { .. }
+        | EmbedError::MeshMismatch { .. } => ErrorKind::Io,
+        EmbedError::Write { .. } => ErrorKind::Write,
+    }
+}
+
+fn project_kind(e: &ProjectError) -> ErrorKind {
+    match e {
+        ProjectError::NoProjection => ErrorKind::NoSolution,
+        ProjectError::EmptyMesh => ErrorKind::InvalidMesh,
+        ProjectError::ThreadPool(_) => ErrorKind::Internal,
+        ProjectError::CoordinateCount { .. }
+        | ProjectError::NonFinite { .. }
+        | ProjectError::OutOfRange { .. }
+        | ProjectError::TooSmall { .. }
+        | ProjectError::NonFiniteQuery
+        | ProjectError::StartOutOfRange { .. }
+        | ProjectError::FaceOutOfRange { .. }
+        | ProjectError::InvalidThreads => ErrorKind::InvalidArgument,
+    }
+}
+
+fn solve_kind(e: &SolveError) -> ErrorKind {
+    match e {
+        SolveError::Project(p) => project_kind(p),
+        e if e.is_no_solution() => ErrorKind::NoSolution,
+        _ => ErrorKind::InvalidArgument,
+    }
+}
+
+fn remesh_kind(e: &RemeshError) -> ErrorKind {
+    match e {
+        RemeshError::Solve { source, .. } => solve_kind(source),
+        e if e.is_invalid_mesh() => ErrorKind::InvalidMesh,
+        _ => ErrorKind::InvalidArgument,
     }
 }
 

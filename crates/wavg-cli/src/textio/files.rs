@@ -6,7 +6,6 @@ use std::io::Write;
 use std::path::Path;
 
 use crate::CliError;
-use crate::common::one_line;
 
 use super::PointSpec;
 
@@ -45,7 +44,7 @@ pub fn write_atomic(
 
 /// An input error at `file:line` (exit status 2).
 pub fn located(file: &Path, line: usize, msg: &dyn fmt::Display) -> CliError {
-    CliError::input(format!("{}:{line}: {}", file.display(), one_line(msg)))
+    CliError::input(format!("{}:{line}: {msg}", file.display()))
 }
 
 /// Reads and parses a point file, mapping errors to `file:line` input errors.

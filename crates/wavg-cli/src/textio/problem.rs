@@ -8,7 +8,8 @@ use wavg::{Anchor, EmbeddedMesh, Projector, Solver, Vec8};
 use wavg::{SurfacePoint, ValidMesh};
 
 use crate::CliError;
-use crate::common::{load_valid, one_line};
+use crate::common::load_valid;
+use crate::error::Context;
 
 use super::{PointSpec, located, read_points};
 
@@ -61,18 +62,15 @@ pub fn load_embedded(
     let Some(path) = embedding.filter(|p| *p != Path::new(NO_EMBEDDING)) else {
         return Ok(Arc::new(EmbeddedMesh::from_positions(mesh)));
     };
-    let e = wavg::embed::file::load(path, &mesh).map_err(|e| CliError::input(one_line(&e)))?;
+    let e = wavg::embed::file::load(path, &mesh)?;
     let coords: Vec<Vec8> = e.coords.iter().map(|c| Vec8::from(*c)).collect();
-    let emb = EmbeddedMesh::new(mesh, coords)
-        .map_err(|e| CliError::input(format!("{}: {}", path.display(), one_line(&e))))?;
+    let emb = EmbeddedMesh::new(mesh, coords).context(path.display())?;
     Ok(Arc::new(emb))
 }
 
 /// Builds the projector (tangent frames, per-triangle data) for an embedded mesh.
 pub fn build_projector(emb: Arc<EmbeddedMesh>) -> Result<Arc<Projector>, CliError> {
-    Projector::new(emb)
-        .map(Arc::new)
-        .map_err(|e| CliError::failure(one_line(&e)))
+    Ok(Projector::new(emb).map(Arc::new)?)
 }
 
 /// Resolves parsed point specs against `mesh`; errors name `file` and the line.
@@ -127,13 +125,12 @@ pub fn load_solver(args: &ProblemArgs) -> Result<Solver, CliError> {
         None => {
             let e = crate::cache::embedding(&mesh, &args.mesh, args.cache.no_cache)?;
             let coords: Vec<Vec8> = e.coords.iter().map(|c| Vec8::from(*c)).collect();
-            let emb =
-                EmbeddedMesh::new(mesh, coords).map_err(|e| CliError::failure(one_line(&e)))?;
+            let emb = EmbeddedMesh::new(mesh, coords)?;
             Arc::new(emb)
         }
     };
     let proj = build_projector(emb)?;
-    Solver::new(proj, anchor_list).map_err(|e| CliError::input(one_line(&e)))
+    Ok(Solver::new(proj, anchor_list)?)
 }
 
 /// Runs `f` on a pool of `threads` threads (rayon's default when `None`).
@@ -143,5 +140,5 @@ pub fn with_threads<T: Send>(
 ) -> Result<T, CliError> {
     let par = wavg::Par::from_threads(threads)
         .map_err(|_| CliError::input("--threads must be at least 1"))?;
-    par.install(f).map_err(|e| CliError::failure(one_line(&e)))
+    Ok(par.install(f)?)
 }

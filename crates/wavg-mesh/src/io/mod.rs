@@ -84,6 +84,13 @@ fn io_err(path: &Path, source: std::io::Error) -> MeshError {
     }
 }
 
+fn write_err(path: &Path, source: std::io::Error) -> MeshError {
+    MeshError::Write {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
 /// Largest accepted expansion of a gzip-compressed mesh file: real meshes expand 2-5x, so
 /// anything beyond this many times the compressed size (and beyond
 /// [`GZIP_MIN_LIMIT`]) is refused as a decompression bomb instead of filling memory.
@@ -128,7 +135,7 @@ fn gunzip_bounded(raw: &[u8]) -> Result<Vec<u8>, String> {
 /// The file is written atomically ([`write_atomic`]).
 pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
     let (format, gz) = Format::from_path(path)?;
-    let bytes = to_bytes(mesh, format).map_err(|e| io_err(path, e))?;
+    let bytes = to_bytes(mesh, format).map_err(|e| write_err(path, e))?;
     write_atomic(path, |w| {
         if gz {
             let mut enc = flate2::write::GzEncoder::new(w, flate2::Compression::default());
@@ -138,7 +145,7 @@ pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
             w.write_all(&bytes)
         }
     })
-    .map_err(|e| io_err(path, e))
+    .map_err(|e| write_err(path, e))
 }
 
 /// Serialises a mesh in memory (uncompressed).
