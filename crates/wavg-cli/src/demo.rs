@@ -11,12 +11,12 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use wavg::DEFAULT_TOLERANCE;
-use wavg::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
+use wavg::anchors::{GOOD_GAP, closed_tour};
+use wavg::sampling::uniform_surface_points;
 use wavg::{Anchor, EmbeddedMesh, ForwardOptions, Solver, Vec8};
 use wavg::{SurfacePoint, ValidMesh};
 
 use crate::CliError;
-use crate::anchors::{GOOD_GAP, closed_tour, largest_gap, spread_to_good_gap};
 use crate::common::{load_valid, one_line};
 use crate::textio::{self, write_numbers};
 
@@ -191,12 +191,20 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // control points are all of them when asked for, else the first (most spread) 8.
     let (anchor_ids, gap) = match args.anchors {
         Some(k) => {
-            let ids = farthest_point_vertices(&mesh, k, args.seed, FpsMetric::Embedding(&coords))
+            let ids = wavg::anchors::spread(&mesh, &coords, k, args.seed)
                 .map_err(|e| CliError::input(one_line(&e)))?;
-            let gap = largest_gap(&coords, &ids) / mesh.bounding_box_diagonal();
+            let gap = wavg::anchors::largest_gap(&mesh, &coords, &ids);
             (ids, gap)
         }
-        None => spread_to_good_gap(&mesh, &coords, args.seed, DEFAULT_CONTROLS, MAX_ANCHORS)?,
+        None => wavg::anchors::spread_to_gap(
+            &mesh,
+            &coords,
+            args.seed,
+            DEFAULT_CONTROLS,
+            MAX_ANCHORS,
+            GOOD_GAP,
+        )
+        .map_err(|e| CliError::input(one_line(&e)))?,
     };
     let controls = match args.anchors {
         Some(_) => anchor_ids.clone(),

@@ -10,7 +10,8 @@
 //! Also: [`AnchorSet`] (editable anchor sets), [`resolve_anchor`] and [`check_point`]
 //! (validating user locations), [`validate_weights`], [`inverse_weights`] (the inverse
 //! problem's kernel on its own), [`sampling`] (seeded anchors and query points for
-//! benchmarks and tests), [`round_trip`] (the paper's Table 1 round-trip protocol) and
+//! benchmarks, tests and `wavg anchors`), [`spread`] (anchor sets judged by their largest
+//! gap, and a closed tour through points), [`round_trip`] (the paper's Table 1 round-trip protocol) and
 //! [`projection_bench`] (the projection benchmark); their reports serialise with the
 //! `serde` feature.
 //!
@@ -46,6 +47,7 @@ pub mod roundtrip;
 pub mod sampling;
 mod simd;
 mod solver;
+pub mod spread;
 mod verified;
 mod weights;
 

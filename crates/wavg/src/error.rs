@@ -34,6 +34,26 @@ pub enum Error {
     /// the embedding); the message says how to fix it.
     #[error("{0}")]
     Unsuitable(String),
+    /// A line of an input file (an anchors file) is malformed or names what the mesh does
+    /// not have, or the file as a whole is unusable (line 0: for example no anchors).
+    #[error("{}{}: {message}", path.display(), at_line(*line))]
+    Input {
+        /// The file.
+        path: std::path::PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// `:LINE` after a file name, or nothing for line 0 (the whole file).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
 }
 
 impl std::fmt::Debug for Error {
@@ -76,6 +96,7 @@ impl Error {
             Error::Solve(e) if e.is_no_solution() => ErrorKind::NoSolution,
             Error::Solve(_) => ErrorKind::InvalidArgument,
             Error::Unsuitable(_) => ErrorKind::InvalidMesh,
+            Error::Input { .. } => ErrorKind::InvalidArgument,
         }
     }
 }
