@@ -142,6 +142,20 @@ typedef bool (*wavg_progress_fn)(enum wavg_stage stage, double fraction, void *u
 extern "C" {
 #endif // __cplusplus
 
+// `k` vertices spread over the surface by farthest-point sampling in its embedding (the
+// vertex positions before a precomputation or load), the first drawn from `seed`, each
+// next one the vertex farthest from those chosen: the vertices `wavg anchors --count k
+// --seed seed` writes for this embedding, in the same order, into `out_vertices` (`k`
+// integers). Errors: `WAVG_STATUS_INVALID_ARGUMENT` (NULL, `k` above the vertex count;
+// `out_vertices` unchanged). `k = 0` writes nothing. Thread-safe.
+//
+// # Safety
+// `surface` must be NULL or live; `out_vertices` NULL or `k` writable integers.
+enum wavg_status wavg_surface_spread_anchors(const struct wavg_surface *surface,
+                                             size_t k,
+                                             uint64_t seed,
+                                             uint32_t *out_vertices);
+
 // Samples a curve on the surface whose control points are the solver's anchors, in
 // anchor order: with `bezier`, a Bézier curve of degree `n_anchors - 1` (`degree` and
 // `closed` are then ignored); otherwise a

@@ -432,7 +432,8 @@ impl Surface {
     }
 
     /// S.spread_anchors(k, seed=0) -> (k,) int64: ``k`` vertices spread over the surface by
-    /// farthest-point sampling (a good default anchor set).
+    /// farthest-point sampling in its embedding (a good default anchor set): what ``wavg
+    /// anchors --count k --seed seed`` writes for the same embedding.
     #[pyo3(signature = (k, seed=Int::of(0)), text_signature = "($self, k, seed=0)")]
     fn spread_anchors<'py>(
         &self,

@@ -10,7 +10,6 @@ use wavg::{Anchor, Embedding, Solver, Surface, ValidMesh};
 use crate::CliError;
 use crate::cache::CacheArg;
 use crate::common::{load_mesh, validate};
-use crate::textio::{located, read_points, spec_anchor};
 
 /// Flags of the commands that relate two surfaces through anchors paired line by line
 /// (correspond, morph, transfer-texture).
@@ -81,10 +80,6 @@ fn mesh_and_anchors_with(
     anchors: &Path,
     lookup: bool,
 ) -> Result<MeshAnchorsCached, CliError> {
-    let specs = read_points(anchors)?;
-    if specs.is_empty() {
-        return Err(CliError::input(format!("{}: no points", anchors.display())));
-    }
     let t = std::time::Instant::now();
     let raw = load_mesh(name)?;
     crate::common::step("read + parse the mesh", t);
@@ -98,13 +93,7 @@ fn mesh_and_anchors_with(
         (validate(name, raw), None)
     };
     let mesh = mesh?;
-    let list = specs
-        .iter()
-        .map(|&(line, s)| spec_anchor(s).map_err(|m| located(anchors, line, &m)))
-        .collect::<Result<Vec<_>, _>>()?;
-    for (&(line, _), a) in specs.iter().zip(&list) {
-        wavg::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
-    }
+    let list = wavg::anchors::read(anchors, &mesh)?;
     Ok((mesh, list, cached))
 }
 

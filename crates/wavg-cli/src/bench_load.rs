@@ -32,8 +32,7 @@ struct JsonReport<'a> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    let r =
-        load_bench(args.mesh.as_ref(), args.repeat)?;
+    let r = load_bench(args.mesh.as_ref(), args.repeat)?;
     if args.json {
         let j = serde_json::to_value(JsonReport {
             mesh: &args.mesh,

@@ -86,9 +86,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         chunk: crate::spline::CHUNK,
         cpu_clock: Some(|| crate::common::cpu_seconds(false)),
     };
-    let report =
-        textio::with_threads(Some(threads), || spline_bench(&solver, &opts))?
-            .context(args.control.display())?;
+    let report = textio::with_threads(Some(threads), || spline_bench(&solver, &opts))?
+        .context(args.control.display())?;
     let json = JsonReport {
         mesh: &args.mesh,
         report: &report,

@@ -10,12 +10,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use wavg::sampling::{FpsMetric, farthest_point_vertices};
+use wavg::anchors::{GOOD_GAP, closed_tour};
 use wavg::{Anchor, EmbeddedMesh, ForwardOptions, Solver, ValidMesh, Vec8};
 use wavg_bench::{RoundTripOptions, round_trip};
 
 use crate::CliError;
-use crate::anchors::{GOOD_GAP, closed_tour, largest_gap, spread_to_good_gap};
 use crate::common::load_valid;
 use crate::error::Context;
 use crate::textio::{self, write_numbers};
@@ -184,11 +183,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // control points are all of them when asked for, else the first (most spread) 8.
     let (anchor_ids, gap) = match args.anchors {
         Some(k) => {
-            let ids = farthest_point_vertices(&mesh, k, args.seed, FpsMetric::Embedding(&coords))?;
-            let gap = largest_gap(&coords, &ids) / mesh.bounding_box_diagonal();
+            let ids = wavg::anchors::spread(&mesh, &coords, k, args.seed)?;
+            let gap = wavg::anchors::largest_gap(&mesh, &coords, &ids);
             (ids, gap)
         }
-        None => spread_to_good_gap(&mesh, &coords, args.seed, DEFAULT_CONTROLS, MAX_ANCHORS)?,
+        None => wavg::anchors::spread_to_gap(
+            &mesh,
+            &coords,
+            args.seed,
+            DEFAULT_CONTROLS,
+            MAX_ANCHORS,
+            GOOD_GAP,
+        )?,
     };
     let controls = match args.anchors {
         Some(_) => anchor_ids.clone(),

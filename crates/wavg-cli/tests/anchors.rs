@@ -98,3 +98,55 @@ fn anchors_json_keys() {
         &keys,
     );
 }
+
+/// `wavg anchors` writes exactly the library's spread for the same mesh, embedding, count
+/// and seed (`wavg::Surface::spread_anchors`, `wavg::anchors::random`), and reports the
+/// library's gap.
+#[test]
+fn the_file_is_the_library_spread() {
+    let dir = tempfile::tempdir().unwrap();
+    let emb = s(&dir.path().join("t.wavg"));
+    wavg_ok(&[
+        "precompute",
+        "builtin:torus",
+        "--landmarks",
+        "40",
+        "-o",
+        &emb,
+    ]);
+    let mut surface =
+        wavg::Surface::from_mesh(wavg::mesh::procedural::builtin("torus").unwrap()).unwrap();
+    surface.load_embedding(&emb).unwrap();
+    let out = dir.path().join("a.txt");
+    for (count, seed, method) in [("17", "4", "fps"), ("1", "0", "fps"), ("9", "3", "random")] {
+        let o = wavg_ok(&[
+            "anchors",
+            "builtin:torus",
+            "--embedding",
+            &emb,
+            "--count",
+            count,
+            "--seed",
+            seed,
+            "--method",
+            method,
+            "-o",
+            &s(&out),
+            "--json",
+        ]);
+        let (k, seed) = (count.parse().unwrap(), seed.parse().unwrap());
+        let want = match method {
+            "fps" => surface.spread_anchors(k, seed).unwrap(),
+            _ => wavg::anchors::random(surface.mesh(), k, seed)
+                .unwrap()
+                .into_iter()
+                .map(wavg::Anchor::Vertex)
+                .collect(),
+        };
+        let text = std::fs::read_to_string(&out).unwrap();
+        assert_eq!(text, wavg::anchors::format(&want), "{method} {k} {seed}");
+        let (j, _) = json_object(&o);
+        let gap = surface.largest_gap(&ids(&out));
+        assert_eq!(j["largest_gap"].as_f64().unwrap(), gap);
+    }
+}

@@ -8,6 +8,7 @@
 #![allow(non_camel_case_types)]
 #![deny(unreachable_pub)]
 
+mod anchors;
 mod apps;
 mod boundary;
 mod decimate;
@@ -19,6 +20,7 @@ mod surface;
 mod transfer;
 mod types;
 
+pub use anchors::wavg_surface_spread_anchors;
 pub use apps::wavg_spline;
 pub use boundary::{wavg_abi_version, wavg_last_error};
 pub use decimate::wavg_surface_decimate;

@@ -9,8 +9,9 @@
 //!
 //! Also: [`AnchorSet`] (editable anchor sets), [`resolve_anchor`] and [`check_point`]
 //! (validating user locations), [`validate_weights`], [`inverse_weights`] (the inverse
-//! problem's kernel on its own) and [`sampling`] (seeded anchors and query points). The
-//! benchmark protocols that measure all this live outside the library, in `wavg-bench`.
+//! problem's kernel on its own), [`sampling`] (seeded anchors and query points) and
+//! [`spread`] (anchor sets judged by their largest gap, and a closed tour through points).
+//! The benchmark protocols that measure all this live outside the library, in `wavg-bench`.
 //!
 //! ```
 //! use std::sync::Arc;
@@ -42,6 +43,7 @@ mod points;
 pub mod sampling;
 mod simd;
 mod solver;
+pub mod spread;
 mod verified;
 mod weights;
 

@@ -94,8 +94,9 @@ pub enum FpsMetric<'a> {
 
 /// `k` distinct vertices by farthest-point sampling: the first is drawn at random from
 /// `seed`, each next one is the vertex farthest (in `metric`) from those already chosen
-/// (ties to the lowest index). Vertices of other connected components are infinitely far,
-/// so every component gets an anchor before any gets a second one.
+/// (ties to the lowest index). Vertices of other connected components are infinitely far
+/// in [`FpsMetric::EdgeGraph`], so every component gets an anchor before any gets a
+/// second one.
 ///
 /// ```
 /// use wavg_mesh::{ValidMesh, procedural};
@@ -116,23 +117,49 @@ pub fn farthest_point_vertices(
             "cannot choose {k} anchors among {nv} vertices"
         )));
     }
-    if let FpsMetric::Embedding(c) = metric
-        && c.len() != nv
-    {
-        return Err(SolveError::InvalidParameter(format!(
-            "{} embedded coordinates for {nv} vertices",
-            c.len()
-        )));
-    }
-    let mut out = Vec::with_capacity(k);
     if k == 0 {
-        return Ok(out);
+        check_metric(nv, metric)?;
+        return Ok(Vec::new());
     }
+    Ok(farthest_point_vertices_until(mesh, seed, metric, k, |_, _| false)?.0)
+}
+
+/// Farthest-point sampling (the order of [`farthest_point_vertices`] with this `seed`)
+/// until `stop(count, gap)` holds or `max` vertices (at least 1, at most the vertex count)
+/// are chosen, where `gap` is the largest distance in `metric` from a vertex to its
+/// nearest chosen one. Returns the vertices and that gap: the one loop behind the
+/// fixed-count spread and the gap-bounded one ([`crate::spread::spread_to_gap`]).
+///
+/// ```
+/// use wavg_mesh::{ValidMesh, procedural};
+/// use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, farthest_point_vertices_until};
+/// let m = ValidMesh::new(procedural::icosphere(2)).unwrap();
+/// let (a, gap) = farthest_point_vertices_until(&m, 1, FpsMetric::EdgeGraph, 100, |_, g| g < 0.5)?;
+/// assert!(gap < 0.5);
+/// assert_eq!(a, farthest_point_vertices(&m, a.len(), 1, FpsMetric::EdgeGraph)?);
+/// # Ok::<(), wavg_solve::SolveError>(())
+/// ```
+pub fn farthest_point_vertices_until(
+    mesh: &ValidMesh,
+    seed: u64,
+    metric: FpsMetric<'_>,
+    max: usize,
+    mut stop: impl FnMut(usize, f64) -> bool,
+) -> Result<(Vec<VertexId>, f64), SolveError> {
+    let nv = mesh.n_vertices();
+    check_metric(nv, metric)?;
+    if nv == 0 {
+        return Err(SolveError::InvalidParameter(
+            "cannot choose anchors on a mesh without vertices".into(),
+        ));
+    }
+    let max = max.clamp(1, nv);
+    let mut out = Vec::with_capacity(max);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut dist = vec![f64::INFINITY; nv];
     let mut next = rng.random_range(0..nv) as VertexId;
     let mut heap = BinaryHeap::new();
-    for _ in 0..k {
+    loop {
         out.push(next);
         match metric {
             FpsMetric::EdgeGraph => relax_from(mesh, next, &mut dist, &mut heap),
@@ -149,9 +176,47 @@ pub fn farthest_point_vertices(
                 best = v;
             }
         }
+        if out.len() >= max || stop(out.len(), dist[best]) {
+            return Ok((out, dist[best]));
+        }
         next = best as VertexId;
     }
-    Ok(out)
+}
+
+/// Refuses embedded coordinates that are not one per vertex.
+fn check_metric(nv: usize, metric: FpsMetric<'_>) -> Result<(), SolveError> {
+    match metric {
+        FpsMetric::Embedding(c) if c.len() != nv => Err(SolveError::InvalidParameter(format!(
+            "{} embedded coordinates for {nv} vertices",
+            c.len()
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// `k` distinct vertices of `n_vertices` drawn uniformly at random from `seed` (in the
+/// order drawn): `wavg anchors --method random`.
+///
+/// ```
+/// let a = wavg_solve::sampling::random_vertices(100, 5, 7).unwrap();
+/// assert_eq!(a, wavg_solve::sampling::random_vertices(100, 5, 7).unwrap());
+/// assert!(wavg_solve::sampling::random_vertices(4, 5, 7).is_err());
+/// ```
+pub fn random_vertices(
+    n_vertices: usize,
+    k: usize,
+    seed: u64,
+) -> Result<Vec<VertexId>, SolveError> {
+    if k > n_vertices {
+        return Err(SolveError::InvalidParameter(format!(
+            "cannot choose {k} anchors among {n_vertices} vertices"
+        )));
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    Ok(rand::seq::index::sample(&mut rng, n_vertices, k)
+        .into_iter()
+        .map(|v| v as VertexId)
+        .collect())
 }
 
 /// Min-heap entry for Dijkstra.

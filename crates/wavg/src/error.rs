@@ -47,6 +47,26 @@ pub enum Error {
     /// A NumPy `.npy` array could not be read.
     #[error(transparent)]
     Npy(#[from] NpyError),
+    /// A line of an input file (an anchors file) is malformed or names what the mesh does
+    /// not have, or the file as a whole is unusable (line 0: for example no anchors).
+    #[error("{}{}: {message}", path.display(), at_line(*line))]
+    Input {
+        /// The file.
+        path: std::path::PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// `:LINE` after a file name, or nothing for line 0 (the whole file).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
 }
 
 impl std::fmt::Debug for Error {
@@ -123,6 +143,7 @@ impl Error {
             Error::App(AppError::Solve(e)) => solve_kind(e),
             Error::Remesh(e) => remesh_kind(e),
             Error::Npy(_) => ErrorKind::Io,
+            Error::Input { .. } => ErrorKind::InvalidArgument,
         }
     }
 

@@ -34,6 +34,7 @@
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
 
+pub mod anchors;
 mod decimate;
 mod error;
 mod oneoff;

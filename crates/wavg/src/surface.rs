@@ -8,7 +8,6 @@ use nalgebra::Vector3;
 use wavg_embed::{Embedding, PrecomputeOptions, Progress, Report};
 use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, VertexId};
 use wavg_project::{EmbeddedMesh, Projector, Vec8};
-use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
 use wavg_solve::{Anchor, Solver};
 
 use crate::error::{Error, Result};
@@ -215,13 +214,6 @@ impl Surface {
     pub fn position(&self, p: &SurfacePoint) -> Result<Vector3<f64>> {
         let p = wavg_solve::check_point(&self.inner.mesh, p)?;
         Ok(p.position(&self.inner.mesh))
-    }
-
-    /// `k` vertices spread over the surface by farthest-point sampling along mesh edges
-    /// (the first drawn from `seed`), as anchors: a good default anchor set.
-    pub fn spread_anchors(&self, k: usize, seed: u64) -> Result<Vec<Anchor>> {
-        let v = farthest_point_vertices(&self.inner.mesh, k, seed, FpsMetric::EdgeGraph)?;
-        Ok(v.into_iter().map(Anchor::Vertex).collect())
     }
 
     /// A solver of forward and inverse problems for these anchors (vertex ids, surface

@@ -9,8 +9,7 @@ mod problem;
 pub use files::{located, read_points, read_text, write_atomic, write_numbers};
 pub use parse::{FORMAT_HELP, PointSpec};
 pub use problem::{
-    ProblemArgs, build_projector, load_embedded, load_solver, resolve_points, spec_anchor,
-    with_threads,
+    ProblemArgs, build_projector, load_embedded, load_solver, resolve_points, with_threads,
 };
 
 #[cfg(test)]

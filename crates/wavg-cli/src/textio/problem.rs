@@ -11,7 +11,7 @@ use crate::CliError;
 use crate::common::load_valid;
 use crate::error::Context;
 
-use super::{PointSpec, located, read_points};
+use super::{PointSpec, located};
 
 /// Arguments shared by `wavg forward` and `wavg inverse`: the mesh, its embedding, the
 /// anchors, the output and the thread count.
@@ -89,7 +89,7 @@ pub fn resolve_points(
 }
 
 /// A spec as an [`Anchor`] (indices must fit in 32 bits).
-pub fn spec_anchor(spec: PointSpec) -> Result<Anchor, String> {
+fn spec_anchor(spec: PointSpec) -> Result<Anchor, String> {
     let idx =
         |i: u64, what: &str| u32::try_from(i).map_err(|_| format!("{what} {i} is out of range"));
     Ok(match spec {
@@ -104,22 +104,9 @@ pub fn spec_anchor(spec: PointSpec) -> Result<Anchor, String> {
 /// cache's) and anchors, and makes the solver (shared by forward/inverse).
 pub fn load_solver(args: &ProblemArgs) -> Result<Solver, CliError> {
     let (mesh, embedding, anchors) = (&*args.mesh, args.embedding.as_deref(), &*args.anchors);
-    let specs = read_points(anchors)?;
-    if specs.is_empty() {
-        return Err(CliError::input(format!(
-            "{}: no anchors",
-            anchors.display()
-        )));
-    }
     let mesh = load_valid(mesh)?;
-    let anchor_list = specs
-        .iter()
-        .map(|&(line, s)| spec_anchor(s).map_err(|m| located(anchors, line, &m)))
-        .collect::<Result<Vec<_>, _>>()?;
-    // Validate each anchor with its line number before building anything expensive.
-    for (&(line, _), a) in specs.iter().zip(&anchor_list) {
-        wavg::resolve_anchor(&mesh, a).map_err(|e| located(anchors, line, &e))?;
-    }
+    // Each anchor checked, errors naming its line, before building anything expensive.
+    let anchor_list = wavg::anchors::read(anchors, &mesh)?;
     let emb = match embedding {
         Some(path) => load_embedded(mesh, Some(path))?,
         None => {
