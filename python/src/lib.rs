@@ -11,6 +11,7 @@
 
 mod apps;
 mod args;
+mod cache;
 mod errors;
 mod image;
 mod json;
@@ -51,6 +52,8 @@ fn _wavg(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<surface::Surface>()?;
     m.add_class::<solver::Solver>()?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(cache::cache_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(cache::cache_entries, m)?)?;
     m.add_function(wrap_pyfunction!(surface::_restore_surface, m)?)?;
     m.add_function(wrap_pyfunction!(solver::_restore_solver, m)?)?;
     apps::register(m)?;

@@ -434,6 +434,7 @@ impl Solver {
         let snapshot = Surface {
             inner: self.made_from.clone(),
             polygons: self.surface.borrow(py).polygons.clone(),
+            source: None,
             busy: Default::default(),
         };
         let args = (
@@ -452,6 +453,7 @@ impl Solver {
         let snapshot = Surface {
             inner: self.made_from.clone(),
             polygons: self.surface.borrow(py).polygons.clone(),
+            source: None,
             busy: Default::default(),
         };
         Ok(Self {

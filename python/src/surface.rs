@@ -28,6 +28,9 @@ pub(crate) struct Surface {
     /// every triangle is its own polygon): `render`'s wireframe leaves out the diagonals
     /// that triangulating the file's quads added.
     pub(crate) polygons: std::sync::Arc<Vec<u32>>,
+    /// The mesh file it was read from (`Surface.open`): such a surface uses the embedding
+    /// cache by default, and names its entries by this path.
+    pub(crate) source: Option<String>,
     /// Set while `precompute` runs (it replaces the embedding when it returns): a second
     /// precompute or a `load_embedding` meanwhile is refused rather than overwritten.
     pub(crate) busy: Busy,
@@ -178,6 +181,7 @@ impl Surface {
         Ok(Self {
             inner,
             polygons: Default::default(),
+            source: None,
             busy: Busy::default(),
         })
     }
@@ -206,6 +210,7 @@ impl Surface {
         Ok(Self {
             inner,
             polygons: std::sync::Arc::new(notes.polygon_of),
+            source: Some(path.display().to_string()),
             busy: Busy::default(),
         })
     }
@@ -225,34 +230,54 @@ impl Surface {
         Self::new(py, &v, &f, None)
     }
 
-    /// S.precompute(landmarks=1000, seed=0, threads=None, progress=True) -> dict
+    /// S.precompute(landmarks=None, seed=0, threads=None, progress=True, cache=None) -> dict
     ///
     /// Computes the 8-D embedding (landmarks, geodesic distances, MDS, least-squares mesh)
-    /// and uses it from now on; returns the report (the keys of ``wavg precompute --json``).
-    /// ``threads``: None for all cores. ``progress``: True draws a text bar on a terminal,
-    /// False nothing, a callable ``(stage: str, done: int, total: int)`` is called at the
-    /// start, at every new stage and about ten times a second in between (also while the
-    /// progress stands still) and cancels (``CancelledError``)
-    /// by returning ``False``. Ctrl-C stops it within a second (``KeyboardInterrupt``). A
-    /// cancelled call returns at once; the abandoned work stops at its next checkpoint in
-    /// the background. On any error the surface is unchanged. While it runs, another
-    /// thread's ``precompute`` or ``load_embedding`` of this surface raises
-    /// ``RuntimeError`` (the other methods go on with the current embedding).
+    /// and uses it from now on; returns the report (the keys of ``wavg precompute --json``,
+    /// plus ``cached`` and ``cache_path``). ``landmarks``: None (or 0) for the library's
+    /// choice for this mesh, the one every way into wavg makes (the paper's 1000).
+    /// ``cache``: the embedding cache every way into wavg shares (``wavg cache list``
+    /// shows it): None (the default) uses it for a surface read with ``Surface.open`` and
+    /// not for one made from arrays, True always, False never, a folder path that folder.
+    /// With a cache, an entry for this mesh and these options is read instead of computed
+    /// (the report then holds what the entry says of itself, with ``cached`` True), and a
+    /// computed embedding is stored there. ``threads``: None for all cores. ``progress``:
+    /// True draws a text bar on a terminal, False nothing, a callable ``(stage: str, done:
+    /// int, total: int)`` is called at the start, at every new stage and about ten times a
+    /// second in between (also while the progress stands still) and cancels
+    /// (``CancelledError``) by returning ``False``. Ctrl-C stops it within a second
+    /// (``KeyboardInterrupt``). A cancelled call returns at once; the abandoned work stops
+    /// at its next checkpoint in the background. On any error the surface is unchanged.
+    /// While it runs, another thread's ``precompute`` or ``load_embedding`` of this surface
+    /// raises ``RuntimeError`` (the other methods go on with the current embedding).
     #[pyo3(
-        signature = (landmarks=Int::of(1000), seed=Int::of(0), threads=None, progress=None),
-        text_signature = "($self, landmarks=1000, seed=0, threads=None, progress=True)"
+        signature = (landmarks=None, seed=Int::of(0), threads=None, progress=None, cache=None),
+        text_signature = "($self, landmarks=None, seed=0, threads=None, progress=True, cache=None)"
     )]
+    #[allow(clippy::too_many_arguments)]
     fn precompute(
         slf: &Bound<'_, Self>,
         py: Python<'_>,
-        landmarks: Int,
+        landmarks: Option<Int>,
         seed: Int,
         threads: Option<Int>,
         progress: Option<Bound<'_, PyAny>>,
+        cache: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Py<PyAny>> {
-        let landmarks = landmarks.within("landmarks", 1, u32::MAX as i128)?;
+        let landmarks = match landmarks {
+            Some(l) => l.within("landmarks", 0, u32::MAX as i128)?,
+            None => 0,
+        };
         let seed = seed.seed("seed")?;
         let par = args::par(threads)?;
+        let (cache, info) = {
+            let me = slf.borrow();
+            let name = me.source.clone().unwrap_or_else(|| "<arrays>".into());
+            (
+                crate::cache::resolve(cache.as_ref(), me.source.is_some())?,
+                wavg::cache::EntryInfo::new(name, crate::cache::WRITER),
+            )
+        };
         let bar = match &progress {
             None => true,
             Some(p) => !p.is_callable() && p.is_truthy()?,
@@ -276,12 +301,17 @@ impl Surface {
         let opts = PrecomputeOptions {
             landmarks: landmarks as usize,
             seed,
-            ..Default::default()
+            ..wavg::default_precompute_options(s.mesh())
         };
         let result = progress::watch(
             py,
             callback.as_ref(),
-            move |p| par.install(|| s.precompute(&opts, p).map(|r| (r, s))),
+            move |p| {
+                par.install(|| {
+                    s.precompute_cached(&opts, cache.as_ref(), &info, p)
+                        .map(|r| (r, s))
+                })
+            },
             |r| matches!(r, Ok(Ok(_))),
         );
         if let Some(bar) = &callback {
@@ -289,11 +319,64 @@ impl Surface {
                 bar.call_method0("close")?;
             }
         }
-        let (report, s) = result?
+        let (outcome, s) = result?
             .map_err(|e| value(format!("threads: {e}")))?
             .map_err(|e| to_py(py, e))?;
+        let n = (s.n_vertices(), s.n_faces());
+        let report = crate::cache::report(py, &outcome, s.embedding(), n)?;
         slf.borrow_mut().inner = s;
-        crate::json::to_py(py, &report)
+        Ok(report)
+    }
+
+    /// S.load_cached(landmarks=None, seed=0, cache=True) -> bool
+    ///
+    /// Uses the embedding cache's entry for this mesh and these options (the arguments of
+    /// ``precompute``, ``cache`` likewise but on by default) when there is one: True when
+    /// it was loaded, False when there is none (nothing computed). An entry that exists but
+    /// does not load raises as ``load_embedding`` does.
+    #[pyo3(signature = (landmarks=None, seed=Int::of(0), cache=None))]
+    fn load_cached(
+        &mut self,
+        py: Python<'_>,
+        landmarks: Option<Int>,
+        seed: Int,
+        cache: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<bool> {
+        let landmarks = match landmarks {
+            Some(l) => l.within("landmarks", 0, u32::MAX as i128)?,
+            None => 0,
+        };
+        let seed = seed.seed("seed")?;
+        let Some(cache) = crate::cache::resolve(cache.as_ref(), true)? else {
+            return Ok(false);
+        };
+        if self.busy.is_set() {
+            return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "a precompute is running on this surface (it replaces the embedding when it \
+                 returns); load the embedding after it",
+            ));
+        }
+        let mut s = self.inner.clone();
+        let opts = wavg::resolve_landmarks(
+            &PrecomputeOptions {
+                landmarks: landmarks as usize,
+                seed,
+                ..wavg::default_precompute_options(s.mesh())
+            },
+            s.mesh(),
+        );
+        let found = py.detach_run(|| match cache.load(s.mesh(), &opts) {
+            None => Ok(false),
+            Some(r) => {
+                let (e, _) = r?;
+                s.set_embedding(e).map(|()| true)
+            }
+        });
+        let found = found.map_err(|e| to_py(py, e))?;
+        if found {
+            self.inner = s;
+        }
+        Ok(found)
     }
 
     /// S.load_embedding(path): reads a ``.wavg`` embedding computed for this mesh (its
@@ -525,6 +608,7 @@ impl Surface {
         Self {
             inner: self.inner.clone(),
             polygons: self.polygons.clone(),
+            source: self.source.clone(),
             busy: Busy::default(),
         }
     }
@@ -533,6 +617,7 @@ impl Surface {
         Self {
             inner: self.inner.clone(),
             polygons: self.polygons.clone(),
+            source: self.source.clone(),
             busy: Busy::default(),
         }
     }

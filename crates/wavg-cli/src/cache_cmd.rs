@@ -22,36 +22,39 @@ whose description is missing or damaged).")]
 #[derive(clap::Args)]
 pub struct ListArgs {
     /// Print one JSON object: dir, entries (key, bytes, mesh, vertices, faces, landmarks,
-    /// seconds, created).
+    /// seconds, created, writer: the door that computed it, `cli`, `python`, `blender`,
+    /// `serve`, `batch` or `c`).
     #[arg(long)]
     pub json: bool,
 }
 
 /// Runs `wavg cache list` or `wavg cache clear`.
 pub fn run(cmd: Command) -> Result<(), CliError> {
-    let dir = cache::dir().ok_or_else(|| {
+    let cache = cache::open(false).ok_or_else(|| {
         CliError::input("no cache folder: set WAVG_CACHE_DIR, XDG_CACHE_HOME or HOME")
     })?;
-    let entries =
-        cache::entries(&dir).map_err(|e| CliError::failure(format!("{}: {e}", dir.display())))?;
+    let dir = cache.dir();
+    let entries = cache.entries()?;
     match cmd {
         Command::List(a) if a.json => {
             let list: Vec<serde_json::Value> = entries
                 .iter()
-                .map(|(key, bytes, meta)| {
+                .map(|e| {
                     // An entry whose description is missing or damaged has the same keys,
                     // null.
-                    let mut v = meta
+                    let mut v = e
+                        .meta
                         .as_ref()
                         .and_then(|m| serde_json::to_value(m).ok())
                         .unwrap_or_else(|| {
                             serde_json::json!({
                                 "mesh": null, "vertices": null, "faces": null,
                                 "landmarks": null, "seconds": null, "created": null,
+                                "writer": null,
                             })
                         });
-                    v["key"] = key.clone().into();
-                    v["bytes"] = (*bytes).into();
+                    v["key"] = e.key.clone().into();
+                    v["bytes"] = e.bytes.into();
                     v
                 })
                 .collect();
@@ -63,16 +66,17 @@ pub fn run(cmd: Command) -> Result<(), CliError> {
             let now = std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0, |d| d.as_secs());
-            for (key, bytes, meta) in &entries {
-                let size = format!("{:.1} MB", *bytes as f64 / 1e6);
-                match meta {
+            for e in &entries {
+                let (key, size) = (&e.key, format!("{:.1} MB", e.bytes as f64 / 1e6));
+                match &e.meta {
                     Some(m) => println!(
                         "{key}  {size:>9}  {} vertices, {} landmarks, {:.1} s to compute, \
-                         {} h old  {}",
+                         {} h old, by {}  {}",
                         m.vertices,
                         m.landmarks,
                         m.seconds,
                         now.saturating_sub(m.created) / 3600,
+                        if m.writer.is_empty() { "?" } else { &m.writer },
                         m.mesh
                     ),
                     None => println!("{key}  {size:>9}"),
@@ -80,23 +84,9 @@ pub fn run(cmd: Command) -> Result<(), CliError> {
             }
         }
         Command::Clear => {
-            let mut freed = 0u64;
-            for (key, bytes, _) in &entries {
-                for ext in ["wavg", "json"] {
-                    let p = dir.join(format!("{key}.{ext}"));
-                    match std::fs::remove_file(&p) {
-                        Ok(()) => {}
-                        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                        Err(e) => {
-                            return Err(CliError::failure(format!("{}: {e}", p.display())));
-                        }
-                    }
-                }
-                freed += bytes;
-            }
+            let (removed, freed) = cache.clear()?;
             println!(
-                "removed {} cached embeddings ({:.1} MB) from {}",
-                entries.len(),
+                "removed {removed} cached embeddings ({:.1} MB) from {}",
                 freed as f64 / 1e6,
                 dir.display()
             );

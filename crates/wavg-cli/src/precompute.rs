@@ -17,7 +17,7 @@ use std::time::Instant;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use wavg::embed;
 use wavg::mesh::repair;
-use wavg::{EmbedError, MeshError, PrecomputeOptions, Progress, Report, Stage, ValidMesh};
+use wavg::{MeshError, PrecomputeOptions, Progress, Report, Stage, ValidMesh};
 
 use crate::CliError;
 use crate::common::load_mesh;
@@ -50,9 +50,10 @@ pub struct Args {
     /// Output .wavg file (written atomically).
     #[arg(short, long, value_name = "OUT.wavg")]
     pub output: PathBuf,
-    /// Number of landmarks (the paper uses 1000).
-    #[arg(long, default_value_t = 1000)]
-    pub landmarks: usize,
+    /// Number of landmarks (default: the library's choice for the mesh, the paper's 1000,
+    /// as every other way into wavg chooses).
+    #[arg(long)]
+    pub landmarks: Option<usize>,
     /// Seed of the quality-check pairs (every other stage is deterministic).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -60,9 +61,9 @@ pub struct Args {
     /// when the mesh has more (0: always on the full mesh).
     #[arg(long, value_name = "N")]
     pub geodesic_vertices: Option<usize>,
-    /// Vertex pairs of the quality check (0 skips it).
-    #[arg(long, default_value_t = 1024)]
-    pub quality_pairs: usize,
+    /// Vertex pairs of the quality check (0 skips it; default: the library's choice, 1024).
+    #[arg(long)]
+    pub quality_pairs: Option<usize>,
     /// Keep only the largest connected component before embedding. The embedding then
     /// belongs to the repaired mesh: save it with --repaired-mesh to use it later.
     #[arg(long)]
@@ -83,13 +84,10 @@ pub struct Args {
 /// geodesic mesh no larger than the landmark set, and an output that is the input mesh or
 /// has a mesh file's extension.
 fn check_args(args: &Args) -> Result<(), CliError> {
-    if let Some(g) = args
-        .geodesic_vertices
-        .filter(|&g| g != 0 && g <= args.landmarks)
-    {
+    let landmarks = args.landmarks.unwrap_or(wavg::DEFAULT_LANDMARKS);
+    if let Some(g) = args.geodesic_vertices.filter(|&g| g != 0 && g <= landmarks) {
         return Err(CliError::input(format!(
-            "--geodesic-vertices {g} must be 0 (the full mesh) or more than --landmarks ({})",
-            args.landmarks
+            "--geodesic-vertices {g} must be 0 (the full mesh) or more than --landmarks ({landmarks})"
         )));
     }
     let out = &args.output;
@@ -135,24 +133,27 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let load_seconds = t_load.elapsed().as_secs_f64();
 
-    let defaults = PrecomputeOptions::default();
+    let defaults = wavg::default_precompute_options(&mesh);
     let opts = PrecomputeOptions {
         geodesic_vertices: args.geodesic_vertices.unwrap_or(defaults.geodesic_vertices),
-        landmarks: args.landmarks,
+        landmarks: args.landmarks.unwrap_or(defaults.landmarks),
         seed: args.seed,
-        quality_pairs: args.quality_pairs,
+        quality_pairs: args.quality_pairs.unwrap_or(defaults.quality_pairs),
         ..defaults
     };
     let bars = Bars::new(std::io::stderr().is_terminal(), interrupted);
     let result =
-        crate::textio::with_threads(args.threads, || embed::precompute(&mesh, &opts, &bars))?;
+        crate::textio::with_threads(args.threads, || wavg::precompute(&mesh, &opts, &bars))?;
     bars.clear();
-    let (embedding, report) = result.map_err(|e| match e {
-        EmbedError::Cancelled => CliError::from(e).with_message(format!(
-            "interrupted; {} was not written",
-            args.output.display()
-        )),
-        e => CliError::from(e).context(&args.mesh),
+    let (embedding, report) = result.map_err(|e| {
+        if e.kind() == wavg::ErrorKind::Cancelled {
+            CliError::from(e).with_message(format!(
+                "interrupted; {} was not written",
+                args.output.display()
+            ))
+        } else {
+            CliError::from(e).context(&args.mesh)
+        }
     })?;
 
     let t_save = Instant::now();

@@ -87,19 +87,28 @@ pub fn run(args: Args) -> Result<(), CliError> {
             Arc::new(AtomicBool::new(false)),
         ));
         let t = Instant::now();
-        let handle = app.precompute_in_background(Some(bars));
+        let info = wavg::cache::EntryInfo::new(mesh_name.clone(), "serve");
+        let cache = crate::cache::open(args.cache.no_cache);
+        let handle = app.precompute_with_cache(Some(bars), cache, info);
         let app2 = app.clone();
-        let (name, no_cache) = (mesh_name.clone(), args.cache.no_cache);
+        let name = mesh_name.clone();
         std::thread::spawn(move || {
-            let _ = handle.join();
+            let outcome = handle.join().ok().flatten();
             match app2.status() {
                 wavg_serve::Status::Ready => {
                     let seconds = t.elapsed().as_secs_f64();
                     eprintln!("embedding ready in {seconds:.1} s; every route answers");
-                    if let Some(s) = app2.ready_surface()
-                        && let Some(emb) = s.embedding()
+                    if let Some(wavg::CacheOutcome {
+                        provenance: wavg::Provenance::Computed { report, stored },
+                        ..
+                    }) = &outcome
                     {
-                        crate::cache::store_computed(s.mesh(), &name, emb, seconds, no_cache);
+                        crate::cache::report_stored(
+                            &name,
+                            report.landmarks,
+                            report.seconds,
+                            stored.as_ref(),
+                        );
                     }
                 }
                 s => eprintln!("wavg: the embedding could not be computed: {s:?}"),

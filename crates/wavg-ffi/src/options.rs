@@ -15,8 +15,9 @@ use crate::boundary::{Failure, guard_value};
 pub struct wavg_precompute_options {
     /// `sizeof(wavg_precompute_options)` of the caller's header (set by the default).
     pub struct_size: usize,
-    /// Number of landmark vertices (at least 4; default 1000). A mesh with fewer vertices
-    /// uses all of them.
+    /// Number of landmark vertices (default 1000, the paper's): 0 lets the library choose
+    /// for the mesh, as every front end does without explicit options; otherwise at least
+    /// 4. A mesh with fewer vertices uses all of them.
     pub landmarks: usize,
     /// Seed of the random choices (the quality-check pairs); every other stage is
     /// deterministic. Default 0.
@@ -37,7 +38,7 @@ impl wavg_precompute_options {
         let d = wavg::PrecomputeOptions::default();
         Self {
             struct_size: std::mem::size_of::<Self>(),
-            landmarks: d.landmarks,
+            landmarks: wavg::DEFAULT_LANDMARKS,
             seed: d.seed,
             geodesic_vertices: d.geodesic_vertices,
             quality_pairs: d.quality_pairs,
@@ -66,9 +67,9 @@ impl wavg_precompute_options {
                 std::ptr::copy_nonoverlapping(ptr.cast::<u8>(), (&raw mut o).cast::<u8>(), n)
             };
         }
-        if o.landmarks < 4 {
+        if o.landmarks != 0 && o.landmarks < 4 {
             return Err(Failure::arg(format!(
-                "{} landmarks requested; at least 4 are needed",
+                "{} landmarks requested; at least 4 are needed (0: the library's choice)",
                 o.landmarks
             )));
         }
@@ -82,8 +83,8 @@ impl wavg_precompute_options {
     }
 }
 
-/// The default precomputation settings (the paper's: 1000 landmarks), with `struct_size`
-/// set. Thread-safe; cannot fail.
+/// The default precomputation settings (the paper's 1000 landmarks, the same as every
+/// other front end's default), with `struct_size` set. Thread-safe; cannot fail.
 #[unsafe(no_mangle)]
 pub extern "C" fn wavg_precompute_options_default() -> wavg_precompute_options {
     guard_value(

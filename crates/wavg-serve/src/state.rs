@@ -3,7 +3,7 @@
 
 use std::sync::{Arc, Mutex, RwLock};
 
-use wavg::{PrecomputeOptions, Progress, Stage, Surface};
+use wavg::{Progress, Stage, Surface};
 
 use crate::ApiError;
 
@@ -62,38 +62,46 @@ impl App {
         }
     }
 
-    /// Computes the embedding on a new thread (a tenth of the vertices as landmarks, 50 to
-    /// 1000, as the command line does), reporting each stage to the status and to
-    /// `terminal` when given. Does nothing when the app is ready.
+    /// [`App::precompute_with_cache`] without a cache (the embedding computed in memory).
     pub fn precompute_in_background(
         &self,
         terminal: Option<Box<dyn Progress + Send>>,
-    ) -> std::thread::JoinHandle<()> {
+    ) -> std::thread::JoinHandle<Option<wavg::CacheOutcome>> {
+        self.precompute_with_cache(terminal, None, wavg::cache::EntryInfo::new("", "serve"))
+    }
+
+    /// Computes the embedding on a new thread with the library's default options for the
+    /// mesh (`wavg::default_precompute_options`), through `cache` when given (its entry is
+    /// read, or computed and stored with `info`), reporting each stage to the status and to
+    /// `terminal` when given. Does nothing when the app is ready. The thread returns where
+    /// the embedding came from (`None` when it failed or was not needed).
+    pub fn precompute_with_cache(
+        &self,
+        terminal: Option<Box<dyn Progress + Send>>,
+        cache: Option<wavg::cache::Cache>,
+        info: wavg::cache::EntryInfo,
+    ) -> std::thread::JoinHandle<Option<wavg::CacheOutcome>> {
         let app = self.clone();
         std::thread::spawn(move || {
             if app.status() == Status::Ready {
-                return;
+                return None;
             }
             let mut surface = app.inner.mesh_surface.clone();
-            let landmarks = (surface.n_vertices() / 10).clamp(50, 1000);
-            let opts = PrecomputeOptions {
-                landmarks,
-                quality_pairs: 0,
-                ..Default::default()
-            };
+            let opts = wavg::default_precompute_options(surface.mesh());
             let sink = Sink {
                 app: &app,
                 terminal: terminal.as_deref(),
             };
-            let result = surface.precompute(&opts, &sink);
-            let status = match result {
-                Ok(_) => {
+            let result = surface.precompute_cached(&opts, cache.as_ref(), &info, &sink);
+            let (status, outcome) = match result {
+                Ok(outcome) => {
                     *app.inner.ready.write().unwrap_or_else(|e| e.into_inner()) = Some(surface);
-                    Status::Ready
+                    (Status::Ready, Some(outcome))
                 }
-                Err(e) => Status::Failed(e.to_string().replace('\n', " ")),
+                Err(e) => (Status::Failed(e.to_string().replace('\n', " ")), None),
             };
             app.set_status(status);
+            outcome
         })
     }
 

@@ -35,15 +35,21 @@
 #![forbid(unsafe_code)]
 
 pub mod anchors;
+pub mod cache;
 mod decimate;
 mod error;
 mod oneoff;
+mod precompute;
 mod surface;
 
 pub use decimate::Decimation;
 pub use error::{Error, ErrorKind, Result};
 pub use nalgebra::Vector3;
 pub use oneoff::{barycentric_weights, weighted_average};
+pub use precompute::{
+    CacheOutcome, DEFAULT_LANDMARKS, Provenance, check_embeddable, default_precompute_options,
+    embedding_cached, precompute, resolve_landmarks,
+};
 pub use surface::Surface;
 pub use wavg_embed::{Embedding, NoProgress, PrecomputeOptions, Progress, Report, Stage};
 /// The file formats: plain-text surface points and weights, NumPy `.npy` arrays.

@@ -10,7 +10,7 @@ use wavg_mesh::{SurfacePoint, TriMesh, ValidMesh, VertexId};
 use wavg_project::{EmbeddedMesh, Projector, Vec8};
 use wavg_solve::{Anchor, Solver};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 
 /// A validated triangle mesh with its embedding in R^8 and the projector built on it.
 ///
@@ -109,25 +109,27 @@ impl Surface {
         options: &PrecomputeOptions,
         progress: &dyn Progress,
     ) -> Result<Report> {
-        let components = self.inner.mesh.topology().n_components();
-        if components != 1 {
-            return Err(Error::Unsuitable(format!(
-                "the mesh has {components} connected components; the embedding needs exactly \
-                 one (keep the largest with `wavg repair --largest-component`)"
-            )));
-        }
-        let n = self.inner.mesh.n_vertices();
-        if n < 4 {
-            return Err(Error::Unsuitable(format!(
-                "the mesh has {n} vertices; the embedding needs at least 4"
-            )));
-        }
-        if let Some(why) = wavg_mesh::coordinates_out_of_range(&self.inner.mesh) {
-            return Err(Error::Unsuitable(why));
-        }
-        let (embedding, report) = wavg_embed::precompute(&self.inner.mesh, options, progress)?;
+        let (embedding, report) = crate::precompute(&self.inner.mesh, options, progress)?;
         self.set_embedding(embedding)?;
         Ok(report)
+    }
+
+    /// [`Surface::precompute`] through an embedding cache ([`crate::embedding_cached`]):
+    /// the cache's entry for this mesh and these options when it has one, else computed
+    /// and stored there (`cache` `None`: computed in memory). A landmark count of 0 means
+    /// the choice of [`crate::default_precompute_options`]. On any error the surface is
+    /// unchanged.
+    pub fn precompute_cached(
+        &mut self,
+        options: &PrecomputeOptions,
+        cache: Option<&crate::cache::Cache>,
+        info: &crate::cache::EntryInfo,
+        progress: &dyn Progress,
+    ) -> Result<crate::CacheOutcome> {
+        let (embedding, outcome) =
+            crate::embedding_cached(&self.inner.mesh, options, cache, info, progress)?;
+        self.set_embedding(embedding)?;
+        Ok(outcome)
     }
 
     /// Reads a `.wavg` file computed for this mesh (its fingerprint is checked) and uses
