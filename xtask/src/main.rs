@@ -10,6 +10,7 @@ mod examples;
 mod fuzz;
 mod lab;
 mod lines;
+mod map;
 mod man;
 mod policy;
 mod python;
@@ -165,13 +166,14 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         steps::cargo_workspace(root, &["test"], &[])
     }) && log.run(
         &format!(
-            "source policy (files over {} lines, forbid(unsafe_code), module style)",
+            "source policy (files over {} lines, forbid(unsafe_code), module style, the map)",
             lines::MAX_LINES
         ),
         || {
             lines::run(root)
                 .and_then(|()| policy::check_unsafe(root))
                 .and_then(|()| policy::check_module_style(root))
+                .and_then(|()| map::check(root))
         },
     ) && log.run("docs (cargo doc, warnings as errors)", || {
         steps::command_env(
