@@ -94,11 +94,19 @@ def test_registered(ctx):
 def test_precompute_cache(ctx):
     ico = scene.icosphere("ico")
     precompute(ico)
-    key = ico["wavg_key"]
-    path = os.path.join(os.environ["WAVG_BLENDER_CACHE"], f"wavg-{key}.wavg")
-    assert os.path.isfile(path), f"no cache file {path}"
-    # A fresh surface of the same mesh loads it: the cache is keyed by the mesh.
     from wavg_blender import surfaces
+
+    # The embedding is an entry of the shared embedding cache in $WAVG_BLENDER_CACHE,
+    # written by the Python door with the library's choice of options.
+    folder = os.environ["WAVG_BLENDER_CACHE"]
+    path = surfaces.find_embedding(ico)
+    assert path is not None and os.path.isfile(path), f"no cache file {path}"
+    assert os.path.dirname(path) == folder, path
+    entries = [e for e in wavg().cache_entries(folder) if e["path"] == path]
+    assert len(entries) == 1 and entries[0]["writer"] == "python", entries
+    assert entries[0]["vertices"] == len(ico.data.vertices), entries
+    assert ico["wavg_landmarks"] == 0 and ico["wavg_seed"] == 0
+    # A fresh surface of the same mesh loads it: the cache is keyed by the mesh.
 
     surfaces.forget_all()
     s = surface(ico)
@@ -252,7 +260,7 @@ def test_decal_uv(ctx):
     write_obj(os.path.join(d, "m.obj"), V, F)
     from wavg_blender import surfaces
 
-    emb = surfaces.find_embedding(ico["wavg_key"])
+    emb = surfaces.find_embedding(ico)
     with open(os.path.join(d, "a.txt"), "w") as f:
         f.writelines(f"v {i}\n" for i in anchors)
     with open(os.path.join(d, "uv.txt"), "w") as f:

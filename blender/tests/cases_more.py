@@ -111,9 +111,9 @@ def test_transfer(ctx):
     assert np.abs(got.reshape(-1, 2) - expect[lv]).max() <= 1e-6
     # The baked image equals wavg.transfer_texture's output.
     t_src = w.Surface(s_src.vertices, s_src.faces, uv=uv_src)
-    t_src.load_embedding(surfaces.find_embedding(src["wavg_key"]))
+    t_src.load_embedding(surfaces.find_embedding(src))
     t_dst = w.Surface(s_dst.vertices, s_dst.faces, uv=corner_uv(dst))
-    t_dst.load_embedding(surfaces.find_embedding(dst["wavg_key"]))
+    t_dst.load_embedding(surfaces.find_embedding(dst))
     ref = np.asarray(w.transfer_texture(t_src, tex, t_dst, a_src, a_dst, size=(64, 64)))
     img = bpy.data.images["wavg_transfer"]
     from wavg_blender import transfer_data
@@ -145,7 +145,9 @@ def test_precompute_cancel(ctx):
         assert "failed" in str(e) or "cancel" in str(e), str(e)
     else:
         raise AssertionError("a cancelled precompute finished")
-    assert surfaces.find_embedding(job.mesh.key) is None, "a cancelled precompute wrote a file"
+    assert surfaces.find_embedding(ico) is None, "a cancelled precompute wrote a file"
+    s = surfaces.new_surface(job.mesh)
+    assert surfaces.load_cached(s, ico) is None, "a cancelled precompute wrote a cache entry"
     assert "wavg_key" not in ico
 
 
@@ -235,8 +237,12 @@ def test_precompute_beside_blend(ctx):
     os.makedirs(os.path.dirname(blend), exist_ok=True)
     bpy.ops.wm.save_as_mainfile(filepath=blend, check_existing=False)
     precompute(ico)
-    key = ico["wavg_key"]
-    assert os.path.isfile(os.path.join(os.path.dirname(blend), f"wavg-{key}.wavg"))
+    from wavg_blender import surfaces
+
+    path = surfaces.find_embedding(ico)
+    assert path is not None and os.path.dirname(path) == os.path.dirname(blend), path
+    assert os.path.isfile(path)
+    assert [e["path"] for e in wavg().cache_entries(os.path.dirname(blend))] == [path]
 
 
 TESTS = [test_transfer, test_precompute_cancel, test_undo, test_bad_inputs,

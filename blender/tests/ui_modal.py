@@ -135,7 +135,10 @@ def step():
                 return 0.5
             print(f"       a whole precompute took {time.time() - STATE['t']:.1f} s")
             files = cache_files()
-            check("precompute finishes and writes the cache", files == [f"wavg-{obj['wavg_key']}.wavg"],
+            # One entry of the shared cache: KEY.wavg and its description KEY.json.
+            entry = os.path.basename(obj.get("wavg_embedding", ""))
+            stem = entry[: -len(".wavg")] if entry.endswith(".wavg") else entry
+            check("precompute finishes and writes the cache", entry and files == [stem + ".json", entry],
                   str(files))
             finish()
     except Exception:

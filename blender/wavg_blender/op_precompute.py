@@ -1,8 +1,9 @@
-"""``wavg.precompute``: the embedding of the active mesh, written to the cache.
+"""``wavg.precompute``: the embedding of the active mesh, through the embedding cache
+every way into wavg shares (read from it when an entry exists, else computed and stored).
 
 From the UI it runs in a worker thread while a modal timer shows the progress in the status
 bar; Esc makes the progress callback return ``False``, which cancels wavg's precomputation
-(nothing is written). From a script (``execute``, also in background mode) it runs in
+(nothing is written: the cache stores only finished embeddings). From a script (``execute``, also in background mode) it runs in
 place, reporting progress to the window manager."""
 
 import threading
@@ -11,7 +12,7 @@ import bpy
 
 from . import surfaces
 from .common import active_mesh, guarded
-from .errors import AddonError, describe, wavg
+from .errors import AddonError, describe
 from .meshdata import MeshInput
 
 
@@ -21,7 +22,10 @@ class _Job:
     def __init__(self, obj, landmarks, seed):
         self.mesh = MeshInput(obj)
         self.surface = surfaces.new_surface(self.mesh)
-        self.landmarks, self.seed = landmarks, seed
+        self.landmarks, self.seed = surfaces.landmarks_arg(landmarks), int(seed)
+        # Decided here, on Blender's thread: the worker must not read bpy.data.
+        self.folder = surfaces.write_dir()
+        self.report = None
         self.stage, self.done, self.total = "starting", 0, 1
         self.cancel = False
         self.error = None
@@ -37,8 +41,11 @@ class _Job:
     def run(self):
         """Precomputes; an error (or the cancellation) is kept in ``self.error``."""
         try:
-            self.surface.precompute(
-                landmarks=self.landmarks, seed=self.seed, progress=self.progress
+            self.report = self.surface.precompute(
+                landmarks=self.landmarks,
+                seed=self.seed,
+                progress=self.progress,
+                cache=self.folder if self.folder is not None else False,
             )
         except BaseException as e:  # noqa: BLE001 (cancellation may be KeyboardInterrupt)
             self.error = e
@@ -48,32 +55,38 @@ class _Job:
         return f"wavg precompute '{self.mesh.name}': {self.stage} {pct:.0f}% (Esc cancels)"
 
     def finish(self, obj):
-        """Writes the embedding to the cache; raises :class:`AddonError` on any failure."""
+        """Keeps the embedding (the cache entry was written by ``precompute``) and records
+        its options on ``obj``; returns the entry's path (``None`` without a cache folder).
+        Raises :class:`AddonError` on any failure."""
         if self.cancel:
             raise AddonError("precompute cancelled; nothing was written")
         if self.error is not None:
             raise AddonError(f"precompute of '{self.mesh.name}' failed: {describe(self.error)}")
-        path = surfaces.write_path(self.mesh.key)
-        w = wavg()
-        try:
-            self.surface.save_embedding(path)
-        except (w.WavgError, OSError, ValueError) as e:
-            raise AddonError(f"cannot write the embedding to {path}: {describe(e)}") from e
+        path = (self.report or {}).get("cache_path")
+        if self.folder is not None and path is None:
+            raise AddonError(
+                f"cannot write the embedding of '{self.mesh.name}' to the cache {self.folder}"
+            )
         surfaces.remember(self.mesh.key, self.surface)
+        surfaces.remember_options(obj, self.landmarks, self.seed, path)
         obj["wavg_key"] = self.mesh.key
         return path
 
 
 class WAVG_OT_precompute(bpy.types.Operator):
     """Compute the embedding of the active mesh (needed by every other wavg operator) and
-    cache it in a .wavg file beside the .blend file or in the user cache"""
+    cache it beside the .blend file or in wavg's user cache"""
 
     bl_idname = "wavg.precompute"
     bl_label = "Precompute Embedding"
     bl_options = {'REGISTER', 'UNDO'}
 
     landmarks: bpy.props.IntProperty(
-        name="Landmarks", default=1000, min=3, description="Landmark vertices of the embedding"
+        name="Landmarks",
+        default=0,
+        min=0,
+        description="Landmark vertices of the embedding (0: the library's choice, the one "
+        "every way into wavg makes)",
     )
     seed: bpy.props.IntProperty(name="Seed", default=0, min=0, description="Random seed")
 
@@ -95,7 +108,7 @@ class WAVG_OT_precompute(bpy.types.Operator):
             finally:
                 wm.progress_end()
             path = job.finish(obj)
-            self.report({'INFO'}, f"embedding of '{obj.name}' written to {path}")
+            self.report({'INFO'}, f"embedding of '{obj.name}' cached in {path}")
             return {'FINISHED'}
 
         return guarded(self, step)
@@ -137,7 +150,7 @@ class WAVG_OT_precompute(bpy.types.Operator):
 
         def end():
             path = job.finish(self._obj)
-            self.report({'INFO'}, f"embedding of '{self._obj.name}' written to {path}")
+            self.report({'INFO'}, f"embedding of '{self._obj.name}' cached in {path}")
             return {'FINISHED'}
 
         return guarded(self, end)

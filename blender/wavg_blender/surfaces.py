@@ -1,10 +1,14 @@
 """wavg surfaces of mesh objects and their embeddings.
 
-An embedding is cached in a ``.wavg`` file named by the mesh's fingerprint
-(``wavg-<key>.wavg``): beside the saved ``.blend`` file, or in the user cache
-(``$WAVG_BLENDER_CACHE``, else ``$XDG_CACHE_HOME/wavg-blender``, else
-``~/.cache/wavg-blender``) while the ``.blend`` is unsaved. Loaded surfaces are kept in
-memory by the same key, so moving a control point does not read the file again.
+Embeddings live in the embedding cache every way into wavg shares (``wavg cache list``
+shows them; the key is the mesh's fingerprint and the precompute options): in a folder
+beside the saved ``.blend`` file, or in the user cache (``$WAVG_BLENDER_CACHE`` when set,
+else ``wavg.cache_dir()``: ``$WAVG_CACHE_DIR``, else the platform's user cache, where the
+command line and Python find them too) while the ``.blend`` is unsaved. The options a
+precompute used are kept on the object (custom properties ``wavg_landmarks``, 0 for the
+library's choice, and ``wavg_seed``), so a lookup uses the same key. Loaded surfaces are
+kept in memory by the mesh's fingerprint, so moving a control point does not read the file
+again.
 """
 
 import os
@@ -23,12 +27,9 @@ _TREES = {}
 
 
 def user_cache_dir():
-    """The user cache folder for embeddings of unsaved files."""
-    env = os.environ.get("WAVG_BLENDER_CACHE")
-    if env:
-        return env
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return os.path.join(base, "wavg-blender")
+    """The user cache folder (embeddings of unsaved files): ``$WAVG_BLENDER_CACHE``, else
+    the cache every way into wavg shares (``None`` when there is none)."""
+    return os.environ.get("WAVG_BLENDER_CACHE") or wavg().cache_dir()
 
 
 def cache_dirs():
@@ -36,29 +37,69 @@ def cache_dirs():
     dirs = []
     if bpy.data.filepath:
         dirs.append(os.path.dirname(os.path.abspath(bpy.data.filepath)))
-    dirs.append(user_cache_dir())
+    user = user_cache_dir()
+    if user:
+        dirs.append(user)
     return dirs
 
 
-def file_name(key):
-    """The cache file name of the mesh with fingerprint ``key``."""
-    return f"wavg-{key}.wavg"
+def write_dir():
+    """The folder a new embedding is cached in (created), or ``None`` when there is none."""
+    dirs = cache_dirs()
+    if not dirs:
+        return None
+    os.makedirs(dirs[0], exist_ok=True)
+    return dirs[0]
 
 
-def find_embedding(key):
-    """The cached ``.wavg`` file of the mesh with fingerprint ``key``, or ``None``."""
+def landmarks_arg(landmarks):
+    """A landmarks setting as ``precompute`` takes it: 0 (the add-on's default) becomes
+    ``None``, the library's choice."""
+    return int(landmarks) or None
+
+
+def options(obj):
+    """``(landmarks, seed)`` of the embedding precomputed for ``obj`` (its custom
+    properties; the defaults for an object without them), as ``load_cached`` takes them."""
+    return landmarks_arg(obj.get("wavg_landmarks", 0)), int(obj.get("wavg_seed", 0))
+
+
+def remember_options(obj, landmarks, seed, path):
+    """Records on ``obj`` the options its embedding was precomputed with and the cache
+    entry it went to (``path``, or ``None``)."""
+    obj["wavg_landmarks"] = int(landmarks or 0)
+    obj["wavg_seed"] = int(seed)
+    if path:
+        obj["wavg_embedding"] = str(path)
+    elif "wavg_embedding" in obj:
+        del obj["wavg_embedding"]
+
+
+def find_embedding(obj):
+    """The cache entry (``.wavg`` file) recorded on ``obj`` by its precompute when it still
+    exists, else ``None``: a cheap check for the UI (lookups go through the cache key)."""
+    path = obj.get("wavg_embedding")
+    return path if path and os.path.isfile(path) else None
+
+
+def load_cached(surface, obj):
+    """Loads into ``surface`` (of ``obj``'s mesh) the cached embedding of the options
+    recorded on ``obj``; returns the folder it came from, or ``None`` when no folder holds
+    one. An entry that does not load is an :class:`AddonError`."""
+    landmarks, seed = options(obj)
+    w = wavg()
     for d in cache_dirs():
-        path = os.path.join(d, file_name(key))
-        if os.path.isfile(path):
-            return path
+        if not os.path.isdir(d):
+            continue
+        try:
+            if surface.load_cached(landmarks=landmarks, seed=seed, cache=d):
+                return d
+        except (w.WavgError, ValueError, OSError) as e:
+            raise AddonError(
+                f"the cached embedding in {d} does not load for '{obj.name}' ({describe(e)}); "
+                "run wavg.precompute again"
+            ) from e
     return None
-
-
-def write_path(key):
-    """Where a new embedding of the mesh ``key`` is written (the folder is created)."""
-    d = cache_dirs()[0]
-    os.makedirs(d, exist_ok=True)
-    return os.path.join(d, file_name(key))
 
 
 def new_surface(mesh):
@@ -89,28 +130,18 @@ def cached(key):
 
 def surface_of(obj):
     """``(surface, mesh)`` for the mesh object ``obj``: the mesh as arrays and its
-    ``wavg.Surface`` with the embedding from memory or the cache file. An object without
+    ``wavg.Surface`` with the embedding from memory or the cache. An object without
     embedding is an :class:`AddonError` telling to run wavg.precompute."""
     mesh = MeshInput(obj)
     s = _SURFACES.get(mesh.key)
     if s is not None:
         return s, mesh
-    path = find_embedding(mesh.key)
-    if path is None:
-        new_surface(mesh)  # a broken mesh says so before the missing embedding
+    s = new_surface(mesh)  # a broken mesh says so before the missing embedding
+    if load_cached(s, obj) is None:
         raise AddonError(
             f"'{obj.name}' has no embedding: run wavg.precompute on it first "
             "(the embedding belongs to the exact mesh; any edit of it needs a new one)"
         )
-    s = new_surface(mesh)
-    w = wavg()
-    try:
-        s.load_embedding(path)
-    except (w.WavgError, ValueError, OSError) as e:
-        raise AddonError(
-            f"the cached embedding {path} does not load for '{obj.name}' ({describe(e)}); "
-            "run wavg.precompute again"
-        ) from e
     remember(mesh.key, s)
     return s, mesh
 
@@ -139,12 +170,10 @@ def textured(mesh, uv):
     """A ``wavg.Surface`` of ``mesh`` (a :class:`MeshInput` whose embedding is cached)
     carrying per-corner texture coordinates ``uv`` ``(m, 3, 2)``, for texture transfer."""
     w = wavg()
-    path = find_embedding(mesh.key)
-    if path is None:
-        raise AddonError(f"'{mesh.name}' has no embedding: run wavg.precompute on it first")
     try:
         s = w.Surface(mesh.V, mesh.F, uv=uv)
-        s.load_embedding(path)
     except (w.WavgError, ValueError, TypeError, OSError) as e:
         raise AddonError(f"wavg cannot use the UVs of '{mesh.name}': {describe(e)}") from e
+    if load_cached(s, mesh.obj) is None:
+        raise AddonError(f"'{mesh.name}' has no embedding: run wavg.precompute on it first")
     return s

@@ -37,7 +37,7 @@ class VIEW3D_PT_wavg(bpy.types.Panel):
             return
         key = obj.get("wavg_key")
         ready = key is not None and (
-            surfaces.cached(key) is not None or surfaces.find_embedding(key) is not None
+            surfaces.cached(key) is not None or surfaces.find_embedding(obj) is not None
         )
         layout.label(
             text="Embedding: cached" if ready else "Embedding: none (precompute first)",

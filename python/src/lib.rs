@@ -9,6 +9,7 @@
 
 #![forbid(unsafe_code)]
 
+mod anchors;
 mod apps;
 mod args;
 mod cache;
@@ -52,6 +53,8 @@ fn _wavg(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<surface::Surface>()?;
     m.add_class::<solver::Solver>()?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(anchors::read_anchors, m)?)?;
+    m.add_function(wrap_pyfunction!(anchors::write_anchors, m)?)?;
     m.add_function(wrap_pyfunction!(cache::cache_dir, m)?)?;
     m.add_function(wrap_pyfunction!(cache::cache_entries, m)?)?;
     m.add_function(wrap_pyfunction!(surface::_restore_surface, m)?)?;

@@ -75,6 +75,17 @@ pub(crate) fn anchors(
     obj: &Bound<'_, PyAny>,
     name: &str,
 ) -> PyResult<Vec<Anchor>> {
+    anchors_within(obj, name, s.n_vertices(), s.n_faces())
+}
+
+/// Anchors from vertex ids `(k,)` or a pair `(faces, bary)`, with vertex ids below
+/// `n_vertices` and face ids below `n_faces`.
+pub(crate) fn anchors_within(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    n_vertices: usize,
+    n_faces: usize,
+) -> PyResult<Vec<Anchor>> {
     if let Ok(t) = obj.cast::<PyTuple>() {
         if t.len() == 2 {
             let second = t.get_item(1)?;
@@ -86,7 +97,7 @@ pub(crate) fn anchors(
                 let p = points(
                     &t.get_item(0)?,
                     &second,
-                    s.n_faces(),
+                    n_faces,
                     &format!("{name}[0]"),
                     &format!("{name}[1]"),
                 )?;
@@ -101,7 +112,7 @@ pub(crate) fn anchors(
         &[],
         "a (k,) array of integer vertex ids or a pair (faces (k,), bary (k, 3))",
     )?;
-    Ok(indices(data(&a), s.n_vertices(), name)?
+    Ok(indices(data(&a), n_vertices, name)?
         .into_iter()
         .map(Anchor::Vertex)
         .collect())

@@ -84,3 +84,12 @@ def cli():
 def random_weights(rng, q, k):
     W = rng.random((q, k))
     return W / W.sum(axis=1, keepdims=True)
+
+
+@pytest.fixture(scope="session")
+def libwavg():
+    """The C library libwavg.so (WAVG_LIBWAVG, else target/debug/libwavg.so)."""
+    for c in (os.environ.get("WAVG_LIBWAVG"), ROOT / "target" / "debug" / "libwavg.so"):
+        if c and pathlib.Path(c).is_file():
+            return str(c)
+    pytest.skip("libwavg.so is not built (cargo build -p wavg-ffi); set WAVG_LIBWAVG")

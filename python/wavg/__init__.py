@@ -17,7 +17,16 @@ from ._errors import (
     WavgIOError,
 )
 from ._types import Correspondence, Points
-from ._wavg import Solver, Surface, __version__, read_mesh
+from ._wavg import (
+    Solver,
+    Surface,
+    __version__,
+    cache_dir,
+    cache_entries,
+    read_anchors,
+    read_mesh,
+    write_anchors,
+)
 from . import _wavg
 
 __all__ = [
@@ -33,8 +42,11 @@ __all__ = [
     "WavgError",
     "WavgIOError",
     "barycentric_weights",
+    "cache_dir",
+    "cache_entries",
     "correspond",
     "decal",
+    "read_anchors",
     "read_mesh",
     "read_png",
     "render",
@@ -42,6 +54,7 @@ __all__ = [
     "spline",
     "transfer_texture",
     "weighted_average",
+    "write_anchors",
 ]
 
 _APPS = (

@@ -1,8 +1,9 @@
 from ._errors import (CancelledError, InvalidArgumentError, InvalidMeshError, NoSolutionError,
                       WavgError, WavgIOError)
 from ._types import Correspondence, Points
-from ._wavg import (Remesher, Solver, Surface, __version__, correspond, decal, read_mesh,
-                    read_png, render, save_png, spline, transfer_texture)
+from ._wavg import (Remesher, Solver, Surface, __version__, cache_dir, cache_entries, correspond,
+                    decal, read_anchors, read_mesh, read_png, render, save_png, spline,
+                    transfer_texture, write_anchors)
 
 import numpy as np
 import numpy.typing as npt

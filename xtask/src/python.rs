@@ -116,7 +116,7 @@ pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
 /// Installs the package as the README says, `pip install ./python` (PEP 517 through maturin, with
 /// build isolation), but in cargo's dev profile and target directory (`MATURIN_PEP517_ARGS`)
 /// so the workspace build's dependencies are reused; then runs `pytest python/tests` there,
-/// in a [`Sandbox`].
+/// in a [`Sandbox`], with the `wavg` binary in `WAVG_CLI` and the C library in `WAVG_LIBWAVG`.
 /// pytest's "no tests ran" (exit 5) fails too.
 pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     let py = ensure_venv(root)?;
@@ -144,12 +144,18 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     let data = data_dir.to_string_lossy();
     let wavg_bin = steps::target_dir(root).join("debug").join("wavg");
     let wavg_bin = wavg_bin.to_string_lossy();
+    let libwavg = steps::target_dir(root).join("debug").join("libwavg.so");
+    let libwavg = libwavg.to_string_lossy();
     Sandbox::new(root, "python")?
         .run(
             root,
             &py_s,
             &["-m", "pytest", "-q", TESTS],
-            &[("WAVG_DATA_DIR", &data), ("WAVG_CLI", &wavg_bin)],
+            &[
+                ("WAVG_DATA_DIR", &data),
+                ("WAVG_CLI", &wavg_bin),
+                ("WAVG_LIBWAVG", &libwavg),
+            ],
         )
         .map_err(|e| format!("{e} (pytest exit 5 means no tests ran)"))
 }

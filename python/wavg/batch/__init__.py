@@ -92,11 +92,16 @@ def _run(
     return m
 
 
+def _landmarks(landmarks: int | None) -> int | None:
+    """The ``landmarks`` option: None (or 0) for the library's choice."""
+    return None if landmarks is None or int(landmarks) == 0 else int(landmarks)
+
+
 def precompute_all(
     meshes: Sequence[PathLike],
     out_dir: PathLike,
     executor: Any = None,
-    landmarks: int = 1000,
+    landmarks: int | None = None,
     overwrite: bool = False,
     *,
     seed: int = 0,
@@ -106,6 +111,10 @@ def precompute_all(
     """Precomputes the embedding of every mesh into ``out_dir/NAME.wavg`` (``NAME``: the
     mesh file's name without ``.obj``/``.off``/``.ply``/``.gz``).
 
+    ``landmarks``: None (the default) for the library's choice, the one every way into
+    wavg makes (``wavg precompute`` without options). Embeddings go through the embedding
+    cache every way into wavg shares (``wavg cache list`` lists them, writer ``python``):
+    a mesh already precomputed with these options, by any door, is read from there.
     ``overwrite=True`` recomputes outputs that are up to date. ``progress(finished,
     total, failed)`` is called after each job. A mesh that cannot be embedded (invalid,
     missing) ends ``failed`` with its message; the others go on.
@@ -113,7 +122,7 @@ def precompute_all(
     meshes = list(meshes)
     threads = _threads(threads, executor)
     out = Path(out_dir)
-    options = {"landmarks": int(landmarks), "seed": int(seed)}
+    options = {"landmarks": _landmarks(landmarks), "seed": int(seed)}
     jobs = [
         Job("precompute", i, os.fspath(m), str(out / name), {"mesh": _abs(m)}, options, bool(overwrite), threads)
         for i, (m, name) in enumerate(zip(meshes, _names(meshes, ".wavg")))
@@ -225,7 +234,7 @@ def transfer_all(
     *,
     size: int | tuple[int, int] | None = None,
     embeddings: Any = None,
-    landmarks: int = 1000,
+    landmarks: int | None = None,
     overwrite: bool = False,
     threads: int | None = None,
     progress: Progress | None = None,
@@ -237,11 +246,11 @@ def transfer_all(
     ``(mesh_path, anchors_path)`` pairs (or ``(mesh, anchors, embedding)`` triples), anchor
     i of each file matching anchor i of ``template_anchors``. Embeddings not given are
     looked up in ``embeddings`` (the :class:`Manifest` of :func:`precompute_all` or its
-    folder) and otherwise precomputed with ``landmarks`` (the template's once, into
-    ``out_dir/template/``). ``size``: the output's ``W`` or ``(W, H)`` (default: the
+    folder) and otherwise taken from the embedding cache or precomputed with ``landmarks``
+    (None: the library's choice; the template's once, into ``out_dir/template/``). ``size``: the output's ``W`` or ``(W, H)`` (default: the
     texture's). Manifest figures: ``valid_fraction``, ``texels_per_s``, ``width``, ``height``.
     """
-    options = {"landmarks": int(landmarks), "seed": 0, "size": size}
+    options = {"landmarks": _landmarks(landmarks), "seed": 0, "size": size}
     return _pair_jobs(
         "transfer", template, template_anchors, targets, out_dir, executor, ".png",
         {"template_texture": template_texture}, options, embeddings, overwrite, threads, progress,
@@ -257,7 +266,7 @@ def correspond_all(
     *,
     validity: str = "local",
     embeddings: Any = None,
-    landmarks: int = 1000,
+    landmarks: int | None = None,
     overwrite: bool = False,
     threads: int | None = None,
     progress: Progress | None = None,
@@ -269,7 +278,7 @@ def correspond_all(
     Arguments as :func:`transfer_all`'s; ``validity`` is ``wavg.correspond``'s. Manifest
     figures: ``valid_fraction``, ``vertices_per_s``.
     """
-    options = {"landmarks": int(landmarks), "seed": 0, "validity": validity}
+    options = {"landmarks": _landmarks(landmarks), "seed": 0, "validity": validity}
     return _pair_jobs(
         "correspond", template, template_anchors, targets, out_dir, executor, ".npz",
         {}, options, embeddings, overwrite, threads, progress,

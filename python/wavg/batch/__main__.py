@@ -104,7 +104,7 @@ def _parser() -> argparse.ArgumentParser:
         where.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler to run on (tcp://host:8786)")
         where.add_argument("--local", type=int, metavar="N", help="Run on a local Dask cluster of N worker processes")
         s.add_argument("--threads", type=int, help="Threads per job (default: 1 on Dask, all cores in-process)")
-        s.add_argument("--landmarks", type=int, default=1000, help="Landmarks of embeddings precomputed here (default 1000)")
+        s.add_argument("--landmarks", type=int, default=None, help="Landmarks of embeddings precomputed here (default: the library's choice)")
         s.add_argument("--overwrite", action="store_true", help="Redo outputs that are up to date")
 
     pre = sub.add_parser("precompute", help="Precompute the embedding of every mesh (NAME.wavg)")

@@ -118,68 +118,42 @@ def _threads_kw(fn: Callable[..., Any], threads: int | None) -> dict[str, Any]:
 
 
 def open_surface(mesh: str, embedding: str | None, options: Mapping[str, Any], threads: int | None) -> Any:
-    """The surface of ``mesh`` with ``embedding`` loaded, or precomputed in memory."""
+    """The surface of ``mesh`` with ``embedding`` loaded, else its embedding from the
+    embedding cache every way into wavg shares, else precomputed (and stored there)."""
     import wavg
 
     if embedding is not None:
         return wavg.Surface.open(mesh, embedding=embedding)
     s = wavg.Surface.open(mesh)
-    s.precompute(
-        landmarks=int(options["landmarks"]),
-        seed=int(options.get("seed", 0)),
-        threads=threads,
-        progress=False,
-    )
+    landmarks, seed = _landmarks(options), int(options.get("seed", 0))
+    if not s.load_cached(landmarks=landmarks, seed=seed):
+        s.precompute(landmarks=landmarks, seed=seed, threads=threads, progress=False)
     return s
 
 
 def read_anchors(path: str | os.PathLike[str], surface: Any) -> Any:
-    """An anchors file (``v VERTEX`` or ``f FACE B0 B1 B2`` per line, ``#`` comments) as
-    the Solver takes it: vertex ids ``(k,)`` when every line is a vertex, else
-    ``(faces (k,), bary (k, 3))``."""
-    faces: list[int] = []
-    bary: list[list[float]] = []
-    vertex_rows: list[tuple[int, int]] = []  # (row, vertex id)
-    with open(path, encoding="utf-8") as f:
-        for lineno, line in enumerate(f, 1):
-            parts = line.split("#", 1)[0].split()
-            if not parts:
-                continue
-            try:
-                if parts[0] == "v" and len(parts) == 2:
-                    vertex_rows.append((len(faces), int(parts[1])))
-                    faces.append(-1)
-                    bary.append([0.0, 0.0, 0.0])
-                    continue
-                if parts[0] == "f" and len(parts) == 5:
-                    faces.append(int(parts[1]))
-                    bary.append([float(x) for x in parts[2:]])
-                    continue
-            except ValueError:
-                pass
-            raise ValueError(f"{path}:{lineno}: expected 'v VERTEX' or 'f FACE B0 B1 B2', got {line.strip()!r}")
-    if not faces:
-        raise ValueError(f"{path}: no anchors")
-    if len(vertex_rows) == len(faces):
-        return np.array([v for _, v in vertex_rows], dtype=np.int64)
-    f_arr = np.array(faces, dtype=np.int64)
-    b_arr = np.array(bary, dtype=np.float64)
-    if vertex_rows:
-        vf, vb = surface.vertex_points(np.array([v for _, v in vertex_rows], dtype=np.int64))
-        rows = [r for r, _ in vertex_rows]
-        f_arr[rows] = np.asarray(vf)
-        b_arr[rows] = np.asarray(vb)
-    return f_arr, b_arr
+    """An anchors file as the Solver takes it (:func:`wavg.read_anchors`: vertex ids
+    ``(k,)`` when every line is a vertex, else ``(faces (k,), bary (k, 3))``)."""
+    import wavg
+
+    return wavg.read_anchors(path, surface)
+
+
+def _landmarks(options: Mapping[str, Any]) -> int | None:
+    """The ``landmarks`` option: None (or absent) for the library's choice."""
+    value = options.get("landmarks")
+    return None if value is None else int(value)
 
 
 def precompute(job: Job) -> dict[str, Any]:
-    """Precomputes the embedding of ``job.files["mesh"]`` and writes the ``.wavg`` file."""
+    """Precomputes the embedding of ``job.files["mesh"]`` (or takes it from the embedding
+    cache, where the precomputation also stores it) and writes the ``.wavg`` file."""
     import wavg
 
     o = job.options
     s = wavg.Surface.open(job.files["mesh"])
     t0 = time.perf_counter()
-    s.precompute(landmarks=int(o["landmarks"]), seed=int(o.get("seed", 0)), threads=job.threads, progress=False)
+    s.precompute(landmarks=_landmarks(o), seed=int(o.get("seed", 0)), threads=job.threads, progress=False)
     seconds = time.perf_counter() - t0
     tmp = store.temporary_path(job.output)
     try:
