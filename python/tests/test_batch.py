@@ -237,3 +237,36 @@ def test_outputs_have_ordinary_permissions(tmp_path: Path) -> None:
     old = os.umask(0o022)
     os.umask(old)
     assert out.stat().st_mode & 0o777 == 0o666 & ~old
+
+
+@pytest.fixture()
+def wavg_bin(cli: str) -> str:
+    """The `wavg` command line (the conftest's `cli`; this module's `cli` is wavg.batch's)."""
+    return cli
+
+
+def test_precompute_goes_through_the_shared_cache(tmp_path: Path, assets: dict, wavg_bin: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    import subprocess
+
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("WAVG_CACHE_DIR", str(cache))
+    meshes = [m for m in assets["meshes"] if m != assets["invalid"]][:2]
+    m = wb.precompute_all(meshes, tmp_path / "out", landmarks=LANDMARKS)
+    assert m.ok
+    # `wavg cache list` shows the entries the batch wrote.
+    listed = json.loads(subprocess.run([wavg_bin, "cache", "list", "--json"], check=True, capture_output=True, text=True).stdout)
+    assert [e["writer"] for e in listed["entries"]] == ["python", "python"]
+    assert [e["landmarks"] for e in listed["entries"]] == [LANDMARKS, LANDMARKS]
+    # Each output is the cache entry's embedding, found under the shared key.
+    for mesh, job in zip(meshes, m):
+        s = wavg.Surface.open(mesh)
+        assert s.load_cached(landmarks=LANDMARKS)
+        out = wavg.Surface.open(mesh, embedding=job["output"])
+        assert np.array_equal(s.embedding, out.embedding)
+    # Without `landmarks`, the library's choice: the key of `precompute()` without options.
+    d = wb.precompute_all(meshes[:1], tmp_path / "default")
+    assert d.ok and d.options["landmarks"] is None
+    s = wavg.Surface.open(meshes[0])
+    assert s.load_cached()
+    assert np.array_equal(s.embedding, wavg.Surface.open(meshes[0], embedding=d.jobs[0]["output"]).embedding)
+    assert len(wavg.cache_entries()) == 3
