@@ -17,9 +17,9 @@ from conftest import torus, write_obj
 
 @pytest.fixture(scope="module")
 def mesh(tmp_path_factory):
-    """A 2304-vertex torus as OBJ: more vertices than the default 1000 landmarks, so the
+    """A 1152-vertex torus as OBJ: more vertices than the default 1000 landmarks, so the
     library's choice of landmarks matters."""
-    V, F = torus(n=64, m=36)
+    V, F = torus(n=48, m=24)
     path = tmp_path_factory.mktemp("doors") / "m.obj"
     write_obj(path, V, F)
     assert len(V) > 1000
