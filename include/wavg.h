@@ -116,8 +116,9 @@ typedef struct wavg_point {
 typedef struct wavg_precompute_options {
   // `sizeof(wavg_precompute_options)` of the caller's header (set by the default).
   size_t struct_size;
-  // Number of landmark vertices (at least 4; default 1000). A mesh with fewer vertices
-  // uses all of them.
+  // Number of landmark vertices (default 1000, the paper's): 0 lets the library choose
+  // for the mesh, as every front end does without explicit options; otherwise at least
+  // 4. A mesh with fewer vertices uses all of them.
   size_t landmarks;
   // Seed of the random choices (the quality-check pairs); every other stage is
   // deterministic. Default 0.
@@ -281,8 +282,8 @@ enum wavg_status wavg_decal_uv(const struct wavg_solver *solver,
                                double *out_uv,
                                enum wavg_status *out_statuses);
 
-// The default precomputation settings (the paper's: 1000 landmarks), with `struct_size`
-// set. Thread-safe; cannot fail.
+// The default precomputation settings (the paper's 1000 landmarks, the same as every
+// other front end's default), with `struct_size` set. Thread-safe; cannot fail.
 struct wavg_precompute_options wavg_precompute_options_default(void);
 
 // Makes a remesher for a base mesh of `n_base` vertices (`base_xyz`: `3 * n_base`

@@ -12,6 +12,7 @@
 mod anchors;
 mod apps;
 mod args;
+mod arrays;
 mod cache;
 mod errors;
 mod image;
@@ -42,7 +43,7 @@ fn read_mesh<'py>(
     let mesh = py
         .detach_run(|| wavg::mesh::io::load(&path))
         .map_err(errors::lib(py))?;
-    surface::mesh_arrays(py, &mesh)
+    arrays::mesh_arrays(py, &mesh)
 }
 
 /// The module.
