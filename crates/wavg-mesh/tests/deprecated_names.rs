@@ -19,13 +19,16 @@ fn old_names_are_the_new_types() {
     let k: ProblemKind = p.kind();
     assert_eq!(k, DefectKind::DuplicateFace);
     assert_eq!(ProblemKind::DuplicateFace.describe(), "duplicate faces");
+    // A repeated face also makes its edges non-manifold: the summary lists those too.
     let s: Vec<ProblemSummary> = a.report.summary();
-    assert_eq!(
-        (s.len(), s[0].kind, s[0].count),
-        (1, DefectKind::DuplicateFace, 1)
-    );
-    let g: ProblemGroup = DefectGroup::from(&s[0]);
+    let dup = s
+        .iter()
+        .find(|x| x.kind == DefectKind::DuplicateFace)
+        .expect("the duplicate face is summarised");
+    assert_eq!(dup.count, 1);
+    let g: ProblemGroup = DefectGroup::from(dup);
     assert_eq!(g.remedy, Some("drop duplicate faces"));
     let info = MeshInfo::new(&m, None, &a);
-    assert_eq!(info.problem_summary, vec![g]);
+    assert_eq!(info.problem_summary.len(), s.len());
+    assert!(info.problem_summary.contains(&g));
 }
