@@ -20,6 +20,28 @@ pub enum SplineKind {
     Bezier,
 }
 
+impl SplineKind {
+    /// The curve the front ends' options name: a Bézier curve when `bezier` is set (then
+    /// `degree` and `closed` are ignored), else a B-spline of `degree`, periodic when
+    /// `closed`.
+    ///
+    /// ```
+    /// use wavg_apps::SplineKind;
+    /// assert_eq!(SplineKind::from_options(3, true, true), SplineKind::Bezier);
+    /// assert_eq!(
+    ///     SplineKind::from_options(2, true, false),
+    ///     SplineKind::BSpline { degree: 2, closed: true }
+    /// );
+    /// ```
+    pub fn from_options(degree: usize, closed: bool, bezier: bool) -> Self {
+        if bezier {
+            Self::Bezier
+        } else {
+            Self::BSpline { degree, closed }
+        }
+    }
+}
+
 /// `samples` rows of `n_controls` weights along the curve: uniform in the parameter, the
 /// first and last samples at the ends of an open curve, a closed curve's samples covering
 /// the loop once (the last sample is not the first again).

@@ -61,26 +61,8 @@ impl From<wavg::Error> for CliError {
     }
 }
 
-/// Library errors of the layers and applications convert through [`wavg::Error`].
-macro_rules! via_facade {
-    ($($t:ty),*) => {$(
-        impl From<$t> for CliError {
-            fn from(e: $t) -> Self {
-                wavg::Error::from(e).into()
-            }
-        }
-    )*};
-}
-
-via_facade!(
-    wavg::MeshError,
-    wavg::EmbedError,
-    wavg::SolveError,
-    wavg::project::ProjectError,
-    wavg::apps::AppError,
-    wavg::apps::RemeshError,
-    wavg::npy::NpyError
-);
+// Layer and application errors convert through `wavg::Error`.
+wavg::from_layer_errors!(CliError);
 
 impl CliError {
     /// The same exit status with another message (one that says more than the library's).

@@ -94,14 +94,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             args.degree
         )));
     }
-    let kind = if args.bezier {
-        SplineKind::Bezier
-    } else {
-        SplineKind::BSpline {
-            degree: args.degree,
-            closed: args.closed,
-        }
-    };
+    let kind = SplineKind::from_options(args.degree, args.closed, args.bezier);
     let solver = crate::apps_common::solver_for(
         &args.mesh,
         args.embedding.as_deref(),

@@ -41,14 +41,7 @@ pub unsafe extern "C" fn wavg_spline(
         }
         // SAFETY: per this function's contract.
         let s = unsafe { handle(solver, "solver")? };
-        let kind = if bezier {
-            SplineKind::Bezier
-        } else {
-            SplineKind::BSpline {
-                degree: degree as usize,
-                closed,
-            }
-        };
+        let kind = SplineKind::from_options(degree as usize, closed, bezier);
         // Check the curve before touching any output.
         wavg::apps::spline_weights(kind, s.inner().n_anchors(), 1)
             .map_err(|e| Failure::from(wavg::Error::from(e)))?;

@@ -49,24 +49,8 @@ impl From<wavg::Error> for Failure {
     }
 }
 
-/// Errors of the layers and applications convert through [`wavg::Error`].
-macro_rules! via_facade {
-    ($($t:ty),*) => {$(
-        impl From<$t> for Failure {
-            fn from(e: $t) -> Self {
-                wavg::Error::from(e).into()
-            }
-        }
-    )*};
-}
-
-via_facade!(
-    wavg::MeshError,
-    wavg::EmbedError,
-    wavg::SolveError,
-    wavg::apps::AppError,
-    wavg::apps::RemeshError
-);
+// Layer and application errors convert through `wavg::Error`.
+wavg::from_layer_errors!(Failure);
 
 pub(crate) type Outcome = Result<(), Failure>;
 

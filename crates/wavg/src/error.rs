@@ -225,3 +225,43 @@ fn remesh_kind(e: &RemeshError) -> ErrorKind {
 
 /// `Result` with the facade's [`Error`].
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Implements `From<E>` for a front end's error type, through [`Error`], for every layer and
+/// application error that [`Error`] wraps, so each front end converts with `?` and the
+/// list of wrapped errors is kept here only. The front end's type must implement
+/// `From<wavg::Error>` (its mapping of [`ErrorKind`] to exit codes, statuses or exceptions).
+///
+/// ```
+/// struct Failure(wavg::ErrorKind);
+/// impl From<wavg::Error> for Failure {
+///     fn from(e: wavg::Error) -> Self {
+///         Failure(e.kind())
+///     }
+/// }
+/// wavg::from_layer_errors!(Failure);
+///
+/// let Failure(kind) = wavg::MeshError::Repair("no faces left".into()).into();
+/// assert_eq!(kind, wavg::ErrorKind::InvalidMesh);
+/// ```
+#[macro_export]
+macro_rules! from_layer_errors {
+    ($target:ty) => {
+        $crate::from_layer_errors!(
+            @each $target;
+            $crate::MeshError,
+            $crate::EmbedError,
+            $crate::project::ProjectError,
+            $crate::SolveError,
+            $crate::apps::AppError,
+            $crate::apps::RemeshError,
+            $crate::npy::NpyError
+        );
+    };
+    (@each $target:ty; $($t:ty),*) => {$(
+        impl ::core::convert::From<$t> for $target {
+            fn from(e: $t) -> Self {
+                $crate::Error::from(e).into()
+            }
+        }
+    )*};
+}
