@@ -86,18 +86,44 @@ static inline void make_torus(size_t nu, size_t nv, double r, double **xyz, size
   }
 }
 
+/* A `nu` x `nv` torus (radii 1 and 0.35) as a surface; its arrays are returned for the
+ * caller to free. */
+static inline wavg_surface *torus_surface(size_t nu, size_t nv, double **xyz, size_t *n_vertices,
+                                          uint32_t **tris, size_t *n_triangles) {
+  make_torus(nu, nv, 0.35, xyz, n_vertices, tris, n_triangles);
+  wavg_surface *s = NULL;
+  CHECK_OK(wavg_surface_from_arrays(*xyz, *n_vertices, *tris, *n_triangles, &s));
+  return s;
+}
+
+/* A small precomputation for tests: `landmarks` landmarks, no quality check. */
+static inline void precompute_quick(wavg_surface *s, size_t landmarks) {
+  wavg_precompute_options opts = wavg_precompute_options_default();
+  opts.landmarks = landmarks;
+  opts.quality_pairs = 0;
+  CHECK_OK(wavg_surface_precompute(s, &opts, NULL, NULL));
+}
+
 /* The 48 x 16 test torus as a surface with a small precomputed embedding (60 landmarks,
  * no quality check); its arrays are returned for the caller to free. */
 static inline wavg_surface *precomputed_torus(double **xyz, size_t *n_vertices, uint32_t **tris,
                                               size_t *n_triangles) {
-  make_torus(48, 16, 0.35, xyz, n_vertices, tris, n_triangles);
-  wavg_surface *s = NULL;
-  CHECK_OK(wavg_surface_from_arrays(*xyz, *n_vertices, *tris, *n_triangles, &s));
-  wavg_precompute_options opts = wavg_precompute_options_default();
-  opts.landmarks = 60;
-  opts.quality_pairs = 0;
-  CHECK_OK(wavg_surface_precompute(s, &opts, NULL, NULL));
+  wavg_surface *s = torus_surface(48, 16, xyz, n_vertices, tris, n_triangles);
+  precompute_quick(s, 60);
   return s;
+}
+
+/* `n` anchors at vertices 0, `step`, 2 `step`, ... of `s`. */
+static inline void vertex_anchors(wavg_surface *s, size_t n, uint32_t step, wavg_point *anchors) {
+  for (size_t a = 0; a < n; a++) CHECK_OK(wavg_surface_vertex_point(s, (uint32_t)a * step, &anchors[a]));
+}
+
+/* A solver over the `n` anchors and one over all but the last (a solver of another anchor
+ * count, for the argument checks of two-solver entries). */
+static inline void solver_and_fewer(wavg_surface *s, const wavg_point *anchors, size_t n,
+                                    wavg_solver **solver, wavg_solver **fewer) {
+  CHECK_OK(wavg_solver_new(s, anchors, n, solver));
+  CHECK_OK(wavg_solver_new(s, anchors, n - 1, fewer));
 }
 
 /* The 3-D position of a surface point from the mesh arrays. */

@@ -20,9 +20,7 @@ int main(void) {
   double *xyz;
   uint32_t *tris;
   size_t nv, nt;
-  make_torus(48, 16, 0.35, &xyz, &nv, &tris, &nt);
-  wavg_surface *s = NULL;
-  CHECK_OK(wavg_surface_from_arrays(xyz, nv, tris, nt, &s));
+  wavg_surface *s = torus_surface(48, 16, &xyz, &nv, &tris, &nt);
   CHECK(wavg_surface_vertex_count(s) == nv);
   CHECK(wavg_surface_face_count(s) == nt);
 

@@ -23,10 +23,7 @@ int main(void) {
   }
   wavg_surface *s = NULL;
   CHECK_OK(wavg_surface_from_arrays(xyz, nv, tris, nt, &s));
-  wavg_precompute_options opts = wavg_precompute_options_default();
-  opts.landmarks = 60;
-  opts.quality_pairs = 0;
-  CHECK_OK(wavg_surface_precompute(s, &opts, NULL, NULL));
+  precompute_quick(s, 60);
 
   wavg_remesher *r = NULL;
   CHECK_OK(wavg_remesher_new(s, bxyz, NB, sizes, NB, quads, 0.0, &r));

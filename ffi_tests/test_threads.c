@@ -38,16 +38,10 @@ int main(void) {
   double *xyz;
   uint32_t *tris;
   size_t nv, nt;
-  make_torus(64, 24, 0.35, &xyz, &nv, &tris, &nt);
-  wavg_surface *s = NULL;
-  CHECK_OK(wavg_surface_from_arrays(xyz, nv, tris, nt, &s));
-  wavg_precompute_options o = wavg_precompute_options_default();
-  o.landmarks = 100;
-  o.quality_pairs = 0;
-  CHECK_OK(wavg_surface_precompute(s, &o, NULL, NULL));
+  wavg_surface *s = torus_surface(64, 24, &xyz, &nv, &tris, &nt);
+  precompute_quick(s, 100);
   wavg_point anchors[NA];
-  for (int i = 0; i < NA; i++)
-    CHECK_OK(wavg_surface_vertex_point(s, (uint32_t)(i * 97), &anchors[i]));
+  vertex_anchors(s, NA, 97, anchors);
   wavg_solver *sv = NULL;
   CHECK_OK(wavg_solver_new(s, anchors, NA, &sv));
   solver = sv;

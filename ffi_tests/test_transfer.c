@@ -10,10 +10,9 @@ int main(void) {
   size_t nv, nt;
   wavg_surface *s = precomputed_torus(&xyz, &nv, &tris, &nt);
   wavg_point anchors[NA];
-  for (int a = 0; a < NA; a++) CHECK_OK(wavg_surface_vertex_point(s, (uint32_t)(a * 61), &anchors[a]));
+  vertex_anchors(s, NA, 61, anchors);
   wavg_solver *solver = NULL, *fewer = NULL;
-  CHECK_OK(wavg_solver_new(s, anchors, NA, &solver));
-  CHECK_OK(wavg_solver_new(s, anchors, NA - 1, &fewer));
+  solver_and_fewer(s, anchors, NA, &solver, &fewer);
 
   /* An atlas of separate triangles: face f in cell f of a k x k grid. */
   size_t k = 1;
