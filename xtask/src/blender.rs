@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::sandbox::{self, Sandbox};
+use crate::system::{apt, installed, is_root, runs};
 use crate::{python, steps};
 
 /// The add-on's folder in the repository.
@@ -201,22 +202,6 @@ fn run_tests(root: &Path, sandbox: &Sandbox, zip: &Path) -> Result<(), String> {
     sandbox.run(root, "xvfb-run", &ui, &[])
 }
 
-fn runs(program: &str, args: &[&str]) -> bool {
-    Command::new(program)
-        .args(args)
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
-
-fn installed(package: &str) -> bool {
-    Command::new("dpkg-query")
-        .args(["-W", "-f=${Status}", package])
-        .output()
-        .is_ok_and(|o| {
-            o.status.success() && String::from_utf8_lossy(&o.stdout).ends_with(" installed")
-        })
-}
-
 /// The running Blender's `major.minor` (from `blender --version`, started in `sandbox`),
 /// or `None` when it does not start.
 fn blender_version(sandbox: &Sandbox) -> Option<String> {
@@ -242,17 +227,7 @@ fn blender_version(sandbox: &Sandbox) -> Option<String> {
 /// here.
 fn ensure_packages(sandbox: &Sandbox) -> Result<Option<String>, String> {
     let missing: Vec<&str> = PACKAGES.iter().copied().filter(|p| !installed(p)).collect();
-    let root_user = Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
-    let apt = |args: &[&str]| {
-        Command::new("apt-get")
-            .args(args)
-            .env("DEBIAN_FRONTEND", "noninteractive")
-            .status()
-            .is_ok_and(|s| s.success())
-    };
+    let root_user = is_root();
     if !missing.is_empty() && root_user && apt(&["--version"]) {
         let list = missing.join(" ");
         eprintln!("==> installing {list} with apt-get");

@@ -3,7 +3,8 @@
 //! then configures, builds and runs `ctest` on the root `CMakeLists.txt`.
 
 use std::path::Path;
-use std::process::Command;
+
+use crate::system::{apt, installed, is_root, runs};
 
 /// A system requirement: how to tell it is present and the Debian package providing it.
 struct Requirement {
@@ -35,34 +36,11 @@ const REQUIREMENTS: &[Requirement] = &[
     },
 ];
 
-fn runs(program: &str, args: &[&str]) -> bool {
-    Command::new(program)
-        .args(args)
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
-
 fn present(r: &Requirement) -> bool {
     match r.program {
         Some(p) => runs(p, &["--version"]),
-        None => {
-            // `dpkg -s` succeeds for installed and for removed-but-configured packages;
-            // check the status line says "install ok installed".
-            Command::new("dpkg-query")
-                .args(["-W", "-f=${Status}", r.package])
-                .output()
-                .is_ok_and(|o| {
-                    o.status.success() && String::from_utf8_lossy(&o.stdout).ends_with(" installed")
-                })
-        }
+        None => installed(r.package),
     }
-}
-
-fn is_root() -> bool {
-    Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
 }
 
 /// Installs the missing packages when possible; otherwise says exactly what to install.
@@ -84,13 +62,6 @@ pub fn ensure_packages() -> Result<(), String> {
         ));
     }
     eprintln!("==> installing {list} with apt-get");
-    let apt = |args: &[&str]| {
-        Command::new("apt-get")
-            .args(args)
-            .env("DEBIAN_FRONTEND", "noninteractive")
-            .status()
-            .is_ok_and(|s| s.success())
-    };
     let mut install = vec!["install", "-y", "--no-install-recommends"];
     install.extend(&missing);
     // A fresh machine may have no package lists yet: update once and retry.

@@ -17,6 +17,7 @@ mod python;
 mod sancov;
 mod sandbox;
 mod steps;
+mod system;
 mod web;
 
 use std::path::{Path, PathBuf};

@@ -42,25 +42,25 @@ pub fn ensure_venv(root: &Path) -> Result<PathBuf, String> {
         .map_err(|e| format!("cannot read {REQUIREMENTS}: {e}"))?;
     let stamp = dir.join("wavg-requirements.txt");
     if std::fs::read_to_string(&stamp).ok().as_deref() != Some(wanted.as_str()) {
-        let py_s = py.to_string_lossy();
-        steps::command_env(
-            root,
-            &py_s,
-            &[
-                "-m",
-                "pip",
-                "install",
-                "--quiet",
-                "--disable-pip-version-check",
-                "-r",
-                REQUIREMENTS,
-            ],
-            &[("PIP_FIND_LINKS", "")],
-        )?;
+        pip_install(root, &py, &["-r", REQUIREMENTS], &[("PIP_FIND_LINKS", "")])?;
         std::fs::write(&stamp, wanted)
             .map_err(|e| format!("cannot write {}: {e}", stamp.display()))?;
     }
     Ok(py)
+}
+
+/// `python -m pip install --quiet ARGS` with the environment's `py`, in `root`, with `env`.
+fn pip_install(root: &Path, py: &Path, args: &[&str], env: &[(&str, &str)]) -> Result<(), String> {
+    let py_s = py.to_string_lossy();
+    let mut all = vec![
+        "-m",
+        "pip",
+        "install",
+        "--quiet",
+        "--disable-pip-version-check",
+    ];
+    all.extend(args);
+    steps::command_env(root, &py_s, &all, env)
 }
 
 /// Builds the `wavg` wheel (abi3, CPython >= 3.10) with the environment's maturin from
@@ -123,19 +123,10 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     let py_s = py.to_string_lossy();
     let target = steps::target_dir(root);
     let target = target.to_string_lossy();
-    steps::command_env(
+    pip_install(
         root,
-        &py_s,
-        &[
-            "-m",
-            "pip",
-            "install",
-            "--quiet",
-            "--disable-pip-version-check",
-            "--force-reinstall",
-            "--no-deps",
-            INSTALL,
-        ],
+        &py,
+        &["--force-reinstall", "--no-deps", INSTALL],
         &[
             ("MATURIN_PEP517_ARGS", "--profile dev"),
             ("CARGO_TARGET_DIR", &target),

@@ -5,7 +5,6 @@
 //! Playwright) on Debian's chromium.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use crate::sandbox::Sandbox;
 use crate::{python, steps};
@@ -125,23 +124,13 @@ fn extra_files(dir: &Path) -> Result<Vec<PathBuf>, String> {
 /// one; whatever chromium keeps in the home goes to the sandbox's).
 pub fn browser_tests(root: &Path, data_dir: &Path) -> Result<(), String> {
     if !Path::new(CHROMIUM).exists() {
-        let root_user = Command::new("id")
-            .arg("-u")
-            .output()
-            .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
-        if !root_user {
+        if !crate::system::is_root() {
             eprintln!(
                 "    SKIPPED browser tests: {CHROMIUM} not installed (apt-get install chromium)"
             );
             return Ok(());
         }
-        let apt = |args: &[&str]| {
-            Command::new("apt-get")
-                .args(args)
-                .env("DEBIAN_FRONTEND", "noninteractive")
-                .status()
-                .is_ok_and(|s| s.success())
-        };
+        use crate::system::apt;
         let install = ["install", "-y", "--no-install-recommends", "chromium"];
         if !(apt(&install) || (apt(&["update"]) && apt(&install))) {
             return Err("apt-get could not install chromium".into());
