@@ -191,15 +191,20 @@ fn every_bad_file_is_diagnosed_and_repairable_ones_are_repaired() {
     }
 }
 
+/// The data set's file `relative`, loaded; `None` (the test is skipped) without the data
+/// folder.
+fn load_data_file(test: &str, relative: &str) -> Option<wavg_mesh::TriMesh> {
+    data::require_data_file(test, relative).map(|p| io::load(&p).unwrap())
+}
+
 #[test]
 fn welding_the_soup_closes_the_cube() {
-    let Some(p) = data::require_data_file(
+    let Some(m) = load_data_file(
         "welding_the_soup_closes_the_cube",
         "bad/synthetic/duplicate_vertices_soup.obj",
     ) else {
         return;
     };
-    let m = io::load(&p).unwrap();
     let r = repair::weld_vertices(&m, 0.0);
     assert_eq!(r.mesh.n_vertices(), 8);
     let v = ValidMesh::new(r.mesh).unwrap();
@@ -210,13 +215,12 @@ fn welding_the_soup_closes_the_cube() {
 
 #[test]
 fn large_dirty_dragon_is_diagnosed_and_repaired() {
-    let Some(p) = data::require_data_file(
+    let Some(m) = load_data_file(
         "large_dirty_dragon_is_diagnosed_and_repaired",
         "bad/dragon_vrip.off.gz",
     ) else {
         return;
     };
-    let m = io::load(&p).unwrap();
     let a = analyze(&m);
     assert_eq!(a.stats.components, 151);
     assert_eq!(a.stats.genus, Some(46));
