@@ -54,12 +54,8 @@ pub struct Args {
     /// Seed of the first (fps) or of every (random) anchor.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// A .wavg embedding of the mesh (default: the embedding cache's, computed on first
-    /// use).
-    #[arg(long)]
-    pub embedding: Option<PathBuf>,
     #[command(flatten)]
-    pub cache: crate::cache::CacheArg,
+    pub embedding: crate::embedding_arg::EmbeddingArg,
     /// Output anchors file (`-` for standard output).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
@@ -89,7 +85,7 @@ struct JsonAnchor {
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
-        &crate::common::inputs([std::path::Path::new(&*args.mesh)], [&args.embedding]),
+        &crate::common::inputs([std::path::Path::new(&*args.mesh)], [&args.embedding.file]),
         &[("-o", &args.output)],
         args.json,
     )?;
@@ -180,9 +176,9 @@ pub fn warn_if_low(fraction: f64, what: &str, anchors: usize, mesh: &str) -> boo
 
 /// The embedding's coordinates: `--embedding`'s file or the cache's.
 fn embedded_coords(mesh: &std::sync::Arc<ValidMesh>, args: &Args) -> Result<Vec<Vec8>, CliError> {
-    let e = match &args.embedding {
+    let e = match &args.embedding.file {
         Some(p) => wavg::embed::file::load(p, mesh)?,
-        None => crate::cache::embedding(mesh, &args.mesh, args.cache.no_cache)?,
+        None => crate::cache::embedding(mesh, &args.mesh, args.embedding.cache.no_cache)?,
     };
     Ok(e.coords.iter().map(|c| Vec8::from(*c)).collect())
 }

@@ -25,11 +25,8 @@ builtin:genus2 (51k vertices, genus 2) is the mesh of the spline figures in BENC
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
-    /// A .wavg embedding of the mesh (default: the embedding cache's).
-    #[arg(long)]
-    pub embedding: Option<std::path::PathBuf>,
     #[command(flatten)]
-    pub cache: crate::cache::CacheArg,
+    pub embedding: crate::embedding_arg::EmbeddingArg,
     /// Control points, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub control: std::path::PathBuf,
@@ -72,12 +69,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         degree: args.degree,
         closed: args.closed,
     };
-    let solver = crate::apps_common::solver_for(
-        &args.mesh,
-        args.embedding.as_deref(),
-        &args.control,
-        args.cache,
-    )?;
+    let solver = args.embedding.solver(&args.mesh, &args.control)?;
     let threads = args.threads.unwrap_or_else(rayon::current_num_threads);
     let opts = SplineBenchOptions {
         kind,

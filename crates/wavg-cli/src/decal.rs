@@ -37,12 +37,8 @@ and anchors.")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
-    /// A .wavg embedding of the mesh (default: the embedding cache's, computed on first
-    /// use).
-    #[arg(long)]
-    pub embedding: Option<PathBuf>,
     #[command(flatten)]
-    pub cache: crate::cache::CacheArg,
+    pub embedding: crate::embedding_arg::EmbeddingArg,
     /// Anchors, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub anchors: PathBuf,
@@ -93,7 +89,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
         &crate::common::inputs(
             [std::path::Path::new(&*args.mesh), &args.anchors, &args.uv],
-            [&args.embedding, &args.texture],
+            [&args.embedding.file, &args.texture],
         ),
         &outputs,
         args.json,
@@ -135,7 +131,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
             anchors.len()
         )));
     }
-    let surface = embed(mesh, args.embedding.as_deref(), &args.mesh, args.cache)?;
+    let surface = embed(
+        mesh,
+        args.embedding.file.as_deref(),
+        &args.mesh,
+        args.embedding.cache,
+    )?;
     let solver = surface.solver(anchors)?;
     let t = Instant::now();
     let decal = decal_vertices(&solver, &uv, args.max_negative)?;

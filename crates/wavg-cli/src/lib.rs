@@ -22,6 +22,7 @@ mod decal_material;
 mod demo;
 mod demo_apps;
 mod demo_pictures;
+mod embedding_arg;
 mod error;
 mod forward;
 mod help_examples;

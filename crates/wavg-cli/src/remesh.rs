@@ -48,12 +48,8 @@ pub struct Args {
     /// The coarse base mesh (OBJ with polygons).
     #[arg(long)]
     pub base: PathBuf,
-    /// A .wavg embedding of the mesh (default: the embedding cache's, computed on first
-    /// use).
-    #[arg(long)]
-    pub embedding: Option<PathBuf>,
     #[command(flatten)]
-    pub cache: crate::cache::CacheArg,
+    pub embedding: crate::embedding_arg::EmbeddingArg,
     /// Levels of splitting (each multiplies the face count by about four).
     #[arg(long, default_value_t = 2)]
     pub levels: usize,
@@ -85,7 +81,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
         &crate::common::inputs(
             [std::path::Path::new(&*args.mesh), &args.base],
-            [&args.embedding],
+            [&args.embedding.file],
         ),
         &[("-o", &args.output)],
         args.json,
@@ -114,7 +110,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
 fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
     let t = Instant::now();
     let surface = surface_for(&args)?;
-    let precompute_seconds = args.embedding.is_none().then(|| t.elapsed().as_secs_f64());
+    let precompute_seconds = args
+        .embedding
+        .file
+        .is_none()
+        .then(|| t.elapsed().as_secs_f64());
     let mut r = Remesher::with_max_distance(surface.projector().clone(), &base, args.max_distance)
         .context(args.base.display())?;
     let t = Instant::now();
@@ -228,8 +228,8 @@ struct Drag {
 fn surface_for(args: &Args) -> Result<Surface, CliError> {
     crate::apps_common::embed(
         load_valid(&args.mesh)?,
-        args.embedding.as_deref(),
+        args.embedding.file.as_deref(),
         &args.mesh,
-        args.cache,
+        args.embedding.cache,
     )
 }

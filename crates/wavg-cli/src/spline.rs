@@ -28,12 +28,8 @@ closed, bezier.")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
-    /// A .wavg embedding of the mesh (default: the embedding cache's, computed on first
-    /// use).
-    #[arg(long)]
-    pub embedding: Option<PathBuf>,
     #[command(flatten)]
-    pub cache: crate::cache::CacheArg,
+    pub embedding: crate::embedding_arg::EmbeddingArg,
     /// Control points, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub control: PathBuf,
@@ -80,7 +76,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
         &crate::common::inputs(
             [std::path::Path::new(&*args.mesh), &args.control],
-            [&args.embedding],
+            [&args.embedding.file],
         ),
         &[("-o", &args.output)],
         args.json,
@@ -95,12 +91,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )));
     }
     let kind = SplineKind::from_options(args.degree, args.closed, args.bezier);
-    let solver = crate::apps_common::solver_for(
-        &args.mesh,
-        args.embedding.as_deref(),
-        &args.control,
-        args.cache,
-    )?;
+    let solver = args.embedding.solver(&args.mesh, &args.control)?;
     let t = Instant::now();
     let curve =
         evaluate_spline(&solver, kind, args.samples, CHUNK).context(args.control.display())?;

@@ -70,8 +70,9 @@ pub fn parse(text: &str, file: &Path, mesh: &ValidMesh) -> Result<Vec<Anchor>> {
         .collect()
 }
 
-/// A point as written in a file, as an [`Anchor`] (indices must fit in 32 bits).
-fn spec_anchor(spec: PointSpec) -> std::result::Result<Anchor, String> {
+/// A point as written in a file, as an [`Anchor`] (indices must fit in 32 bits); the error
+/// says which index is out of range.
+pub fn spec_anchor(spec: PointSpec) -> std::result::Result<Anchor, String> {
     let idx =
         |i: u64, what: &str| u32::try_from(i).map_err(|_| format!("{what} {i} is out of range"));
     Ok(match spec {

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use wavg::{Anchor, EmbeddedMesh, Projector, Solver, Vec8};
+use wavg::{EmbeddedMesh, Projector, Solver, Vec8};
 use wavg::{SurfacePoint, ValidMesh};
 
 use crate::CliError;
@@ -82,22 +82,10 @@ pub fn resolve_points(
     specs
         .iter()
         .map(|&(line, spec)| {
-            let a = spec_anchor(spec).map_err(|m| located(file, line, &m))?;
+            let a = wavg::anchors::spec_anchor(spec).map_err(|m| located(file, line, &m))?;
             wavg::resolve_anchor(mesh, &a).map_err(|e| located(file, line, &e))
         })
         .collect()
-}
-
-/// A spec as an [`Anchor`] (indices must fit in 32 bits).
-fn spec_anchor(spec: PointSpec) -> Result<Anchor, String> {
-    let idx =
-        |i: u64, what: &str| u32::try_from(i).map_err(|_| format!("{what} {i} is out of range"));
-    Ok(match spec {
-        PointSpec::Vertex(v) => Anchor::Vertex(idx(v, "vertex")?),
-        PointSpec::Face { face, bary } => {
-            Anchor::Point(SurfacePoint::new(idx(face, "face")?, bary))
-        }
-    })
 }
 
 /// Loads mesh, embedding (the file, `none` for the 3-D positions, or by default the
