@@ -58,6 +58,19 @@ fn get(addr: &str, path: &str) -> String {
     out
 }
 
+/// Stops the server and returns everything it wrote on standard error.
+fn kill_for_stderr(child: &mut Child) -> String {
+    child.kill().unwrap();
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    err
+}
+
 #[test]
 fn serve_answers_and_becomes_ready() {
     for args in [
@@ -125,14 +138,7 @@ fn a_computed_embedding_is_cached_unless_no_cache() {
     // The next server loads the entry: ready at once, nothing precomputed.
     let (mut child, addr) = serve_cached(&["builtin:sphere-small"], &dir);
     assert!(get(&addr, "/api/status").contains("\"ready\""));
-    child.kill().unwrap();
-    let mut err = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
+    let err = kill_for_stderr(&mut child);
     child.wait().unwrap();
     assert!(!err.contains("precomputing"), "{err}");
 }
@@ -140,14 +146,7 @@ fn a_computed_embedding_is_cached_unless_no_cache() {
 #[test]
 fn other_hosts_get_a_warning_and_bad_meshes_fail() {
     let (mut child, _) = serve(&["builtin:sphere-small", "--host", "0.0.0.0"]);
-    child.kill().unwrap();
-    let mut err = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
+    let err = kill_for_stderr(&mut child);
     assert!(err.contains("warning") && err.contains("0.0.0.0"), "{err}");
     let out = Command::new(env!("CARGO_BIN_EXE_wavg"))
         .args(["serve", "no-such-mesh.obj", "--port", "0"])

@@ -70,8 +70,7 @@ fn bad_input_writes_nothing() {
     std::fs::write(&control, "v 0\nv 500\nv 1000\n").unwrap();
     let out = dir.path().join("curve.txt");
     let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
-    // Three controls are too few for a cubic.
-    let r = wavg(&[
+    let args = [
         "spline",
         "--mesh",
         "builtin:sphere-small",
@@ -79,7 +78,9 @@ fn bad_input_writes_nothing() {
         &s(&control),
         "-o",
         &s(&out),
-    ]);
+    ];
+    // Three controls are too few for a cubic.
+    let r = wavg(&args);
     assert_eq!(
         r.status.code(),
         Some(2),
@@ -89,15 +90,7 @@ fn bad_input_writes_nothing() {
     assert!(!out.exists());
     // A control point out of range names its line.
     std::fs::write(&control, "v 0\nv 1\nv 2\nv 99999\n").unwrap();
-    let r = wavg(&[
-        "spline",
-        "--mesh",
-        "builtin:sphere-small",
-        "--control",
-        &s(&control),
-        "-o",
-        &s(&out),
-    ]);
+    let r = wavg(&args);
     assert_eq!(r.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&r.stderr).contains(":4:"));
     assert!(!out.exists());
