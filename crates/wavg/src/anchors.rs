@@ -100,7 +100,7 @@ pub fn format(anchors: &[Anchor]) -> String {
     String::from_utf8(out).unwrap_or_default()
 }
 
-/// Writes an anchors file ([`format`]) atomically: a temporary file beside it, renamed
+/// Writes an anchors file ([`format()`]) atomically: a temporary file beside it, renamed
 /// into place, so a failure leaves nothing at `path`.
 pub fn write(path: impl AsRef<Path>, anchors: &[Anchor]) -> Result<()> {
     let path = path.as_ref();
