@@ -45,7 +45,7 @@ fn solver_for(
     py.detach_run(|| s.solver(a)).map_err(|e| to_py(py, e))
 }
 
-/// spline(S, control, samples=200, degree=3, closed=False, bezier=False, threads=None) -> Points
+/// spline(S, control, samples=500, degree=3, closed=False, bezier=False, threads=None) -> Points
 ///
 /// A curve on the surface through the control points ``control`` (``(k,)`` vertex ids or
 /// ``(faces (k,), bary (k, 3))``), in order: a uniform B-spline of ``degree`` (clamped,
@@ -54,8 +54,8 @@ fn solver_for(
 /// (``face (samples,)``, ``bary``, ``xyz (samples, 3)``, ``ok``).
 #[pyfunction]
 #[pyo3(
-    signature = (S, control, samples=Int::of(200), degree=Int::of(3), closed=false, bezier=false, threads=None),
-    text_signature = "(S, control, samples=200, degree=3, closed=False, bezier=False, threads=None)"
+    signature = (S, control, samples=Int::of(wavg::apps::DEFAULT_SPLINE_SAMPLES as i128), degree=Int::of(wavg::apps::DEFAULT_SPLINE_DEGREE as i128), closed=false, bezier=false, threads=None),
+    text_signature = "(S, control, samples=500, degree=3, closed=False, bezier=False, threads=None)"
 )]
 #[allow(non_snake_case, clippy::too_many_arguments)]
 fn spline<'py>(
@@ -81,7 +81,11 @@ fn spline<'py>(
     };
     let par = par(threads)?;
     let curve = py
-        .detach_run(|| par.install(|| evaluate_spline(&solver, kind, samples as usize, 256)))
+        .detach_run(|| {
+            par.install(|| {
+                evaluate_spline(&solver, kind, samples as usize, wavg::apps::SPLINE_CHUNK)
+            })
+        })
         .map_err(lib(py))?
         .map_err(lib(py))?;
     points_tuple(py, &curve.samples, false)
@@ -222,7 +226,7 @@ fn correspond<'py>(
 /// combination with its inverse-problem weights. ``valid`` is False where the weights do
 /// not round-trip or one is below ``max_negative`` (``uv`` is then NaN).
 #[pyfunction]
-#[pyo3(signature = (S, anchors, uv, max_negative=-0.1, threads=None))]
+#[pyo3(signature = (S, anchors, uv, max_negative=wavg::apps::DEFAULT_MAX_NEGATIVE, threads=None))]
 #[allow(non_snake_case)]
 fn decal<'py>(
     py: Python<'py>,

@@ -33,7 +33,7 @@ pub(crate) struct Remesher {
 impl Remesher {
     #[new]
     #[pyo3(
-        signature = (S, base_V, base_F, levels=Int::of(2), smooth=Int::of(3)),
+        signature = (S, base_V, base_F, levels=Int::of(wavg::apps::DEFAULT_LEVELS as i128), smooth=Int::of(wavg::apps::DEFAULT_SMOOTH_STEPS as i128)),
         text_signature = "(S, base_V, base_F, levels=2, smooth=3)"
     )]
     #[allow(non_snake_case)]

@@ -68,7 +68,7 @@ class Solver:
     @property
     def surface(self) -> Surface: ...
 
-def spline(S: Surface, control: _Anchors, samples: int = 200, degree: int = 3, closed: bool = False,
+def spline(S: Surface, control: _Anchors, samples: int = 500, degree: int = 3, closed: bool = False,
            bezier: bool = False, threads: Optional[int] = None) -> Points: ...
 def correspond(src: Surface, dst: Surface, src_anchors: _Anchors, dst_anchors: _Anchors,
                validity: str = "local", verified: bool = True, max_negative: float = -0.1,

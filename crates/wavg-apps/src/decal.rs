@@ -12,6 +12,10 @@ use wavg_solve::{SolveError, Solver};
 use crate::correspond::{paper_round_trip, vertex_points};
 use crate::metrics::{Distortion, distortion};
 
+/// Default most negative weight a decal point's weights may hold before it is marked, in
+/// every front end.
+pub const DEFAULT_MAX_NEGATIVE: f64 = -0.1;
+
 /// The coordinates of surface points.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DecalUv {

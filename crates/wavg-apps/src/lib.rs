@@ -14,10 +14,15 @@ mod spline;
 
 pub use basis::{SplineKind, spline_weights, spline_weights_flat};
 pub use remesh::{
-    BaseMesh, DEFAULT_MAX_BASE_DISTANCE, MAX_LEVELS, MAX_POLYGON, MAX_SMOOTH_STEPS, RemeshError,
-    RemeshReport, RemeshResult, Remesher, polygons_to_obj,
+    BaseMesh, DEFAULT_CAGE_VERTICES, DEFAULT_LEVELS, DEFAULT_MAX_BASE_DISTANCE,
+    DEFAULT_SMOOTH_STEPS, MAX_CAGE_VERTICES, MAX_LEVELS, MAX_POLYGON, MAX_SMOOTH_STEPS,
+    MIN_CAGE_VERTICES, RemeshError, RemeshReport, RemeshResult, Remesher, default_cage_vertices,
+    max_cage_vertices, polygons_to_obj,
 };
-pub use spline::{Curve, CurveReport, evaluate_spline};
+pub use spline::{
+    Curve, CurveReport, DEFAULT_SPLINE_DEGREE, DEFAULT_SPLINE_SAMPLES, SPLINE_CHUNK,
+    evaluate_spline,
+};
 
 mod correspond;
 mod ground_truth;
@@ -43,7 +48,7 @@ mod decal;
 mod decal_obj;
 mod morph;
 
-pub use decal::{Decal, DecalReport, DecalUv, decal_uv, decal_vertices};
+pub use decal::{DEFAULT_MAX_NEGATIVE, Decal, DecalReport, DecalUv, decal_uv, decal_vertices};
 pub use decal_obj::{DECAL_MATERIAL, PLAIN_MATERIAL, untextured_faces, write_decal_obj};
 pub use morph::{MorphReport, harmonic_fill, morph_frames};
 mod error;

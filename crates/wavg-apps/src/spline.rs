@@ -6,6 +6,17 @@ use wavg_solve::{ForwardOptions, ForwardResult, SolveError, Solver};
 
 use crate::basis::{SplineKind, spline_weights_flat};
 
+/// Default degree of a B-spline (cubic), in every front end.
+pub const DEFAULT_SPLINE_DEGREE: usize = 3;
+
+/// Default number of samples of a curve, in every front end.
+pub const DEFAULT_SPLINE_SAMPLES: usize = 500;
+
+/// Samples evaluated in sequence, warm-started, per parallel chunk of
+/// [`evaluate_spline`] as the front ends call it: long enough that warm starts pay,
+/// short enough to spread a few hundred samples over the cores.
+pub const SPLINE_CHUNK: usize = 256;
+
 /// A sampled curve on the surface.
 #[derive(Clone, Debug)]
 pub struct Curve {

@@ -31,13 +31,13 @@ pub struct Args {
     #[arg(long)]
     pub control: std::path::PathBuf,
     /// B-spline degree.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_SPLINE_DEGREE)]
     pub degree: usize,
     /// A closed (periodic) B-spline.
     #[arg(long)]
     pub closed: bool,
     /// Samples along the curve.
-    #[arg(long, default_value_t = 500, value_parser = crate::common::parse_samples)]
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_SPLINE_SAMPLES, value_parser = crate::common::parse_samples)]
     pub samples: usize,
     /// Timed runs.
     #[arg(long, default_value_t = 50, value_parser = crate::common::parse_repeat)]
@@ -75,7 +75,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         kind,
         samples: args.samples,
         repeat: args.repeat,
-        chunk: crate::spline::CHUNK,
+        chunk: wavg::apps::SPLINE_CHUNK,
         cpu_clock: Some(|| crate::common::cpu_seconds(false)),
     };
     let report = textio::with_threads(Some(threads), || spline_bench(&solver, &opts))?

@@ -74,7 +74,7 @@ pub fn validate(path_or_builtin: &str, mesh: TriMesh) -> Result<Arc<ValidMesh>, 
 
 /// A per-sample solver error as the one-line reason of a `none` output line.
 pub fn reason(e: &wavg::SolveError) -> String {
-    wavg::Error::from(e.clone()).message()
+    wavg::lines::reason(e)
 }
 
 /// With `WAVG_STEP_TIMES` set (to anything), prints `step NAME MS` on stderr, the

@@ -46,7 +46,7 @@ pub struct Args {
     #[arg(long)]
     pub uv: PathBuf,
     /// The most negative weight a vertex may have without being marked.
-    #[arg(long, default_value_t = -0.1, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_NEGATIVE, allow_negative_numbers = true)]
     pub max_negative: f64,
     /// Output OBJ file (`-` for standard output).
     #[arg(short = 'o', long = "output")]

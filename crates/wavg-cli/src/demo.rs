@@ -17,7 +17,7 @@ use wavg_bench::{RoundTripOptions, round_trip};
 use crate::CliError;
 use crate::common::load_valid;
 use crate::error::Context;
-use crate::textio::{self, write_numbers};
+use crate::textio;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -365,17 +365,7 @@ fn write_outputs(
         anchors.iter().try_for_each(|v| writeln!(w, "v {v}"))
     })?;
     textio::write_atomic(&dir.join("curve.txt"), |w: &mut dyn Write| {
-        for r in curve {
-            match r {
-                Ok(r) => {
-                    write!(w, "{} ", r.point.face)?;
-                    write_numbers(w, r.point.bary.iter().chain(r.position.iter()).copied())?;
-                }
-                Err(e) => write!(w, "none {}", crate::common::reason(e))?,
-            }
-            writeln!(w)?;
-        }
-        Ok(())
+        w.write_all(&wavg::lines::points_text(curve))
     })?;
     textio::write_atomic(&dir.join("curve.obj"), |w: &mut dyn Write| {
         let pts: Vec<_> = curve.iter().flatten().map(|r| r.position).collect();

@@ -1,7 +1,5 @@
 //! `wavg forward`: anchors + weights -> points on the surface.
 
-use std::io::Write;
-
 use std::path::PathBuf;
 
 use rayon::prelude::*;
@@ -121,16 +119,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         missing += results.iter().filter(|r| r.is_err()).count();
         sink.write(
             &results,
-            |r, out| match r {
-                Ok(r) => {
-                    let p = r.point;
-                    let _ = write!(out, "{} ", p.face);
-                    text::push_numbers(out, p.bary.into_iter().chain(r.position.iter().copied()));
-                }
-                Err(e) => {
-                    out.extend_from_slice(format!("none {}", crate::common::reason(e)).as_bytes())
-                }
-            },
+            |r, out| wavg::lines::push_point(out, r),
             |r, row| match r {
                 Ok(r) => {
                     row[0] = f64::from(r.point.face);

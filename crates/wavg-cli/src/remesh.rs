@@ -51,10 +51,10 @@ pub struct Args {
     #[command(flatten)]
     pub embedding: crate::embedding_arg::EmbeddingArg,
     /// Levels of splitting (each multiplies the face count by about four).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_LEVELS)]
     pub levels: usize,
     /// Laplacian smoothing steps after splitting.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_SMOOTH_STEPS)]
     pub smooth: usize,
     /// Largest distance of a base vertex from the surface, over the bounding-box diagonal.
     #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_BASE_DISTANCE, allow_negative_numbers = true)]

@@ -5,11 +5,11 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use wavg::apps::{CurveReport, SplineKind, evaluate_spline};
+use wavg::apps::{CurveReport, SPLINE_CHUNK, SplineKind, evaluate_spline};
 
 use crate::CliError;
 use crate::error::Context;
-use crate::textio::{self, write_numbers};
+use crate::textio;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -34,7 +34,7 @@ pub struct Args {
     #[arg(long)]
     pub control: PathBuf,
     /// B-spline degree.
-    #[arg(long, default_value_t = 3, conflicts_with = "bezier")]
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_SPLINE_DEGREE, conflicts_with = "bezier")]
     pub degree: usize,
     /// A closed (periodic) B-spline.
     #[arg(long, conflicts_with = "bezier")]
@@ -43,7 +43,7 @@ pub struct Args {
     #[arg(long)]
     pub bezier: bool,
     /// Samples along the curve.
-    #[arg(long, default_value_t = 500, value_parser = crate::common::parse_samples)]
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_SPLINE_SAMPLES, value_parser = crate::common::parse_samples)]
     pub samples: usize,
     /// Output file (`-` for standard output).
     #[arg(short = 'o', long = "output")]
@@ -68,9 +68,6 @@ struct JsonReport<'a> {
     us_per_sample: f64,
 }
 
-/// Samples evaluated in sequence, warm-started, per parallel chunk.
-pub(crate) const CHUNK: usize = 256;
-
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
@@ -93,25 +90,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let kind = SplineKind::from_options(args.degree, args.closed, args.bezier);
     let solver = args.embedding.solver(&args.mesh, &args.control)?;
     let t = Instant::now();
-    let curve =
-        evaluate_spline(&solver, kind, args.samples, CHUNK).context(args.control.display())?;
+    let curve = evaluate_spline(&solver, kind, args.samples, SPLINE_CHUNK)
+        .context(args.control.display())?;
     let seconds = t.elapsed().as_secs_f64();
     let t = crate::common::step("spline", t);
     textio::write_atomic(&args.output, |w: &mut dyn Write| {
-        for r in &curve.samples {
-            match r {
-                Ok(r) => {
-                    write!(w, "{} ", r.point.face)?;
-                    write_numbers(
-                        w,
-                        r.point.bary.into_iter().chain(r.position.iter().copied()),
-                    )?;
-                }
-                Err(e) => write!(w, "none {}", crate::common::reason(e))?,
-            }
-            writeln!(w)?;
-        }
-        Ok(())
+        w.write_all(&wavg::lines::points_text(&curve.samples))
     })?;
     crate::common::step("write the curve", t);
     let ok = curve.ok_samples();

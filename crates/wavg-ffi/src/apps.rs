@@ -53,7 +53,7 @@ pub unsafe extern "C" fn wavg_spline(
                 optional(out_statuses, n_samples, "out_statuses")?,
             )
         };
-        let curve = evaluate_spline(s.inner(), kind, n_samples, 256)
+        let curve = evaluate_spline(s.inner(), kind, n_samples, wavg::apps::SPLINE_CHUNK)
             .map_err(|e| Failure::from(wavg::Error::from(e)))?;
         write_points(&curve.samples, points, xyz, statuses)
     })

@@ -2,7 +2,11 @@
 //! starts remeshing from.
 
 use serde_json::{Value, json};
-use wavg::apps::{BaseMesh, Remesher, decal_vertices, polygons_to_obj, write_decal_obj};
+use wavg::apps::{
+    BaseMesh, DEFAULT_LEVELS, DEFAULT_MAX_NEGATIVE, DEFAULT_SMOOTH_STEPS, MIN_CAGE_VERTICES,
+    Remesher, decal_vertices, default_cage_vertices, max_cage_vertices, polygons_to_obj,
+    write_decal_obj,
+};
 use wavg::{DecimateOptions, NoProgress, Vector3};
 
 use crate::body::{self, text_format};
@@ -23,7 +27,7 @@ pub(crate) fn decal(app: &App, body: body::Decal) -> Result<Reply, ApiError> {
             anchors.len()
         )));
     }
-    let max_negative = body.max_negative.unwrap_or(-0.1);
+    let max_negative = body.max_negative.unwrap_or(DEFAULT_MAX_NEGATIVE);
     let obj = text_format(body.format.as_deref(), "obj")?;
     let solver = surface.solver(anchors).map_err(ApiError::lib)?;
     let d = decal_vertices(&solver, &uv, max_negative).map_err(ApiError::lib)?;
@@ -54,28 +58,33 @@ pub(crate) fn remesh(app: &App, body: body::Remesh) -> Result<Reply, ApiError> {
             positions: c.vertices.0.iter().map(|&p| Vector3::from(p)).collect(),
             faces: c.faces.0.into_iter().map(|f| f.0).collect(),
         },
-        (None, Some(text)) => BaseMesh::from_obj_str(&text).map_err(|e| ApiError::remesh(&e))?,
+        (None, Some(text)) => BaseMesh::from_obj_str(&text).map_err(ApiError::lib)?,
         _ => return Err(ApiError::bad("give exactly one of \"cage\" and \"base\"")),
     };
-    let levels = body::in_range("levels", body.levels, 2, 0, wavg::apps::MAX_LEVELS.min(5))?;
-    let corners: usize = base.faces.iter().map(Vec::len).sum();
-    let faces = corners.saturating_mul(4usize.pow(levels.saturating_sub(1) as u32));
-    if faces > crate::MAX_FACES {
-        return Err(ApiError::bad(format!(
-            "{levels} levels on this base make about {faces} faces, more than {} in one \
-             answer: use fewer levels or a smaller base",
-            crate::MAX_FACES
-        )));
-    }
-    base.validate().map_err(|e| ApiError::remesh(&e))?;
-    let smooth = body::in_range("smooth", body.smooth, 3, 0, wavg::apps::MAX_SMOOTH_STEPS)?;
+    let levels = body::in_range(
+        "levels",
+        body.levels,
+        DEFAULT_LEVELS,
+        0,
+        wavg::apps::MAX_LEVELS.min(crate::MAX_REMESH_LEVELS),
+    )?;
+    base.check_size(levels, crate::MAX_FACES)
+        .map_err(ApiError::lib)?;
+    base.validate().map_err(ApiError::lib)?;
+    let smooth = body::in_range(
+        "smooth",
+        body.smooth,
+        DEFAULT_SMOOTH_STEPS,
+        0,
+        wavg::apps::MAX_SMOOTH_STEPS,
+    )?;
     let max_distance = body
         .max_distance
         .unwrap_or(wavg::apps::DEFAULT_MAX_BASE_DISTANCE);
     let obj = text_format(body.format.as_deref(), "obj")?;
     let mut r = Remesher::with_max_distance(surface.projector().clone(), &base, max_distance)
-        .map_err(|e| ApiError::remesh(&e))?;
-    let out = r.remesh(levels, smooth).map_err(|e| ApiError::remesh(&e))?;
+        .map_err(ApiError::lib)?;
+    let out = r.remesh(levels, smooth).map_err(ApiError::lib)?;
     if obj {
         return Ok(Reply::text(
             polygons_to_obj(&out.positions, &out.faces).into_bytes(),
@@ -103,8 +112,14 @@ pub(crate) fn remesh(app: &App, body: body::Remesh) -> Result<Reply, ApiError> {
 /// k], ...]}`: the mesh decimated to that many vertices, a starting cage for remeshing.
 pub(crate) fn cage(app: &App, body: body::CageRequest) -> Result<Reply, ApiError> {
     let surface = app.mesh_surface();
-    let max = surface.n_vertices().clamp(4, 5000);
-    let target = body::in_range("vertices", body.vertices, 40.min(max), 4, max)?;
+    let n = surface.n_vertices();
+    let target = body::in_range(
+        "vertices",
+        body.vertices,
+        default_cage_vertices(n),
+        MIN_CAGE_VERTICES,
+        max_cage_vertices(n),
+    )?;
     let opts = DecimateOptions {
         target,
         ..Default::default()

@@ -2,7 +2,6 @@
 //! status (4xx for the caller's input, 5xx for ours).
 
 use wavg::ErrorKind;
-use wavg::apps::RemeshError;
 
 /// A request the server refuses: its HTTP status and a one-line message (sent as
 /// `{"error": MESSAGE}`).
@@ -42,13 +41,7 @@ impl ApiError {
     /// A library failure, with the status [`status_of`] its kind.
     pub(crate) fn lib(e: impl Into<wavg::Error>) -> Self {
         let e = e.into();
-        Self::status(status_of(e.kind()), one_line(&e))
-    }
-
-    /// A failure of the remesher: each is about the base or the parameters the caller
-    /// sent, or a point of the refined base without a weighted average (400).
-    pub(crate) fn remesh(e: &RemeshError) -> Self {
-        Self::bad(one_line(e))
+        Self::status(status_of(e.kind()), e.message())
     }
 
     /// The same refusal with `what` (the field it is about) before its message.
@@ -58,11 +51,6 @@ impl ApiError {
             ..self
         }
     }
-}
-
-/// `e`'s message on one line.
-fn one_line(e: &dyn std::fmt::Display) -> String {
-    e.to_string().replace('\n', " ")
 }
 
 #[cfg(test)]

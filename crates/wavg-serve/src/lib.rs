@@ -55,5 +55,8 @@ pub const MAX_ANSWER: usize = 1 << 22;
 /// Most faces one `/api/remesh` may make (counted before remeshing as the base's corners
 /// times 4 per level after the first).
 pub const MAX_FACES: usize = 1 << 20;
+/// Most levels of splitting one `/api/remesh` may ask for (the library takes
+/// `wavg::apps::MAX_LEVELS`; past five, answers grow beyond what the page draws).
+pub const MAX_REMESH_LEVELS: usize = 5;
 /// Worker threads answering requests.
 pub const WORKERS: usize = 8;

@@ -3,7 +3,9 @@
 
 use serde::Serialize;
 use serde_json::{Value, json};
-use wavg::apps::{SplineKind, evaluate_spline};
+use wavg::apps::{
+    DEFAULT_SPLINE_DEGREE, DEFAULT_SPLINE_SAMPLES, SPLINE_CHUNK, SplineKind, evaluate_spline,
+};
 use wavg::{
     DEFAULT_TOLERANCE, ForwardOptions, ForwardResult, Normalization, RoundTrip, SolveError, Solver,
 };
@@ -11,9 +13,6 @@ use wavg::{
 use crate::body::{self, Anchors};
 use crate::reply::Reply;
 use crate::{ApiError, App, MAX_ANSWER, MAX_SAMPLES, points};
-
-/// Samples evaluated in sequence, warm-started, per parallel chunk (as `wavg spline`).
-const CHUNK: usize = 256;
 
 /// A point returned: `[face, b0, b1, b2, x, y, z]`, serialized as a JSON array.
 type PointRow = (u32, f64, f64, f64, f64, f64, f64);
@@ -128,31 +127,21 @@ pub(crate) fn spline(app: &App, body: body::Spline) -> Result<Reply, ApiError> {
         SplineKind::Bezier
     } else {
         SplineKind::BSpline {
-            degree: body::in_range("degree", body.degree, 3, 1, 64)?,
+            degree: body::in_range("degree", body.degree, DEFAULT_SPLINE_DEGREE, 1, 64)?,
             closed: body.closed.unwrap_or(false),
         }
     };
-    let samples = body::in_range("samples", body.samples, 500, 1, MAX_SAMPLES)?;
+    let samples = body::in_range(
+        "samples",
+        body.samples,
+        DEFAULT_SPLINE_SAMPLES,
+        1,
+        MAX_SAMPLES,
+    )?;
     let text = body::text_format(body.format.as_deref(), "text")?;
-    let curve = evaluate_spline(&solver, kind, samples, CHUNK).map_err(ApiError::lib)?;
+    let curve = evaluate_spline(&solver, kind, samples, SPLINE_CHUNK).map_err(ApiError::lib)?;
     if text {
-        let mut out = Vec::new();
-        for r in &curve.samples {
-            match r {
-                Ok(r) => {
-                    out.extend_from_slice(format!("{} ", r.point.face).as_bytes());
-                    wavg::text::push_numbers(
-                        &mut out,
-                        r.point.bary.into_iter().chain(r.position.iter().copied()),
-                    );
-                }
-                Err(e) => out.extend_from_slice(
-                    format!("none {}", e.to_string().replace('\n', " ")).as_bytes(),
-                ),
-            }
-            out.push(b'\n');
-        }
-        return Ok(Reply::text(out));
+        return Ok(Reply::text(wavg::lines::points_text(&curve.samples)));
     }
     Reply::serialize(&SplinePoints {
         length: curve.length(),
@@ -164,14 +153,10 @@ pub(crate) fn spline(app: &App, body: body::Spline) -> Result<Reply, ApiError> {
 /// Euclidean distance in the 8-D embedding from the source point to every vertex (an
 /// approximation of the geodesic distance).
 pub(crate) fn distance(app: &App, body: body::Distance) -> Result<Reply, ApiError> {
-    let surface = app.surface()?;
-    let p = points::point(&body.source, "source", surface.mesh())?;
-    let coords = surface.embedded_coords();
-    let tri = surface.mesh().triangles[p.face as usize];
-    let at = (0..3).fold(wavg::Vec8::zeros(), |acc, k| {
-        acc + coords[tri[k] as usize] * p.bary[k]
-    });
-    let d: Vec<f64> = coords.iter().map(|c| (c - at).norm()).collect();
+    let d = app
+        .surface()?
+        .embedding_distances(body.source.0)
+        .map_err(|e| ApiError::lib(e).within("source"))?;
     let max = d.iter().copied().fold(0.0, f64::max);
     Ok(Reply::value(&json!({ "distances": d, "max": max })))
 }

@@ -29,7 +29,8 @@
 //! [`solve`], [`apps`]) for what the front door does not cover: mesh files
 //! ([`mesh::io`]), procedural meshes, repair and subdivision ([`mesh::procedural`],
 //! [`mesh::repair`], [`mesh::subdivide`]), `.wavg` files ([`embed::file`]) and the
-//! applications ([`apps`]); the file formats are [`text`] and [`npy`] (the `wavg-io` crate).
+//! applications ([`apps`]); the file formats are [`text`] and [`npy`] (the `wavg-io` crate),
+//! and [`lines`] writes answers as their lines.
 
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
@@ -38,6 +39,7 @@ pub mod anchors;
 pub mod cache;
 mod decimate;
 mod error;
+pub mod lines;
 mod oneoff;
 mod precompute;
 mod surface;

@@ -218,6 +218,19 @@ impl Surface {
         Ok(p.position(&self.inner.mesh))
     }
 
+    /// The Euclidean distance in the embedding from `source` (a vertex id or a surface
+    /// point, checked) to every vertex: an approximation of the geodesic distance, the
+    /// distance field of `wavg serve`'s `/api/distance`.
+    pub fn embedding_distances(&self, source: impl Into<Anchor>) -> Result<Vec<f64>> {
+        let p = wavg_solve::resolve_anchor(&self.inner.mesh, &source.into())?;
+        let coords = self.embedded_coords();
+        let tri = self.inner.mesh.triangles[p.face as usize];
+        let at = (0..3).fold(Vec8::zeros(), |acc, k| {
+            acc + coords[tri[k] as usize] * p.bary[k]
+        });
+        Ok(coords.iter().map(|c| (c - at).norm()).collect())
+    }
+
     /// A solver of forward and inverse problems for these anchors (vertex ids, surface
     /// points or [`Anchor`]s; each is validated). The solver shares this surface's
     /// projector and keeps working if the surface later changes its embedding.

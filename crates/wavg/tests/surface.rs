@@ -92,6 +92,29 @@ fn precompute_save_load_round_trip() {
 }
 
 #[test]
+fn embedding_distances_are_zero_at_the_source_and_checked() {
+    let s = torus();
+    let d = s.embedding_distances(5u32).unwrap();
+    assert_eq!(d.len(), s.n_vertices());
+    assert_eq!(d[5], 0.0);
+    // Without an embedding the distance is the 3-D one.
+    let (a, b) = (s.mesh().positions[5], s.mesh().positions[77]);
+    assert!((d[77] - (a - b).norm()).abs() < 1e-12);
+    // A point between a face's corners is nearer to each corner than the corners' spread.
+    let tri = s.mesh().triangles[3];
+    let mid = s
+        .embedding_distances(SurfacePoint::new(3, [1.0 / 3.0; 3]))
+        .unwrap();
+    assert!(tri.iter().all(|&v| mid[v as usize] > 0.0));
+    let e = s.embedding_distances(s.n_vertices() as u32).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::InvalidArgument);
+    let e = s
+        .embedding_distances(SurfacePoint::new(3, [0.5, 0.5, 0.5]))
+        .unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::InvalidArgument);
+}
+
+#[test]
 fn saving_without_an_embedding_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("none.wavg");

@@ -163,6 +163,33 @@ pub(crate) fn polygon_edges(f: &[u32]) -> impl Iterator<Item = (u32, u32)> + '_ 
 }
 
 impl BaseMesh {
+    /// About how many faces `levels` levels of splitting make of this base, counted
+    /// before any work: its corners times four per level after the first (the first
+    /// level makes `n` quads of a polygon of `n` corners, each later one four faces of
+    /// every face).
+    pub fn estimated_faces(&self, levels: usize) -> usize {
+        let corners: usize = self.faces.iter().map(Vec::len).sum();
+        let per_corner = u32::try_from(levels.saturating_sub(1))
+            .ok()
+            .and_then(|e| 4usize.checked_pow(e))
+            .unwrap_or(usize::MAX);
+        corners.saturating_mul(per_corner)
+    }
+
+    /// Refuses `levels` levels of splitting when they would make more than `max_faces`
+    /// faces ([`BaseMesh::estimated_faces`]), a bound on one answer's size; returns the
+    /// estimate.
+    pub fn check_size(&self, levels: usize, max_faces: usize) -> Result<usize, RemeshError> {
+        let faces = self.estimated_faces(levels);
+        if faces > max_faces {
+            return Err(RemeshError::InvalidParameter(format!(
+                "{levels} levels on this base make about {faces} faces, more than \
+                 {max_faces}: use fewer levels or a smaller base"
+            )));
+        }
+        Ok(faces)
+    }
+
     /// Checks the base: at least one vertex and face, finite positions, every face with 3
     /// to [`MAX_POLYGON`] distinct in-range corners, every vertex used, and every edge in
     /// at most two faces that traverse it in opposite directions (an oriented manifold
@@ -242,6 +269,20 @@ mod tests {
             ],
             faces: vec![vec![0, 1, 2, 3], vec![1, 4, 2]],
         }
+    }
+
+    #[test]
+    fn face_estimates_count_corners_times_four_per_later_level_and_bound_answers() {
+        let b = square();
+        assert_eq!(b.estimated_faces(0), 7);
+        assert_eq!(b.estimated_faces(1), 7);
+        assert_eq!(b.estimated_faces(3), 7 * 16);
+        assert_eq!(b.estimated_faces(usize::MAX), usize::MAX);
+        assert_eq!(b.check_size(3, 112).unwrap(), 112);
+        let e = b.check_size(3, 111).unwrap_err();
+        assert!(matches!(e, RemeshError::InvalidParameter(_)), "{e}");
+        assert!(e.to_string().contains("faces, more than 111"), "{e}");
+        assert!(!e.is_invalid_mesh());
     }
 
     #[test]

@@ -18,6 +18,7 @@
 //! interactively.
 
 mod base;
+mod defaults;
 mod obj;
 mod plan;
 
@@ -31,6 +32,10 @@ use wavg_solve::{
 };
 
 pub use base::{BaseMesh, MAX_POLYGON, RemeshError};
+pub use defaults::{
+    DEFAULT_CAGE_VERTICES, DEFAULT_LEVELS, DEFAULT_SMOOTH_STEPS, MAX_CAGE_VERTICES,
+    MIN_CAGE_VERTICES, default_cage_vertices, max_cage_vertices,
+};
 pub use obj::polygons_to_obj;
 use plan::{Plan, Stencils};
 
