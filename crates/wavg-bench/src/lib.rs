@@ -11,6 +11,8 @@
 //! * [`spline_bench`]: time per sample of a curve on the surface, checked against the
 //!   closest valid projections (`wavg bench spline`).
 //! * [`load_bench`]: reading, parsing and validating a mesh file (`wavg bench load`).
+//! * [`drag_remesh`]: recomputing a remeshing while a base vertex is dragged (`wavg remesh
+//!   --frames`).
 //!
 //! The library (the `wavg` facade and its inner crates) exports no benchmark: the round
 //! trip and projection protocols were `wavg::round_trip`, `wavg::projection_bench` and
@@ -35,12 +37,14 @@
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
 
+pub mod drag;
 pub mod load;
 pub mod projection;
 pub mod roundtrip;
 pub mod spline;
 mod timing;
 
+pub use drag::{DragError, DragOptions, DragReport, drag_remesh};
 pub use load::{LoadBenchReport, load_bench};
 pub use projection::{ProjectionBenchOptions, ProjectionBenchReport, projection_bench};
 pub use roundtrip::{

@@ -8,14 +8,14 @@ use std::time::Instant;
 
 use wavg::apps::{
     CorrespondOptions, CorrespondTimings, Correspondence, Distortion, GroundTruthErrors,
-    ReasonCounts, Validity, ValidityTest, correspond_vertices,
+    ReasonCounts, ValidityTest, correspond_vertices,
 };
 use wavg::{Anchor, Solver, Surface};
 
 use crate::CliError;
 use crate::apps_common::{PairArgs, embed, mesh_and_anchors};
 use crate::error::Context;
-use crate::textio::{self, write_numbers};
+use crate::textio;
 
 /// The validity test, on the command line.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -272,22 +272,9 @@ fn anchors_of(a: &MapArgs) -> Result<usize, CliError> {
     Ok(textio::read_points(&a.pair.source_anchors)?.len())
 }
 
-/// Writes one line per source vertex: its image or `none REASON`.
+/// Writes one line per source vertex: its image or `none REASON` (the library's lines).
 pub fn write_map(path: &Path, map: &Correspondence) -> Result<(), CliError> {
     textio::write_atomic(path, |w: &mut dyn Write| {
-        for (m, v) in map.mapped.iter().zip(&map.validity) {
-            match (v, &m.target) {
-                (Validity::Valid, Ok(r)) => {
-                    write!(w, "{} ", r.point.face)?;
-                    write_numbers(
-                        w,
-                        r.point.bary.into_iter().chain(r.position.iter().copied()),
-                    )?;
-                }
-                (v, _) => write!(w, "none {}", v.reason())?,
-            }
-            writeln!(w)?;
-        }
-        Ok(())
+        w.write_all(&wavg::lines::correspondence_text(map))
     })
 }

@@ -7,11 +7,10 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 use wavg::anchors::{GOOD_GAP, closed_tour};
-use wavg::{Anchor, EmbeddedMesh, ForwardOptions, Solver, ValidMesh, Vec8};
+use wavg::{Anchor, ForwardOptions, Solver, Surface, ValidMesh, Vec8};
 use wavg_bench::{RoundTripOptions, round_trip};
 
 use crate::CliError;
@@ -175,10 +174,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let (emb, _) =
         wavg::embed::precompute(&mesh, &opts, &wavg::NoProgress).context("precompute")?;
     let precompute_s = t0.elapsed().as_secs_f64();
-    let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
-    let embedded = EmbeddedMesh::new(mesh.clone(), coords).map(Arc::new)?;
-    let proj = textio::build_projector(embedded)?;
-    let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
+    let surface = Surface::from_valid_with_embedding(mesh.clone(), emb.clone())?;
+    let (proj, coords) = (surface.projector(), surface.embedded_coords());
     // The anchors: as many as asked, else enough for a small gap between them; the spline's
     // control points are all of them when asked for, else the first (most spread) 8.
     let (anchor_ids, gap) = match args.anchors {
@@ -264,8 +261,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let t0 = Instant::now();
         let drawn = crate::demo_pictures::write_pictures(
             dir,
-            &mesh,
-            &coords,
+            &surface,
             &controls,
             &curve,
             &spline_solver,

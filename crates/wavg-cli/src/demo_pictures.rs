@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use wavg::Vector3;
 use wavg::apps::{Colouring, Image, Overlays, RenderOptions, TransferOptions, View};
 use wavg::sampling::{FpsMetric, farthest_point_vertices};
-use wavg::{ForwardResult, SolveError, Vec8};
+use wavg::{ForwardResult, SolveError};
 use wavg::{NoProgress, PrecomputeOptions, Surface};
 use wavg::{TexCoords, TriMesh, ValidMesh};
 
@@ -32,8 +32,7 @@ pub struct Pictures {
 /// Draws the demo's pictures into `dir`.
 pub fn write_pictures(
     dir: &Path,
-    mesh: &ValidMesh,
-    coords: &[Vec8],
+    surface: &Surface,
     anchors: &[u32],
     curve: &[Result<ForwardResult, SolveError>],
     solver: &wavg::Solver,
@@ -43,7 +42,7 @@ pub fn write_pictures(
     let fail = |what: &str, e: &dyn std::fmt::Display| {
         CliError::failure(format!("{}: {what}: {e}", dir.display()))
     };
-    let tri = mesh.mesh();
+    let tri = surface.mesh().mesh();
     let opts = RenderOptions {
         width: SIZE.0,
         height: SIZE.1,
@@ -82,8 +81,9 @@ pub fn write_pictures(
     save("spline.png", Ok(img))?;
 
     // A per-vertex scalar: distance in the embedding from the first anchor.
-    let a = coords[anchors[0] as usize];
-    let dist: Vec<f64> = coords.iter().map(|c| (c - a).norm()).collect();
+    let dist = surface
+        .embedding_distances(anchors[0])
+        .map_err(|e| fail("distance.png", &e))?;
     let ov = Overlays {
         curves: vec![],
         points: dots[..1].to_vec(),

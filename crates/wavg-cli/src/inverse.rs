@@ -170,7 +170,7 @@ const NOT_REACHED: &str = "none not-reached";
 
 /// `none REASON` for a point without weights.
 fn none(out: &mut Vec<u8>, e: &wavg::SolveError) {
-    out.extend_from_slice(format!("none {}", crate::common::reason(e)).as_bytes());
+    wavg::lines::push_answer(out, Err(&crate::common::reason(e)));
 }
 
 /// What `--verified` reports on standard error: penalised points and points no weights

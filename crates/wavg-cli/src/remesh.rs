@@ -6,8 +6,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use wavg::Surface;
 use wavg::apps::{BaseMesh, RemeshReport, Remesher, polygons_to_obj};
-use wavg::{Surface, Vector3};
+use wavg_bench::{DragOptions, DragReport, drag_remesh};
 
 use crate::CliError;
 use crate::common::load_valid;
@@ -121,7 +122,7 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
     let out = r.remesh(args.levels, args.smooth)?;
     let seconds = t.elapsed().as_secs_f64();
     let drag = drag_frames(&mut r, &base, &args)?;
-    let warm = drag.median;
+    let warm = drag.median_s;
     // The file is the first (undragged) result.
     let obj = polygons_to_obj(&out.positions, &out.faces);
     textio::write_atomic(&args.output, |w: &mut dyn Write| {
@@ -136,8 +137,8 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
             remesh,
             seconds,
             warm_seconds: warm,
-            warm_seconds_max: drag.max,
-            warm_cpu_seconds: drag.cpu,
+            warm_seconds_max: drag.max_s,
+            warm_cpu_seconds: drag.cpu_s,
             frames: args.frames,
             threads: rayon::current_num_threads(),
             precompute_seconds,
@@ -181,47 +182,18 @@ struct JsonReport<'a> {
     precompute_seconds: Option<f64>,
 }
 
-/// Drags base vertex `--drag` over `--frames` frames (a small circle of radius 2% of the
-/// diagonal around its start, each position put on the surface), recomputing warm each
-/// time.
-fn drag_frames(r: &mut Remesher, base: &BaseMesh, args: &Args) -> Result<Drag, CliError> {
-    if args.frames == 0 {
-        return Ok(Drag::default());
-    }
-    let start = base.positions[args.drag];
-    let radius = 0.02 * r.diagonal();
-    let mut times = Vec::with_capacity(args.frames);
-    let mut cpu = 0.0;
-    for k in 0..args.frames {
-        let a = std::f64::consts::TAU * (k + 1) as f64 / args.frames as f64;
-        let target = start + radius * Vector3::new(a.cos() - 1.0, a.sin(), 0.0);
-        let (p, _) = r.closest_point(&target);
-        let t = Instant::now();
-        let c = crate::common::cpu_seconds(false);
-        r.move_base_vertex(args.drag, p)
-            .and_then(|()| r.remesh(args.levels, args.smooth))
-            .context(format_args!("dragged frame {}", k + 1))?;
-        times.push(t.elapsed().as_secs_f64());
-        if let (Some(a), Some(b)) = (c, crate::common::cpu_seconds(false)) {
-            cpu += b - a;
-        }
-    }
-    let max = times.iter().copied().fold(0.0, f64::max);
-    times.sort_by(f64::total_cmp);
-    Ok(Drag {
-        median: Some(times[times.len() / 2]),
-        max: Some(max),
-        cpu: Some(cpu / args.frames as f64),
-    })
-}
-
-/// Times of the dragged frames (none without frames): median and largest wall time, and
-/// the mean CPU time of the whole process (all threads) per frame.
-#[derive(Default)]
-struct Drag {
-    median: Option<f64>,
-    max: Option<f64>,
-    cpu: Option<f64>,
+/// Times `--frames` recomputations while base vertex `--drag` moves (the bench crate's
+/// protocol).
+fn drag_frames(r: &mut Remesher, base: &BaseMesh, args: &Args) -> Result<DragReport, CliError> {
+    let opts = DragOptions {
+        vertex: args.drag,
+        frames: args.frames,
+        levels: args.levels,
+        smooth: args.smooth,
+        cpu_clock: Some(|| crate::common::cpu_seconds(false)),
+    };
+    drag_remesh(r, base, &opts)
+        .map_err(|e| CliError::from(e.error).context(format_args!("dragged frame {}", e.frame)))
 }
 
 /// The surface with its embedding: loaded, or the embedding cache's.

@@ -1,7 +1,9 @@
 //! Answers as lines of the text formats, written the same way by every front end that
-//! writes them (`wavg forward`, `wavg spline`, `wavg demo`, `wavg serve`'s `/api/spline`):
-//! a surface point `FACE B0 B1 B2 X Y Z`, or `none REASON` where there is no answer.
+//! writes them (`wavg forward`, `wavg spline`, `wavg correspond`, `wavg demo`, `wavg
+//! serve`'s `/api/spline`): a surface point `FACE B0 B1 B2 X Y Z`, or `none REASON` where
+//! there is no answer.
 
+use wavg_apps::{Correspondence, Validity};
 use wavg_solve::{ForwardResult, SolveError};
 
 use crate::Error;
@@ -11,10 +13,11 @@ pub fn reason(e: &SolveError) -> String {
     Error::from(e.clone()).message()
 }
 
-/// Appends the line of one forward result, without its line break: `FACE B0 B1 B2 X Y Z`
-/// (shortest round-trip numbers), or `none REASON`.
-pub fn push_point(out: &mut Vec<u8>, r: &Result<ForwardResult, SolveError>) {
-    match r {
+/// Appends the line of one answer, without its line break: the point `FACE B0 B1 B2 X Y Z`
+/// (shortest round-trip numbers), or `none REASON` with the given one-word or one-line
+/// reason.
+pub fn push_answer(out: &mut Vec<u8>, answer: Result<&ForwardResult, &str>) {
+    match answer {
         Ok(r) => {
             out.extend_from_slice(r.point.face.to_string().as_bytes());
             out.push(b' ');
@@ -23,11 +26,35 @@ pub fn push_point(out: &mut Vec<u8>, r: &Result<ForwardResult, SolveError>) {
                 r.point.bary.into_iter().chain(r.position.iter().copied()),
             );
         }
-        Err(e) => {
+        Err(why) => {
             out.extend_from_slice(b"none ");
-            out.extend_from_slice(reason(e).as_bytes());
+            out.extend_from_slice(why.as_bytes());
         }
     }
+}
+
+/// Appends the line of one forward result, without its line break: `FACE B0 B1 B2 X Y Z`
+/// (shortest round-trip numbers), or `none REASON` with the error's [`reason`].
+pub fn push_point(out: &mut Vec<u8>, r: &Result<ForwardResult, SolveError>) {
+    match r {
+        Ok(r) => push_answer(out, Ok(r)),
+        Err(e) => push_answer(out, Err(&reason(e))),
+    }
+}
+
+/// The text of a correspondence map (`wavg correspond`'s output file): one line per source
+/// vertex, its image on the target, or `none REASON` with the [`Validity::reason`] of a
+/// vertex that is not kept.
+pub fn correspondence_text(map: &Correspondence) -> Vec<u8> {
+    let mut out = Vec::new();
+    for (m, v) in map.mapped.iter().zip(&map.validity) {
+        match (v, &m.target) {
+            (Validity::Valid, Ok(r)) => push_answer(&mut out, Ok(r)),
+            (v, _) => push_answer(&mut out, Err(v.reason())),
+        }
+        out.push(b'\n');
+    }
+    out
 }
 
 /// The lines of a sequence of forward results (a spline's samples), each ended by a line
@@ -76,5 +103,35 @@ mod tests {
             format!("none {}", reason(&SolveError::NoWeightedAverage))
         );
         assert!(!lines[1]["none ".len()..].is_empty());
+    }
+
+    #[test]
+    fn correspondence_lines_keep_valid_images_and_name_the_others_reason() {
+        let s = Surface::from_mesh(wavg_mesh::procedural::icosphere(2)).unwrap();
+        let solver = s.solver([0u32, 5, 9]).unwrap();
+        let r = solver.forward(&[0.2, 0.3, 0.5], &Default::default());
+        let mapped = |target| wavg_apps::Mapped {
+            target,
+            round_trip: true,
+            min_weight: 0.0,
+        };
+        let map = Correspondence {
+            mapped: vec![mapped(r.clone()), mapped(r.clone()), mapped(r.clone())],
+            validity: vec![
+                Validity::Valid,
+                Validity::NoRoundTrip,
+                Validity::Inconsistent,
+            ],
+            distortion: wavg_apps::distortion(&[], &[], &[], &[]),
+            timings: Default::default(),
+        };
+        let text = String::from_utf8(correspondence_text(&map)).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(text.ends_with('\n'));
+        assert_eq!(
+            lines[0],
+            String::from_utf8(points_text(&[r])).unwrap().trim_end()
+        );
+        assert_eq!(lines[1..], ["none no-round-trip", "none inconsistent"]);
     }
 }
