@@ -193,14 +193,21 @@ def test_surface_spline(ctx):
     b2 = np.array(curve["wavg_bary"]).reshape(-1, 3)
     ref2 = w.spline(s, (f2, b2), samples=200, degree=3)
     assert np.abs(moved - ref2.xyz[ref2.ok]).max() <= 1e-6 * diag
+    # The default sample count is wavg.spline's own (the library's), and live updates keep it.
+    scene.select_in_order(ico, ids, edit=False)
+    bpy.ops.wavg.surface_spline(degree=3)
+    default = bpy.data.objects["wavg_spline.001"]
+    ref3 = w.spline(s, (faces, bary), degree=3)
+    assert default["wavg_samples"] == len(ref3.ok), (default["wavg_samples"], len(ref3.ok))
+    assert len(scene.curve_points(default)) == int(np.count_nonzero(ref3.ok))
     # Other settings: closed, Bezier, degree 2, in Object mode (selection order kept).
     scene.select_in_order(ico, ids[:4], edit=False)
     bpy.ops.wavg.surface_spline(degree=2, closed=True, samples=120)
-    closed = bpy.data.objects["wavg_spline.001"]
+    closed = bpy.data.objects["wavg_spline.002"]
     assert closed.data.splines[0].use_cyclic_u
     assert scene.surface_distance(ico, scene.curve_points(closed)) <= 1e-6 * diag
     bpy.ops.wavg.surface_spline(bezier=True, samples=50)
-    bez = bpy.data.objects["wavg_spline.002"]
+    bez = bpy.data.objects["wavg_spline.003"]
     assert scene.surface_distance(ico, scene.curve_points(bez)) <= 1e-6 * diag
 
 

@@ -12,12 +12,14 @@ from .meshdata import selected_vertices
 
 
 def evaluate(surface, faces, bary, settings):
-    """The spline's samples (a ``wavg.Points``) for control points ``(faces, bary)``."""
+    """The spline's samples (a ``wavg.Points``) for control points ``(faces, bary)``;
+    ``samples`` 0 takes ``wavg.spline``'s default count."""
     w = wavg()
     degree, closed, bezier, samples = settings
+    count = {"samples": samples} if samples else {}
     try:
         pts = w.spline(
-            surface, (faces, bary), samples=samples, degree=degree, closed=closed, bezier=bezier
+            surface, (faces, bary), degree=degree, closed=closed, bezier=bezier, **count
         )
     except (w.WavgError, ValueError, TypeError) as e:
         raise AddonError(f"wavg cannot make this spline: {describe(e)}") from e
@@ -75,7 +77,13 @@ class WAVG_OT_surface_spline(ActiveMeshOperator, bpy.types.Operator):
     bezier: bpy.props.BoolProperty(
         name="Bézier", default=False, description="Control points form Bézier segments"
     )
-    samples: bpy.props.IntProperty(name="Samples", default=200, min=2, max=100000)
+    samples: bpy.props.IntProperty(
+        name="Samples",
+        default=0,
+        min=0,
+        max=100000,
+        description="Samples along the curve (0: the default of wavg.spline, the library's)",
+    )
 
     def _run(self, context):
         obj = active_mesh(context)
@@ -110,7 +118,7 @@ class WAVG_OT_surface_spline(ActiveMeshOperator, bpy.types.Operator):
         curve_obj["wavg_degree"] = self.degree
         curve_obj["wavg_closed"] = self.closed
         curve_obj["wavg_bezier"] = self.bezier
-        curve_obj["wavg_samples"] = self.samples
+        curve_obj["wavg_samples"] = len(pts.ok)
         store_control(curve_obj, faces, bary)
         for i, v in enumerate(control):
             cv = bpy.data.objects.new("wavg_cv", None)
@@ -123,7 +131,7 @@ class WAVG_OT_surface_spline(ActiveMeshOperator, bpy.types.Operator):
             cv["wavg_curve"] = curve_obj
             cv["wavg_index"] = i
         ok = int(np.count_nonzero(pts.ok))
-        self.report({'INFO'}, f"{curve_obj.name}: {ok} of {self.samples} samples on the surface")
+        self.report({'INFO'}, f"{curve_obj.name}: {ok} of {len(pts.ok)} samples on the surface")
         return {'FINISHED'}
 
 
