@@ -180,13 +180,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // control points are all of them when asked for, else the first (most spread) 8.
     let (anchor_ids, gap) = match args.anchors {
         Some(k) => {
-            let ids = wavg::anchors::spread(&mesh, &coords, k, args.seed)?;
-            let gap = wavg::anchors::largest_gap(&mesh, &coords, &ids);
+            let ids = wavg::anchors::spread(&mesh, coords, k, args.seed)?;
+            let gap = wavg::anchors::largest_gap(&mesh, coords, &ids);
             (ids, gap)
         }
         None => wavg::anchors::spread_to_gap(
             &mesh,
-            &coords,
+            coords,
             args.seed,
             DEFAULT_CONTROLS,
             MAX_ANCHORS,
