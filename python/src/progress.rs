@@ -18,13 +18,7 @@ use wavg::{Progress, Stage};
 const POLL: Duration = Duration::from_millis(100);
 
 /// The stages, in the order of their codes.
-const STAGES: [Stage; 5] = [
-    Stage::Decimate,
-    Stage::Geodesics,
-    Stage::Mds,
-    Stage::LsMesh,
-    Stage::Quality,
-];
+const STAGES: [Stage; 5] = Stage::ALL;
 
 /// Steps of a stage reported to Python (`done` out of this `total`).
 pub(crate) const TOTAL: u64 = 1000;

@@ -193,15 +193,6 @@ fn concurrent_processes_share_one_whole_entry() {
         );
     }
     assert_eq!(entries(&cache).len(), 1);
-    let leftovers = std::fs::read_dir(&cache)
-        .unwrap()
-        .filter(|e| {
-            e.as_ref()
-                .unwrap()
-                .file_name()
-                .to_string_lossy()
-                .starts_with('.')
-        })
-        .count();
+    let leftovers = common::entries_starting_with(&cache, ".");
     assert_eq!(leftovers, 0, "temporary files left in the cache");
 }

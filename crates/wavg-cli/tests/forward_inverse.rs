@@ -4,7 +4,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{json_object, wavg, wavg_ok};
+use common::{json_object, parse_floats, read_rows, wavg, wavg_ok};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
@@ -47,21 +47,6 @@ fn solve_args<'a>(
     ];
     v.extend_from_slice(extra);
     v
-}
-
-/// A text file of numbers, one row per line.
-fn read_rows(p: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(p)
-        .unwrap()
-        .lines()
-        .map(parse_floats)
-        .collect()
-}
-
-fn parse_floats(line: &str) -> Vec<f64> {
-    line.split_whitespace()
-        .map(|t| t.parse().unwrap())
-        .collect()
 }
 
 #[test]
@@ -119,16 +104,7 @@ fn expect_input_error(args: &[&str], out_file: &Path, needle: &str) {
         std::fs::read_to_string(out_file).unwrap(),
         "previous contents\n"
     );
-    let leftovers = std::fs::read_dir(out_file.parent().unwrap())
-        .unwrap()
-        .filter(|e| {
-            e.as_ref()
-                .unwrap()
-                .file_name()
-                .to_string_lossy()
-                .starts_with(".wavg-tmp")
-        })
-        .count();
+    let leftovers = common::entries_starting_with(out_file.parent().unwrap(), ".wavg-tmp");
     assert_eq!(leftovers, 0, "temporary file left behind");
 }
 

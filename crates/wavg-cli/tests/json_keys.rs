@@ -6,7 +6,9 @@ mod common;
 
 use std::path::Path;
 
-use common::{assert_keys, json_object, key_paths, s, sphere_anchors, wavg_ok};
+use common::{
+    assert_keys, json_object, key_paths, pair_args, s, sphere_anchors, wavg_ok, wavg_ok_with,
+};
 use serde_json::Value;
 
 #[test]
@@ -66,20 +68,7 @@ fn correspond_json_keys() {
     let a = s(&sphere_anchors(dir.path()));
     let out = s(&dir.path().join("map.txt"));
     let m = "builtin:icosphere";
-    let args = [
-        "correspond",
-        "--source",
-        m,
-        "--target",
-        m,
-        "--source-anchors",
-        &a,
-        "--target-anchors",
-        &a,
-        "-o",
-        &out,
-        "--json",
-    ];
+    let args = pair_args("correspond", [m, m], [&a, &a], &out);
     let keys = [
         "source",
         "target",
@@ -105,7 +94,7 @@ fn correspond_json_keys() {
         "vertices_per_cpu_s",
         "ground_truth",
     ];
-    let (o, _) = json_object(&wavg_ok(&args));
+    let (o, _) = json_object(&wavg_ok_with(&args, &["--json"]));
     let mut want: Vec<String> = keys.iter().map(|k| k.to_string()).collect();
     // `reasons` counts by reason: its keys depend on the map, not on the format.
     want.extend(
@@ -117,7 +106,7 @@ fn correspond_json_keys() {
     );
     want.sort();
     assert_eq!(key_paths(&Value::Object(o)), want);
-    let (o, _) = json_object(&wavg_ok(&[&args[..], &["--ground-truth"]].concat()));
+    let (o, _) = json_object(&wavg_ok_with(&args, &["--json", "--ground-truth"]));
     let truth = key_paths(&o["ground_truth"]);
     let stats = ["count", "max", "mean", "p95"];
     let mut want: Vec<String> = ["answered", "valid"]
@@ -293,28 +282,6 @@ fn remesh_json_keys() {
     )
     .unwrap();
     let out = s(&dir.path().join("fine.obj"));
-    let keys = [
-        "mesh",
-        "base",
-        "base_vertices",
-        "base_faces",
-        "vertices",
-        "faces",
-        "levels",
-        "smooth_steps",
-        "seconds",
-        "warm_seconds",
-        "warm_seconds_max",
-        "warm_cpu_seconds",
-        "frames",
-        "max_offsurface",
-        "roughness",
-        "problems",
-        "forward_problems_solved",
-        "fallbacks",
-        "threads",
-        "precompute_seconds",
-    ];
     let args = [
         "remesh",
         "--mesh",
@@ -329,7 +296,7 @@ fn remesh_json_keys() {
         &out,
         "--json",
     ];
-    assert_keys(&args, &keys);
+    assert_keys(&args, &common::REMESH_KEYS);
 }
 
 #[test]
@@ -338,23 +305,8 @@ fn morph_json_keys() {
     let a = s(&sphere_anchors(dir.path()));
     let out = s(&dir.path().join("frames"));
     let m = "builtin:icosphere";
-    let args = [
-        "morph",
-        "--source",
-        m,
-        "--target",
-        m,
-        "--source-anchors",
-        &a,
-        "--target-anchors",
-        &a,
-        "--frames",
-        "2",
-        "-o",
-        &out,
-        "--json",
-    ];
-    let (o, _) = json_object(&wavg_ok(&args));
+    let args = pair_args("morph", [m, m], [&a, &a], &out);
+    let (o, _) = json_object(&wavg_ok_with(&args, &["--frames", "2", "--json"]));
     let mut want: Vec<String> = [
         "source",
         "target",

@@ -6,7 +6,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{json_object, sphere_anchors, wavg, wavg_ok};
+use common::{json_object, pair_args, sphere_anchors, wavg, wavg_ok, wavg_ok_with};
 
 fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()
@@ -24,23 +24,10 @@ fn correspond_a_surface_onto_itself() {
     let a = s(&sphere_anchors(dir.path()));
     let out = dir.path().join("map.txt");
     let m = "builtin:icosphere";
-    let base = [
-        "correspond",
-        "--source",
-        m,
-        "--target",
-        m,
-        "--source-anchors",
-        &a,
-        "--target-anchors",
-        &a,
-        "-o",
-        &s(&out),
-        "--json",
-        "--ground-truth",
-    ];
+    let base = pair_args("correspond", [m, m], [&a, &a], &s(&out));
     for extra in [&[][..], &["--validity", "paper"], &["--paper-weights"]] {
-        let (o, keys) = json_object(&wavg_ok(&[&base[..], extra].concat()));
+        let extra = [&["--json", "--ground-truth"][..], extra].concat();
+        let (o, keys) = json_object(&wavg_ok_with(&base, &extra));
         has_keys(
             &keys,
             &[
@@ -186,21 +173,8 @@ fn a_pose_pair_maps_close_to_its_ground_truth() {
     let text: String = (0..2046).step_by(51).map(|v| format!("v {v}\n")).collect();
     std::fs::write(&a, text).unwrap();
     let out = dir.path().join("map.txt");
-    let r = wavg_ok(&[
-        "correspond",
-        "--source",
-        &s(&f0),
-        "--target",
-        &s(&f1),
-        "--source-anchors",
-        &s(&a),
-        "--target-anchors",
-        &s(&a),
-        "-o",
-        &s(&out),
-        "--json",
-        "--ground-truth",
-    ]);
+    let args = pair_args("correspond", [&s(&f0), &s(&f1)], [&s(&a), &s(&a)], &s(&out));
+    let r = wavg_ok_with(&args, &["--json", "--ground-truth"]);
     let (o, _) = json_object(&r);
     let frac = o["valid_fraction"].as_f64().unwrap();
     let err = o["ground_truth"]["valid"]["mean"].as_f64().unwrap();
@@ -258,20 +232,13 @@ fn different_shapes_map_through_markers_after_repair() {
     std::fs::write(&hp, ha).unwrap();
     std::fs::write(&cp, ca).unwrap();
     let out = dir.path().join("map.txt");
-    let r = wavg_ok(&[
+    let args = pair_args(
         "correspond",
-        "--source",
-        &s(&horse),
-        "--target",
-        &s(&fixed),
-        "--source-anchors",
-        &s(&hp),
-        "--target-anchors",
-        &s(&cp),
-        "-o",
+        [&s(&horse), &s(&fixed)],
+        [&s(&hp), &s(&cp)],
         &s(&out),
-        "--json",
-    ]);
+    );
+    let r = wavg_ok_with(&args, &["--json"]);
     let (o, _) = json_object(&r);
     let frac = o["valid_fraction"].as_f64().unwrap();
     let stretch = o["stretch_best95"].as_f64().unwrap();
@@ -305,27 +272,12 @@ fn bad_input_writes_nothing() {
     };
     let (a, short, far, o) = (s(&a), s(&short), s(&far), s(&out));
     let pair = |sa: &str, ta: &str, cmd: &str| -> Vec<String> {
-        let mut v: Vec<String> = [
-            cmd,
-            "--source",
-            m,
-            "--target",
-            m,
-            "--source-anchors",
-            sa,
-            "--target-anchors",
-            ta,
-            "-o",
-        ]
-        .iter()
-        .map(|x| x.to_string())
-        .collect();
-        v.push(if cmd == "morph" {
+        let out = if cmd == "morph" {
             s(&frames)
         } else {
             o.clone()
-        });
-        v
+        };
+        pair_args(cmd, [m, m], [sa, ta], &out)
     };
     for cmd in ["correspond", "morph"] {
         let v = pair(&a, &short, cmd);

@@ -5,7 +5,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{wavg, wavg_ok};
+use common::{parse_floats, read_rows, wavg, wavg_ok};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
@@ -15,20 +15,6 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-fn parse_floats(line: &str) -> Vec<f64> {
-    line.split_whitespace()
-        .map(|x| x.parse().unwrap())
-        .collect()
-}
-
-fn read_rows(p: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(p)
-        .unwrap()
-        .lines()
-        .map(parse_floats)
-        .collect()
 }
 
 #[test]

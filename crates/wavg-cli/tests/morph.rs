@@ -9,23 +9,9 @@ use common::{json_object, sphere_anchors, wavg, wavg_ok};
 /// `wavg morph` of the icosphere onto itself with anchors `a`, 4 frames into `out`.
 fn morph_args(a: &str, out: &Path) -> Vec<String> {
     let m = "builtin:icosphere";
-    [
-        "morph",
-        "--source",
-        m,
-        "--target",
-        m,
-        "--source-anchors",
-        a,
-        "--target-anchors",
-        a,
-        "--frames",
-        "4",
-        "-o",
-        out.to_str().unwrap(),
-    ]
-    .map(String::from)
-    .to_vec()
+    let mut args = common::pair_args("morph", [m, m], [a, a], out.to_str().unwrap());
+    args.extend(["--frames", "4"].map(String::from));
+    args
 }
 
 #[test]

@@ -79,6 +79,15 @@ pub enum Stage {
 }
 
 impl Stage {
+    /// Every stage, in pipeline order.
+    pub const ALL: [Stage; 5] = [
+        Stage::Decimate,
+        Stage::Geodesics,
+        Stage::Mds,
+        Stage::LsMesh,
+        Stage::Quality,
+    ];
+
     /// Lower-case name used in JSON and progress bars.
     pub fn name(self) -> &'static str {
         match self {

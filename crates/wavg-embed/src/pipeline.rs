@@ -574,13 +574,7 @@ mod tests {
     #[test]
     fn cancellation_stops_every_stage_and_stages_keep_their_order() {
         let mesh = ValidMesh::new(procedural::torus(40, 20, 1.0, 0.4)).unwrap();
-        for stage in [
-            Stage::Decimate,
-            Stage::Geodesics,
-            Stage::Mds,
-            Stage::LsMesh,
-            Stage::Quality,
-        ] {
+        for stage in Stage::ALL {
             let p = CancelAt {
                 stage,
                 flag: AtomicBool::new(false),
@@ -619,13 +613,7 @@ mod tests {
         let rec = Record(Mutex::new(Vec::new()));
         precompute(&mesh, &opts(60), &rec).unwrap();
         let seen = rec.0.into_inner().unwrap();
-        for stage in [
-            Stage::Decimate,
-            Stage::Geodesics,
-            Stage::Mds,
-            Stage::LsMesh,
-            Stage::Quality,
-        ] {
+        for stage in Stage::ALL {
             let last = seen.iter().rev().find(|(s, _)| *s == stage).map(|x| x.1);
             assert_eq!(last, Some(1.0), "{stage:?}");
         }

@@ -108,3 +108,91 @@ pub fn assert_keys(args: &[&str], want: &[&str]) {
         args[0]
     );
 }
+
+/// The numbers of one line of a text file.
+pub fn parse_floats(line: &str) -> Vec<f64> {
+    line.split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect()
+}
+
+/// A text file of numbers, one row per line.
+pub fn read_rows(p: &std::path::Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(p)
+        .unwrap()
+        .lines()
+        .map(parse_floats)
+        .collect()
+}
+
+/// How many entries of folder `dir` have names starting with `prefix` (temporary files
+/// left behind).
+pub fn entries_starting_with(dir: &std::path::Path, prefix: &str) -> usize {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with(prefix)
+        })
+        .count()
+}
+
+/// The keys of `wavg remesh --json`.
+pub const REMESH_KEYS: [&str; 20] = [
+    "mesh",
+    "base",
+    "base_vertices",
+    "base_faces",
+    "vertices",
+    "faces",
+    "levels",
+    "smooth_steps",
+    "seconds",
+    "warm_seconds",
+    "warm_seconds_max",
+    "warm_cpu_seconds",
+    "frames",
+    "max_offsurface",
+    "roughness",
+    "problems",
+    "forward_problems_solved",
+    "fallbacks",
+    "threads",
+    "precompute_seconds",
+];
+
+/// The arguments of a command on a source and a target mesh with paired anchors
+/// (`correspond`, `morph`, `transfer-texture`): `COMMAND --source S --target T
+/// --source-anchors A --target-anchors B -o OUT`.
+pub fn pair_args(
+    command: &str,
+    [source, target]: [&str; 2],
+    [source_anchors, target_anchors]: [&str; 2],
+    out: &str,
+) -> Vec<String> {
+    [
+        command,
+        "--source",
+        source,
+        "--target",
+        target,
+        "--source-anchors",
+        source_anchors,
+        "--target-anchors",
+        target_anchors,
+        "-o",
+        out,
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+/// `wavg_ok` on owned arguments followed by `extra`.
+pub fn wavg_ok_with(args: &[String], extra: &[&str]) -> Output {
+    let mut all: Vec<&str> = args.iter().map(String::as_str).collect();
+    all.extend_from_slice(extra);
+    wavg_ok(&all)
+}

@@ -49,7 +49,7 @@ pub fn bilaplacian(mesh: &TriMesh) -> Result<SparseColMat<usize, f64>, EmbedErro
 }
 
 /// Checks landmark ids (distinct, in range, at least one) and returns the fixed-vertex mask.
-fn fixed_mask(n: usize, landmarks: &[u32]) -> Result<Vec<bool>, EmbedError> {
+pub(super) fn fixed_mask(n: usize, landmarks: &[u32]) -> Result<Vec<bool>, EmbedError> {
     if landmarks.is_empty() {
         return Err(EmbedError::InvalidArgument(
             "the least-squares mesh needs at least one landmark".into(),

@@ -98,21 +98,15 @@ impl TwoLevelLsMesh {
         progress: &dyn Progress,
     ) -> Result<Self, EmbedError> {
         let n = mesh.n_vertices();
-        let mut fixed = vec![false; n];
-        let mut coarse_landmarks = Vec::with_capacity(landmarks.len());
-        for &s in landmarks {
-            let slot = fixed.get_mut(s as usize).ok_or_else(|| {
-                EmbedError::InvalidArgument(format!("landmark {s} out of range ({n} vertices)"))
-            })?;
-            if std::mem::replace(slot, true) {
-                return Err(EmbedError::InvalidArgument(format!(
-                    "landmark {s} appears twice"
-                )));
-            }
-            coarse_landmarks.push(coarse.coarse_index(s).ok_or_else(|| {
-                EmbedError::InvalidArgument(format!("landmark {s} is not a coarse vertex"))
-            })?);
-        }
+        let fixed = super::fixed_mask(n, landmarks)?;
+        let coarse_landmarks = landmarks
+            .iter()
+            .map(|&s| {
+                coarse.coarse_index(s).ok_or_else(|| {
+                    EmbedError::InvalidArgument(format!("landmark {s} is not a coarse vertex"))
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         if coarse.landmarks.iter().any(|&v| v as usize >= n) {
             return Err(EmbedError::InvalidArgument(
                 "the coarse mesh is not a decimation of this mesh".into(),
@@ -444,14 +438,15 @@ mod tests {
         max_iterations: 20_000,
     };
 
+    /// A torus of `n` x `m` quads with 0.2% noise (seeded), so that it is not symmetric.
+    fn noisy_torus(n: u32, m: u32, seed: u64) -> ValidMesh {
+        let torus = procedural::torus(n, m, 1.0, 0.35);
+        ValidMesh::new(procedural::with_noise(torus, 0.002, seed)).unwrap()
+    }
+
     #[test]
     fn converges_to_the_direct_solve() {
-        let mesh = ValidMesh::new(procedural::with_noise(
-            procedural::torus(160, 80, 1.0, 0.35),
-            0.002,
-            3,
-        ))
-        .unwrap();
+        let mesh = noisy_torus(160, 80, 3);
         let err = both(&mesh, 100, 2000, CONVERGE);
         let default = both(&mesh, 100, 2000, CgOptions::default());
         eprintln!(
@@ -484,12 +479,7 @@ mod tests {
     #[test]
     fn precompute_through_two_levels_keeps_quality() {
         // The pipeline forced onto the two-level path against its direct solve.
-        let mesh = ValidMesh::new(procedural::with_noise(
-            procedural::torus(200, 100, 1.0, 0.35),
-            0.002,
-            5,
-        ))
-        .unwrap();
+        let mesh = noisy_torus(200, 100, 5);
         let direct = crate::PrecomputeOptions {
             landmarks: 200,
             ..Default::default()

@@ -221,14 +221,7 @@ mod tests {
             assert_eq!((st.components, st.genus), (1, Some(0)), "{st:?}");
             assert!(a.report.is_valid(), "{:?}", a.report);
             // Outward: positive enclosed volume.
-            let vol: f64 = m
-                .triangles
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|v| m.positions[v as usize]);
-                    a.dot(&b.cross(&c)) / 6.0
-                })
-                .sum();
+            let vol = super::super::enclosed_volume(&m);
             assert!(vol > 0.0, "volume {vol}");
             ValidMesh::new(m).unwrap();
         }

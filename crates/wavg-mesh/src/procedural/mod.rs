@@ -241,3 +241,16 @@ pub fn builtin(name: &str) -> Result<TriMesh, MeshError> {
         }
     })
 }
+
+/// The signed volume a closed mesh encloses (positive when its faces point outward): the
+/// tests' check of orientation.
+#[cfg(test)]
+fn enclosed_volume(m: &TriMesh) -> f64 {
+    m.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| m.positions[v as usize]);
+            a.dot(&b.cross(&c)) / 6.0
+        })
+        .sum()
+}

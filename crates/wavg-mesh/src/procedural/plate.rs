@@ -88,14 +88,7 @@ mod tests {
             assert!(a.report.is_valid(), "{:?}", a.report);
             assert!(st.manifold && st.oriented && st.watertight, "{st:?}");
             assert_eq!((st.components, st.genus), (1, Some(i64::from(hx * hy))));
-            let vol: f64 = m
-                .triangles
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|v| m.positions[v as usize]);
-                    a.dot(&b.cross(&c)) / 6.0
-                })
-                .sum();
+            let vol = super::super::enclosed_volume(&m);
             let solid = f64::from((2 * hx + 1) * (2 * hy + 1) - hx * hy);
             assert!((vol - solid * 0.05).abs() < 1e-9, "volume {vol}");
             ValidMesh::new(m).unwrap();
