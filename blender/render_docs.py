@@ -177,12 +177,7 @@ def decal_uv_picture(out):
             np.linspace(0, 2 * math.pi, 8, endpoint=False)]
     ids = anchors_on(obj, dirs)
     obj.vertex_groups.new(name="wavg_anchors").add(ids, 1.0, 'REPLACE')
-    attr = obj.data.attributes.new("wavg_uv", 'FLOAT2', 'POINT')
-    uv = np.zeros((len(obj.data.vertices), 2), dtype=np.float32)
-    for k, i in enumerate(ids):
-        t = 2 * math.pi * k / len(ids)
-        uv[i] = (0.5 + 0.5 * math.cos(t), 0.5 + 0.5 * math.sin(t))
-    attr.data.foreach_set("vector", uv.ravel())
+    scene.circle_uv(obj, ids)
     bpy.ops.wavg.decal_uv()
     checker_colors(obj, "wavg_decal", set(scene.group_ids(obj, "wavg_invalid")))
     stage(os.path.join(out, "blender_decal_uv.png"), color_type='VERTEX')

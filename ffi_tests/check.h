@@ -126,6 +126,33 @@ static inline void solver_and_fewer(wavg_surface *s, const wavg_point *anchors, 
   CHECK_OK(wavg_solver_new(s, anchors, n - 1, fewer));
 }
 
+/* The set-up of the tests of the two-surface entries (maps, texture transfer): the
+ * precomputed torus with its arrays, MAP_ANCHORS anchors at every 61st vertex, a solver
+ * over them and one over all but the last. */
+enum { MAP_ANCHORS = 12 };
+typedef struct {
+  double *xyz;
+  uint32_t *tris;
+  size_t nv, nt;
+  wavg_surface *s;
+  wavg_point anchors[MAP_ANCHORS];
+  wavg_solver *solver, *fewer;
+} map_fixture;
+
+static inline void map_fixture_init(map_fixture *fx) {
+  fx->s = precomputed_torus(&fx->xyz, &fx->nv, &fx->tris, &fx->nt);
+  vertex_anchors(fx->s, MAP_ANCHORS, 61, fx->anchors);
+  solver_and_fewer(fx->s, fx->anchors, MAP_ANCHORS, &fx->solver, &fx->fewer);
+}
+
+static inline void map_fixture_free(map_fixture *fx) {
+  wavg_solver_free(fx->fewer);
+  wavg_solver_free(fx->solver);
+  wavg_surface_free(fx->s);
+  free(fx->xyz);
+  free(fx->tris);
+}
+
 /* The 3-D position of a surface point from the mesh arrays. */
 static inline void point_position(const double *xyz, const uint32_t *tris, wavg_point p,
                            double out[3]) {

@@ -19,9 +19,7 @@ int main(void) {
   double *xyz;
   uint32_t *tris;
   size_t nv, nt;
-  make_torus(60, 24, 0.35, &xyz, &nv, &tris, &nt);
-  wavg_surface *s = NULL;
-  CHECK_OK(wavg_surface_from_arrays(xyz, nv, tris, nt, &s));
+  wavg_surface *s = torus_surface(60, 24, &xyz, &nv, &tris, &nt);
   double *before = malloc(sizeof(double) * 8 * nv), *after = malloc(sizeof(double) * 8 * nv);
   CHECK_OK(wavg_surface_embedding(s, before, 8 * nv));
   wavg_precompute_options o = wavg_precompute_options_default();

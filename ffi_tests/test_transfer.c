@@ -2,24 +2,35 @@
  * texel finds its own point, hence its own colour), and bad arguments write nothing. */
 #include "check.h"
 
-enum { NA = 12, W = 256 };
+enum { NA = MAP_ANCHORS, W = 256 };
+
+/* The one atlas of the test: `n` (u, v) pairs `uv` with the face triples `uvf`. */
+typedef struct {
+  const double *uv;
+  size_t n;
+  const uint32_t *uvf;
+} atlas;
+
+/* wavg_transfer_texture of the W x W image `src` from `source` to `target`, both on the
+ * atlas `a`, into a W x W `out` with `stride`. */
+static wavg_status transfer(const wavg_solver *source, const wavg_solver *target, atlas a,
+                            const uint8_t *src, uint32_t stride, uint8_t *out, size_t *valid,
+                            size_t *covered) {
+  return wavg_transfer_texture(source, a.uv, a.n, a.uvf, src, W, W, target, a.uv, a.n, a.uvf, W, W,
+                               stride, out, valid, covered);
+}
 
 int main(void) {
-  double *xyz;
-  uint32_t *tris;
-  size_t nv, nt;
-  wavg_surface *s = precomputed_torus(&xyz, &nv, &tris, &nt);
-  wavg_point anchors[NA];
-  vertex_anchors(s, NA, 61, anchors);
-  wavg_solver *solver = NULL, *fewer = NULL;
-  solver_and_fewer(s, anchors, NA, &solver, &fewer);
+  map_fixture fx;
+  map_fixture_init(&fx);
+  wavg_solver *solver = fx.solver, *fewer = fx.fewer;
 
   /* An atlas of separate triangles: face f in cell f of a k x k grid. */
   size_t k = 1;
-  while (k * k < nt) k++;
-  double *uv = malloc(6 * nt * sizeof *uv);
-  uint32_t *uvf = malloc(3 * nt * sizeof *uvf);
-  for (size_t f = 0; f < nt; f++) {
+  while (k * k < fx.nt) k++;
+  double *uv = malloc(6 * fx.nt * sizeof *uv);
+  uint32_t *uvf = malloc(3 * fx.nt * sizeof *uvf);
+  for (size_t f = 0; f < fx.nt; f++) {
     double x0 = (double)(f % k) / (double)k, y0 = (double)(f / k) / (double)k, c = 1.0 / (double)k;
     double corner[6] = {x0 + 0.1 * c, y0 + 0.1 * c, x0 + 0.9 * c, y0 + 0.1 * c, x0 + 0.1 * c, y0 + 0.9 * c};
     for (int i = 0; i < 6; i++) uv[6 * f + (size_t)i] = corner[i];
@@ -32,9 +43,9 @@ int main(void) {
       uint8_t *p = src + 4 * (y * W + x);
       p[0] = (uint8_t)x, p[1] = (uint8_t)y, p[2] = 128, p[3] = 255;
     }
+  atlas a = {uv, 3 * fx.nt, uvf};
   size_t valid = 0, covered = 0;
-  CHECK_OK(wavg_transfer_texture(solver, uv, 3 * nt, uvf, src, W, W, solver, uv, 3 * nt, uvf, W, W, 1,
-                                 out, &valid, &covered));
+  CHECK_OK(transfer(solver, solver, a, src, 1, out, &valid, &covered));
   CHECK(covered > 10000 && valid >= covered * 99 / 100);
   size_t opaque = 0, close = 0;
   for (int i = 0; i < W * W; i++) {
@@ -48,32 +59,18 @@ int main(void) {
 
   /* Bad arguments: a status, a message, and an untouched output. */
   memset(out, 0xAB, 4 * W * W);
-  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT,
-              wavg_transfer_texture(solver, uv, 3 * nt, uvf, src, W, W, fewer, uv, 3 * nt, uvf, W, W, 4,
-                                    out, NULL, NULL));
-  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT,
-              wavg_transfer_texture(solver, uv, 3 * nt, uvf, src, W, W, solver, uv, 3 * nt, uvf, W, W, 0,
-                                    out, NULL, NULL));
-  uvf[5] = (uint32_t)(3 * nt); /* out of range */
-  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT,
-              wavg_transfer_texture(solver, uv, 3 * nt, uvf, src, W, W, solver, uv, 3 * nt, uvf, W, W, 4,
-                                    out, NULL, NULL));
-  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT,
-              wavg_transfer_texture(NULL, uv, 3 * nt, uvf, src, W, W, solver, uv, 3 * nt, uvf, W, W, 4,
-                                    out, NULL, NULL));
-  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT,
-              wavg_transfer_texture(solver, uv, 3 * nt, uvf, src, W, W, solver, uv, 3 * nt, uvf, W, W, 4,
-                                    NULL, NULL, NULL));
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, transfer(solver, fewer, a, src, 4, out, NULL, NULL));
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, transfer(solver, solver, a, src, 0, out, NULL, NULL));
+  uvf[5] = (uint32_t)(3 * fx.nt); /* out of range */
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, transfer(solver, solver, a, src, 4, out, NULL, NULL));
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, transfer(NULL, solver, a, src, 4, out, NULL, NULL));
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, transfer(solver, solver, a, src, 4, NULL, NULL, NULL));
   CHECK(out[0] == 0xAB && out[4 * W * W - 1] == 0xAB);
 
-  wavg_solver_free(fewer);
-  wavg_solver_free(solver);
-  wavg_surface_free(s);
   free(uv);
   free(uvf);
   free(src);
   free(out);
-  free(xyz);
-  free(tris);
+  map_fixture_free(&fx);
   return check_report("test_transfer");
 }

@@ -221,12 +221,7 @@ def decal_setup(obj):
     ids = scene.nearest_vertices(obj, cap_directions(35, 8))
     group = obj.vertex_groups.new(name="wavg_anchors")
     group.add(ids, 1.0, 'REPLACE')
-    attr = obj.data.attributes.new("wavg_uv", 'FLOAT2', 'POINT')
-    uv = np.zeros((len(obj.data.vertices), 2), dtype=np.float32)
-    for k, i in enumerate(ids):
-        t = 2 * math.pi * k / len(ids)
-        uv[i] = (0.5 + 0.5 * math.cos(t), 0.5 + 0.5 * math.sin(t))
-    attr.data.foreach_set("vector", uv.ravel())
+    uv = scene.circle_uv(obj, ids)
     return sorted(ids), uv
 
 

@@ -1,6 +1,8 @@
 """Scene helpers of the headless tests: meshes built in code, selections, a snapshot of
 everything an operator could change, and surface-distance checks."""
 
+import math
+
 import bmesh
 import bpy
 import numpy as np
@@ -111,6 +113,19 @@ def surface_distance(obj, points):
         assert ok, f"no closest point on '{obj.name}' for {p}"
         worst = max(worst, float(np.linalg.norm(np.array(loc) - np.asarray(p))))
     return worst
+
+
+def circle_uv(obj, ids, name="wavg_uv"):
+    """Puts the vertices ``ids`` on a circle of the (u, v) square, in order (centre
+    (0.5, 0.5), radius 0.5), as the 2-D point attribute ``name`` (the decal's anchors;
+    other vertices get (0, 0)); returns the ``(n, 2)`` values."""
+    attr = obj.data.attributes.new(name, 'FLOAT2', 'POINT')
+    uv = np.zeros((len(obj.data.vertices), 2), dtype=np.float32)
+    for k, i in enumerate(ids):
+        t = 2 * math.pi * k / len(ids)
+        uv[i] = (0.5 + 0.5 * math.cos(t), 0.5 + 0.5 * math.sin(t))
+    attr.data.foreach_set("vector", uv.ravel())
+    return uv
 
 
 def curve_points(curve_obj):

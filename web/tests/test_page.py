@@ -50,6 +50,22 @@ def add_anchors(page, count):
     return spots
 
 
+def drag_anchor(page, index, target, steps, settle_each=False):
+    """Drags anchor ``index`` to the screen point ``target`` with real mouse events in
+    ``steps`` moves (letting each frame finish when ``settle_each``), then lets the page
+    settle."""
+    start = page.js(f"window.wavg.anchorScreen({index})")
+    m = page.page.mouse
+    m.move(start["x"], start["y"])
+    m.down()
+    for k in range(1, steps + 1):
+        m.move(start["x"] + (target["x"] - start["x"]) * k / steps, start["y"] + (target["y"] - start["y"]) * k / steps)
+        if settle_each:
+            page.idle()
+    m.up()
+    page.idle()
+
+
 def test_page_loads_without_console_errors(page):
     assert page.js("window.wavg.stats.readyMs") > 0
     assert page.js("document.getElementById('meshinfo').textContent").endswith("faces")
@@ -67,15 +83,8 @@ def test_clicks_and_drags_change_the_spline_as_the_api_computes_it(page, server)
     assert sum(p is not None for p in drawn) == body["samples"]
     # Drag anchor 2 to a free spot of the surface with real mouse events.
     target = page.visible_vertices(7)[6]
-    start = page.js("window.wavg.anchorScreen(2)")
     before = page.js("window.wavg.anchors[2].point")
-    m = page.page.mouse
-    m.move(start["x"], start["y"])
-    m.down()
-    for k in range(1, 21):
-        m.move(start["x"] + (target["x"] - start["x"]) * k / 20, start["y"] + (target["y"] - start["y"]) * k / 20)
-    m.up()
-    page.idle()
+    drag_anchor(page, 2, target, 20)
     after = page.js("window.wavg.anchors[2].point")
     assert after != before
     moved = page.js("window.wavg.anchorScreen(2)")
@@ -86,6 +95,7 @@ def test_clicks_and_drags_change_the_spline_as_the_api_computes_it(page, server)
     assert page.js("window.wavg.modes.last.spline") == want2["points"]
     assert want2["points"] != want["points"]
     # Orbiting (a drag away from anchors) adds nothing.
+    m = page.page.mouse
     m.move(20, 20)
     m.down()
     m.move(120, 60, steps=5)
@@ -99,15 +109,7 @@ def test_a_drag_frame_equals_a_full_redraw(page):
     must be those of the whole canvas redrawn from the cached mesh (no trail left)."""
     add_anchors(page, 5)
     target = page.visible_vertices(7)[6]
-    start = page.js("window.wavg.anchorScreen(1)")
-    m = page.page.mouse
-    m.move(start["x"], start["y"])
-    m.down()
-    for k in range(1, 11):
-        m.move(start["x"] + (target["x"] - start["x"]) * k / 10, start["y"] + (target["y"] - start["y"]) * k / 10)
-        page.idle()
-    m.up()
-    page.idle()
+    drag_anchor(page, 1, target, 10, settle_each=True)
     grab = """() => { const c = window.wavg.renderer.domElement; const g = document.createElement('canvas');
         g.width = c.width; g.height = c.height; const ctx = g.getContext('2d'); ctx.drawImage(c, 0, 0);
         window.__grab = ctx.getImageData(0, 0, c.width, c.height).data; }"""

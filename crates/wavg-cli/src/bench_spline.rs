@@ -24,9 +24,7 @@ samples, ok_samples, controls, threads, repeat, load (1-minute load average) and
 builtin:genus2 (51k vertices, genus 2) is the mesh of the spline figures in BENCHMARKS.md.")]
 pub struct Args {
     #[command(flatten)]
-    pub mesh: crate::mesh_arg::MeshArg,
-    #[command(flatten)]
-    pub embedding: crate::embedding_arg::EmbeddingArg,
+    pub surface: crate::embedding_arg::SurfaceArgs,
     /// Control points, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub control: std::path::PathBuf,
@@ -69,7 +67,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         degree: args.degree,
         closed: args.closed,
     };
-    let solver = args.embedding.solver(&args.mesh, &args.control)?;
+    let solver = args.surface.solver(&args.control)?;
     let threads = args.threads.unwrap_or_else(rayon::current_num_threads);
     let opts = SplineBenchOptions {
         kind,
@@ -81,7 +79,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let report = textio::with_threads(Some(threads), || spline_bench(&solver, &opts))?
         .context(args.control.display())?;
     let json = JsonReport {
-        mesh: &args.mesh,
+        mesh: &args.surface.mesh,
         report: &report,
         load: load_average(),
     };

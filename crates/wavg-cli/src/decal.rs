@@ -8,7 +8,7 @@ use std::time::Instant;
 use wavg::apps::{DecalReport, decal_vertices, untextured_faces, write_decal_obj};
 
 use crate::CliError;
-use crate::apps_common::{embed, mesh_and_anchors};
+use crate::apps_common::mesh_and_anchors;
 use crate::decal_material;
 use crate::textio::{self, located};
 
@@ -36,9 +36,7 @@ with a marked corner), mtl and texture (the files the OBJ names; null for `-o -`
 and anchors.")]
 pub struct Args {
     #[command(flatten)]
-    pub mesh: crate::mesh_arg::MeshArg,
-    #[command(flatten)]
-    pub embedding: crate::embedding_arg::EmbeddingArg,
+    pub surface: crate::embedding_arg::SurfaceArgs,
     /// Anchors, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub anchors: PathBuf,
@@ -88,8 +86,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     crate::common::check_outputs(
         &crate::common::inputs(
-            [std::path::Path::new(&*args.mesh), &args.anchors, &args.uv],
-            [&args.embedding.file, &args.texture],
+            [
+                std::path::Path::new(&*args.surface.mesh),
+                &args.anchors,
+                &args.uv,
+            ],
+            [&args.surface.embedding.file, &args.texture],
         ),
         &outputs,
         args.json,
@@ -121,7 +123,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if let Some(t) = &args.texture {
         decal_material::check_texture(t)?;
     }
-    let (mesh, anchors) = mesh_and_anchors(&args.mesh, &args.anchors)?;
+    let (mesh, anchors) = mesh_and_anchors(&args.surface.mesh, &args.anchors)?;
     if uv.len() != anchors.len() {
         return Err(CliError::input(format!(
             "{} has {} (u, v) lines but {} has {} anchors; give one per anchor",
@@ -131,12 +133,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             anchors.len()
         )));
     }
-    let surface = embed(
-        mesh,
-        args.embedding.file.as_deref(),
-        &args.mesh,
-        args.embedding.cache,
-    )?;
+    let surface = args.surface.embed(mesh)?;
     let solver = surface.solver(anchors)?;
     let t = Instant::now();
     let decal = decal_vertices(&solver, &uv, args.max_negative)?;
@@ -159,7 +156,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let report = decal.report();
     if args.json {
         let j = serde_json::to_value(JsonReport {
-            mesh: &args.mesh,
+            mesh: &args.surface.mesh,
             anchors: uv.len(),
             decal: report,
             seconds,

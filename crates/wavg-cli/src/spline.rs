@@ -27,9 +27,7 @@ length (3-D length of the polyline through the samples), plus mesh, controls, de
 closed, bezier.")]
 pub struct Args {
     #[command(flatten)]
-    pub mesh: crate::mesh_arg::MeshArg,
-    #[command(flatten)]
-    pub embedding: crate::embedding_arg::EmbeddingArg,
+    pub surface: crate::embedding_arg::SurfaceArgs,
     /// Control points, one per line (`v VERTEX` or `f FACE B0 B1 B2`).
     #[arg(long)]
     pub control: PathBuf,
@@ -72,8 +70,8 @@ struct JsonReport<'a> {
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(
         &crate::common::inputs(
-            [std::path::Path::new(&*args.mesh), &args.control],
-            [&args.embedding.file],
+            [std::path::Path::new(&*args.surface.mesh), &args.control],
+            [&args.surface.embedding.file],
         ),
         &[("-o", &args.output)],
         args.json,
@@ -88,7 +86,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )));
     }
     let kind = SplineKind::from_options(args.degree, args.closed, args.bezier);
-    let solver = args.embedding.solver(&args.mesh, &args.control)?;
+    let solver = args.surface.solver(&args.control)?;
     let t = Instant::now();
     let curve = evaluate_spline(&solver, kind, args.samples, SPLINE_CHUNK)
         .context(args.control.display())?;
@@ -103,12 +101,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ok as f64 / args.samples as f64,
         "samples of the curve on the surface",
         solver.n_anchors(),
-        &args.mesh,
+        &args.surface.mesh,
     );
     let us = seconds / args.samples as f64 * 1e6;
     if args.json {
         let j = serde_json::to_value(JsonReport {
-            mesh: &args.mesh,
+            mesh: &args.surface.mesh,
             controls: solver.n_anchors(),
             degree: if args.bezier {
                 solver.n_anchors() - 1

@@ -233,11 +233,50 @@ fn transfer_texture_json_keys() {
     assert_keys(&args, &keys);
 }
 
+/// A curve's five control points on `builtin:icosphere`, in `dir`: `--mesh builtin:icosphere
+/// --control FILE --samples 50`.
+fn icosphere_curve(dir: &Path) -> Vec<String> {
+    let control = dir.join("c.txt");
+    std::fs::write(&control, "v 0\nv 500\nv 1000\nv 1500\nv 2000\n").unwrap();
+    [
+        "--mesh",
+        "builtin:icosphere",
+        "--control",
+        &s(&control),
+        "--samples",
+        "50",
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+#[test]
+fn bench_spline_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let keys = [
+        "mesh",
+        "controls",
+        "samples",
+        "ok_samples",
+        "threads",
+        "repeat",
+        "us_per_sample",
+        "us_per_sample_median",
+        "cpu_us_per_sample",
+        "agree_fraction",
+        "max_disagreement",
+        "load",
+    ];
+    let mut args = ["bench", "spline"].map(String::from).to_vec();
+    args.extend(icosphere_curve(dir.path()));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    assert_keys(&[&args[..], &["--repeat", "2", "--json"]].concat(), &keys);
+}
+
 #[test]
 fn spline_json_keys() {
     let dir = tempfile::tempdir().unwrap();
-    let control = dir.path().join("c.txt");
-    std::fs::write(&control, "v 0\nv 500\nv 1000\nv 1500\nv 2000\n").unwrap();
+    let curve = icosphere_curve(dir.path());
     let out = s(&dir.path().join("curve.txt"));
     let keys = [
         "mesh",
@@ -251,18 +290,9 @@ fn spline_json_keys() {
         "us_per_sample",
         "length",
     ];
-    let args = [
-        "spline",
-        "--mesh",
-        "builtin:icosphere",
-        "--control",
-        &s(&control),
-        "--samples",
-        "50",
-        "-o",
-        &out,
-        "--json",
-    ];
+    let mut args = vec!["spline"];
+    args.extend(curve.iter().map(String::as_str));
+    args.extend(["-o", &out, "--json"]);
     assert_keys(&args, &keys);
     assert_keys(&[&args[..], &["--bezier"]].concat(), &keys);
 }
@@ -281,22 +311,17 @@ fn remesh_json_keys() {
          f 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n",
     )
     .unwrap();
-    let out = s(&dir.path().join("fine.obj"));
-    let args = [
-        "remesh",
-        "--mesh",
-        "builtin:icosphere",
-        "--base",
-        &s(&base),
-        "--levels",
-        "1",
-        "--frames",
-        "2",
-        "-o",
-        &out,
-        "--json",
-    ];
-    assert_keys(&args, &common::REMESH_KEYS);
+    let out = dir.path().join("fine.obj");
+    let run = common::remesh_on_sphere(&base, &out, &["--levels", "1", "--frames", "2", "--json"]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let (o, _) = json_object(&run);
+    let mut want = common::REMESH_KEYS.map(String::from);
+    want.sort();
+    assert_eq!(key_paths(&Value::Object(o)), want);
 }
 
 #[test]

@@ -5,10 +5,20 @@ mod common;
 use common::{wavg, wavg_ok};
 
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Output};
 
 use serde_json::Value;
 use wavg::mesh::{TriMesh, ValidMesh, io, procedural};
+
+/// Runs `wavg precompute MESH -o OUT EXTRA...`.
+fn precompute(mesh: &str, out: &Path, extra: &[&str]) -> Output {
+    let args = [
+        &["precompute", mesh, "-o", out.to_str().unwrap()][..],
+        extra,
+    ]
+    .concat();
+    wavg(&args)
+}
 
 fn write(dir: &Path, name: &str, mesh: &TriMesh) -> String {
     let path = dir.join(name);
@@ -22,17 +32,16 @@ fn json_report_and_loadable_file() {
     let mesh = procedural::torus(48, 24, 1.0, 0.4);
     let mesh_path = write(dir.path(), "torus.off", &mesh);
     let out_path = dir.path().join("torus.wavg");
-    let out = wavg_ok(&[
-        "precompute",
+    let out = precompute(
         &mesh_path,
-        "-o",
-        out_path.to_str().unwrap(),
-        "--landmarks",
-        "100",
-        "--seed",
-        "7",
-        "--json",
-    ]);
+        &out_path,
+        &["--landmarks", "100", "--seed", "7", "--json"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // Not a terminal: no progress output at all.
     assert!(
         out.stderr.is_empty(),
@@ -74,14 +83,7 @@ fn json_report_and_loadable_file() {
     ));
 
     // Text mode works too and overwrites atomically.
-    let out = wavg(&[
-        "precompute",
-        &mesh_path,
-        "-o",
-        out_path.to_str().unwrap(),
-        "--landmarks",
-        "50",
-    ]);
+    let out = precompute(&mesh_path, &out_path, &["--landmarks", "50"]);
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("landmarks     50"), "{text}");
@@ -107,14 +109,7 @@ fn two_components_need_largest_component() {
         .extend(small.triangles.iter().map(|t| t.map(|v| v + nb)));
     let mesh_path = write(dir.path(), "two.obj", &m);
     let out_path = dir.path().join("two.wavg");
-    let out = wavg(&[
-        "precompute",
-        &mesh_path,
-        "-o",
-        out_path.to_str().unwrap(),
-        "--landmarks",
-        "60",
-    ]);
+    let out = precompute(&mesh_path, &out_path, &["--landmarks", "60"]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -129,18 +124,23 @@ fn two_components_need_largest_component() {
     assert!(!out_path.exists());
 
     let repaired = dir.path().join("big.off");
-    let out = wavg_ok(&[
-        "precompute",
+    let out = precompute(
         &mesh_path,
-        "-o",
-        out_path.to_str().unwrap(),
-        "--landmarks",
-        "60",
-        "--largest-component",
-        "--repaired-mesh",
-        repaired.to_str().unwrap(),
-        "--json",
-    ]);
+        &out_path,
+        &[
+            "--landmarks",
+            "60",
+            "--largest-component",
+            "--repaired-mesh",
+            repaired.to_str().unwrap(),
+            "--json",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["vertices"], big.n_vertices());
     assert_eq!(
@@ -164,18 +164,13 @@ fn invalid_and_unreadable_meshes_are_clear_errors() {
     m.triangles.push([t[0], t[1], extra]);
     let mesh_path = write(dir.path(), "bad.obj", &m);
     let out_path = dir.path().join("bad.wavg");
-    let out = wavg(&["precompute", &mesh_path, "-o", out_path.to_str().unwrap()]);
+    let out = precompute(&mesh_path, &out_path, &[]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("not a valid oriented manifold"), "{err}");
     assert!(!out_path.exists());
 
-    let out = wavg(&[
-        "precompute",
-        "/nonexistent/x.off",
-        "-o",
-        out_path.to_str().unwrap(),
-    ]);
+    let out = precompute("/nonexistent/x.off", &out_path, &[]);
     assert_eq!(out.status.code(), Some(2));
     assert!(!String::from_utf8_lossy(&out.stderr).contains("panicked"));
 }

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{json_object, wavg, wavg_ok};
+use common::json_object;
 
 /// A cube on the unit sphere with one face split into two triangles.
 const CUBE: &str = "\
@@ -25,22 +25,13 @@ f 1 5 7 3
 f 2 4 8 6
 ";
 
-fn s(p: &std::path::Path) -> String {
-    p.to_str().unwrap().to_string()
-}
-
 #[test]
 fn cube_on_the_sphere() {
     let dir = tempfile::tempdir().unwrap();
     let base = dir.path().join("cube.obj");
     std::fs::write(&base, CUBE).unwrap();
     let out = dir.path().join("fine.obj");
-    let run = wavg_ok(&[
-        "remesh",
-        "--mesh",
-        "builtin:icosphere",
-        "--base",
-        &s(&base),
+    let extra = [
         "--levels",
         "2",
         "--smooth",
@@ -49,10 +40,13 @@ fn cube_on_the_sphere() {
         "3",
         "--threads",
         "2",
-        "-o",
-        &s(&out),
-        "--json",
-    ]);
+    ];
+    let run = common::remesh_on_sphere(&base, &out, &[&extra[..], &["--json"]].concat());
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     let (o, keys) = json_object(&run);
     let mut want = common::REMESH_KEYS.map(String::from);
     want.sort();
@@ -101,15 +95,7 @@ fn bad_bases_write_nothing() {
         ("v 0 0\n", "line 1"),
     ] {
         std::fs::write(&base, text).unwrap();
-        let r = wavg(&[
-            "remesh",
-            "--mesh",
-            "builtin:icosphere",
-            "--base",
-            &s(&base),
-            "-o",
-            &s(&out),
-        ]);
+        let r = common::remesh_on_sphere(&base, &out, &[]);
         let err = String::from_utf8_lossy(&r.stderr);
         assert_eq!(r.status.code(), Some(2), "{text:?}: {err}");
         assert!(err.contains(needle), "{needle}: {err}");

@@ -196,3 +196,19 @@ pub fn wavg_ok_with(args: &[String], extra: &[&str]) -> Output {
     all.extend_from_slice(extra);
     wavg_ok(&all)
 }
+
+/// `wavg remesh` of the base mesh `base` on `builtin:icosphere` (the unit sphere) into
+/// `out`, followed by `extra`.
+pub fn remesh_on_sphere(base: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> Output {
+    let (base, out) = (s(base), s(out));
+    let args = [
+        "remesh",
+        "--mesh",
+        "builtin:icosphere",
+        "--base",
+        &base,
+        "-o",
+        &out,
+    ];
+    wavg(&[&args[..], extra].concat())
+}
