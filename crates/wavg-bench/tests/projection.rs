@@ -7,6 +7,7 @@ use wavg::mesh::procedural;
 use wavg::{EmbeddedMesh, SolveError, ValidMesh};
 use wavg_bench::projection::BRUTE_FORCE_CHECKS;
 use wavg_bench::{ProjectionBenchOptions, ProjectionBenchReport, projection_bench};
+use wavg_testdata::json_keys::{BENCH_PROJECT, sorted};
 
 fn torus() -> Arc<EmbeddedMesh> {
     let mesh = Arc::new(ValidMesh::new(procedural::torus(40, 14, 1.0, 0.35)).unwrap());
@@ -79,20 +80,5 @@ fn serialises_to_the_documented_keys() {
     let v = serde_json::to_value(run(50, 1, true)).unwrap();
     let mut keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
     keys.sort();
-    let mut want = [
-        "vertices",
-        "faces",
-        "queries",
-        "init_s",
-        "bytes_per_face",
-        "onsurface_us",
-        "onsurface_self_fraction",
-        "offset_us",
-        "offset_bruteforce_agree_fraction",
-        "onsurface_fallback_fraction",
-        "offset_fallback_fraction",
-        "fallback_us",
-    ];
-    want.sort();
-    assert_eq!(keys, want);
+    assert_eq!(keys, sorted(BENCH_PROJECT, &[]));
 }

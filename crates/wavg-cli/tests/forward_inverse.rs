@@ -3,8 +3,10 @@
 mod common;
 
 use std::path::{Path, PathBuf};
+use std::process::Output;
 
 use common::{json_object, parse_floats, read_rows, wavg, wavg_ok};
+use wavg_testdata::json_keys::{BENCH_ROUNDTRIP, BENCH_ROUNDTRIP_VERIFIED, sorted};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
@@ -108,6 +110,20 @@ fn expect_input_error(args: &[&str], out_file: &Path, needle: &str) {
     assert_eq!(leftovers, 0, "temporary file left behind");
 }
 
+/// Runs `wavg COMMAND` ([`solve_args`], no extra arguments) and asserts success.
+fn solve_ok(command: &str, anchors: &Path, input: &Path, out: &Path) -> Output {
+    wavg_ok(&solve_args(command, s(anchors), s(input), s(out), &[]))
+}
+
+/// [`expect_input_error`] of `wavg COMMAND` ([`solve_args`], no extra arguments).
+fn expect_solve_error(command: &str, anchors: &Path, input: &Path, out: &Path, needle: &str) {
+    expect_input_error(
+        &solve_args(command, s(anchors), s(input), s(out), &[]),
+        out,
+        needle,
+    );
+}
+
 #[test]
 fn malformed_weights_are_reported_with_their_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -124,11 +140,7 @@ fn malformed_weights_are_reported_with_their_line() {
         ("0.2 0.3 0.5\n0.2 inf 0.5\n", "not finite"),
     ] {
         let w = write(dir.path(), "w.txt", text);
-        expect_input_error(
-            &solve_args("forward", s(&anchors), s(&w), s(&out), &[]),
-            &out,
-            needle,
-        );
+        expect_solve_error("forward", &anchors, &w, &out, needle);
     }
     // --normalize accepts a wrong sum.
     let w = write(dir.path(), "w.txt", "2 3 5\n");
@@ -161,25 +173,13 @@ fn malformed_points_and_anchors_are_reported_with_their_line() {
         ("v -3\n", "p.txt:1:"),
     ] {
         let p = write(dir.path(), "p.txt", text);
-        expect_input_error(
-            &solve_args("inverse", s(&good), s(&p), s(&out), &[]),
-            &out,
-            needle,
-        );
+        expect_solve_error("inverse", &good, &p, &out, needle);
         // The same file as anchors is rejected with its line too.
         let w = write(dir.path(), "w.txt", "1\n");
-        expect_input_error(
-            &solve_args("forward", s(&p), s(&w), s(&out), &[]),
-            &out,
-            needle,
-        );
+        expect_solve_error("forward", &p, &w, &out, needle);
     }
     let missing = dir.path().join("missing.txt");
-    expect_input_error(
-        &solve_args("inverse", s(&good), s(&missing), s(&out), &[]),
-        &out,
-        "missing.txt",
-    );
+    expect_solve_error("inverse", &good, &missing, &out, "missing.txt");
 }
 
 #[test]
@@ -210,24 +210,7 @@ fn bench_roundtrip_reports_the_documented_json() {
     let obj = v.as_object().unwrap();
     let mut keys: Vec<&str> = obj.keys().map(|k| k.as_str()).collect();
     keys.sort();
-    assert_eq!(
-        keys,
-        [
-            "anchors",
-            "faces",
-            "forward_us",
-            "forward_warm_us",
-            "inverse_us",
-            "mesh",
-            "negative_weight_fraction",
-            "queries",
-            "roundtrip_err_p50",
-            "roundtrip_err_p99",
-            "roundtrip_ok_fraction",
-            "threads",
-            "vertices",
-        ]
-    );
+    assert_eq!(keys, sorted(BENCH_ROUNDTRIP, &["mesh"]));
     assert_eq!(obj["anchors"], 12);
     assert_eq!(obj["queries"], 300);
     assert_eq!(obj["threads"], 2);
@@ -269,13 +252,7 @@ fn inverse_forward_back(
         assert!((r.iter().sum::<f64>() - 1.0).abs() < 1e-9);
     }
     let back = dir.join("back.txt");
-    wavg_ok(&solve_args(
-        "forward",
-        s(&anchors),
-        s(&weights),
-        s(&back),
-        &[],
-    ));
+    solve_ok("forward", &anchors, &weights, &back);
     let back: Vec<Vec<f64>> = read_rows(&back);
     for (b, o) in back.iter().zip(originals) {
         assert_eq!(b.len(), 7, "FACE B0 B1 B2 X Y Z");
@@ -320,13 +297,14 @@ fn bench_roundtrip_verified_adds_its_keys() {
     ]);
     let (obj, keys) = json_object(&out);
     assert_eq!(keys.len(), 13 + 5);
-    for k in [
-        "verified_inverse_us",
-        "verified_roundtrip_ok_fraction",
-        "verified_negative_weight_fraction",
-        "verified_penalized_fraction",
-        "verified_not_reached_fraction",
-    ] {
+    assert_eq!(
+        keys,
+        sorted(
+            &[BENCH_ROUNDTRIP, &["mesh"]].concat(),
+            BENCH_ROUNDTRIP_VERIFIED
+        )
+    );
+    for &k in BENCH_ROUNDTRIP_VERIFIED {
         let x = obj[k].as_f64().unwrap_or_else(|| panic!("{k}"));
         assert!(x.is_finite() && x >= 0.0, "{k} = {x}");
     }
@@ -355,37 +333,19 @@ fn long_files_stream_in_chunks() {
     }
     let pts = write(dir.path(), "points.txt", &points);
     let w_file = dir.path().join("weights.txt");
-    wavg_ok(&solve_args(
-        "inverse",
-        s(&anchors),
-        s(&pts),
-        s(&w_file),
-        &[],
-    ));
+    solve_ok("inverse", &anchors, &pts, &w_file);
     let weights = read_rows(&w_file);
     assert_eq!(weights.len(), n);
     // Spot checks against a one-line run at a chunk boundary and far into the file.
     for i in [0usize, 65_535, 65_536, 131_072, n - 1] {
         let one = write(dir.path(), "one.txt", points.lines().nth(i).unwrap());
         let one_out = dir.path().join("one_out.txt");
-        wavg_ok(&solve_args(
-            "inverse",
-            s(&anchors),
-            s(&one),
-            s(&one_out),
-            &[],
-        ));
+        solve_ok("inverse", &anchors, &one, &one_out);
         assert_eq!(read_rows(&one_out)[0], weights[i], "line {}", i + 1);
     }
     // Forward on one thread to stdout equals forward to a file on all threads.
     let back = dir.path().join("back.txt");
-    wavg_ok(&solve_args(
-        "forward",
-        s(&anchors),
-        s(&w_file),
-        s(&back),
-        &[],
-    ));
+    solve_ok("forward", &anchors, &w_file, &back);
     let out = wavg_ok(&solve_args(
         "forward",
         s(&anchors),
@@ -398,8 +358,10 @@ fn long_files_stream_in_chunks() {
     let mut bad = points.clone();
     bad.push_str("f 1 0.5 0.5\n");
     let bad_pts = write(dir.path(), "bad.txt", &bad);
-    expect_input_error(
-        &solve_args("inverse", s(&anchors), s(&bad_pts), s(&w_file), &[]),
+    expect_solve_error(
+        "inverse",
+        &anchors,
+        &bad_pts,
         &w_file,
         &format!("bad.txt:{}:", n + 1),
     );
@@ -428,8 +390,10 @@ fn long_files_stream_in_chunks() {
     write_npy(&bad_npy, rows[0].len(), &rows.concat());
     for (input, output) in [(&bad_w, &back), (&bad_npy, &dir.path().join("back.npy"))] {
         let name = input.file_name().unwrap().to_string_lossy().into_owned();
-        expect_input_error(
-            &solve_args("forward", s(&anchors), s(input), s(output), &[]),
+        expect_solve_error(
+            "forward",
+            &anchors,
+            input,
             output,
             &format!("{name}:{}:", k + 1),
         );
@@ -485,13 +449,7 @@ fn npy_files_match_the_text_formats() {
         (&pts_npy, j("w.npy")),
         (&pts_txt, j("w2.npy")),
     ] {
-        wavg_ok(&solve_args(
-            "inverse",
-            s(&anchors),
-            s(input),
-            s(&output),
-            &[],
-        ));
+        solve_ok("inverse", &anchors, input, &output);
     }
     let text_rows: Vec<f64> = read_rows(&j("w.txt")).concat();
     for f in ["w.npy", "w2.npy"] {
@@ -499,48 +457,22 @@ fn npy_files_match_the_text_formats() {
         assert_eq!((rows, cols), (3, 12));
         assert_eq!(data, text_rows, "{f}");
     }
-    wavg_ok(&solve_args(
-        "forward",
-        s(&anchors),
-        s(&j("w.npy")),
-        s(&j("b.npy")),
-        &[],
-    ));
-    wavg_ok(&solve_args(
-        "forward",
-        s(&anchors),
-        s(&j("w.txt")),
-        s(&j("b.txt")),
-        &[],
-    ));
+    solve_ok("forward", &anchors, &j("w.npy"), &j("b.npy"));
+    solve_ok("forward", &anchors, &j("w.txt"), &j("b.txt"));
     let (rows, cols, data) = read_npy(&j("b.npy"));
     assert_eq!((rows, cols), (3, 7));
     assert_eq!(data, read_rows(&j("b.txt")).concat());
     assert_eq!(data[0], 3.0);
     // A row with a fractional face and a truncated file are input errors naming the file.
     write_npy(&j("bad.npy"), 4, &[3.0, 0.2, 0.3, 0.5, 1.5, 0.2, 0.3, 0.5]);
-    expect_input_error(
-        &solve_args(
-            "inverse",
-            s(&anchors),
-            s(&j("bad.npy")),
-            s(&j("w.npy")),
-            &[],
-        ),
+    expect_solve_error(
+        "inverse",
+        &anchors,
+        &j("bad.npy"),
         &j("w.npy"),
         "bad.npy:2: face index 1.5",
     );
     let bytes = std::fs::read(&pts_npy).unwrap();
     std::fs::write(j("cut.npy"), &bytes[..bytes.len() - 8]).unwrap();
-    expect_input_error(
-        &solve_args(
-            "inverse",
-            s(&anchors),
-            s(&j("cut.npy")),
-            s(&j("w.npy")),
-            &[],
-        ),
-        &j("w.npy"),
-        "cut.npy",
-    );
+    expect_solve_error("inverse", &anchors, &j("cut.npy"), &j("w.npy"), "cut.npy");
 }
