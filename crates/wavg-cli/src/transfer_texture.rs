@@ -63,7 +63,7 @@ pub struct Args {
     pub paper: bool,
     /// Solve texels on every N-th row and column exactly and interpolate between them
     /// inside a chart (1: solve every texel).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = wavg::apps::TransferOptions::default().stride)]
     pub stride: u32,
     /// Print one JSON object on standard output.
     #[arg(long)]
