@@ -103,7 +103,10 @@ fn spline<'py>(
 /// valid (n,), reason (n,), report)``; ``report`` has the keys of
 /// ``wavg correspond --json``.
 #[pyfunction]
-#[pyo3(signature = (src, dst, src_anchors, dst_anchors, validity="local", verified=true, max_negative=-0.1, max_stretch=4.0, threads=None))]
+#[pyo3(
+    signature = (src, dst, src_anchors, dst_anchors, validity="local", verified=true, max_negative=CorrespondOptions::default().max_negative, max_stretch=CorrespondOptions::default().max_stretch, threads=None),
+    text_signature = "(src, dst, src_anchors, dst_anchors, validity=\"local\", verified=True, max_negative=-0.1, max_stretch=4.0, threads=None)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn correspond<'py>(
     py: Python<'py>,
@@ -284,7 +287,7 @@ fn decal<'py>(
 /// ``Surface(V, F, uv=...)``). ``size``: ``(W, H)`` of the result (default: the source
 /// texture's). Texels nothing maps to have alpha 0.
 #[pyfunction]
-#[pyo3(signature = (src, src_texture, dst, src_anchors, dst_anchors, size=None, verified=true, stride=Int::of(4), threads=None), text_signature = "(src, src_texture, dst, src_anchors, dst_anchors, size=None, verified=True, stride=4, threads=None)")]
+#[pyo3(signature = (src, src_texture, dst, src_anchors, dst_anchors, size=None, verified=true, stride=Int::of(TransferOptions::default().stride as i128), threads=None), text_signature = "(src, src_texture, dst, src_anchors, dst_anchors, size=None, verified=True, stride=4, threads=None)")]
 #[allow(clippy::too_many_arguments)]
 fn transfer_texture<'py>(
     py: Python<'py>,
