@@ -1,7 +1,7 @@
 """Headless tests of the wavg Blender add-on, run inside Blender:
 
     blender -b --factory-startup --python-exit-code 1 --python blender/tests/run.py -- \\
-        --zip target/wavg_blender.zip [--wavg-cli target/debug/wavg] [--bench]
+        --zip target/wavg_blender.zip [--wavg-cli target/debug/wavg] [--bench | --bench-only]
 
 Installs the add-on from the zip (into a temporary script folder), builds meshes in code,
 runs every operator as a script would (active object, selected objects, selection order)
@@ -31,6 +31,7 @@ def parse_args():
     p.add_argument("--zip", required=True, help="the add-on zip (cargo xtask blender-addon)")
     p.add_argument("--wavg-cli", help="the wavg command line, to compare the decal with")
     p.add_argument("--bench", action="store_true", help="also measure (50k-face mesh)")
+    p.add_argument("--bench-only", action="store_true", help="measure only (no checks)")
     p.add_argument(
         "--extension", action="store_true",
         help="install as a Blender 4.2+ extension (Install from Disk) instead of a legacy add-on",
@@ -74,8 +75,8 @@ def main():
     os.environ["WAVG_BLENDER_CACHE"] = os.path.join(tmp, "cache")
     install(args.zip, tmp, args.extension)
     ctx = cases.Context(tmp=tmp, cli=args.wavg_cli)
-    tests = cases.TESTS + cases_more.TESTS
-    if args.bench:
+    tests = [] if args.bench_only else cases.TESTS + cases_more.TESTS
+    if args.bench or args.bench_only:
         import bench
 
         tests += bench.TESTS

@@ -81,3 +81,96 @@ fn no_cross_section_of_a_thin_tube_collapses() {
         "opposite points embedded {worst} x their distance apart"
     );
 }
+
+/// The worst ratio of embedded to straight-line distance over `pairs` of body `shape`'s
+/// vertices (`procedural::body`: fingers, toes, ears), with its pair, after the default
+/// precomputation.
+fn worst_pair(
+    shape: &procedural::FigureShape,
+    pairs: impl Fn(&ValidMesh) -> Vec<(usize, usize)>,
+) -> (f64, usize, usize) {
+    let mesh = ValidMesh::new(procedural::body(shape)).unwrap();
+    let opts = PrecomputeOptions {
+        quality_pairs: 0,
+        ..Default::default()
+    };
+    let (emb, _) = precompute(&mesh, &opts, &NoProgress).unwrap();
+    let p = &mesh.positions;
+    let ratio = |a: usize, b: usize| {
+        let (x, y) = (emb.coords[a], emb.coords[b]);
+        let e = x
+            .iter()
+            .zip(&y)
+            .map(|(s, t)| (s - t).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        e / (p[a] - p[b]).norm()
+    };
+    pairs(&mesh)
+        .into_iter()
+        .map(|(a, b)| (ratio(a, b), a, b))
+        .min_by(|x, y| x.0.total_cmp(&y.0))
+        .unwrap()
+}
+
+/// 2,048 seeded random pairs of distinct vertices, as the exact-geodesic comparison
+/// samples them (a small linear congruential generator: no dependency).
+fn random_pairs(mesh: &ValidMesh) -> Vec<(usize, usize)> {
+    let n = mesh.n_vertices();
+    let mut s = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = || {
+        s = s.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        (s >> 33) as usize % n
+    };
+    (0..2048)
+        .map(|_| (next(), next()))
+        .filter(|(a, b)| a != b)
+        .collect()
+}
+
+/// Human-like bodies (fingers, toes, ears) embed no random pair of vertices closer than
+/// half their straight-line distance (a collapsed pair: one part folded onto another).
+#[test]
+fn no_random_pair_of_a_body_collapses() {
+    for shape in [
+        procedural::FigureShape::SLIM,
+        procedural::FigureShape::HEAVY,
+    ] {
+        let (worst, a, b) = worst_pair(&shape, random_pairs);
+        assert!(
+            worst >= 0.5,
+            "{shape:?}: vertices {a} and {b} embedded {worst:.3} x their distance apart"
+        );
+    }
+}
+
+/// The same for every pair within 1.5 cm of each other (the cross-sections of fingers
+/// and toes, ears beside the head). Fails today: the cross-sections of fingers and toes
+/// (8 vertices around, 0.6-1.1 cm radius) collapse to 0.003-0.008 of their width,
+/// as the landmarks of a part that thin do not go round it.
+#[test]
+#[ignore = "fails today: finger and toe cross-sections collapse (issue 41)"]
+fn no_close_pair_of_a_body_collapses() {
+    let close = |mesh: &ValidMesh| {
+        let p = &mesh.positions;
+        let mut pairs = Vec::new();
+        for a in 0..p.len() {
+            for b in a + 1..p.len() {
+                if (p[a] - p[b]).norm() < 0.015 {
+                    pairs.push((a, b));
+                }
+            }
+        }
+        pairs
+    };
+    for shape in [
+        procedural::FigureShape::SLIM,
+        procedural::FigureShape::HEAVY,
+    ] {
+        let (worst, a, b) = worst_pair(&shape, close);
+        assert!(
+            worst >= 0.5,
+            "{shape:?}: vertices {a} and {b} embedded {worst:.3} x their distance apart"
+        );
+    }
+}

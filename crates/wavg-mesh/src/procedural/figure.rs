@@ -70,8 +70,28 @@ fn j(x: f64, y: f64, z: f64, radius: f64, rows: usize) -> Joint {
 /// assert_ne!(a.positions, b.positions);
 /// ```
 pub fn figure(s: &FigureShape) -> TriMesh {
-    let (_, tape) = build(TIP, &skeleton(&FigureShape::SLIM), None);
-    let (mut mesh, _) = build(TIP, &skeleton(s), Some(tape));
+    shaped(s, false)
+}
+
+/// [`figure`] with ears and five toes per foot (5,000-odd vertices): more thin parts
+/// that lie close to others (ears beside the head, toes beside each other), and again
+/// the same connectivity for every shape.
+///
+/// ```
+/// use wavg_mesh::procedural::{FigureShape, body, figure};
+/// let (a, b) = (body(&FigureShape::SLIM), body(&FigureShape::HEAVY));
+/// assert_eq!(a.triangles, b.triangles);
+/// assert!(a.n_vertices() > figure(&FigureShape::SLIM).n_vertices());
+/// ```
+pub fn body(s: &FigureShape) -> TriMesh {
+    shaped(s, true)
+}
+
+/// The figure of shape `s`, with ears and toes when `extremities`: the slim skeleton
+/// records the connectivity's choices, `s`'s replays them.
+fn shaped(s: &FigureShape, extremities: bool) -> TriMesh {
+    let (_, tape) = build(TIP, &skeleton(&FigureShape::SLIM, extremities), None);
+    let (mut mesh, _) = build(TIP, &skeleton(s, extremities), Some(tape));
     for p in &mut mesh.positions {
         *p *= s.height;
     }
@@ -81,8 +101,9 @@ pub fn figure(s: &FigureShape) -> TriMesh {
 const TIP: V3 = V3::new(0.0, 0.0, 1.80);
 
 /// Head and neck down to the shoulders, where the left arm splits off, then the right
-/// arm, then the legs at the hips.
-fn skeleton(s: &FigureShape) -> Limb {
+/// arm, then the legs at the hips; with `extremities`, the ears split off the head and
+/// the feet end in toes.
+fn skeleton(s: &FigureShape, extremities: bool) -> Limb {
     let g = s.girth;
     let torso = Limb {
         joints: vec![
@@ -90,7 +111,10 @@ fn skeleton(s: &FigureShape) -> Limb {
             j(0.0, 0.0, 0.93, 0.15 * g, 3),
         ],
         around: 36,
-        children: vec![(18, leg(s, -1.0)), (18, leg(s, 1.0))],
+        children: vec![
+            (18, leg(s, -1.0, extremities)),
+            (18, leg(s, 1.0, extremities)),
+        ],
         relative: false,
     };
     let chest = Limb {
@@ -99,22 +123,60 @@ fn skeleton(s: &FigureShape) -> Limb {
         children: vec![(8, arm(s, 1.0)), (32, torso)],
         relative: false,
     };
-    Limb {
-        joints: vec![
-            j(0.0, 0.0, 1.74, 0.07, 2),
-            j(0.0, 0.0, 1.63, 0.095, 3),
-            j(0.0, 0.0, 1.53, 0.05, 3),
-            j(0.0, 0.0, 1.47, 0.055, 2),
-            j(0.0, 0.0, 1.40, 0.17 * g, 2),
-        ],
+    let neck = vec![
+        j(0.0, 0.0, 1.53, 0.05, 3),
+        j(0.0, 0.0, 1.47, 0.055, 2),
+        j(0.0, 0.0, 1.40, 0.17 * g, 2),
+    ];
+    let shoulders = vec![(10, arm(s, -1.0)), (38, chest)];
+    if !extremities {
+        let mut joints = vec![j(0.0, 0.0, 1.74, 0.07, 2), j(0.0, 0.0, 1.63, 0.095, 3)];
+        joints.extend(neck);
+        return Limb {
+            joints,
+            around: 48,
+            children: shoulders,
+            relative: false,
+        };
+    }
+    // Down to the ears' height, where the left ear splits off; a row lower the right.
+    let lower = Limb {
+        joints: neck,
         around: 48,
-        children: vec![(10, arm(s, -1.0)), (38, chest)],
+        children: shoulders,
+        relative: false,
+    };
+    let right = Limb {
+        joints: vec![j(0.0, 0.0, 1.60, 0.093, 2)],
+        around: 48,
+        children: vec![(6, ear(1.0)), (42, lower)],
+        relative: false,
+    };
+    Limb {
+        joints: vec![j(0.0, 0.0, 1.74, 0.07, 2), j(0.0, 0.0, 1.63, 0.095, 3)],
+        around: 48,
+        children: vec![(6, ear(-1.0)), (42, right)],
         relative: false,
     }
 }
 
-/// A leg on side `side` (-1 or 1), ending in a foot.
-fn leg(s: &FigureShape, side: f64) -> Limb {
+/// An ear on side `side` (-1 or 1): a short flat-ish tube out of the side of the head,
+/// bent backwards and up, close to the head.
+fn ear(side: f64) -> Limb {
+    Limb {
+        joints: vec![
+            j(side * 0.105, -0.005, 1.615, 0.018, 2),
+            j(side * 0.118, -0.02, 1.625, 0.016, 2),
+            j(side * 0.122, -0.035, 1.64, 0.01, 2),
+        ],
+        around: 8,
+        children: Vec::new(),
+        relative: false,
+    }
+}
+
+/// A leg on side `side` (-1 or 1), ending in a foot, with five toes when `toes`.
+fn leg(s: &FigureShape, side: f64, toes: bool) -> Limb {
     let g = s.girth;
     let (sx, cz) = (s.leg_spread.sin(), s.leg_spread.cos());
     let hip = V3::new(side * 0.08 * g, 0.0, 0.86);
@@ -149,8 +211,28 @@ fn leg(s: &FigureShape, side: f64) -> Limb {
             },
         ],
         around: 24,
-        children: Vec::new(),
+        children: if toes {
+            [4, 5, 5, 5, 5].map(|arc| (arc, toe(s))).to_vec()
+        } else {
+            Vec::new()
+        },
         relative: false,
+    }
+}
+
+/// A toe: a short tube ahead of its arc of the foot's end, spreading a little outwards.
+fn toe(s: &FigureShape) -> Limb {
+    let radius = 0.7 * s.finger_radius;
+    Limb {
+        joints: (0..=2)
+            .map(|k| {
+                let t = 0.008 + 0.012 * k as f64;
+                j(0.2 * t, 0.0, t, radius * (1.0 - 0.1 * k as f64), 2)
+            })
+            .collect(),
+        around: 8,
+        children: Vec::new(),
+        relative: true,
     }
 }
 
@@ -213,8 +295,8 @@ mod tests {
 
     #[test]
     fn every_shape_is_a_closed_oriented_genus_0_surface() {
-        for s in [FigureShape::SLIM, FigureShape::HEAVY] {
-            let m = figure(&s);
+        let shapes = [FigureShape::SLIM, FigureShape::HEAVY];
+        for m in shapes.iter().flat_map(|s| [figure(s), body(s)]) {
             let a = analyze(&m);
             let st = a.stats;
             assert!(st.manifold && st.oriented && st.watertight, "{st:?}");

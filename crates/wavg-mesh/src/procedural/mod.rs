@@ -14,7 +14,7 @@ mod plate;
 mod tubes;
 
 use crate::mesh::TriMesh;
-pub use figure::{FigureShape, figure};
+pub use figure::{FigureShape, body, figure};
 pub use plate::holed_plate;
 
 /// Unit sphere: an icosahedron subdivided `level` times (10 * 4^level + 2 vertices).
