@@ -15,6 +15,11 @@ pub const PEAK_BYTES_PER_VERTEX: u64 = 1500;
 /// program): with [`PEAK_BYTES_PER_VERTEX`], the smallest that covers every measured
 /// peak (0.2M to 8.6M vertices).
 pub const PEAK_BYTES_BASE: u64 = 700 << 20;
+/// Below about 0.9M vertices the peak follows a steeper, lower line (the least-squares
+/// mesh is factored directly): 300 MB + 2,000 B a vertex covers the peaks measured at 0.2M
+/// and 0.8M, so that small meshes are not refused on small machines.
+const SMALL_BASE: u64 = 300_000_000;
+const SMALL_PER_VERTEX: u64 = 2000;
 
 /// The environment variable that overrides the memory available (bytes, or with a `K`,
 /// `M` or `G` suffix): for tests, and to let a precomputation run that the estimate
@@ -57,7 +62,10 @@ impl std::fmt::Display for MemoryShortfall {
 /// assert!(small < wavg::precompute_peak_bytes(10_000_000));
 /// ```
 pub fn precompute_peak_bytes(vertices: usize) -> u64 {
-    PEAK_BYTES_BASE.saturating_add(PEAK_BYTES_PER_VERTEX.saturating_mul(vertices as u64))
+    let line = |base: u64, per_vertex: u64| {
+        base.saturating_add(per_vertex.saturating_mul(vertices as u64))
+    };
+    line(PEAK_BYTES_BASE, PEAK_BYTES_PER_VERTEX).min(line(SMALL_BASE, SMALL_PER_VERTEX))
 }
 
 /// The memory this process may still use, and where the figure came from: the
@@ -158,6 +166,12 @@ mod tests {
         assert!(m.contains("2.00 GB are available (a test)"), "{m}");
         assert!(check_fits(3_000_000, Some((6_000_000_000, "a test"))).is_ok());
         assert!(check_fits(3_000_000, None).is_ok());
+        // Small meshes follow the lower line: 320 MB for 10,000 vertices.
+        assert_eq!(precompute_peak_bytes(10_000), 320_000_000);
+        assert_eq!(
+            precompute_peak_bytes(3_000_000),
+            (700 << 20) + 4_500_000_000
+        );
     }
 
     #[test]
