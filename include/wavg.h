@@ -54,6 +54,9 @@ typedef enum wavg_status {
   WAVG_STATUS_CANCELLED = 5,
   // An internal error (a bug in the library); the handles involved stay valid.
   WAVG_STATUS_PANIC = 6,
+  // The computation would need more memory than the machine has available (the
+  // message gives the estimate and the available bytes); refused before it started.
+  WAVG_STATUS_OUT_OF_MEMORY = 7,
 } wavg_status;
 
 // Stage of the precomputation, passed to the progress callback.

@@ -25,7 +25,8 @@ pub(crate) fn raise(py: Python<'_>, name: &str, message: String) -> PyErr {
 /// The Python exception for a library error, the one table from error kinds to classes:
 /// `InvalidMeshError` (with `.problems`), `InvalidArgumentError` (a `ValueError`),
 /// `WavgIOError` (an `OSError`, for failed reads and writes), `NoSolutionError`,
-/// `CancelledError`, and `WavgError` itself (the base of them all) for a failure of the
+/// `CancelledError`, `OutOfMemoryError` (a `MemoryError`: a precomputation the machine
+/// cannot hold, refused before it starts), and `WavgError` itself (the base of them all) for a failure of the
 /// library on valid input.
 pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
     let message = e.message();
@@ -48,6 +49,7 @@ pub(crate) fn to_py(py: Python<'_>, e: Error) -> PyErr {
         ErrorKind::NoSolution => raise(py, "NoSolutionError", message),
         ErrorKind::Cancelled => raise(py, "CancelledError", message),
         ErrorKind::Internal => raise(py, "WavgError", message),
+        ErrorKind::OutOfMemory => raise(py, "OutOfMemoryError", message),
     }
 }
 

@@ -12,6 +12,8 @@ def test_exception_hierarchy():
     assert issubclass(wavg.InvalidMeshError, ValueError)
     assert issubclass(wavg.InvalidArgumentError, ValueError)
     assert issubclass(wavg.WavgIOError, OSError)
+    assert issubclass(wavg.OutOfMemoryError, wavg.WavgError)
+    assert issubclass(wavg.OutOfMemoryError, MemoryError)
 
 
 def test_invalid_mesh_lists_problems(torus_mesh):

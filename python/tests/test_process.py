@@ -126,3 +126,23 @@ def test_the_callable_sees_every_stage_in_order():
     assert stages == ["decimate", "geodesics", "mds", "lsmesh", "quality"], calls
     assert all(0 <= d <= t for _, d, t in calls)
     assert calls[-1][1] == calls[-1][2], calls[-1]
+
+
+OUT_OF_MEMORY = textwrap.dedent("""
+    import wavg
+    from conftest import torus
+    S = wavg.Surface(*torus())
+    try:
+        S.precompute(landmarks=40, progress=False, cache=False)
+    except wavg.OutOfMemoryError as e:
+        assert isinstance(e, MemoryError) and isinstance(e, wavg.WavgError)
+        print("refused:", e)
+""")
+
+
+def test_a_precompute_beyond_the_available_memory_raises_out_of_memory():
+    # The environment override stands in for a small machine; the check runs before any work.
+    env = dict(os.environ, WAVG_MEMORY_AVAILABLE="1M")
+    out = subprocess.run([sys.executable, "-c", OUT_OF_MEMORY], capture_output=True, text=True,
+                         env=env, cwd=os.path.dirname(__file__), check=True).stdout
+    assert out.startswith("refused:") and "are available" in out, out

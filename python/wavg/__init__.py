@@ -13,6 +13,7 @@ from ._errors import (
     InvalidArgumentError,
     InvalidMeshError,
     NoSolutionError,
+    OutOfMemoryError,
     WavgError,
     WavgIOError,
 )
@@ -35,6 +36,7 @@ __all__ = [
     "InvalidArgumentError",
     "InvalidMeshError",
     "NoSolutionError",
+    "OutOfMemoryError",
     "Points",
     "Remesher",
     "Solver",

@@ -1,5 +1,5 @@
 from ._errors import (CancelledError, InvalidArgumentError, InvalidMeshError, NoSolutionError,
-                      WavgError, WavgIOError)
+                      OutOfMemoryError, WavgError, WavgIOError)
 from ._types import Correspondence, Points
 from ._wavg import (Remesher, Solver, Surface, __version__, cache_dir, cache_entries, correspond,
                     decal, read_anchors, read_mesh, read_png, render, save_png, spline,

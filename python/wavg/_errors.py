@@ -30,3 +30,10 @@ class NoSolutionError(WavgError):
 
 class CancelledError(WavgError):
     """The progress callable asked to stop."""
+
+
+class OutOfMemoryError(WavgError, MemoryError):
+    """A precomputation would need more memory than the machine has available.
+
+    Refused before it starts; the message gives the estimate and the available memory.
+    """

@@ -49,6 +49,7 @@ pub fn exit_code(kind: ErrorKind) -> u8 {
         ErrorKind::InvalidArgument | ErrorKind::InvalidMesh | ErrorKind::Io => 2,
         ErrorKind::Cancelled => 130,
         ErrorKind::NoSolution | ErrorKind::Write | ErrorKind::Internal => 1,
+        ErrorKind::OutOfMemory => 1,
     }
 }
 

@@ -156,7 +156,9 @@ fn root_long_help() -> String {
          accept,\nthe limits on options and how outputs are written: docs/limits.md.\n\n\
          Exit status: 0 success; 2 unreadable or malformed input (one line on stderr naming the \
          file\nand line); 130 interrupted (Ctrl-C); 1 any other failure (an output that cannot \
-         be\nwritten, a question without an answer, a failure of wavg itself).",
+         be\nwritten, a question without an answer, a precomputation refused because the \
+         machine's\navailable memory is below its estimated peak (the message gives both; \
+         `docs/limits.md`),\na failure of wavg itself).",
         names.join(", ")
     )
 }

@@ -57,3 +57,39 @@ fn a_failed_write_exits_1() {
         "{err}"
     );
 }
+
+/// A precomputation the machine's memory cannot hold is refused before it starts (exit
+/// 1, not the input's fault), with the estimate and the available memory, and nothing is
+/// written; the environment override stands in for a small machine.
+#[test]
+fn a_precomputation_beyond_the_available_memory_is_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.wavg");
+    let run = |available: &str| {
+        common::wavg_command()
+            .env("WAVG_MEMORY_AVAILABLE", available)
+            .args(["precompute", "builtin:torus", "-o", out.to_str().unwrap()])
+            .output()
+            .unwrap()
+    };
+    let t = std::time::Instant::now();
+    let refused = run("1M");
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("needs about") && err.contains("0.00 GB are available"),
+        "{err}"
+    );
+    assert!(err.contains("WAVG_MEMORY_AVAILABLE"), "{err}");
+    assert!(!out.exists());
+    assert!(t.elapsed().as_secs() < 30, "refused up front");
+    // The same with room: computed.
+    let ok = run("64G");
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    assert!(out.exists());
+}

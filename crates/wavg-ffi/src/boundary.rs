@@ -37,6 +37,7 @@ pub(crate) const fn status_of(kind: ErrorKind) -> wavg_status {
         ErrorKind::NoSolution => wavg_status::WAVG_STATUS_NO_SOLUTION,
         ErrorKind::Cancelled => wavg_status::WAVG_STATUS_CANCELLED,
         ErrorKind::Internal => wavg_status::WAVG_STATUS_PANIC,
+        ErrorKind::OutOfMemory => wavg_status::WAVG_STATUS_OUT_OF_MEMORY,
     }
 }
 

@@ -24,6 +24,9 @@ pub enum wavg_status {
     WAVG_STATUS_CANCELLED = 5,
     /// An internal error (a bug in the library); the handles involved stay valid.
     WAVG_STATUS_PANIC = 6,
+    /// The computation would need more memory than the machine has available (the
+    /// message gives the estimate and the available bytes); refused before it started.
+    WAVG_STATUS_OUT_OF_MEMORY = 7,
 }
 
 /// A point on the surface: a triangle and barycentric coordinates with respect to its

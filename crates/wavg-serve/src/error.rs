@@ -7,20 +7,22 @@ use wavg::ErrorKind;
 /// `{"error": MESSAGE}`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ApiError {
-    /// HTTP status (400, 404, 405, 413, 503, 500).
+    /// HTTP status (400, 404, 405, 413, 503, 500, 507).
     pub status: u16,
     /// What is wrong, on one line.
     pub message: String,
 }
 
 /// The HTTP status of a library failure of `kind`: 400 for what the caller sent (values,
-/// meshes, questions without an answer), 500 for failures of the server's own work.
+/// meshes, questions without an answer), 500 for failures of the server's own work, 507
+/// Insufficient Storage for a precomputation the machine's memory cannot hold.
 pub fn status_of(kind: ErrorKind) -> u16 {
     match kind {
         ErrorKind::InvalidArgument | ErrorKind::InvalidMesh | ErrorKind::NoSolution => 400,
         // No request names a file, and nothing cancels a request.
         ErrorKind::Io | ErrorKind::Cancelled => 500,
         ErrorKind::Write | ErrorKind::Internal => 500,
+        ErrorKind::OutOfMemory => 507,
     }
 }
 
@@ -69,6 +71,7 @@ mod tests {
         for kind in [ErrorKind::Io, ErrorKind::Cancelled] {
             assert_eq!(status_of(kind), 500, "{kind:?}");
         }
+        assert_eq!(status_of(ErrorKind::OutOfMemory), 507);
     }
 
     #[test]

@@ -47,6 +47,10 @@ pub enum Error {
     /// A NumPy `.npy` array could not be read.
     #[error(transparent)]
     Npy(#[from] NpyError),
+    /// A precomputation refused before it started: the mesh needs more memory than the
+    /// machine has available (the estimate and the available bytes).
+    #[error("{0}")]
+    OutOfMemory(Box<crate::memory::MemoryShortfall>),
     /// A line of an input file (an anchors file) is malformed or names what the mesh does
     /// not have, or the file as a whole is unusable (line 0: for example no anchors).
     #[error("{}{}: {message}", path.display(), at_line(*line))]
@@ -100,11 +104,14 @@ pub enum ErrorKind {
     /// The library failed on valid input (threads could not start, a bug). Not the
     /// caller's fault.
     Internal,
+    /// The computation would need more memory than the machine has available, so it was
+    /// refused before it started. Not the caller's input: the machine is too small for it.
+    OutOfMemory,
 }
 
 impl ErrorKind {
     /// Every kind, for front ends and tests that go through all of them.
-    pub const ALL: [ErrorKind; 7] = [
+    pub const ALL: [ErrorKind; 8] = [
         ErrorKind::InvalidArgument,
         ErrorKind::InvalidMesh,
         ErrorKind::Io,
@@ -112,6 +119,7 @@ impl ErrorKind {
         ErrorKind::Cancelled,
         ErrorKind::Write,
         ErrorKind::Internal,
+        ErrorKind::OutOfMemory,
     ];
 
     /// True when the caller's input or choice caused the error (a front end answers with
@@ -124,7 +132,7 @@ impl ErrorKind {
             | ErrorKind::Io
             | ErrorKind::NoSolution
             | ErrorKind::Cancelled => true,
-            ErrorKind::Write | ErrorKind::Internal => false,
+            ErrorKind::Write | ErrorKind::Internal | ErrorKind::OutOfMemory => false,
         }
     }
 }
@@ -144,6 +152,7 @@ impl Error {
             Error::Remesh(e) => remesh_kind(e),
             Error::Npy(_) => ErrorKind::Io,
             Error::Input { .. } => ErrorKind::InvalidArgument,
+            Error::OutOfMemory(_) => ErrorKind::OutOfMemory,
         }
     }
 

@@ -40,12 +40,17 @@ pub mod cache;
 mod decimate;
 mod error;
 pub mod lines;
+mod memory;
 mod oneoff;
 mod precompute;
 mod surface;
 
 pub use decimate::Decimation;
 pub use error::{Error, ErrorKind, Result};
+pub use memory::{
+    MEMORY_AVAILABLE_VAR, MemoryShortfall, PEAK_BYTES_BASE, PEAK_BYTES_PER_VERTEX,
+    available_memory, precompute_peak_bytes,
+};
 pub use nalgebra::Vector3;
 pub use oneoff::{barycentric_weights, weighted_average};
 pub use precompute::{

@@ -68,7 +68,9 @@ pub fn check_embeddable(mesh: &ValidMesh) -> Result<()> {
 }
 
 /// Computes the 8-D embedding of `mesh` (landmarks, geodesics, MDS, least-squares mesh)
-/// after [`check_embeddable`]; `progress` receives per-stage fractions and can cancel
+/// after [`check_embeddable`] and a check that the machine has the memory it needs
+/// ([`crate::precompute_peak_bytes`] against [`crate::available_memory`]: else
+/// [`crate::ErrorKind::OutOfMemory`], before any work); `progress` receives per-stage fractions and can cancel
 /// ([`crate::ErrorKind::Cancelled`]). A landmark count of 0 means "choose"
 /// ([`resolve_landmarks`]).
 pub fn precompute(
@@ -77,6 +79,7 @@ pub fn precompute(
     progress: &dyn Progress,
 ) -> Result<(Embedding, Report)> {
     check_embeddable(mesh)?;
+    crate::memory::check_fits(mesh.n_vertices(), crate::memory::available_memory())?;
     let options = resolve_landmarks(options, mesh);
     Ok(wavg_embed::precompute(mesh, &options, progress)?)
 }

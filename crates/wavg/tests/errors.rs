@@ -22,7 +22,7 @@ fn every_kind_is_listed_once_and_classed() {
         | ErrorKind::Io
         | ErrorKind::NoSolution
         | ErrorKind::Cancelled => true,
-        ErrorKind::Write | ErrorKind::Internal => false,
+        ErrorKind::Write | ErrorKind::Internal | ErrorKind::OutOfMemory => false,
     };
     let all: std::collections::HashSet<_> = ErrorKind::ALL.into_iter().collect();
     assert_eq!(all.len(), ErrorKind::ALL.len(), "a kind is listed twice");
@@ -34,11 +34,12 @@ fn every_kind_is_listed_once_and_classed() {
         ErrorKind::Cancelled,
         ErrorKind::Write,
         ErrorKind::Internal,
+        ErrorKind::OutOfMemory,
     ] {
         assert!(all.contains(&k), "{k:?} missing from ErrorKind::ALL");
         assert_eq!(k.is_callers_fault(), expected_callers(k), "{k:?}");
     }
-    assert_eq!(ErrorKind::ALL.len(), 7);
+    assert_eq!(ErrorKind::ALL.len(), 8);
 }
 
 #[test]

@@ -23,6 +23,7 @@ pub(crate) mod format;
 mod obj;
 mod off;
 mod ply;
+mod source;
 mod text;
 
 use std::io::{Read, Write};
@@ -41,9 +42,25 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
 }
 
 /// Like [`load`], also returning what the file held beyond the triangle mesh.
+///
+/// The file is parsed as it is read (and decompressed), a block at a time: the whole
+/// file is never in memory beside the mesh.
 pub fn load_with_notes(path: &Path) -> Result<(TriMesh, LoadNotes), MeshError> {
-    let (format, bytes) = read_file(path)?;
-    parse_bytes(&bytes, format, path)
+    let (format, gz) = Format::from_path(path)?;
+    let file = std::fs::File::open(path).map_err(|e| io_err(path, e))?;
+    let size = file.metadata().map_err(|e| io_err(path, e))?.len();
+    if gz {
+        let limit = gzip_limit(size);
+        let hint = limit.min(size.saturating_mul(8));
+        let reader = Gunzip {
+            inner: flate2::read::MultiGzDecoder::new(file),
+            left: limit,
+            limit,
+        };
+        parse_from(reader, format, path, hint as usize)
+    } else {
+        parse_from(file, format, path, size as usize)
+    }
 }
 
 /// The (decompressed) bytes of a mesh file and its format: the I/O half of [`load`],
@@ -60,16 +77,35 @@ pub fn parse_bytes(
     format: Format,
     path: &Path,
 ) -> Result<(TriMesh, LoadNotes), MeshError> {
-    let located = |e: text::ParseError| MeshError::Parse {
-        path: path.to_path_buf(),
-        line: e.line,
-        message: e.message,
+    parse_from(bytes, format, path, bytes.len())
+}
+
+/// Parses what `reader` yields; `hint` is about its size in bytes (for capacities only).
+fn parse_from(
+    reader: impl Read,
+    format: Format,
+    path: &Path,
+    hint: usize,
+) -> Result<(TriMesh, LoadNotes), MeshError> {
+    let located = |e: text::ParseError| match e.io {
+        // Corrupt compressed data is the file's fault, said without a line.
+        Some(source) if source.kind() != std::io::ErrorKind::InvalidData => MeshError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+        io => MeshError::Parse {
+            path: path.to_path_buf(),
+            line: if io.is_some() { 0 } else { e.line },
+            message: e.message,
+        },
     };
+    let mut src = source::Source::new(reader);
     let (mesh, mut notes) = match format {
-        Format::Obj => obj::parse(text::as_text(bytes).map_err(located)?).map_err(located)?,
-        Format::Off => off::parse(text::as_text(bytes).map_err(located)?).map_err(located)?,
-        Format::Ply => ply::parse(bytes).map_err(located)?,
-    };
+        Format::Obj => obj::parse(&mut text::TextLines::new(&mut src)),
+        Format::Off => off::parse(&mut text::TextLines::new(&mut src), hint),
+        Format::Ply => ply::parse(&mut src, hint),
+    }
+    .map_err(located)?;
     notes.format = Some(format);
     if notes.non_triangles == 0 {
         notes.polygon_of = Vec::new();
@@ -110,20 +146,47 @@ fn read_bytes(path: &Path, gz: bool) -> Result<Vec<u8>, MeshError> {
     })
 }
 
-/// Decompresses `raw`, refusing output beyond `max(GZIP_MIN_LIMIT, GZIP_MAX_RATIO x
-/// compressed size)`: memory and time stay proportional to the bytes in the file.
+/// The most bytes a gzip stream of `compressed` bytes may expand to:
+/// `max(GZIP_MIN_LIMIT, GZIP_MAX_RATIO x compressed size)`, so memory and time stay
+/// proportional to the bytes in the file.
+fn gzip_limit(compressed: u64) -> u64 {
+    GZIP_MIN_LIMIT.max(GZIP_MAX_RATIO.saturating_mul(compressed))
+}
+
+fn bomb(limit: u64) -> String {
+    format!(
+        "gzip: the data expands to more than {limit} bytes ({GZIP_MAX_RATIO}x the \
+         compressed size): refused as a decompression bomb"
+    )
+}
+
+/// A gzip stream that refuses to expand beyond `limit` bytes; its errors are
+/// `InvalidData` (the file's fault) and say "gzip".
+struct Gunzip<R: Read> {
+    inner: flate2::read::MultiGzDecoder<R>,
+    left: u64,
+    limit: u64,
+}
+
+impl<R: Read> Read for Gunzip<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidData, m);
+        let n = (self.inner.read(buf)).map_err(|e| invalid(format!("gzip: {e}")))?;
+        self.left = (self.left.checked_sub(n as u64)).ok_or_else(|| invalid(bomb(self.limit)))?;
+        Ok(n)
+    }
+}
+
+/// Decompresses `raw`, refusing output beyond [`gzip_limit`].
 fn gunzip_bounded(raw: &[u8]) -> Result<Vec<u8>, String> {
-    let limit = GZIP_MIN_LIMIT.max(GZIP_MAX_RATIO.saturating_mul(raw.len() as u64));
+    let limit = gzip_limit(raw.len() as u64);
     let mut out = Vec::with_capacity(raw.len().saturating_mul(4));
     flate2::read::MultiGzDecoder::new(raw)
         .take(limit.saturating_add(1))
         .read_to_end(&mut out)
         .map_err(|e| format!("gzip: {e}"))?;
     if out.len() as u64 > limit {
-        return Err(format!(
-            "gzip: the data expands to more than {limit} bytes ({GZIP_MAX_RATIO}x the \
-             compressed size): refused as a decompression bomb"
-        ));
+        return Err(bomb(limit));
     }
     Ok(out)
 }

@@ -7,10 +7,12 @@
 //! own global indexing (positions are never split at UV seams) needs only this small
 //! reader; tobj serves as a cross-check in the tests.
 
+use std::io::Read;
+
 use nalgebra::{Vector2, Vector3};
 
 use super::LoadNotes;
-use super::text::{ParseError, Result, next_float, strip_comment};
+use super::text::{ParseError, Result, TextLines, next_float, strip_comment};
 use crate::mesh::{NONE, TexCoords, TriMesh};
 
 /// One face corner: position index and optional texture index, both 0-based.
@@ -59,7 +61,8 @@ fn corner(tok: &str, nv: usize, nvt: usize, line: usize) -> Result<Corner> {
     Ok(Corner { v, vt })
 }
 
-pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
+/// Reads an OBJ file a line at a time.
+pub(crate) fn parse<R: Read>(lines: &mut TextLines<'_, R>) -> Result<(TriMesh, LoadNotes)> {
     let mut positions: Vec<Vector3<f64>> = Vec::new();
     let mut coords: Vec<Vector2<f64>> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
@@ -69,8 +72,7 @@ pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
     let mut notes = LoadNotes::default();
     let mut poly: Vec<Corner> = Vec::new();
 
-    for (i, raw) in text.lines().enumerate() {
-        let line = i + 1;
+    while let Some((line, raw)) = lines.next_line()? {
         let mut it = strip_comment(raw).split_ascii_whitespace();
         let Some(tag) = it.next() else { continue };
         match tag {

@@ -5,29 +5,25 @@
 //! not come back as a smaller mesh). Extra values after the coordinates or after a face's
 //! indices (colours, normals, texture coordinates) are ignored.
 
+use std::io::Read;
+
 use nalgebra::Vector3;
 
 use super::LoadNotes;
-use super::text::{ParseError, Result, next_float, strip_comment};
+use super::text::{ParseError, Result, TextLines, next_float, strip_comment};
 use crate::mesh::TriMesh;
 
-/// Lines with content (comments stripped), numbered from 1.
-struct Lines<'a> {
-    inner: std::iter::Enumerate<std::str::Lines<'a>>,
-    last: usize,
-}
-
-impl<'a> Lines<'a> {
-    fn next_content(&mut self) -> Option<(usize, &'a str)> {
-        for (i, raw) in self.inner.by_ref() {
-            self.last = i + 1;
-            let s = strip_comment(raw).trim();
-            if !s.is_empty() {
-                return Some((i + 1, s));
-            }
+/// The next line with content (comment stripped), numbered from 1.
+fn next_content<'a, R: Read>(lines: &'a mut TextLines<'_, R>) -> Result<Option<(usize, &'a str)>> {
+    let n = loop {
+        let Some((n, raw)) = lines.next_line()? else {
+            return Ok(None);
+        };
+        if !strip_comment(raw).trim().is_empty() {
+            break n;
         }
-        None
-    }
+    };
+    Ok(Some((n, strip_comment(lines.current()).trim())))
 }
 
 /// Parses the count line `nv nf [ne]`.
@@ -48,12 +44,12 @@ fn counts(s: &str, line: usize) -> Result<(usize, usize)> {
     Ok((nv, nf))
 }
 
-pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
-    let mut lines = Lines {
-        inner: text.lines().enumerate(),
-        last: 0,
-    };
-    let Some((hline, header)) = lines.next_content() else {
+/// Reads an OFF file a line at a time; `hint` is about its size in bytes.
+pub(crate) fn parse<R: Read>(
+    lines: &mut TextLines<'_, R>,
+    hint: usize,
+) -> Result<(TriMesh, LoadNotes)> {
+    let Some((hline, header)) = next_content(lines)? else {
         return Err(ParseError::new(1, "empty file (expected an OFF header)"));
     };
     let mut words = header.split_ascii_whitespace();
@@ -78,7 +74,7 @@ pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
         return Err(ParseError::new(hline, "binary OFF is not supported"));
     }
     let (nv, nf) = if rest.is_empty() {
-        let Some((l, s)) = lines.next_content() else {
+        let Some((l, s)) = next_content(lines)? else {
             return Err(ParseError::new(hline + 1, "missing vertex/face counts"));
         };
         counts(s, l)?
@@ -87,10 +83,10 @@ pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
     };
 
     // Never trust the header for allocation: a corrupt count must not exhaust memory.
-    let cap = text.len() / 6 + 1;
+    let cap = hint / 6 + 1;
     let mut positions = Vec::with_capacity(nv.min(cap));
     for k in 0..nv {
-        let Some((line, s)) = lines.next_content() else {
+        let Some((line, s)) = next_content(lines)? else {
             return Err(ParseError::new(
                 lines.last + 1,
                 format!("file ends after {k} of {nv} vertices"),
@@ -118,7 +114,7 @@ pub(crate) fn parse(text: &str) -> Result<(TriMesh, LoadNotes)> {
     let mut triangles = Vec::with_capacity(nf.min(cap));
     let mut poly: Vec<u32> = Vec::new();
     for k in 0..nf {
-        let Some((line, s)) = lines.next_content() else {
+        let Some((line, s)) = next_content(lines)? else {
             return Err(ParseError::new(
                 lines.last + 1,
                 format!("file ends after {k} of {nf} faces"),

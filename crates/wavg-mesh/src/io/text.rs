@@ -1,10 +1,17 @@
-//! Shared pieces of the text parsers: located errors, UTF-8 check, number parsing.
+//! Shared pieces of the text parsers: located errors, numbered lines read from a
+//! [`Source`], number parsing.
+
+use std::io::Read;
+
+use super::source::Source;
 
 /// A parse failure at a 1-based line (0 when there is no line, e.g. binary data).
 #[derive(Debug)]
 pub(crate) struct ParseError {
     pub line: usize,
     pub message: String,
+    /// The read that failed, when the bytes could not be had at all.
+    pub io: Option<std::io::Error>,
 }
 
 impl ParseError {
@@ -12,21 +19,59 @@ impl ParseError {
         Self {
             line,
             message: message.into(),
+            io: None,
+        }
+    }
+
+    /// A failed read at `line` (its message also names the cause: gzip data, a disk).
+    pub(crate) fn io(line: usize, e: std::io::Error) -> Self {
+        Self {
+            line,
+            message: e.to_string(),
+            io: Some(e),
         }
     }
 }
 
 pub(crate) type Result<T> = std::result::Result<T, ParseError>;
 
-/// The bytes as text (without a UTF-8 byte-order mark, which would otherwise hide the first
-/// statement), or an error naming the line of the first invalid UTF-8 byte.
-pub(crate) fn as_text(bytes: &[u8]) -> Result<&str> {
-    let bytes = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes);
-    std::str::from_utf8(bytes).map_err(|e| {
-        let at = e.valid_up_to();
-        let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
-        ParseError::new(line, "invalid UTF-8 (binary data in a text format?)")
-    })
+/// The lines of a text file, numbered from 1, checked to be UTF-8 (a byte-order mark at
+/// the start is dropped, as it would otherwise hide the first statement).
+pub(crate) struct TextLines<'a, R> {
+    src: &'a mut Source<R>,
+    /// The number of the line last returned.
+    pub last: usize,
+}
+
+impl<'a, R: Read> TextLines<'a, R> {
+    pub(crate) fn new(src: &'a mut Source<R>) -> Self {
+        Self { src, last: 0 }
+    }
+
+    /// The next line and its number, `None` at the end.
+    pub(crate) fn next_line(&mut self) -> Result<Option<(usize, &str)>> {
+        let n = self.last + 1;
+        let Some(mut bytes) = self.src.line().map_err(|e| ParseError::io(n, e))? else {
+            return Ok(None);
+        };
+        self.last = n;
+        if n == 1 {
+            bytes = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes);
+        }
+        let text = std::str::from_utf8(bytes)
+            .map_err(|_| ParseError::new(n, "invalid UTF-8 (binary data in a text format?)"))?;
+        Ok(Some((n, text)))
+    }
+
+    /// The line [`Self::next_line`] returned last.
+    pub(crate) fn current(&self) -> &str {
+        let bytes = self.src.last_line();
+        let bytes = match self.last {
+            1 => bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes),
+            _ => bytes,
+        };
+        std::str::from_utf8(bytes).unwrap_or_default()
+    }
 }
 
 /// A float token; `nan`/`inf` are accepted (validation reports them, they are data).

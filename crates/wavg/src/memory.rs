@@ -1,0 +1,191 @@
+//! Refusing a precomputation the machine's memory cannot hold, before it starts: the
+//! peak resident size estimated from the mesh's counts, against the memory available
+//! (`MemAvailable` of `/proc/meminfo`, and the process's cgroup limit less its usage when
+//! one is set), so that a mesh too large is refused with both figures instead of being
+//! killed by the kernel minutes later.
+
+use crate::error::{Error, Result};
+
+/// Bytes of the precomputation's peak per mesh vertex (faces included, about two per
+/// vertex): the slope of the peak resident sizes measured with `/usr/bin/time -v` from
+/// 0.8M to 3.1M vertices (1,450), and of 2.1M to 8.6M (1,520), rounded up
+/// (`BENCHMARKS.md`).
+pub const PEAK_BYTES_PER_VERTEX: u64 = 1500;
+/// Bytes of the peak whatever the mesh (the landmark stages' dense matrices, the
+/// program): with [`PEAK_BYTES_PER_VERTEX`], the smallest that covers every measured
+/// peak (0.2M to 8.6M vertices).
+pub const PEAK_BYTES_BASE: u64 = 700 << 20;
+/// Below about 0.9M vertices the peak follows a steeper, lower line (the least-squares
+/// mesh is factored directly): 300 MB + 2,000 B a vertex covers the peaks measured at 0.2M
+/// and 0.8M, so that small meshes are not refused on small machines.
+const SMALL_BASE: u64 = 300_000_000;
+const SMALL_PER_VERTEX: u64 = 2000;
+
+/// The environment variable that overrides the memory available (bytes, or with a `K`,
+/// `M` or `G` suffix): for tests, and to let a precomputation run that the estimate
+/// would refuse.
+pub const MEMORY_AVAILABLE_VAR: &str = "WAVG_MEMORY_AVAILABLE";
+
+/// A precomputation refused for want of memory: the estimate and what was available.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MemoryShortfall {
+    /// Vertices of the mesh.
+    pub vertices: usize,
+    /// Estimated peak resident bytes of the precomputation.
+    pub needed: u64,
+    /// Bytes available when it was asked.
+    pub available: u64,
+    /// Where `available` came from (`/proc/meminfo`, the cgroup, the environment).
+    pub source: &'static str,
+}
+
+impl std::fmt::Display for MemoryShortfall {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let gb = |b: u64| b as f64 / 1e9;
+        write!(
+            f,
+            "the precomputation of this mesh ({} vertices) needs about {:.2} GB of memory at \
+             its peak, and {:.2} GB are available ({}): decimate the mesh first or \
+             free memory (set {MEMORY_AVAILABLE_VAR} to override the check)",
+            self.vertices,
+            gb(self.needed),
+            gb(self.available),
+            self.source
+        )
+    }
+}
+
+/// The estimated peak resident bytes of precomputing a mesh of `vertices` vertices.
+///
+/// ```
+/// let small = wavg::precompute_peak_bytes(10_000);
+/// assert!(small < wavg::precompute_peak_bytes(10_000_000));
+/// ```
+pub fn precompute_peak_bytes(vertices: usize) -> u64 {
+    let line = |base: u64, per_vertex: u64| {
+        base.saturating_add(per_vertex.saturating_mul(vertices as u64))
+    };
+    line(PEAK_BYTES_BASE, PEAK_BYTES_PER_VERTEX).min(line(SMALL_BASE, SMALL_PER_VERTEX))
+}
+
+/// The memory this process may still use, and where the figure came from: the
+/// environment override, else the smaller of `MemAvailable` and the cgroup's room;
+/// `None` when neither can be read (then nothing is refused).
+pub fn available_memory() -> Option<(u64, &'static str)> {
+    if let Ok(v) = std::env::var(MEMORY_AVAILABLE_VAR) {
+        return parse_bytes(&v).map(|b| (b, MEMORY_AVAILABLE_VAR));
+    }
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok();
+    let mem = meminfo.as_deref().and_then(mem_available);
+    let cgroup = cgroup_room();
+    match (mem, cgroup) {
+        (Some(m), Some(c)) if c < m => Some((c, "the cgroup's memory limit less its usage")),
+        (Some(m), _) => Some((m, "MemAvailable in /proc/meminfo")),
+        (None, Some(c)) => Some((c, "the cgroup's memory limit less its usage")),
+        (None, None) => None,
+    }
+}
+
+/// Refuses a precomputation of `vertices` vertices that needs more than `available`.
+pub(crate) fn check_fits(vertices: usize, available: Option<(u64, &'static str)>) -> Result<()> {
+    let needed = precompute_peak_bytes(vertices);
+    match available {
+        Some((available, source)) if needed > available => {
+            Err(Error::OutOfMemory(Box::new(MemoryShortfall {
+                vertices,
+                needed,
+                available,
+                source,
+            })))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// `MemAvailable` of `/proc/meminfo`'s text, in bytes.
+fn mem_available(meminfo: &str) -> Option<u64> {
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kb.checked_mul(1024)
+}
+
+/// The room left under the memory limit of this process's cgroup (v2, then v1).
+fn cgroup_room() -> Option<u64> {
+    let read = |p: &str| std::fs::read_to_string(p).ok();
+    let own = read("/proc/self/cgroup").and_then(|s| {
+        s.lines()
+            .find_map(|l| l.strip_prefix("0::").map(String::from))
+    });
+    let mut dirs = Vec::new();
+    if let Some(own) = own.filter(|o| o != "/") {
+        dirs.push(format!("/sys/fs/cgroup{own}"));
+    }
+    dirs.push("/sys/fs/cgroup".to_string());
+    for dir in dirs {
+        let limit = read(&format!("{dir}/memory.max")).and_then(|s| s.trim().parse::<u64>().ok());
+        let used =
+            read(&format!("{dir}/memory.current")).and_then(|s| s.trim().parse::<u64>().ok());
+        if let (Some(limit), Some(used)) = (limit, used) {
+            return Some(limit.saturating_sub(used));
+        }
+    }
+    let limit = read("/sys/fs/cgroup/memory/memory.limit_in_bytes")?;
+    let used = read("/sys/fs/cgroup/memory/memory.usage_in_bytes")?;
+    let (limit, used): (u64, u64) = (limit.trim().parse().ok()?, used.trim().parse().ok()?);
+    // v1 reports "no limit" as a huge number.
+    (limit < 1 << 60).then(|| limit.saturating_sub(used))
+}
+
+/// Bytes written as a number with an optional `K`, `M` or `G` suffix (powers of 1024).
+fn parse_bytes(text: &str) -> Option<u64> {
+    let t = text.trim();
+    let (digits, shift) = match t.as_bytes().last()? {
+        b'K' | b'k' => (&t[..t.len() - 1], 10),
+        b'M' | b'm' => (&t[..t.len() - 1], 20),
+        b'G' | b'g' => (&t[..t.len() - 1], 30),
+        _ => (t, 0),
+    };
+    digits.trim().parse::<u64>().ok()?.checked_mul(1 << shift)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ErrorKind;
+
+    #[test]
+    fn a_mesh_beyond_the_available_memory_is_refused_with_both_figures() {
+        let e = check_fits(3_000_000, Some((2_000_000_000, "a test"))).unwrap_err();
+        assert_eq!(e.kind(), ErrorKind::OutOfMemory);
+        assert!(!e.kind().is_callers_fault());
+        let m = e.message();
+        assert!(
+            m.contains("3000000 vertices") && m.contains("5.23 GB"),
+            "{m}"
+        );
+        assert!(m.contains("2.00 GB are available (a test)"), "{m}");
+        assert!(check_fits(3_000_000, Some((6_000_000_000, "a test"))).is_ok());
+        assert!(check_fits(3_000_000, None).is_ok());
+        // Small meshes follow the lower line: 320 MB for 10,000 vertices.
+        assert_eq!(precompute_peak_bytes(10_000), 320_000_000);
+        assert_eq!(
+            precompute_peak_bytes(3_000_000),
+            (700 << 20) + 4_500_000_000
+        );
+    }
+
+    #[test]
+    fn meminfo_cgroup_and_override_figures_parse() {
+        let text = "MemTotal:       24000000 kB\nMemAvailable:   16000000 kB\n";
+        assert_eq!(mem_available(text), Some(16_000_000 * 1024));
+        assert_eq!(mem_available("MemTotal: 1 kB\n"), None);
+        assert_eq!(parse_bytes("1M"), Some(1 << 20));
+        assert_eq!(parse_bytes(" 3g "), Some(3 << 30));
+        assert_eq!(parse_bytes("12345"), Some(12345));
+        assert_eq!(parse_bytes("lots"), None);
+        // This machine has a /proc/meminfo.
+        if std::env::var_os(MEMORY_AVAILABLE_VAR).is_none() {
+            assert!(available_memory().is_some_and(|(b, _)| b > 0));
+        }
+    }
+}
