@@ -55,3 +55,30 @@ pub fn require_data_file(test: &str, relative: &str) -> Option<PathBuf> {
     );
     Some(p)
 }
+
+/// The folder named by `WAVG_GLTF_DIR`, where tests leave a copy of every glTF file they
+/// write, for `cargo xtask test` to run the Khronos glTF Validator over.
+pub const GLTF_DIR_VAR: &str = "WAVG_GLTF_DIR";
+
+/// Keeps a copy of the glTF file `path` (and of the `.bin` beside a `.gltf`) in
+/// `$WAVG_GLTF_DIR` when it is set, under `name` (unique per test, e.g. the test's
+/// name): a no-op otherwise. Panics when the copy fails (a test helper).
+pub fn keep_gltf(path: &std::path::Path, name: &str) {
+    let Some(dir) = std::env::var_os(GLTF_DIR_VAR) else {
+        return;
+    };
+    let dir = PathBuf::from(dir).join(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let copy = |p: &std::path::Path| {
+        if p.exists() {
+            std::fs::copy(p, dir.join(p.file_name().unwrap())).unwrap();
+        }
+    };
+    copy(path);
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf"))
+    {
+        copy(&path.with_extension("bin"));
+    }
+}

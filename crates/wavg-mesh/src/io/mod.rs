@@ -20,6 +20,7 @@
 
 mod atomic;
 pub(crate) mod format;
+pub mod gltf;
 mod obj;
 mod off;
 mod ply;
@@ -120,7 +121,7 @@ fn io_err(path: &Path, source: std::io::Error) -> MeshError {
     }
 }
 
-fn write_err(path: &Path, source: std::io::Error) -> MeshError {
+pub(crate) fn write_err(path: &Path, source: std::io::Error) -> MeshError {
     MeshError::Write {
         path: path.to_path_buf(),
         source,
@@ -195,8 +196,12 @@ fn gunzip_bounded(raw: &[u8]) -> Result<Vec<u8>, String> {
 /// texture coordinates), OFF (positions and triangles only) or binary little-endian PLY
 /// (double positions; texture coordinates as a per-face `texcoord` list). A trailing `.gz`
 /// compresses. Positions are written exactly (shortest round-trip decimal, or raw doubles).
-/// The file is written atomically ([`write_atomic`]).
+/// The file is written atomically ([`write_atomic`]). A `.glb` or `.gltf` path writes glTF
+/// ([`gltf::GltfScene`]: 32-bit float positions, texture coordinates split at seams).
 pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
+    if gltf::is_gltf_path(path) {
+        return gltf::GltfScene::from_mesh(mesh).save(path);
+    }
     let (format, gz) = Format::from_path(path)?;
     let bytes = to_bytes(mesh, format).map_err(|e| write_err(path, e))?;
     write_atomic(path, |w| {
