@@ -8,6 +8,7 @@ mod cbuild;
 mod cli_docs;
 mod examples;
 mod fuzz;
+mod gltf;
 mod lab;
 mod lines;
 mod man;
@@ -55,6 +56,7 @@ fn main() -> ExitCode {
             Some("--check") => report(web::check_assets(&workspace_root())),
             Some(_) => usage(),
         },
+        Some("gltf-validate") if args.len() == 1 => report(gltf::validate(&workspace_root())),
         Some("venv") if args.len() == 1 => {
             report(python::ensure_venv(&workspace_root()).map(|py| println!("{}", py.display())))
         }
@@ -69,7 +71,7 @@ fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
          cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask cli-docs | cargo xtask venv | cargo xtask wheel | \
-         cargo xtask blender-addon | cargo xtask blender | cargo xtask web [--check]\n\n  \
+         cargo xtask blender-addon | cargo xtask blender | cargo xtask web [--check] | cargo xtask gltf-validate\n\n  \
          test   every check, in CI's order (the steps: docs/development.md), then a table of \
          step times\n  \
          test --quick   rustfmt check, clippy and the unit tests, for the edit loop\n  \
@@ -83,7 +85,8 @@ fn usage() -> ExitCode {
          wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path\n  \
          blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)\n  \
          blender   the blender step of `test` alone: the add-on's tests in Blender, with a temporary home holding a decoy add-on\n  \
-         web    vendor three.js for the page of `wavg serve` into web/vendor/three by npm ci of web/package-lock.json (--check: verify the checked-in files)",
+         web    vendor three.js for the page of `wavg serve` into web/vendor/three by npm ci of web/package-lock.json (--check: verify the checked-in files)\n  \
+         gltf-validate   the Khronos glTF Validator over the glTF files the last `test` run's tests wrote (target/gltf-written)",
         MAX = lines::MAX_LINES
     );
     ExitCode::from(2)
@@ -164,7 +167,9 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         });
     }
     log.run("tests (unit, integration, doc; examples built)", || {
-        steps::cargo_workspace(root, &["test"], &[])
+        let gltf_dir = gltf::clear(root)?;
+        let gltf_dir = gltf_dir.to_string_lossy();
+        steps::cargo_workspace_env(root, &["test"], &[], &[(gltf::DIR_VAR, &gltf_dir)])
     }) && log.run(
         &format!(
             "source policy (files over {} lines, forbid(unsafe_code), module style, the map)",
@@ -195,6 +200,9 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         })
         && log.run("blender", || blender::test(root))
         && log.run("web assets", || web::check_assets(root))
+        && log.run("glTF validator (every .glb/.gltf the tests wrote)", || {
+            gltf::validate(root)
+        })
         && log.run("browser tests", || web::browser_tests(root, data_dir))
         && log.run("C/C++ packages", cbuild::ensure_packages)
         && cbuild::steps(root, data_dir)

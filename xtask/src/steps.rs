@@ -92,9 +92,19 @@ pub fn run(program: &str, args: &[&str], cmd: &mut Command) -> Result<(), String
 
 /// `cargo ARGS... <EXCLUDED>`: a cargo command over the everyday workspace.
 pub fn cargo_workspace(root: &Path, args: &[&str], tail: &[&str]) -> Result<(), String> {
+    cargo_workspace_env(root, args, tail, &[])
+}
+
+/// [`cargo_workspace`] with extra environment variables.
+pub fn cargo_workspace_env(
+    root: &Path,
+    args: &[&str],
+    tail: &[&str],
+    env: &[(&str, &str)],
+) -> Result<(), String> {
     let mut all: Vec<&str> = args.to_vec();
     all.push("--workspace");
     all.extend(EXCLUDED);
     all.extend(tail);
-    command(root, "cargo", &all)
+    command_env(root, "cargo", &all, env)
 }
