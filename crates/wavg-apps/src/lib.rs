@@ -52,10 +52,15 @@ pub use decal::{DEFAULT_MAX_NEGATIVE, Decal, DecalReport, DecalUv, decal_uv, dec
 pub use decal_obj::{DECAL_MATERIAL, PLAIN_MATERIAL, untextured_faces, write_decal_obj};
 pub use morph::{MorphReport, harmonic_fill, morph_frames};
 mod error;
+mod gltf_out;
 mod render;
 mod transfer;
 
 pub use error::AppError;
+pub use gltf_out::{
+    MAX_GLTF_FACE, correspondence_scene, curve_scene, curves_scene, decal_scene, morph_scene, textured_scene,
+    validity_code,
+};
 pub use render::{
     Camera, Colouring, FOV_DEGREES, Image, MAX_DECODED_BYTES, MAX_SIDE, Overlays, RenderOptions,
     RenderReport, View, render, viridis,

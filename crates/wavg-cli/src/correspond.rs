@@ -8,8 +8,9 @@ use std::time::Instant;
 
 use wavg::apps::{
     CorrespondOptions, CorrespondTimings, Correspondence, Distortion, GroundTruthErrors,
-    ReasonCounts, ValidityTest, correspond_vertices,
+    ReasonCounts, ValidityTest, correspond_vertices, correspondence_scene,
 };
+use wavg::mesh::io::gltf::is_gltf_path;
 use wavg::{Anchor, Solver, Surface};
 
 use crate::CliError;
@@ -72,6 +73,13 @@ vertices_per_cpu_s (CPU time of the map, all threads), counts per reason and, wi
 target's bounding-box diagonal, with rejected_correct (images within 2% rejected) and
 accepted_wrong (valid vertices farther than 2%).
 
+With -o OUT.glb (or OUT.gltf, its buffer in OUT.bin) the map is written as glTF instead:
+the source mesh with custom per-vertex attributes, 32-bit floats (glTF forbids unsigned
+integers there): _TARGET_FACE (the target face, -1 without a valid image; exact up to
+2^24 faces), _TARGET_BARY (VEC3, its barycentric coordinates), _TARGET_POSITION (VEC3,
+the point on the target) and _VALIDITY (0 valid, 1 unanswered, 2 no-round-trip,
+3 negative-weight, 4 inconsistent); the vectors are 0 without a valid image.
+
 Why `local`: `paper` judges the weights, not the image, and on pose pairs most vertices it
 rejects are mapped correctly. A single wrong image spoils all of its own edges but one of
 each neighbour's, so correct neighbours stay; on thin parts (fingers), images a fraction of
@@ -90,7 +98,8 @@ problems on the target) and validity_seconds (validity test and distortion).")]
 pub struct Args {
     #[command(flatten)]
     pub map: MapArgs,
-    /// Output map file (`-` for standard output).
+    /// Output map file (`-` for standard output), or .glb/.gltf: the source mesh with the
+    /// map as custom vertex attributes.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// The two meshes share connectivity (vertex i corresponds to vertex i): report the
@@ -223,7 +232,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else {
         None
     };
-    write_map(&args.output, &c.map)?;
+    if is_gltf_path(&args.output) {
+        let scene = correspondence_scene(c.source.mesh(), &c.map).map_err(wavg::Error::from)?;
+        scene.save(&args.output).map_err(wavg::Error::from)?;
+    } else {
+        write_map(&args.output, &c.map)?;
+    }
     let n = c.map.validity.len();
     let d = &c.map.distortion;
     let per_s = n as f64 / c.seconds.max(1e-12);

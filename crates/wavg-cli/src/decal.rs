@@ -5,7 +5,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use wavg::apps::{DecalReport, decal_vertices, untextured_faces, write_decal_obj};
+use wavg::apps::{DecalReport, decal_scene, decal_vertices, untextured_faces, write_decal_obj};
+use wavg::mesh::io::gltf::is_gltf_path;
 
 use crate::CliError;
 use crate::apps_common::mesh_and_anchors;
@@ -33,7 +34,13 @@ the surface-to-plane map over faces with three unmarked corners; null when there
 flipped_faces (against the
 decal's own orientation), seconds, marked (the marked vertex ids), untextured_faces (faces
 with a marked corner), mtl and texture (the files the OBJ names; null for `-o -`), plus mesh
-and anchors.")]
+and anchors.
+
+With -o OUT.glb (or OUT.gltf, its buffer in OUT.bin) the decal is written as glTF instead:
+TEXCOORD_0 per vertex on the faces with three unmarked corners, whose base colour texture
+is --texture (or the checkerboard) embedded as PNG; the faces with a marked corner form a
+second primitive, without texture coordinates, in plain grey. No .mtl is written (mtl and
+texture are null in --json).")]
 pub struct Args {
     #[command(flatten)]
     pub surface: crate::embedding_arg::SurfaceArgs,
@@ -46,7 +53,7 @@ pub struct Args {
     /// The most negative weight a vertex may have without being marked.
     #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_NEGATIVE, allow_negative_numbers = true)]
     pub max_negative: f64,
-    /// Output OBJ file (`-` for standard output).
+    /// Output OBJ file (`-` for standard output), or .glb/.gltf.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// The decal's image (PNG), named in the .mtl written beside the OBJ (default: a
@@ -96,11 +103,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &outputs,
         args.json,
     )?;
-    crate::common::require_extension(
-        &args.output,
-        "obj",
-        "a decal is written as an OBJ file (with its .mtl and texture)",
-    )?;
+    if !is_gltf_path(&args.output) {
+        crate::common::require_extension(
+            &args.output,
+            "obj",
+            "a decal is written as an OBJ file (with its .mtl and texture) or .glb/.gltf",
+        )?;
+    }
     let text = textio::read_text(&args.uv)?;
     let lines =
         wavg::text::parse_weights(&text, 1).map_err(|e| located(&args.uv, e.line, &e.message))?;
@@ -139,16 +148,28 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let decal = decal_vertices(&solver, &uv, args.max_negative)?;
     let seconds = t.elapsed().as_secs_f64();
     let mesh = surface.mesh();
-    let material = decal_material::write(&args.output, args.texture.as_deref())?;
+    if is_gltf_path(&args.output) {
+        let png = decal_material::png_bytes(args.texture.as_deref())?;
+        decal_scene(mesh, &decal.uv, Some(png))
+            .save(&args.output)
+            .map_err(wavg::Error::from)?;
+    }
+    let material = if is_gltf_path(&args.output) {
+        None
+    } else {
+        decal_material::write(&args.output, args.texture.as_deref())?
+    };
     let mtllib = material.as_ref().map(decal_material::Material::file_name);
-    textio::write_atomic(&args.output, |w: &mut dyn Write| {
-        write_decal_obj(w, mesh, &decal.uv, mtllib.as_deref())
-    })
-    .inspect_err(|_| {
-        if let Some(m) = &material {
-            m.remove();
-        }
-    })?;
+    if !is_gltf_path(&args.output) {
+        textio::write_atomic(&args.output, |w: &mut dyn Write| {
+            write_decal_obj(w, mesh, &decal.uv, mtllib.as_deref())
+        })
+        .inspect_err(|_| {
+            if let Some(m) = &material {
+                m.remove();
+            }
+        })?;
+    }
     let untextured_faces = untextured_faces(mesh, &decal.uv);
     let marked: Vec<usize> = (0..mesh.n_vertices())
         .filter(|&v| decal.uv.marked[v])

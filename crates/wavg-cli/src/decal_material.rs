@@ -90,6 +90,20 @@ pub fn write(obj: &Path, texture: Option<&Path>) -> Result<Option<Material>, Cli
     Ok(Some(material))
 }
 
+/// The PNG a glTF decal embeds: the file `texture`, or the checkerboard encoded.
+pub fn png_bytes(texture: Option<&Path>) -> Result<Vec<u8>, CliError> {
+    match texture {
+        Some(t) => std::fs::read(t)
+            .map_err(|e| CliError::input(format!("--texture {}: {e}", t.display()))),
+        None => {
+            let board = crate::demo_pictures::decal_board().map_err(CliError::failure)?;
+            let mut png = Vec::new();
+            board.encode_png(&mut png).map_err(wavg::Error::from)?;
+            Ok(png)
+        }
+    }
+}
+
 /// Refuses a `--texture` that is not a readable PNG (before anything is computed).
 pub fn check_texture(texture: &Path) -> Result<(), CliError> {
     Image::read_png(texture).map(drop).context("--texture")

@@ -6,7 +6,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use wavg::apps::{MorphReport, ReasonCounts, harmonic_fill, morph_frames};
+use wavg::apps::{MorphReport, ReasonCounts, harmonic_fill, morph_frames, morph_scene};
+use wavg::mesh::io::gltf::is_gltf_path;
 
 use crate::CliError;
 use crate::correspond::{MapArgs, compute};
@@ -23,7 +24,12 @@ with the source's faces, blending linearly from the source positions (first fram
 mapped ones (last frame). The folder is created if needed; nothing is written on error (a
 frame that cannot be written removes the frames written before it).
 --json prints one object: frames, valid_fraction, seconds (map and fill, precomputation
-excluded), plus the per-reason counts and the output folder.")]
+excluded), plus the per-reason counts and the output folder.
+
+With -o OUT.glb (or OUT.gltf, its buffer in OUT.bin) the frames go into one glTF file
+instead: one mesh (the source's faces at the first frame's positions) with every frame a
+morph target named frame_000, frame_001, ... (weights 0; Blender imports them as shape
+keys).")]
 pub struct Args {
     #[command(flatten)]
     pub map: MapArgs,
@@ -31,7 +37,7 @@ pub struct Args {
     /// single frame is the mapped shape).
     #[arg(long, default_value_t = 10, value_parser = crate::common::parse_frames)]
     pub frames: usize,
-    /// Output folder.
+    /// Output folder (or a .glb/.gltf file: the frames as morph targets of one mesh).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Print one JSON object on standard output.
@@ -58,7 +64,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.frames == 0 || args.frames > 100_000 {
         return Err(CliError::input("--frames must be between 1 and 100000"));
     }
-    if args.output.is_file() {
+    let gltf = is_gltf_path(&args.output);
+    if !gltf && args.output.is_file() {
         return Err(CliError::input(format!(
             "{}: is a file; -o names a folder",
             args.output.display()
@@ -70,36 +77,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mapped = harmonic_fill(mesh, &c.map.valid_positions()).context(&args.map.pair.source)?;
     let frames = morph_frames(&mesh.positions, &mapped, args.frames);
     let seconds = c.seconds + t.elapsed().as_secs_f64();
-    let created = !args.output.exists();
-    std::fs::create_dir_all(&args.output)
-        .map_err(|e| CliError::failure(format!("{}: {e}", args.output.display())))?;
-    let mut written = Vec::with_capacity(frames.len());
-    for (k, f) in frames.iter().enumerate() {
-        let path = args.output.join(format!("frame_{k:03}.obj"));
-        let r = textio::write_atomic(&path, |w: &mut dyn Write| {
-            for p in f {
-                write!(w, "v ")?;
-                write_numbers(w, p.iter().copied())?;
-                writeln!(w)?;
-            }
-            for t in &mesh.triangles {
-                let [a, b, c] = t.map(|v| v + 1);
-                writeln!(w, "f {a} {b} {c}")?;
-            }
-            Ok(())
-        });
-        if let Err(e) = r {
-            // Nothing half-written: the frames of this run go, and the folder if this run
-            // made it.
-            for p in &written {
-                let _ = std::fs::remove_file(p);
-            }
-            if created {
-                let _ = std::fs::remove_dir(&args.output);
-            }
-            return Err(e);
-        }
-        written.push(path);
+    if gltf {
+        morph_scene(mesh, &frames)
+            .save(&args.output)
+            .map_err(wavg::Error::from)?;
+    } else {
+        write_frames(&args.output, &mesh.triangles, &frames)?;
     }
     if args.json {
         let j = serde_json::to_value(JsonReport {
@@ -123,6 +106,47 @@ pub fn run(args: Args) -> Result<(), CliError> {
             100.0 * c.map.valid_fraction(),
             args.output.display()
         );
+    }
+    Ok(())
+}
+
+/// Writes the frames as OBJ files `dir/frame_000.obj`, ...: all of them or none (a frame
+/// that cannot be written removes the ones before it, and the folder if this made it).
+fn write_frames(
+    dir: &Path,
+    triangles: &[[u32; 3]],
+    frames: &[Vec<wavg::Vector3<f64>>],
+) -> Result<(), CliError> {
+    let created = !dir.exists();
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::failure(format!("{}: {e}", dir.display())))?;
+    let mut written = Vec::with_capacity(frames.len());
+    for (k, f) in frames.iter().enumerate() {
+        let path = dir.join(format!("frame_{k:03}.obj"));
+        let r = textio::write_atomic(&path, |w: &mut dyn Write| {
+            for p in f {
+                write!(w, "v ")?;
+                write_numbers(w, p.iter().copied())?;
+                writeln!(w)?;
+            }
+            for t in triangles {
+                let [a, b, c] = t.map(|v| v + 1);
+                writeln!(w, "f {a} {b} {c}")?;
+            }
+            Ok(())
+        });
+        if let Err(e) = r {
+            // Nothing half-written: the frames of this run go, and the folder if this run
+            // made it.
+            for p in &written {
+                let _ = std::fs::remove_file(p);
+            }
+            if created {
+                let _ = std::fs::remove_dir(dir);
+            }
+            return Err(e);
+        }
+        written.push(path);
     }
     Ok(())
 }

@@ -5,7 +5,8 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use wavg::apps::{CurveReport, SPLINE_CHUNK, SplineKind, evaluate_spline};
+use wavg::apps::{CurveReport, SPLINE_CHUNK, SplineKind, curve_scene, evaluate_spline};
+use wavg::mesh::io::gltf::is_gltf_path;
 
 use crate::CliError;
 use crate::error::Context;
@@ -24,7 +25,9 @@ weights (forward problem), warm-started from the previous sample.
 Output: one line per sample, `FACE B0 B1 B2 X Y Z`, or `none REASON` where the average has
 no projection. --json prints one object: samples, ok_samples, seconds, us_per_sample,
 length (3-D length of the polyline through the samples), plus mesh, controls, degree,
-closed, bezier.")]
+closed, bezier. With -o OUT.glb (or OUT.gltf, its buffer in OUT.bin) the samples on the
+surface are written as one glTF polyline instead (LINE_STRIP, LINE_LOOP when --closed), to
+view over the mesh.")]
 pub struct Args {
     #[command(flatten)]
     pub surface: crate::embedding_arg::SurfaceArgs,
@@ -43,7 +46,7 @@ pub struct Args {
     /// Samples along the curve.
     #[arg(long, default_value_t = wavg::apps::DEFAULT_SPLINE_SAMPLES, value_parser = crate::common::parse_samples)]
     pub samples: usize,
-    /// Output file (`-` for standard output).
+    /// Output file (`-` for standard output), or .glb/.gltf: the curve as a polyline.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Print one JSON object on standard output.
@@ -92,9 +95,15 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .context(args.control.display())?;
     let seconds = t.elapsed().as_secs_f64();
     let t = crate::common::step("spline", t);
-    textio::write_atomic(&args.output, |w: &mut dyn Write| {
-        w.write_all(&wavg::lines::points_text(&curve.samples))
-    })?;
+    if is_gltf_path(&args.output) {
+        curve_scene(&curve)
+            .save(&args.output)
+            .map_err(wavg::Error::from)?;
+    } else {
+        textio::write_atomic(&args.output, |w: &mut dyn Write| {
+            w.write_all(&wavg::lines::points_text(&curve.samples))
+        })?;
+    }
     crate::common::step("write the curve", t);
     let ok = curve.ok_samples();
     crate::anchors::warn_if_low(

@@ -6,7 +6,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use wavg::apps::{Image, TextureTransfer, TransferOptions, check_uv, transfer_texture};
+use wavg::apps::{
+    Image, TextureTransfer, TransferOptions, check_uv, textured_scene, transfer_texture,
+};
+use wavg::mesh::io::gltf::is_gltf_path;
 
 use crate::CliError;
 use crate::apps_common::{PairArgs, solver_for};
@@ -25,7 +28,9 @@ over the source anchors (the forward problem: the corresponding point on the sou
 the source texture sampled bilinearly at that point's UV. Anchor i of --source-anchors
 corresponds to anchor i of --target-anchors (anchors format: `v VERTEX` or
 `f FACE B0 B1 B2`). Uncovered texels and texels without a source point are transparent
-(RGBA output); 4 rings of texels around the charts are filled (seam dilation).
+(RGBA output); 4 rings of texels around the charts are filled (seam dilation). With -o
+OUT.glb (or OUT.gltf, its buffer in OUT.bin) the target mesh is written with the new
+texture embedded as its base colour texture (PNG) instead.
 
 Without --source-embedding / --target-embedding the embeddings are precomputed in memory
 (a progress bar shows on a terminal). --size W[xH] sets the output (default: the source
@@ -55,7 +60,8 @@ pub struct Args {
     /// Output size W or WxH (default: the source texture's).
     #[arg(long)]
     pub size: Option<String>,
-    /// Output PNG (RGBA).
+    /// Output PNG (RGBA), or .glb/.gltf: the target mesh with the new texture embedded as
+    /// its base colour (PNG).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Use the paper's inverse only (faster; weights need not lead back to the point).
@@ -90,7 +96,13 @@ struct JsonReport<'a> {
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
     crate::common::check_outputs(&[&args.source_texture], &[("-o", &args.output)], args.json)?;
-    crate::common::require_extension(&args.output, "png", "the texture is written as a PNG file")?;
+    if !is_gltf_path(&args.output) {
+        crate::common::require_extension(
+            &args.output,
+            "png",
+            "the texture is written as a PNG file (or .glb/.gltf: the target with it)",
+        )?;
+    }
     crate::textio::with_threads(args.pair.threads, || run_inner(args))?
 }
 
@@ -163,7 +175,12 @@ fn run_inner(args: Args) -> Result<(), CliError> {
     })?;
     let seconds = t.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    write_png(&args.output, &out.image)?;
+    if is_gltf_path(&args.output) {
+        let scene = textured_scene(target.mesh().mesh(), &out.image).map_err(wavg::Error::from)?;
+        scene.save(&args.output).map_err(wavg::Error::from)?;
+    } else {
+        write_png(&args.output, &out.image)?;
+    }
     let valid_fraction = if out.covered > 0 {
         out.valid as f64 / out.covered as f64
     } else {
