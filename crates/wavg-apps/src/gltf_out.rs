@@ -54,7 +54,9 @@ pub fn decal_scene(mesh: &TriMesh, uv: &DecalUv, texture_png: Option<Vec<u8>>) -
         .triangles
         .iter()
         .map(|t| {
-            if t.iter().any(|&v| uv.marked.get(v as usize).copied().unwrap_or(true)) {
+            if t.iter()
+                .any(|&v| uv.marked.get(v as usize).copied().unwrap_or(true))
+            {
                 [NONE; 3]
             } else {
                 *t

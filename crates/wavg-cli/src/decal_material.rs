@@ -93,8 +93,9 @@ pub fn write(obj: &Path, texture: Option<&Path>) -> Result<Option<Material>, Cli
 /// The PNG a glTF decal embeds: the file `texture`, or the checkerboard encoded.
 pub fn png_bytes(texture: Option<&Path>) -> Result<Vec<u8>, CliError> {
     match texture {
-        Some(t) => std::fs::read(t)
-            .map_err(|e| CliError::input(format!("--texture {}: {e}", t.display()))),
+        Some(t) => {
+            std::fs::read(t).map_err(|e| CliError::input(format!("--texture {}: {e}", t.display())))
+        }
         None => {
             let board = crate::demo_pictures::decal_board().map_err(CliError::failure)?;
             let mut png = Vec::new();

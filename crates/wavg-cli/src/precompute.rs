@@ -84,6 +84,17 @@ pub struct Args {
 /// geodesic mesh no larger than the landmark set, and an output that is the input mesh or
 /// has a mesh file's extension.
 fn check_args(args: &Args) -> Result<(), CliError> {
+    if let Some(m) = args
+        .repaired_mesh
+        .as_deref()
+        .filter(|m| wavg::mesh::io::gltf::is_gltf_path(m))
+    {
+        return Err(CliError::input(format!(
+            "--repaired-mesh {}: glTF rounds positions to 32-bit floats, so the embedding \
+             would not belong to the file; save the repaired mesh as .obj, .off or .ply",
+            m.display()
+        )));
+    }
     let landmarks = args.landmarks.unwrap_or(wavg::DEFAULT_LANDMARKS);
     if let Some(g) = args.geodesic_vertices.filter(|&g| g != 0 && g <= landmarks) {
         return Err(CliError::input(format!(
@@ -97,7 +108,7 @@ fn check_args(args: &Args) -> Result<(), CliError> {
             out.display()
         )));
     }
-    if wavg::mesh::Format::from_path(out).is_ok() {
+    if wavg::mesh::io::check_save_path(out).is_ok() {
         return Err(CliError::input(format!(
             "the output {} has a mesh file's extension; the embedding is a .wavg file",
             out.display()

@@ -216,6 +216,23 @@ pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
     .map_err(|e| write_err(path, e))
 }
 
+/// Checks that [`save`] writes the format `path`'s extension names (OBJ, OFF, PLY,
+/// optionally `.gz`, or glTF `.glb`/`.gltf`), before any work is done.
+///
+/// ```
+/// use std::path::Path;
+/// use wavg_mesh::io::check_save_path;
+/// assert!(check_save_path(Path::new("a.glb")).is_ok());
+/// assert!(check_save_path(Path::new("a.ply.gz")).is_ok());
+/// assert!(check_save_path(Path::new("a.stl")).is_err());
+/// ```
+pub fn check_save_path(path: &Path) -> Result<(), MeshError> {
+    if gltf::is_gltf_path(path) {
+        return Ok(());
+    }
+    Format::from_path(path).map(drop)
+}
+
 /// Serialises a mesh in memory (uncompressed).
 pub fn to_bytes(mesh: &TriMesh, format: Format) -> std::io::Result<Vec<u8>> {
     match format {
