@@ -77,6 +77,22 @@ pub fn decal_scene(mesh: &TriMesh, uv: &DecalUv, texture_png: Option<Vec<u8>>) -
     )
 }
 
+/// A polygon mesh (a remeshing's quads or triangles) fan-triangulated, as glTF has no
+/// polygons: what `wavg remesh -o OUT.glb` writes.
+pub fn polygons_scene(positions: &[Vector3<f64>], faces: &[Vec<u32>]) -> GltfScene {
+    let triangles = faces
+        .iter()
+        .flat_map(|f| (2..f.len()).map(move |k| [f[0], f[k - 1], f[k]]))
+        .collect();
+    one(
+        "remeshed",
+        GltfMesh {
+            mesh: TriMesh::new(positions.to_vec(), triangles),
+            ..Default::default()
+        },
+    )
+}
+
 /// A morph: one mesh (`mesh` at its own positions) with every frame a morph target named
 /// `frame_000`, `frame_001`, ... (weights 0: viewers show the first frame until a
 /// weight is set; Blender imports them as shape keys).

@@ -59,7 +59,7 @@ mod transfer;
 pub use error::AppError;
 pub use gltf_out::{
     MAX_GLTF_FACE, correspondence_scene, curve_scene, curves_scene, decal_scene, morph_scene,
-    textured_scene, validity_code,
+    polygons_scene, textured_scene, validity_code,
 };
 pub use render::{
     Camera, Colouring, FOV_DEGREES, Image, MAX_DECODED_BYTES, MAX_SIDE, Overlays, RenderOptions,

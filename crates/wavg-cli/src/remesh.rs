@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use wavg::Surface;
-use wavg::apps::{BaseMesh, RemeshReport, Remesher, polygons_to_obj};
+use wavg::apps::{BaseMesh, RemeshReport, Remesher, polygons_scene, polygons_to_obj};
+use wavg::mesh::io::gltf::is_gltf_path;
 use wavg_bench::{DragOptions, DragReport, drag_remesh};
 
 use crate::CliError;
@@ -29,7 +30,8 @@ vertices on the boundary of an open base stay. Every average is a forward proble
 surface over its own 2 to n points.
 
 Output: the refined mesh as OBJ (quads where the base had polygons of 4 or more corners,
-triangles where it had triangles). --json prints one object: base_faces, base_vertices,
+triangles where it had triangles), or glTF for -o OUT.glb / OUT.gltf (the polygons
+fan-triangulated). --json prints one object: base_faces, base_vertices,
 vertices, faces, levels, smooth_steps, seconds (the first, cold remeshing), warm_seconds
 (median of --frames recomputations while base vertex --drag moves, each warm-started from
 the previous frame; null with --frames 0), warm_seconds_max, warm_cpu_seconds (mean CPU
@@ -69,7 +71,8 @@ pub struct Args {
     /// Worker threads (default: all cores; the limit: docs/limits.md).
     #[arg(long, value_parser = crate::common::parse_threads)]
     pub threads: Option<usize>,
-    /// Output OBJ file (`-` for standard output; written atomically).
+    /// Output OBJ file (`-` for standard output; written atomically), or .glb/.gltf (the
+    /// polygons fan-triangulated).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Print one JSON object on standard output.
@@ -124,10 +127,16 @@ fn run_in_pool(args: Args, base: BaseMesh) -> Result<(), CliError> {
     let drag = drag_frames(&mut r, &base, &args)?;
     let warm = drag.median_s;
     // The file is the first (undragged) result.
-    let obj = polygons_to_obj(&out.positions, &out.faces);
-    textio::write_atomic(&args.output, |w: &mut dyn Write| {
-        w.write_all(obj.as_bytes())
-    })?;
+    if is_gltf_path(&args.output) {
+        polygons_scene(&out.positions, &out.faces)
+            .save(&args.output)
+            .map_err(wavg::Error::from)?;
+    } else {
+        let obj = polygons_to_obj(&out.positions, &out.faces);
+        textio::write_atomic(&args.output, |w: &mut dyn Write| {
+            w.write_all(obj.as_bytes())
+        })?;
+    }
     if args.json {
         let remesh = r.report(&out);
         let j = serde_json::to_value(JsonReport {

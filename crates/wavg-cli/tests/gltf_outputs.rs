@@ -244,3 +244,32 @@ fn a_failed_gltf_write_leaves_nothing() {
     assert!(!r.status.success());
     assert!(!out.exists());
 }
+
+#[test]
+fn remesh_writes_its_polygons_as_triangles() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("cube.obj");
+    let c = 0.5773502691896258;
+    let mut text = String::new();
+    for k in 0..8 {
+        let sign = |b: i32| if k & b != 0 { c } else { -c };
+        text += &format!("v {} {} {}\n", sign(1), sign(2), sign(4));
+    }
+    text += "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+    std::fs::write(&base, text).unwrap();
+    let out = dir.path().join("fine.glb");
+    wavg_ok(&[
+        "remesh",
+        "builtin:icosphere",
+        "--base",
+        &s(&base),
+        "--levels",
+        "2",
+        "-o",
+        &s(&out),
+    ]);
+    wavg_testdata::keep_gltf(&out, "cli_remesh");
+    let (doc, blob) = read(&out);
+    // 6 quads, each split into 16 at two levels, two triangles each.
+    assert_eq!(counts(&doc, &blob), (98, 6 * 16 * 2));
+}
