@@ -46,6 +46,28 @@ fn read_mesh<'py>(
     arrays::mesh_arrays(py, &mesh)
 }
 
+/// write_mesh(path, V, F, uv=None)
+///
+/// Writes a mesh file in the format its extension names: .obj, .off, .ply (optionally
+/// gzipped as .gz), .glb or .gltf (with its buffer in a .bin of the same stem beside it).
+/// V (n, 3) float positions, F (m, 3) 0-based triangles, uv optional per-corner texture
+/// coordinates (m, 3, 2). The file is written atomically (nothing half-written). glTF
+/// stores 32-bit floats and splits a vertex where its corners' texture coordinates differ.
+#[pyfunction]
+#[pyo3(signature = (path, V, F, uv=None))]
+#[allow(non_snake_case)]
+fn write_mesh(
+    py: Python<'_>,
+    path: PathBuf,
+    V: &Bound<'_, PyAny>,
+    F: &Bound<'_, PyAny>,
+    uv: Option<&Bound<'_, PyAny>>,
+) -> PyResult<()> {
+    let mesh = arrays::mesh_from(V, F, uv, "V", "F")?;
+    py.detach_run(|| wavg::mesh::io::save(&path, &mesh))
+        .map_err(errors::lib(py))
+}
+
 /// The module.
 #[pymodule]
 fn _wavg(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -54,6 +76,7 @@ fn _wavg(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<surface::Surface>()?;
     m.add_class::<solver::Solver>()?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(anchors::read_anchors, m)?)?;
     m.add_function(wrap_pyfunction!(anchors::write_anchors, m)?)?;
     m.add_function(wrap_pyfunction!(cache::cache_dir, m)?)?;

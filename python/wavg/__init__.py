@@ -27,6 +27,7 @@ from ._wavg import (
     read_anchors,
     read_mesh,
     write_anchors,
+    write_mesh,
 )
 from . import _wavg
 
@@ -57,6 +58,7 @@ __all__ = [
     "transfer_texture",
     "weighted_average",
     "write_anchors",
+    "write_mesh",
 ]
 
 _APPS = (

@@ -3,7 +3,7 @@ from ._errors import (CancelledError, InvalidArgumentError, InvalidMeshError, No
 from ._types import Correspondence, Points
 from ._wavg import (Remesher, Solver, Surface, __version__, cache_dir, cache_entries, correspond,
                     decal, read_anchors, read_mesh, read_png, render, save_png, spline,
-                    transfer_texture, write_anchors)
+                    transfer_texture, write_anchors, write_mesh)
 
 import numpy as np
 import numpy.typing as npt

@@ -137,6 +137,8 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     let wavg_bin = wavg_bin.to_string_lossy();
     let libwavg = steps::target_dir(root).join("debug").join("libwavg.so");
     let libwavg = libwavg.to_string_lossy();
+    let gltf_dir = crate::gltf::written_dir(root);
+    let gltf_dir = gltf_dir.to_string_lossy();
     Sandbox::new(root, "python")?
         .run(
             root,
@@ -146,6 +148,7 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
                 ("WAVG_DATA_DIR", &data),
                 ("WAVG_CLI", &wavg_bin),
                 ("WAVG_LIBWAVG", &libwavg),
+                (crate::gltf::DIR_VAR, &gltf_dir),
             ],
         )
         .map_err(|e| format!("{e} (pytest exit 5 means no tests ran)"))

@@ -415,3 +415,25 @@ fn a_failed_write_keeps_the_previous_file() {
     assert_eq!(std::fs::read(&path).unwrap(), before);
     assert_eq!(names_in(d.path()), [path]);
 }
+
+/// Coordinates stored once per corner (as Python's per-corner arrays give them) split a
+/// vertex only where their values differ.
+#[test]
+fn equal_coordinates_stored_twice_do_not_split() {
+    let d = dir();
+    let path = d.path().join("corners.glb");
+    let mut mesh = procedural::icosphere(1);
+    let coords = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| t.map(|v| Vector2::new(mesh.positions[v as usize].x, 0.5)))
+        .collect();
+    let faces = (0..mesh.triangles.len() as u32)
+        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+        .collect();
+    mesh.uv = Some(TexCoords { coords, faces });
+    io::save(&path, &mesh).unwrap();
+    keep(&path, "equal_coordinates_stored_twice_do_not_split");
+    let (doc, blob) = read(&path);
+    assert_eq!(triangles_of(&doc, &blob).0.len(), mesh.positions.len());
+}

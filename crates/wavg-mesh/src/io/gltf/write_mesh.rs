@@ -70,11 +70,12 @@ fn primitive(
 ) -> Result<json::mesh::Primitive, MeshError> {
     let mesh = &m.mesh;
     let uv = mesh.uv.as_ref().filter(|_| with_uv);
+    let same = uv.map(|uv| same_coords(&uv.coords)).unwrap_or_default();
     let mut split = Split::default();
     let mut indices = Vec::with_capacity(3 * faces.len());
     for &f in faces {
         for c in 0..3 {
-            let t = uv.map_or(NONE, |uv| uv.faces[f][c]);
+            let t = uv.map_or(NONE, |uv| same[uv.faces[f][c] as usize]);
             indices.push(split.vertex(mesh.triangles[f][c], t));
         }
     }
@@ -129,6 +130,21 @@ fn primitive(
         mode: Valid(Mode::Triangles),
         targets: (!targets.is_empty()).then_some(targets),
     })
+}
+
+/// Per texture coordinate, the first one with the same value: a vertex is split only where
+/// its coordinates differ, not where they are stored twice (per-corner arrays).
+fn same_coords(coords: &[nalgebra::Vector2<f64>]) -> Vec<u32> {
+    let mut first = std::collections::HashMap::with_capacity(coords.len());
+    coords
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            *first
+                .entry((c.x.to_bits(), c.y.to_bits()))
+                .or_insert(i as u32)
+        })
+        .collect()
 }
 
 /// A material whose base colour is the PNG `png`, embedded in the buffer.
