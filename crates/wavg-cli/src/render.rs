@@ -7,7 +7,10 @@ use std::time::Instant;
 
 use wavg::TriMesh;
 use wavg::Vector3;
-use wavg::apps::{Colouring, Image, Overlays, RenderOptions, RenderReport, View, render};
+use wavg::apps::{
+    Colouring, Image, Overlays, RenderOptions, RenderReport, View, curves_scene, render,
+};
+use wavg::mesh::io::gltf::is_gltf_path;
 
 use crate::CliError;
 use crate::common::load_mesh_notes;
@@ -35,11 +38,16 @@ dots are depth-tested against the surface with a small bias, so parts behind it 
 Bad input (a missing texture, --texture on a mesh without UVs, a scalar count that differs
 from the vertex count) is an error and nothing is written. --json prints one object:
 output, width, height, vertices, faces, covered_fraction (of pixels showing the mesh),
-seconds, plus scalar_min and scalar_max with --scalar.")]
+seconds, plus scalar_min and scalar_max with --scalar.
+
+With -o OUT.glb (or OUT.gltf, its buffer in OUT.bin) the scene is written as glTF instead
+of the picture: the mesh (with --texture embedded as its base colour texture) and each
+--curve as a polyline (LINE_STRIP, one per unbroken run of samples); --points, --scalar and
+--wireframe are not written.")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
-    /// Output PNG.
+    /// Output PNG, or .glb/.gltf: the mesh and its curves.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Picture size WIDTHxHEIGHT in pixels.
@@ -218,7 +226,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
     };
     let img =
         render(&mesh, &colouring, &overlays, &opts).context(format_args!("{}{file}", args.mesh))?;
-    write_png(&args.output, &img)?;
+    if is_gltf_path(&args.output) {
+        let curves: Vec<_> = overlays.curves.iter().map(|c| (c.clone(), false)).collect();
+        let mut scene = curves_scene(Some(&mesh), &curves);
+        if let (Some(t), Some(m)) = (&texture, scene.meshes.first_mut()) {
+            let mut png = Vec::new();
+            t.encode_png(&mut png).map_err(wavg::Error::from)?;
+            m.texture_png = Some(png);
+        }
+        scene.save(&args.output).map_err(wavg::Error::from)?;
+    } else {
+        write_png(&args.output, &img)?;
+    }
     let seconds = t.elapsed().as_secs_f64();
     if args.json {
         let report = RenderReport::new(&mesh, &img, scalars.as_deref(), seconds);

@@ -273,3 +273,46 @@ fn remesh_writes_its_polygons_as_triangles() {
     // 6 quads, each split into 16 at two levels, two triangles each.
     assert_eq!(counts(&doc, &blob), (98, 6 * 16 * 2));
 }
+
+#[test]
+fn render_writes_the_mesh_and_its_curves() {
+    let dir = tempfile::tempdir().unwrap();
+    let control = dir.path().join("c.txt");
+    std::fs::write(&control, "v 0\nv 500\nv 1000\nv 1500\n").unwrap();
+    let curve = dir.path().join("curve.txt");
+    wavg_ok(&[
+        "spline",
+        "builtin:icosphere",
+        "--control",
+        &s(&control),
+        "--samples",
+        "40",
+        "-o",
+        &s(&curve),
+    ]);
+    let out = dir.path().join("scene.glb");
+    wavg_ok(&[
+        "render",
+        "builtin:icosphere",
+        "--curve",
+        &s(&curve),
+        "-o",
+        &s(&out),
+    ]);
+    wavg_testdata::keep_gltf(&out, "cli_render");
+    let (doc, blob) = read(&out);
+    assert_eq!(counts(&doc, &blob), (2562, 5120));
+    let lines: Vec<_> = doc
+        .meshes()
+        .skip(1)
+        .map(|m| m.primitives().next().unwrap())
+        .collect();
+    assert_eq!(lines.len(), 1);
+    assert_eq!(lines[0].mode(), gltf::mesh::Mode::LineStrip);
+    let n = lines[0]
+        .reader(|_| Some(&blob[..]))
+        .read_positions()
+        .unwrap()
+        .count();
+    assert_eq!(n, 40);
+}
