@@ -316,3 +316,22 @@ fn render_writes_the_mesh_and_its_curves() {
         .count();
     assert_eq!(n, 40);
 }
+
+/// glTF rounds positions to 32-bit floats: a repaired mesh saved so would not be the mesh
+/// the embedding belongs to.
+#[test]
+fn precompute_refuses_a_gltf_repaired_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let (emb, fixed) = (dir.path().join("m.wavg"), dir.path().join("fixed.glb"));
+    let r = wavg(&[
+        "precompute",
+        "builtin:icosphere",
+        "-o",
+        &s(&emb),
+        "--repaired-mesh",
+        &s(&fixed),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("32-bit floats"));
+    assert!(!emb.exists() && !fixed.exists());
+}

@@ -28,10 +28,10 @@ pub(super) fn push_mesh(
     let (textured, plain) = textured_faces(&m.mesh);
     let mut primitives = Vec::new();
     if !textured.is_empty() {
-        let material = match &m.texture_png {
-            Some(png) => Some(textured_material(doc, png, &m.name)),
-            None => None,
-        };
+        let material = m
+            .texture_png
+            .as_ref()
+            .map(|png| textured_material(doc, png, &m.name));
         primitives.push(primitive(doc, m, &textured, true, material)?);
     }
     if !plain.is_empty() {
