@@ -457,15 +457,16 @@ enum wavg_status wavg_inverse(const struct wavg_solver *solver,
                               double *out_weights,
                               enum wavg_status *out_statuses);
 
-// Loads a mesh file (`.obj`, `.off`, `.ply`, each optionally gzipped as `.gz`; `mesh_path`
-// is a NUL-terminated path) and validates it. On success `*out` is a new surface whose
+// Loads a mesh file (`.obj`, `.off`, `.ply`, each optionally gzipped as `.gz`; `.gltf` or
+// `.glb`, `scene.glb#Name` for one of its meshes; `mesh_path` is a NUL-terminated path) and validates it. On success `*out` is a new surface whose
 // embedding is the vertex positions until one is precomputed or loaded; on failure `*out`
 // is left unchanged. Errors: `WAVG_STATUS_IO` (missing or unreadable file),
 // `WAVG_STATUS_INVALID_MESH` (not an oriented manifold, degenerate faces...).
 //
 // # Safety
 // `mesh_path` must be NULL or NUL-terminated; `out` NULL or writable.
-enum wavg_status wavg_surface_open(const char *mesh_path, struct wavg_surface **out);
+enum wavg_status wavg_surface_open(const char *mesh_path,
+                                   struct wavg_surface **out);
 
 // Makes a surface from arrays: `xyz` holds `3 * n_vertices` coordinates (x, y, z per
 // vertex), `triangles` holds `3 * n_triangles` 0-based vertex indices, counter-clockwise

@@ -79,6 +79,12 @@ pub(crate) fn type_error(message: impl Into<String>) -> PyErr {
 
 /// `FileNotFoundError` when `path` does not exist (checked before reading, so a missing
 /// file is told apart from an unreadable one).
+/// [`require_file`] for a mesh path, whose `#NAME` suffix (one mesh of a glTF file) is not
+/// part of the file's name.
+pub(crate) fn require_mesh_file(path: &Path) -> PyResult<()> {
+    require_file(&wavg::mesh::io::gltf::split_mesh_name(path).0)
+}
+
 pub(crate) fn require_file(path: &Path) -> PyResult<()> {
     if path.exists() {
         Ok(())

@@ -32,14 +32,15 @@ use crate::pool::DetachRun;
 
 /// read_mesh(path) -> (V (n, 3) float64, F (m, 3) int64)
 ///
-/// Reads a mesh file (.obj, .off, .ply, optionally gzipped as .gz): vertex positions and
+/// Reads a mesh file (.obj, .off, .ply, optionally gzipped as .gz; .gltf or .glb, welded
+/// into one surface, ``scene.glb#Name`` for one of its meshes): vertex positions and
 /// 0-based triangles (polygons are triangulated). The mesh is not validated.
 #[pyfunction]
 fn read_mesh<'py>(
     py: Python<'py>,
     path: PathBuf,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    errors::require_file(&path)?;
+    errors::require_mesh_file(&path)?;
     let mesh = py
         .detach_run(|| wavg::mesh::io::load(&path))
         .map_err(errors::lib(py))?;

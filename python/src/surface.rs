@@ -95,12 +95,13 @@ impl Surface {
 
     /// Surface.open(path, embedding=None) -> Surface
     ///
-    /// Reads a mesh file (.obj, .off, .ply, optionally .gz; texture coordinates of .obj
-    /// are kept) and, when ``embedding`` names a ``.wavg`` file, its embedding.
+    /// Reads a mesh file (.obj, .off, .ply, optionally .gz; .gltf or .glb, welded into one
+    /// surface, ``scene.glb#Name`` for one of its meshes; texture coordinates of .obj and
+    /// glTF are kept) and, when ``embedding`` names a ``.wavg`` file, its embedding.
     #[staticmethod]
     #[pyo3(signature = (path, embedding=None))]
     fn open(py: Python<'_>, path: PathBuf, embedding: Option<PathBuf>) -> PyResult<Self> {
-        require_file(&path)?;
+        crate::errors::require_mesh_file(&path)?;
         if let Some(e) = &embedding {
             require_file(e)?;
         }

@@ -17,6 +17,7 @@ pub const TARGETS: &[&str] = &[
     "solver",
     "text_formats",
     "png_texture",
+    "gltf_read",
 ];
 
 /// Longest input libFuzzer makes for `target` (its own default otherwise, which is the
@@ -25,7 +26,7 @@ pub const TARGETS: &[&str] = &[
 /// milliseconds each; every branch of the readers (headers, counts, lists, binary
 /// layouts) is reachable within a few kilobytes.
 fn max_len(target: &str) -> Option<usize> {
-    (target == "mesh_read").then_some(4096)
+    matches!(target, "mesh_read" | "gltf_read").then_some(4096)
 }
 
 /// The smoke run of `cargo xtask test`: the build and `seconds` of every target, as two
@@ -195,6 +196,7 @@ fn run_one(
 /// shared meshes when the data folder is there) into the corpus folders, once.
 fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
     let seeds = fuzz_dir.join("corpus");
+    seed_gltf(&seeds.join("gltf_read"))?;
     let mesh_dir = seeds.join("mesh_read");
     let file_dir = seeds.join("wavg_file");
     if mesh_dir.is_dir() && file_dir.is_dir() && seeds.join("png_texture").is_dir() {
@@ -293,6 +295,42 @@ fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
     ])?;
     let _ = std::fs::remove_dir_all(&tmp);
     Ok(())
+}
+
+/// A GLB of a tetrahedron with texture coordinates, one vertex split at a seam, placed
+/// by a node with a transform: the glTF reader's seed (built here, as the `wavg` binary
+/// does not write glTF).
+fn seed_gltf(dir: &Path) -> Result<(), String> {
+    if dir.is_dir() {
+        return Ok(());
+    }
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let pos: [f32; 15] = [0., 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1., 0., 0., 0.];
+    let uv: [f32; 10] = [0., 0., 1., 0., 0., 1., 1., 1., 0.5, 0.5];
+    let idx: [u16; 12] = [0, 2, 1, 4, 1, 3, 1, 2, 3, 2, 0, 3];
+    let mut bin: Vec<u8> = pos.iter().flat_map(|x| x.to_le_bytes()).collect();
+    bin.extend(uv.iter().flat_map(|x| x.to_le_bytes()));
+    bin.extend(idx.iter().flat_map(|x| x.to_le_bytes()));
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"translation":[1,2,3],"children":[1]}},{{"mesh":0,"scale":[-1,1,1]}}],"meshes":[{{"name":"tet","primitives":[{{"attributes":{{"POSITION":0,"TEXCOORD_0":1}},"indices":2}}]}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":5,"type":"VEC3","min":[0,0,0],"max":[1,1,1]}},{{"bufferView":1,"componentType":5126,"count":5,"type":"VEC2"}},{{"bufferView":2,"componentType":5123,"count":12,"type":"SCALAR"}}],"bufferViews":[{{"buffer":0,"byteLength":60}},{{"buffer":0,"byteOffset":60,"byteLength":40}},{{"buffer":0,"byteOffset":100,"byteLength":24}}],"buffers":[{{"byteLength":{}}}]}}"#,
+        bin.len()
+    );
+    let mut j = json.into_bytes();
+    while j.len() % 4 != 0 {
+        j.push(b' ');
+    }
+    let total = 12 + 8 + j.len() + 8 + bin.len();
+    let mut glb = b"glTF".to_vec();
+    for word in [2, total as u32, j.len() as u32, 0x4E4F_534A] {
+        glb.extend(word.to_le_bytes());
+    }
+    glb.extend(&j);
+    for word in [bin.len() as u32, 0x004E_4942] {
+        glb.extend(word.to_le_bytes());
+    }
+    glb.extend(&bin);
+    let dst = dir.join("seed-tet.glb");
+    std::fs::write(&dst, glb).map_err(|e| format!("{}: {e}", dst.display()))
 }
 
 #[cfg(test)]

@@ -15,7 +15,8 @@ use crate::common::{load_mesh, validate};
 /// (correspond, morph, transfer-texture).
 #[derive(clap::Args)]
 pub struct PairArgs {
-    /// Source mesh (.obj/.off/.ply, optionally .gz) or builtin:NAME.
+    /// Source mesh (.obj/.off/.ply, optionally .gz; .gltf/.glb, FILE#NAME for one mesh) or
+    /// builtin:NAME.
     #[arg(long)]
     pub source: String,
     /// Target mesh.

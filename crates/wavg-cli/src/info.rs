@@ -20,12 +20,13 @@ whether `wavg repair` would fix them. Succeeds for any file it can parse, valid 
 --json prints one object with at least vertices, faces, components, boundary_loops, genus
 (null when undefined), manifold (bool), problems (list of strings), plus edges,
 euler_characteristic, oriented, watertight, valid, uv, bounding_box, problem_summary,
+welded_vertices (glTF: vertex copies merged by position), skipped_primitives,
 repair and out_of_range: null, or why the embedding and the solvers would refuse this
 valid mesh's size (docs/limits.md), with the remedy. Validity is judged by shape whatever
 the scale; an invalid mesh gets null (repair it first).")]
 pub struct Args {
-    /// Mesh file: .obj, .off or .ply, optionally gzip-compressed (.gz), or builtin:NAME
-    /// (as the other commands take it).
+    /// Mesh file: .obj, .off or .ply, optionally gzip-compressed (.gz), .gltf or .glb
+    /// (SCENE.glb#NAME: one mesh), or builtin:NAME (as the other commands take it).
     pub mesh: Option<String>,
     /// The same as the positional MESH.
     #[arg(long = "mesh", value_name = "MESH")]
@@ -109,6 +110,21 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, s: &MeshIn
         );
     }
     let _ = writeln!(o);
+    if s.welded_vertices > 0 {
+        let _ = writeln!(
+            o,
+            "welded:               {} vertex copies merged by position (the file splits \
+             vertices at UV seams and sharp edges)",
+            s.welded_vertices
+        );
+    }
+    if s.skipped_primitives > 0 {
+        let _ = writeln!(
+            o,
+            "skipped:              {} primitives of points or lines",
+            s.skipped_primitives
+        );
+    }
     let _ = writeln!(o, "edges:                {}", s.edges);
     let _ = writeln!(o, "components:           {}", s.components);
     let _ = writeln!(o, "boundary loops:       {}", s.boundary_loops);

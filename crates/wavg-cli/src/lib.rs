@@ -147,7 +147,8 @@ fn root_long_help() -> String {
         .map(|(name, _)| *name)
         .collect();
     format!(
-        "A mesh argument is a file (.obj, .off or .ply, each optionally gzipped as .gz) or\n\
+        "A mesh argument is a file (.obj, .off or .ply, each optionally gzipped as .gz; .gltf\n\
+         or .glb, welded into one surface, SCENE.glb#NAME for its mesh or node NAME) or\n\
          builtin:NAME, a mesh generated in code (`wavg info --builtin NAME` describes one):\n  \
          {}\n\
          Every command that works on one mesh takes it positionally or as --mesh (`wavg render\n\

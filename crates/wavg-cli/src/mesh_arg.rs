@@ -9,8 +9,8 @@ use clap::{ArgGroup, Args, FromArgMatches};
 pub struct MeshArg(String);
 
 /// Help text of both spellings.
-const HELP: &str = "Mesh file (.obj/.off/.ply, optionally .gz) or builtin:NAME; positional or \
-                    as --mesh";
+const HELP: &str = "Mesh file (.obj/.off/.ply, optionally .gz; .gltf/.glb, FILE#NAME for one \
+                    mesh) or builtin:NAME; positional or as --mesh";
 /// Argument ids (the positional's and the flag's) and their group.
 const POSITIONAL: &str = "mesh_positional";
 const FLAG: &str = "mesh";

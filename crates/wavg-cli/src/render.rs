@@ -28,7 +28,8 @@ supersampling.
 Colour: light grey, or --texture T.png through the mesh's OBJ texture coordinates (`vt`,
 bilinear; faces without them, as `wavg decal` writes the unusable ones, stay grey), or
 --scalar S.txt (one number per vertex and line) through the viridis colour map with a
-legend bar labelled with the minimum and maximum.
+legend bar labelled with the minimum and maximum. A glTF mesh with texture coordinates and a
+base colour texture is drawn with that texture unless --texture or --scalar is given.
 Overlays: --curve C.txt (the output of `wavg spline`: `FACE B0 B1 B2 X Y Z` per sample,
 `none ...` lines break the curve) as a thick red line, --points P.txt (the anchors
 format: `v VERTEX` or `f FACE B0 B1 B2`) as dots, --wireframe the edges of the file's
@@ -62,7 +63,7 @@ pub struct Args {
     /// Points to draw as dots (anchors format).
     #[arg(long)]
     pub points: Option<PathBuf>,
-    /// A texture (PNG) mapped through the mesh's UVs.
+    /// A texture (PNG or JPEG) mapped through the mesh's UVs.
     #[arg(long, conflicts_with = "scalar")]
     pub texture: Option<PathBuf>,
     /// Per-vertex scalars (one number per line), coloured with viridis.
@@ -186,7 +187,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .transpose()?
         .unwrap_or_default();
     let t = Instant::now();
-    let (mut mesh, notes): (TriMesh, _) = load_mesh_notes(&args.mesh)?;
+    let (mut mesh, mut notes): (TriMesh, _) = load_mesh_notes(&args.mesh)?;
+    let notes_texture = wavg::LoadNotes {
+        texture: notes.texture.take(),
+        ..Default::default()
+    };
     if args.texture.is_some() && mesh.uv.is_none() {
         // Faces the file gave no texture coordinates are drawn plain.
         mesh.uv = notes.partial_uv;
@@ -204,8 +209,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let pts = resolve_points(&valid, &specs, p)?;
         overlays.points = pts.iter().map(|q| q.position(&mesh)).collect();
     }
-    let texture = args.texture.as_deref().map(Image::read_png).transpose();
-    let texture = texture?;
+    let texture = match &args.texture {
+        Some(path) => Some(Image::read(path)?),
+        // A glTF file's own base colour texture, when no colouring is asked for.
+        None if args.scalar.is_none() && mesh.uv.is_some() => wavg::mesh_texture(&notes_texture)?,
+        None => None,
+    };
     let scalars = args.scalar.as_deref().map(read_scalars).transpose()?;
     let colouring = match (&texture, &scalars) {
         (Some(t), _) => Colouring::Texture(t),
@@ -220,7 +229,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         ..Default::default()
     };
     let file = match colouring {
-        Colouring::Texture(_) => format!(" with {}", args.texture.as_ref().expect("set").display()),
+        Colouring::Texture(_) => match &args.texture {
+            Some(t) => format!(" with {}", t.display()),
+            None => " with its base colour texture".to_string(),
+        },
         Colouring::Scalars(_) => format!(" with {}", args.scalar.as_ref().expect("set").display()),
         Colouring::Plain => String::new(),
     };

@@ -34,8 +34,10 @@ texture embedded as its base colour texture (PNG) instead.
 
 Without --source-embedding / --target-embedding the embeddings are precomputed in memory
 (a progress bar shows on a terminal). --size W[xH] sets the output (default: the source
-texture's size). Bad input (anchor counts that differ, a mesh without UVs, an unreadable
-texture, anchors out of range) is an error and nothing is written.
+texture's size). The source texture is --source-texture (PNG or JPEG), or else the base
+colour texture of a glTF source mesh (embedded, or a file beside the .gltf). Bad input
+(anchor counts that differ, a mesh without UVs, an unreadable texture or none, anchors out
+of range) is an error and nothing is written.
 
 --json prints one object: texels (covered texels, each an inverse and a forward problem),
 valid_fraction (of them with a source point), seconds (the transfer, precomputation
@@ -54,9 +56,9 @@ Spot onto itself (same anchors) reproduces its texture with a mean colour error 
 pub struct Args {
     #[command(flatten)]
     pub pair: PairArgs,
-    /// Source texture (PNG).
+    /// Source texture (PNG or JPEG; default: the base colour texture of a glTF source).
     #[arg(long)]
-    pub source_texture: PathBuf,
+    pub source_texture: Option<PathBuf>,
     /// Output size W or WxH (default: the source texture's).
     #[arg(long)]
     pub size: Option<String>,
@@ -93,9 +95,21 @@ struct JsonReport<'a> {
     stride: u32,
 }
 
+/// The base colour texture of the source mesh's file, or an error asking for
+/// --source-texture.
+fn source_texture(mesh: &str) -> Result<Image, CliError> {
+    let (_, notes) = crate::common::load_mesh_notes(mesh)?;
+    wavg::mesh_texture(&notes)?.ok_or_else(|| {
+        CliError::input(format!(
+            "{mesh} carries no base colour texture: give --source-texture (PNG or JPEG)"
+        ))
+    })
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
-    crate::common::check_outputs(&[&args.source_texture], &[("-o", &args.output)], args.json)?;
+    let inputs = crate::common::inputs([], [&args.source_texture]);
+    crate::common::check_outputs(&inputs, &[("-o", &args.output)], args.json)?;
     if !is_gltf_path(&args.output) {
         crate::common::require_extension(
             &args.output,
@@ -125,7 +139,10 @@ fn run_inner(args: Args) -> Result<(), CliError> {
         let m = load_mesh(mesh)?;
         check_uv(&m, what).context(mesh)?;
     }
-    let texture = Image::read_png(&args.source_texture)?;
+    let texture = match &args.source_texture {
+        Some(path) => Image::read(path)?,
+        None => source_texture(&args.pair.source)?,
+    };
     if args.stride == 0 {
         return Err(CliError::input("--stride must be at least 1"));
     }

@@ -366,6 +366,8 @@ fn info_json_keys() {
         "polygons",
         "skipped_faces",
         "uv_dropped",
+        "welded_vertices",
+        "skipped_primitives",
         "edges",
         "components",
         "boundary_loops",

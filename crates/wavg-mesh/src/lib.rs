@@ -10,7 +10,7 @@
 //! assert_eq!(mesh.topology().genus(), 1);
 //! ```
 //!
-//! A file from a scanner, end to end ([`io::load`] reads OBJ/OFF/PLY, optionally `.gz`):
+//! A file from a scanner, end to end ([`io::load`] reads OBJ/OFF/PLY, optionally `.gz`, and glTF):
 //!
 //! ```
 //! use wavg_mesh::{RepairOptions, ValidMesh, analyze, io, repair};

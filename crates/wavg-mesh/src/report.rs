@@ -32,6 +32,11 @@ pub struct MeshInfo {
     pub skipped_faces: usize,
     /// Whether the file's texture coordinates were dropped (only some faces had them).
     pub uv_dropped: bool,
+    /// Vertices the reader merged into others by welding exactly equal positions (glTF
+    /// splits a vertex at every UV seam); 0 for OBJ, OFF and PLY.
+    pub welded_vertices: usize,
+    /// glTF primitives of points or lines, skipped.
+    pub skipped_primitives: usize,
     /// Edges.
     pub edges: usize,
     /// Connected components.
@@ -81,6 +86,8 @@ impl MeshInfo {
             polygons: notes.map_or(s.faces, |n| n.polygons),
             skipped_faces: notes.map_or(0, |n| n.skipped_faces),
             uv_dropped: notes.is_some_and(|n| n.uv_dropped),
+            welded_vertices: notes.map_or(0, |n| n.welded_vertices),
+            skipped_primitives: notes.map_or(0, |n| n.skipped_primitives),
             edges: s.edges,
             components: s.components,
             boundary_loops: s.boundary_loops,

@@ -2,12 +2,14 @@
 //! the repository) for tests and benchmarks. The meshes are never copied into the repository.
 //! [`json_keys`]: the documented keys of the `wavg bench` reports, for the tests of the
 //! protocols and of the commands.
+//! [`gltf`] builds glTF files in code.
 
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
 
 use std::path::PathBuf;
 
+pub mod gltf;
 pub mod json_keys;
 
 /// The data folder if it exists: `$WAVG_DATA_DIR`, else `<repository>/../shared/data`.

@@ -44,6 +44,7 @@ mod memory;
 mod oneoff;
 mod precompute;
 mod surface;
+mod texture;
 
 pub use decimate::Decimation;
 pub use error::{Error, ErrorKind, Result};
@@ -58,6 +59,7 @@ pub use precompute::{
     embedding_cached, precompute, resolve_landmarks,
 };
 pub use surface::Surface;
+pub use texture::mesh_texture;
 pub use wavg_embed::{Embedding, NoProgress, PrecomputeOptions, Progress, Report, Stage};
 /// The file formats: plain-text surface points and weights, NumPy `.npy` arrays.
 pub use wavg_io::{npy, text};

@@ -44,7 +44,8 @@ struct Inner {
 }
 
 impl Surface {
-    /// Loads a mesh file (`.obj`, `.off`, `.ply`, each optionally gzipped as `.gz`) and
+    /// Loads a mesh file (`.obj`, `.off`, `.ply`, each optionally gzipped as `.gz`; `.gltf`
+    /// or `.glb`, `scene.glb#Name` for one of its meshes: [`wavg_mesh::io::load`]) and
     /// validates it. The embedding is the 3-D positions until one is computed or loaded.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let mesh = wavg_mesh::io::load(path.as_ref())?;

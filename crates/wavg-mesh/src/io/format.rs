@@ -25,6 +25,15 @@ pub struct LoadNotes {
     /// had, the corners of the triangles without them being [`NONE`](crate::NONE), for
     /// a renderer that draws those faces untextured.
     pub partial_uv: Option<crate::TexCoords>,
+    /// Vertices merged into others by welding exactly equal positions (glTF, whose files
+    /// split a vertex wherever its texture coordinate or normal changes); 0 for the other
+    /// formats, which keep the file's vertices.
+    pub welded_vertices: usize,
+    /// glTF primitives of points or lines, skipped (they make no surface).
+    pub skipped_primitives: usize,
+    /// The glTF material's base colour texture, when the file has one on its textured
+    /// primitives (the first such primitive's).
+    pub texture: Option<super::gltf::TextureSource>,
 }
 
 impl LoadNotes {
@@ -44,20 +53,26 @@ pub enum Format {
     Off,
     /// Stanford PLY (ASCII or binary).
     Ply,
+    /// glTF 2.0 as JSON (`.gltf`), its buffers and images beside it or as `data:` URIs.
+    Gltf,
+    /// glTF 2.0 binary (`.glb`).
+    Glb,
 }
 
 impl Format {
-    /// The format for a path from its extension (a trailing `.gz` is looked through),
-    /// and whether the file is gzip-compressed.
+    /// The format for a path from its extension (a trailing `.gz` is looked through; so
+    /// is a glTF mesh name, `scene.glb#Body`), and whether the file is gzip-compressed.
     ///
     /// ```
     /// use wavg_mesh::Format;
     /// use std::path::Path;
     /// assert_eq!(Format::from_path(Path::new("a/b.off.gz")).unwrap(), (Format::Off, true));
+    /// assert_eq!(Format::from_path(Path::new("s.glb#Body")).unwrap(), (Format::Glb, false));
     /// assert!(Format::from_path(Path::new("b.stl")).is_err());
     /// ```
     pub fn from_path(path: &Path) -> Result<(Format, bool), MeshError> {
-        let name = path
+        let (file, _) = super::gltf::split_mesh_name(path);
+        let name = file
             .file_name()
             .map(|n| n.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
@@ -73,11 +88,14 @@ impl Format {
             "obj" => Format::Obj,
             "off" => Format::Off,
             "ply" => Format::Ply,
+            "gltf" => Format::Gltf,
+            "glb" => Format::Glb,
             _ => {
                 return Err(MeshError::Unsupported {
                     path: path.to_path_buf(),
                     message: format!(
-                        "unknown extension {:?} (expected .obj, .off or .ply, optionally .gz)",
+                        "unknown extension {:?} (expected .obj, .off, .ply, optionally .gz, or \
+                         .gltf, .glb)",
                         ext
                     ),
                 });

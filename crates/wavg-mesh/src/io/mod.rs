@@ -1,5 +1,5 @@
 //! Reading and writing mesh files: OBJ, OFF and PLY (ASCII and binary), each optionally
-//! gzip-compressed (`.gz` suffix).
+//! gzip-compressed (`.gz` suffix), and glTF 2.0 (`.gltf`, `.glb`; [`gltf`]).
 //!
 //! Readers produce a raw [`TriMesh`] that keeps the file's vertex indexing exactly
 //! (unreferenced vertices stay, out-of-range indices stay so that validation can name
@@ -37,7 +37,8 @@ use crate::error::MeshError;
 use crate::mesh::TriMesh;
 
 /// Reads a mesh file, choosing the format from the extension (`.obj`, `.off`, `.ply`,
-/// each optionally followed by `.gz`).
+/// each optionally followed by `.gz`; `.gltf`, `.glb`, optionally followed by `#MeshName`
+/// to read one mesh of the file: [`gltf::split_mesh_name`]).
 pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
     load_with_notes(path).map(|(m, _)| m)
 }
@@ -48,6 +49,11 @@ pub fn load(path: &Path) -> Result<TriMesh, MeshError> {
 /// file is never in memory beside the mesh.
 pub fn load_with_notes(path: &Path) -> Result<(TriMesh, LoadNotes), MeshError> {
     let (format, gz) = Format::from_path(path)?;
+    if matches!(format, Format::Gltf | Format::Glb) {
+        // glTF is read whole: its JSON says where in the bytes each array is.
+        let (_, bytes) = read_file(path)?;
+        return parse_bytes(&bytes, format, path);
+    }
     let file = std::fs::File::open(path).map_err(|e| io_err(path, e))?;
     let size = file.metadata().map_err(|e| io_err(path, e))?.len();
     if gz {
@@ -68,16 +74,27 @@ pub fn load_with_notes(path: &Path) -> Result<(TriMesh, LoadNotes), MeshError> {
 /// for callers that time reading and parsing separately.
 pub fn read_file(path: &Path) -> Result<(Format, Vec<u8>), MeshError> {
     let (format, gz) = Format::from_path(path)?;
-    Ok((format, read_bytes(path, gz)?))
+    let (file, _) = gltf::split_mesh_name(path);
+    Ok((format, read_bytes(&file, gz)?))
 }
 
-/// Parses an in-memory (uncompressed) file of the given format; `path` is only used in
-/// error messages.
+/// Parses an in-memory (uncompressed) file of the given format; `path` is used in error
+/// messages and, for glTF, to find the buffers and images beside the file and the mesh
+/// name after `#`.
 pub fn parse_bytes(
     bytes: &[u8],
     format: Format,
     path: &Path,
 ) -> Result<(TriMesh, LoadNotes), MeshError> {
+    if matches!(format, Format::Gltf | Format::Glb) {
+        let (mesh, mut notes) = gltf::parse(bytes, path).map_err(|message| MeshError::Parse {
+            path: gltf::split_mesh_name(path).0,
+            line: 0,
+            message,
+        })?;
+        notes.format = Some(format);
+        return Ok((mesh, notes));
+    }
     parse_from(bytes, format, path, bytes.len())
 }
 
@@ -105,6 +122,8 @@ fn parse_from(
         Format::Obj => obj::parse(&mut text::TextLines::new(&mut src)),
         Format::Off => off::parse(&mut text::TextLines::new(&mut src), hint),
         Format::Ply => ply::parse(&mut src, hint),
+        // Read whole by `parse_bytes`, never streamed.
+        Format::Gltf | Format::Glb => Err(text::ParseError::new(0, "glTF is read whole")),
     }
     .map_err(located)?;
     notes.format = Some(format);
@@ -233,12 +252,19 @@ pub fn check_save_path(path: &Path) -> Result<(), MeshError> {
     Format::from_path(path).map(drop)
 }
 
-/// Serialises a mesh in memory (uncompressed).
+/// Serialises a mesh in memory (uncompressed; `.glb` as one binary glTF file).
 pub fn to_bytes(mesh: &TriMesh, format: Format) -> std::io::Result<Vec<u8>> {
     match format {
         Format::Obj => Ok(obj::write(mesh)),
         Format::Off => Ok(off::write(mesh)),
         Format::Ply => ply::write(mesh),
+        Format::Glb => gltf::GltfScene::from_mesh(mesh)
+            .to_glb()
+            .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.to_string())),
+        Format::Gltf => Err(std::io::Error::new(
+            std::io::ErrorKind::Unsupported,
+            "a .gltf file is two files (JSON and .bin): write it with `save`",
+        )),
     }
 }
 

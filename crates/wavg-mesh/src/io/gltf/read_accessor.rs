@@ -1,0 +1,225 @@
+//! Accessors decoded from their buffers: every offset, stride and count checked against
+//! the bytes present before the output is allocated; sparse accessors applied with their
+//! indices checked.
+
+use std::borrow::Cow;
+
+use gltf::accessor::{DataType, Dimensions};
+
+use super::read_limits::Budget;
+
+/// The bytes of one accessor's elements inside a buffer view.
+struct Strided<'b> {
+    bytes: &'b [u8],
+    stride: usize,
+    count: usize,
+}
+
+impl<'b> Strided<'b> {
+    fn element(&self, i: usize) -> &'b [u8] {
+        &self.bytes[i * self.stride..]
+    }
+}
+
+/// The buffers of a file and the reading budget: what every accessor is decoded from.
+pub(crate) struct Source<'a> {
+    /// Every buffer's bytes, in document order.
+    pub buffers: Vec<Cow<'a, [u8]>>,
+    /// Elements left to read.
+    pub budget: Budget,
+}
+
+fn what(acc: &gltf::Accessor) -> String {
+    format!("accessor {}", acc.index())
+}
+
+/// The `count` elements of `size` bytes at `offset` in `view`, with the view's stride:
+/// checked against the view and the view against its buffer.
+fn strided<'b>(
+    buffers: &'b [Cow<'_, [u8]>],
+    view: &gltf::buffer::View,
+    offset: usize,
+    count: usize,
+    size: usize,
+    name: &str,
+) -> Result<Strided<'b>, String> {
+    let buf = &buffers[view.buffer().index()];
+    let view_bytes = view
+        .offset()
+        .checked_add(view.length())
+        .and_then(|end| buf.get(view.offset()..end))
+        .ok_or_else(|| {
+            format!(
+                "buffer view {} (bytes {}..+{}) lies past the end of buffer {} ({} bytes)",
+                view.index(),
+                view.offset(),
+                view.length(),
+                view.buffer().index(),
+                buf.len()
+            )
+        })?;
+    let stride = view.stride().unwrap_or(size);
+    if stride < size {
+        return Err(format!(
+            "{name}: byte stride {stride} is smaller than its element ({size} bytes)"
+        ));
+    }
+    let needed = match count {
+        0 => Some(0),
+        n => (n - 1)
+            .checked_mul(stride)
+            .and_then(|b| b.checked_add(size))
+            .and_then(|b| b.checked_add(offset)),
+    };
+    match needed {
+        Some(n) if n <= view_bytes.len() => Ok(Strided {
+            bytes: &view_bytes[offset.min(view_bytes.len())..],
+            stride,
+            count,
+        }),
+        _ => Err(format!(
+            "{name}: {count} elements of {size} bytes (stride {stride}) from byte {offset} do \
+             not fit in buffer view {} ({} bytes)",
+            view.index(),
+            view_bytes.len()
+        )),
+    }
+}
+
+/// Decodes an accessor's elements with `decode` (given an element's bytes, at least the
+/// element's size): from its buffer view, or zeros without one, then its sparse values.
+fn decode<T: Copy>(
+    src: &mut Source,
+    acc: &gltf::Accessor,
+    zero: T,
+    decode: impl Fn(&[u8]) -> T,
+) -> Result<Vec<T>, String> {
+    let name = what(acc);
+    let (count, size) = (acc.count(), acc.size());
+    let mut out = match acc.view() {
+        Some(view) => {
+            let s = strided(&src.buffers, &view, acc.offset(), count, size, &name)?;
+            src.budget.take(count as u64, &name)?;
+            (0..s.count).map(|i| decode(s.element(i))).collect()
+        }
+        None if acc.sparse().is_some() => {
+            src.budget.take(count as u64, &name)?;
+            vec![zero; count]
+        }
+        None => {
+            return Err(format!(
+                "{name} has neither a buffer view nor sparse values"
+            ));
+        }
+    };
+    if let Some(sparse) = acc.sparse() {
+        let n = sparse.count();
+        let idx = sparse.indices();
+        let isize = match idx.index_type() {
+            gltf::accessor::sparse::IndexType::U8 => 1,
+            gltf::accessor::sparse::IndexType::U16 => 2,
+            gltf::accessor::sparse::IndexType::U32 => 4,
+        };
+        let sparse_name = format!("{name} (sparse)");
+        let is = strided(
+            &src.buffers,
+            &idx.view(),
+            idx.offset(),
+            n,
+            isize,
+            &sparse_name,
+        )?;
+        let vals = sparse.values();
+        let vs = strided(
+            &src.buffers,
+            &vals.view(),
+            vals.offset(),
+            n,
+            size,
+            &sparse_name,
+        )?;
+        for k in 0..n {
+            let at = unsigned(is.element(k), isize);
+            let slot = usize::try_from(at)
+                .ok()
+                .and_then(|a| out.get_mut(a))
+                .ok_or_else(|| {
+                    format!("{sparse_name}: index {at} is out of range (count {count})")
+                })?;
+            *slot = decode(vs.element(k));
+        }
+    }
+    Ok(out)
+}
+
+fn unsigned(b: &[u8], size: usize) -> u32 {
+    match size {
+        1 => b[0] as u32,
+        2 => u16::from_le_bytes([b[0], b[1]]) as u32,
+        _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+    }
+}
+
+fn f32_at(b: &[u8], k: usize) -> f32 {
+    f32::from_le_bytes([b[4 * k], b[4 * k + 1], b[4 * k + 2], b[4 * k + 3]])
+}
+
+/// A `VEC3` float accessor (POSITION).
+pub(crate) fn vec3(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<[f32; 3]>, String> {
+    if acc.dimensions() != Dimensions::Vec3 || acc.data_type() != DataType::F32 {
+        return Err(format!(
+            "{}: positions must be VEC3 of FLOAT, not {:?} of {:?}",
+            what(acc),
+            acc.dimensions(),
+            acc.data_type()
+        ));
+    }
+    decode(src, acc, [0.0; 3], |b| {
+        [f32_at(b, 0), f32_at(b, 1), f32_at(b, 2)]
+    })
+}
+
+/// A `VEC2` texture-coordinate accessor: float, or normalised unsigned byte or short.
+pub(crate) fn vec2(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<[f32; 2]>, String> {
+    if acc.dimensions() != Dimensions::Vec2 {
+        return Err(format!(
+            "{}: texture coordinates must be VEC2, not {:?}",
+            what(acc),
+            acc.dimensions()
+        ));
+    }
+    match (acc.data_type(), acc.normalized()) {
+        (DataType::F32, _) => decode(src, acc, [0.0; 2], |b| [f32_at(b, 0), f32_at(b, 1)]),
+        (DataType::U8, true) => decode(src, acc, [0.0; 2], |b| {
+            [b[0] as f32 / 255.0, b[1] as f32 / 255.0]
+        }),
+        (DataType::U16, true) => decode(src, acc, [0.0; 2], |b| {
+            [
+                u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
+                u16::from_le_bytes([b[2], b[3]]) as f32 / 65535.0,
+            ]
+        }),
+        (t, n) => Err(format!(
+            "{}: texture coordinates of {t:?}{} (glTF allows FLOAT and normalised \
+             UNSIGNED_BYTE or UNSIGNED_SHORT)",
+            what(acc),
+            if n { " normalised" } else { "" }
+        )),
+    }
+}
+
+/// A `SCALAR` unsigned index accessor.
+pub(crate) fn indices(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<u32>, String> {
+    let size = match (acc.dimensions(), acc.data_type()) {
+        (Dimensions::Scalar, DataType::U8) => 1,
+        (Dimensions::Scalar, DataType::U16) => 2,
+        (Dimensions::Scalar, DataType::U32) => 4,
+        (d, t) => {
+            return Err(format!(
+                "{}: indices must be SCALAR of an unsigned type, not {d:?} of {t:?}",
+                what(acc)
+            ));
+        }
+    };
+    decode(src, acc, 0, |b| unsigned(b, size))
+}
