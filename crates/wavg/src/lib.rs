@@ -58,6 +58,11 @@ pub use precompute::{
     embedding_cached, precompute, resolve_landmarks,
 };
 pub use surface::Surface;
+
+/// The crate's README (its page on the registry) compiles and runs as written.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeQuickstart;
 pub use wavg_embed::{Embedding, NoProgress, PrecomputeOptions, Progress, Report, Stage};
 /// The file formats: plain-text surface points and weights, NumPy `.npy` arrays.
 pub use wavg_io::{npy, text};
