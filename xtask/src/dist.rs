@@ -199,6 +199,9 @@ fn c_tarball(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String>
             "-DWAVG_BUILD_EXAMPLES=OFF",
             "-DWAVG_BUILD_HARNESS=OFF",
             "-DWAVG_CARGO_PROFILE=release",
+            // With the Python extension's crate, so cargo resolves the features the
+            // wheel's build had and reuses its release build of the shared crates.
+            "-DWAVG_CARGO_BUILD_ARGS=--package;wavg-ffi;--package;wavg-py",
             "-DCMAKE_INSTALL_LIBDIR=lib",
             &format!("-DWAVG_CARGO_TARGET_DIR={}", target.display()),
         ],
