@@ -92,11 +92,16 @@ fn only_file(dir: &Path, prefix: &str, suffix: &str) -> Result<PathBuf, String> 
     }
 }
 
-/// maturin in the test environment (`python/requirements-test.txt` pins it), in the
-/// package's folder with cargo's target directory.
+/// maturin in the test environment (`python/requirements-test.txt` pins it and zig, the
+/// `ziglang` package), in the package's folder with cargo's target directory and the
+/// environment's `bin/` first on `PATH` (where maturin finds zig).
 fn maturin(root: &Path, args: &[&str]) -> Result<(), String> {
     let py = python::ensure_venv(root)?;
-    let maturin = python::venv_dir(root).join("bin").join("maturin");
+    let bin = python::venv_dir(root).join("bin");
+    let maturin = bin.join("maturin");
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    let path = std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(&path)))
+        .map_err(|e| format!("PATH: {e}"))?;
     let target = steps::target_dir(root);
     let mut all = args.to_vec();
     let py_s = py.to_string_lossy();
@@ -107,12 +112,18 @@ fn maturin(root: &Path, args: &[&str]) -> Result<(), String> {
         &root.join("python"),
         &maturin.to_string_lossy(),
         &all,
-        &[("CARGO_TARGET_DIR", &target.to_string_lossy())],
+        &[
+            ("CARGO_TARGET_DIR", &target.to_string_lossy()),
+            ("PATH", &path.to_string_lossy()),
+        ],
     )
 }
 
-/// The release wheel, tagged [`MANYLINUX`] by maturin (which refuses a library needing a
-/// newer glibc) and checked again by `auditwheel show`; at most [`MAX_WHEEL`] bytes.
+/// The release wheel, linked by zig against glibc 2.28's symbols (this machine's linker
+/// would use its own glibc's newer ones, which maturin refuses for the tag), tagged
+/// [`MANYLINUX`] and checked again by `auditwheel show`; at most [`MAX_WHEEL`] bytes.
+/// (`--target` and zig put this build in `target/x86_64-unknown-linux-gnu/release/`,
+/// apart from the C library's.)
 fn wheel(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String> {
     let out = dist.to_string_lossy();
     maturin(
@@ -121,6 +132,7 @@ fn wheel(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String> {
             "build",
             "--release",
             "--strip",
+            "--zig",
             "--compatibility",
             MANYLINUX,
             "--out",
@@ -199,9 +211,6 @@ fn c_tarball(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String>
             "-DWAVG_BUILD_EXAMPLES=OFF",
             "-DWAVG_BUILD_HARNESS=OFF",
             "-DWAVG_CARGO_PROFILE=release",
-            // With the Python extension's crate, so cargo resolves the features the
-            // wheel's build had and reuses its release build of the shared crates.
-            "-DWAVG_CARGO_BUILD_ARGS=--package;wavg-ffi;--package;wavg-py",
             "-DCMAKE_INSTALL_LIBDIR=lib",
             &format!("-DWAVG_CARGO_TARGET_DIR={}", target.display()),
         ],
