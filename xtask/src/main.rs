@@ -58,7 +58,22 @@ fn main() -> ExitCode {
             Some("--check") => report(web::check_assets(&workspace_root())),
             Some(_) => usage(),
         },
-        Some("dist") if args.len() == 1 => report(dist::run(&workspace_root()).map(|_| ())),
+        Some("dist") => match args.get(1).map(String::as_str) {
+            None => report(dist::run(&workspace_root()).map(|_| ())),
+            Some("--installed") => {
+                let root = workspace_root();
+                let data_dir = report_data_dir(&root);
+                let mut log = steps::Log::default();
+                let ok = release(&root, &data_dir, &mut log);
+                log.print_table();
+                if ok {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::FAILURE
+                }
+            }
+            Some(_) => usage(),
+        },
         Some("venv") if args.len() == 1 => {
             report(python::ensure_venv(&workspace_root()).map(|py| println!("{}", py.display())))
         }
@@ -72,7 +87,7 @@ fn main() -> ExitCode {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
-         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask cli-docs | cargo xtask venv | cargo xtask wheel | cargo xtask dist | \
+         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask cli-docs | cargo xtask venv | cargo xtask wheel | cargo xtask dist [--installed] | \
          cargo xtask blender-addon | cargo xtask blender | cargo xtask web [--check]\n\n  \
          test   every check, in CI's order (the steps: docs/development.md), then a table of \
          step times\n  \
@@ -85,7 +100,7 @@ fn usage() -> ExitCode {
          cli-docs   write docs/cli.md from the command definitions (help texts and examples)\n  \
          venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
          wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path\n  \
-         dist   every release artifact (wheel, sdist, Blender zip, C tarball, crates) into target/dist/ with SHA256SUMS (docs/release.md)\n  \
+         dist   every release artifact (wheel, sdist, Blender zip, C tarball, crates) into target/dist/ with SHA256SUMS (docs/release.md); --installed: then the release steps of `test` (each artifact installed and used)\n  \
          blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)\n  \
          blender   the blender step of `test` alone: the add-on's tests in Blender, with a temporary home holding a decoy add-on\n  \
          web    vendor three.js for the page of `wavg serve` into web/vendor/three by npm ci of web/package-lock.json (--check: verify the checked-in files)",
