@@ -15,6 +15,10 @@ static bool count_progress(wavg_stage stage, double fraction, void *user_data) {
 
 int main(void) {
   CHECK(wavg_abi_version() == WAVG_ABI_VERSION);
+  char version[32];
+  snprintf(version, sizeof version, "%d.%d.%d", WAVG_VERSION_MAJOR, WAVG_VERSION_MINOR,
+           WAVG_VERSION_PATCH);
+  CHECK(strcmp(wavg_version(), version) == 0);
   CHECK(strcmp(wavg_last_error(), "") == 0);
 
   double *xyz;

@@ -190,6 +190,11 @@ enum wavg_status wavg_spline(const struct wavg_solver *solver,
 // header you compiled against. Thread-safe; cannot fail.
 uint32_t wavg_abi_version(void);
 
+// The library's version as loaded, `"MAJOR.MINOR.PATCH"` (the workspace version, as
+// `WAVG_VERSION_MAJOR`/`_MINOR`/`_PATCH` of the header). The string is static: never free
+// it. Thread-safe; cannot fail.
+const char *wavg_version(void);
+
 // The message of the calling thread's last failed call ("" if none failed yet). The
 // string is owned by the library and stays valid until the thread's next call into the
 // library; copy it to keep it. Thread-safe (each thread has its own message).

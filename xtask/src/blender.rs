@@ -27,6 +27,15 @@ const PACKAGES: &[&str] = &["blender", "python3-numpy", "xvfb"];
 /// Builds `target/wavg_blender.zip` (the wheel first) and returns its path.
 pub fn build_addon(root: &Path) -> Result<PathBuf, String> {
     let wheel = python::build_wheel(root)?;
+    let zip = steps::target_dir(root).join("wavg_blender.zip");
+    pack(root, &wheel, &zip)?;
+    Ok(zip)
+}
+
+/// Packs the add-on's sources with `wheel` unpacked in its `vendor/` folder as `zip`: one
+/// file that Blender 4.2+ installs as an extension (its `blender_manifest.toml`) and older
+/// Blenders as a legacy add-on (its `bl_info`).
+pub fn pack(root: &Path, wheel: &Path, zip: &Path) -> Result<(), String> {
     let target = steps::target_dir(root);
     let stage = target.join("blender-addon");
     if stage.exists() {
@@ -42,13 +51,12 @@ pub fn build_addon(root: &Path) -> Result<PathBuf, String> {
         &["-m", "zipfile", "-e", &wheel_s, &vendor_s],
     )?;
     // Written beside and renamed, so a failed build never leaves a partial zip.
-    let zip = target.join("wavg_blender.zip");
-    let tmp = target.join("wavg_blender.zip.part");
+    let tmp = zip.with_extension("zip.part");
     let (tmp_s, addon_s) = (tmp.to_string_lossy(), addon.to_string_lossy());
     steps::command(root, "python3", &["-m", "zipfile", "-c", &tmp_s, &addon_s])?;
-    std::fs::rename(&tmp, &zip).map_err(|e| format!("{}: {e}", zip.display()))?;
+    std::fs::rename(&tmp, zip).map_err(|e| format!("{}: {e}", zip.display()))?;
     eprintln!("==> {} (with {})", zip.display(), wheel.display());
-    Ok(zip)
+    Ok(())
 }
 
 /// Copies the add-on's files (not caches, not a `vendor/` folder of a local install).

@@ -6,9 +6,11 @@
 mod blender;
 mod cbuild;
 mod cli_docs;
+mod dist;
 mod examples;
 mod fuzz;
 mod gltf;
+mod installed;
 mod lab;
 mod lines;
 mod man;
@@ -19,6 +21,7 @@ mod sancov;
 mod sandbox;
 mod steps;
 mod system;
+mod version;
 mod web;
 
 use std::path::{Path, PathBuf};
@@ -57,6 +60,22 @@ fn main() -> ExitCode {
             Some(_) => usage(),
         },
         Some("gltf-validate") if args.len() == 1 => report(gltf::validate(&workspace_root())),
+        Some("dist") => match args.get(1).map(String::as_str) {
+            None => report(dist::run(&workspace_root()).map(|_| ())),
+            Some("--installed") => {
+                let root = workspace_root();
+                let data_dir = report_data_dir(&root);
+                let mut log = steps::Log::default();
+                let ok = release(&root, &data_dir, &mut log);
+                log.print_table();
+                if ok {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::FAILURE
+                }
+            }
+            Some(_) => usage(),
+        },
         Some("venv") if args.len() == 1 => {
             report(python::ensure_venv(&workspace_root()).map(|py| println!("{}", py.display())))
         }
@@ -70,7 +89,7 @@ fn main() -> ExitCode {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
-         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask cli-docs | cargo xtask venv | cargo xtask wheel | \
+         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask cli-docs | cargo xtask venv | cargo xtask wheel | cargo xtask dist [--installed] | \
          cargo xtask blender-addon | cargo xtask blender | cargo xtask web [--check] | cargo xtask gltf-validate\n\n  \
          test   every check, in CI's order (the steps: docs/development.md), then a table of \
          step times\n  \
@@ -83,6 +102,7 @@ fn usage() -> ExitCode {
          cli-docs   write docs/cli.md from the command definitions (help texts and examples)\n  \
          venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
          wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path\n  \
+         dist   every release artifact (wheel, sdist, Blender zip, C tarball, crates) into target/dist/ with SHA256SUMS (docs/release.md); --installed: then the release steps of `test` (each artifact installed and used)\n  \
          blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)\n  \
          blender   the blender step of `test` alone: the add-on's tests in Blender, with a temporary home holding a decoy add-on\n  \
          web    vendor three.js for the page of `wavg serve` into web/vendor/three by npm ci of web/package-lock.json (--check: verify the checked-in files)\n  \
@@ -172,7 +192,7 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         steps::cargo_workspace_env(root, &["test"], &[], &[(gltf::DIR_VAR, &gltf_dir)])
     }) && log.run(
         &format!(
-            "source policy (files over {} lines, forbid(unsafe_code), module style, the map)",
+            "source policy (files over {} lines, forbid(unsafe_code), module style, the map, one version)",
             lines::MAX_LINES
         ),
         || {
@@ -180,6 +200,7 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
                 .and_then(|()| policy::check_unsafe(root))
                 .and_then(|()| policy::check_module_style(root))
                 .and_then(|()| map::check(root))
+                .and_then(|()| version::check(root))
         },
     ) && log.run("docs (cargo doc, warnings as errors)", || {
         steps::command_env(
@@ -211,7 +232,30 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
                 let args: Vec<&str> = args.iter().map(String::as_str).collect();
                 log.run(name, || steps::command(root, &program, &args))
             })
+        && release(root, data_dir, log)
         && fuzz::smoke(root, SMOKE_SECONDS, log)
+}
+
+/// `cargo xtask dist`, then each artifact installed and used as its users do.
+fn release(root: &Path, data_dir: &Path, log: &mut steps::Log) -> bool {
+    let mut built = None;
+    if !log.run("release artifacts (cargo xtask dist)", || {
+        built = Some(dist::run(root)?);
+        Ok(())
+    }) {
+        return false;
+    }
+    let Some(a) = built else { return false };
+    log.run(
+        "installed: wheel, CPython 3.10-3.13, NumPy 1.x/2.x, no Rust",
+        || installed::wheels(root, data_dir, &a),
+    ) && log.run("installed: sdist (pip with Rust)", || {
+        installed::sdist(root, &a)
+    }) && log.run("installed: C tarball (CMake, pkg-config)", || {
+        installed::c_tarball(root, data_dir, &a)
+    }) && log.run("installed: Blender 4.2/4.5/5.0 extension (bpy)", || {
+        installed::blender(root, &a)
+    })
 }
 
 /// rustfmt and clippy ship as rustup components; they cannot be downloaded from here, so

@@ -188,6 +188,15 @@ pub extern "C" fn wavg_abi_version() -> u32 {
     crate::WAVG_ABI_VERSION
 }
 
+/// The library's version as loaded, `"MAJOR.MINOR.PATCH"` (the workspace version, as
+/// `WAVG_VERSION_MAJOR`/`_MINOR`/`_PATCH` of the header). The string is static: never free
+/// it. Thread-safe; cannot fail.
+#[unsafe(no_mangle)]
+pub extern "C" fn wavg_version() -> *const c_char {
+    const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "\0");
+    VERSION.as_ptr().cast()
+}
+
 /// The message of the calling thread's last failed call ("" if none failed yet). The
 /// string is owned by the library and stays valid until the thread's next call into the
 /// library; copy it to keep it. Thread-safe (each thread has its own message).
@@ -206,6 +215,21 @@ mod tests {
         unsafe { CStr::from_ptr(wavg_last_error()) }
             .to_string_lossy()
             .into_owned()
+    }
+
+    #[test]
+    fn the_version_is_the_packages() {
+        // SAFETY: wavg_version returns a static NUL-terminated string.
+        let v = unsafe { CStr::from_ptr(wavg_version()) };
+        assert_eq!(v.to_str(), Ok(env!("CARGO_PKG_VERSION")));
+        let numbers = [
+            crate::WAVG_VERSION_MAJOR,
+            crate::WAVG_VERSION_MINOR,
+            crate::WAVG_VERSION_PATCH,
+        ]
+        .map(|n| n.to_string())
+        .join(".");
+        assert_eq!(numbers, env!("CARGO_PKG_VERSION"));
     }
 
     #[test]

@@ -22,7 +22,7 @@ mod types;
 
 pub use anchors::wavg_surface_spread_anchors;
 pub use apps::wavg_spline;
-pub use boundary::{wavg_abi_version, wavg_last_error};
+pub use boundary::{wavg_abi_version, wavg_last_error, wavg_version};
 pub use decimate::wavg_surface_decimate;
 pub use maps::{wavg_correspond, wavg_correspond_vertices, wavg_decal_uv};
 pub use options::{wavg_precompute_options, wavg_precompute_options_default};

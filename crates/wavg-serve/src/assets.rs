@@ -1,7 +1,8 @@
 //! The page's files, embedded at compile time: our sources from `web/src/` (their only
 //! copy) and the pinned three.js files from `web/vendor/three/` (checked against
 //! `web/package-lock.json` by `cargo xtask web --check`). No path from a request reaches
-//! the file system.
+//! the file system. They are read through `web`, a link to the repository's `web/` folder
+//! beside this crate's `Cargo.toml`, so that `cargo package` carries them in the package.
 
 /// One embedded file: its URL path, content type and bytes, from `web/$dir/$name`.
 macro_rules! file {
@@ -11,7 +12,7 @@ macro_rules! file {
             $ty,
             include_bytes!(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/../../web/",
+                "/web/",
                 $dir,
                 "/",
                 $name

@@ -60,6 +60,11 @@ pub use precompute::{
 };
 pub use surface::Surface;
 pub use texture::mesh_texture;
+
+/// The crate's README (its page on the registry) compiles and runs as written.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeQuickstart;
 pub use wavg_embed::{Embedding, NoProgress, PrecomputeOptions, Progress, Report, Stage};
 /// The file formats: plain-text surface points and weights, NumPy `.npy` arrays.
 pub use wavg_io::{npy, text};

@@ -1,0 +1,304 @@
+//! `cargo xtask dist`: every release artifact of one version in `target/dist/`, with a
+//! `SHA256SUMS` file (docs/release.md says what goes where):
+//! - `wavg-X.Y.Z-cp310-abi3-manylinux_2_28_x86_64.whl`: the Python wheel (release profile,
+//!   stripped, linked for glibc 2.28 and checked by `auditwheel show`);
+//! - `wavg-X.Y.Z.tar.gz`: the Python sdist (`pip install` builds it with a Rust toolchain);
+//! - `wavg_blender-X.Y.Z-linux_x64.zip`: the Blender add-on, an extension for 4.2+ that
+//!   also installs as a legacy add-on in 3.4-4.1, with that wheel unpacked in `vendor/`;
+//! - `wavg-X.Y.Z-linux-x86_64.tar.gz`: the C/C++ prefix (`lib/libwavg.so.0` and its
+//!   link, `lib/libwavg.a`, `include/wavg.h`, `include/wavg.hpp`, the CMake package, `wavg.pc`,
+//!   the licences), from the CMake install with the tests and examples off;
+//! - `crates/*.crate`: `cargo package --workspace` (each crate built from its package).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::{blender, python, steps, version};
+
+/// The largest wheel a release ships (bytes).
+const MAX_WHEEL: u64 = 15 * 1024 * 1024;
+/// The oldest glibc the wheel supports, as a wheel platform tag.
+pub const MANYLINUX: &str = "manylinux_2_28";
+/// The platform of the C tarball's name.
+const PLATFORM: &str = "linux-x86_64";
+/// The crates the release leaves out: automation, the lab and the fuzz targets (not
+/// published) and the Python extension's crate (shipped as the wheel).
+const NOT_PACKAGED: &[&str] = &["xtask", "wavg-lab", "wavg-fuzz", "wavg-py", "wavg-testdata"];
+
+/// The artifacts of one `dist` run.
+pub struct Artifacts {
+    /// The workspace version they carry.
+    pub version: String,
+    /// The abi3 wheel.
+    pub wheel: PathBuf,
+    /// The Python sdist.
+    pub sdist: PathBuf,
+    /// The Blender add-on / extension zip.
+    pub blender_zip: PathBuf,
+    /// The C/C++ tarball.
+    pub c_tarball: PathBuf,
+}
+
+/// `target/dist/`.
+pub fn dist_dir(root: &Path) -> PathBuf {
+    steps::target_dir(root).join("dist")
+}
+
+/// Builds every artifact into an emptied `target/dist/` and writes `SHA256SUMS`.
+pub fn run(root: &Path) -> Result<Artifacts, String> {
+    version::check(root)?;
+    let version = version::workspace(root)?;
+    let dist = dist_dir(root);
+    if dist.exists() {
+        std::fs::remove_dir_all(&dist).map_err(|e| format!("{}: {e}", dist.display()))?;
+    }
+    std::fs::create_dir_all(&dist).map_err(|e| format!("{}: {e}", dist.display()))?;
+    let wheel = wheel(root, &dist, &version)?;
+    let sdist = sdist(root, &dist, &version)?;
+    let blender_zip = dist.join(format!("wavg_blender-{version}-linux_x64.zip"));
+    blender::pack(root, &wheel, &blender_zip)?;
+    let c_tarball = c_tarball(root, &dist, &version)?;
+    crates(root, &dist)?;
+    checksums(&dist)?;
+    eprintln!("==> {}: wavg {version}", dist.display());
+    Ok(Artifacts {
+        version,
+        wheel,
+        sdist,
+        blender_zip,
+        c_tarball,
+    })
+}
+
+/// The one file in `dir` whose name starts with `prefix` and ends with `suffix`.
+fn only_file(dir: &Path, prefix: &str, suffix: &str) -> Result<PathBuf, String> {
+    let found: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| {
+            p.file_name()
+                .map(|n| n.to_string_lossy())
+                .is_some_and(|n| n.starts_with(prefix) && n.ends_with(suffix))
+        })
+        .collect();
+    match found.as_slice() {
+        [one] => Ok(one.clone()),
+        _ => Err(format!(
+            "expected one {prefix}*{suffix} in {}, found {}",
+            dir.display(),
+            found.len()
+        )),
+    }
+}
+
+/// maturin in the test environment (`python/requirements-test.txt` pins it and zig, the
+/// `ziglang` package), in the package's folder with cargo's target directory and the
+/// environment's `bin/` first on `PATH` (where maturin finds zig).
+fn maturin(root: &Path, args: &[&str]) -> Result<(), String> {
+    let py = python::ensure_venv(root)?;
+    let bin = python::venv_dir(root).join("bin");
+    let maturin = bin.join("maturin");
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    let path = std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(&path)))
+        .map_err(|e| format!("PATH: {e}"))?;
+    let target = steps::target_dir(root);
+    let mut all = args.to_vec();
+    let py_s = py.to_string_lossy();
+    if args.first() == Some(&"build") {
+        all.extend(["--interpreter", &py_s]);
+    }
+    steps::command_env(
+        &root.join("python"),
+        &maturin.to_string_lossy(),
+        &all,
+        &[
+            ("CARGO_TARGET_DIR", &target.to_string_lossy()),
+            ("PATH", &path.to_string_lossy()),
+        ],
+    )
+}
+
+/// The release wheel, linked by zig against glibc 2.28's symbols (this machine's linker
+/// would use its own glibc's newer ones, which maturin refuses for the tag), tagged
+/// [`MANYLINUX`] and checked again by `auditwheel show`; at most [`MAX_WHEEL`] bytes.
+/// (`--target` and zig put this build in `target/x86_64-unknown-linux-gnu/release/`,
+/// apart from the C library's.)
+fn wheel(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String> {
+    let out = dist.to_string_lossy();
+    maturin(
+        root,
+        &[
+            "build",
+            "--release",
+            "--strip",
+            "--zig",
+            "--compatibility",
+            MANYLINUX,
+            "--out",
+            &out,
+        ],
+    )?;
+    let wheel = only_file(dist, &format!("wavg-{version}-"), ".whl")?;
+    let name = wheel.file_name().unwrap_or_default().to_string_lossy();
+    let tag = format!("-cp310-abi3-{MANYLINUX}_x86_64.whl");
+    if !name.ends_with(&tag) {
+        return Err(format!("{name}: not tagged {tag}"));
+    }
+    let size = std::fs::metadata(&wheel)
+        .map_err(|e| format!("{}: {e}", wheel.display()))?
+        .len();
+    if size > MAX_WHEEL {
+        return Err(format!("{name}: {size} bytes, over {MAX_WHEEL}"));
+    }
+    auditwheel_show(root, &wheel)?;
+    eprintln!("    {name}: {:.1} MB", size as f64 / 1e6);
+    Ok(wheel)
+}
+
+/// `auditwheel show WHEEL` must find it consistent with [`MANYLINUX`].
+fn auditwheel_show(root: &Path, wheel: &Path) -> Result<(), String> {
+    let auditwheel = python::venv_dir(root).join("bin").join("auditwheel");
+    let out = Command::new(&auditwheel)
+        .arg("show")
+        .arg(wheel)
+        .output()
+        .map_err(|e| format!("{}: {e}", auditwheel.display()))?;
+    let text = String::from_utf8_lossy(&out.stdout).replace('\n', " ");
+    let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    eprintln!("    auditwheel show: {text}");
+    let expected = format!("consistent with the following platform tag: \"{MANYLINUX}_x86_64\"");
+    if out.status.success() && text.contains(&expected) {
+        Ok(())
+    } else {
+        Err(format!(
+            "auditwheel show {}: not {MANYLINUX}: {text}",
+            wheel.display()
+        ))
+    }
+}
+
+/// The sdist (maturin packs the workspace crates the extension depends on).
+fn sdist(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String> {
+    maturin(root, &["sdist", "--out", &dist.to_string_lossy()])?;
+    only_file(dist, &format!("wavg-{version}"), ".tar.gz")
+}
+
+/// The C/C++ tarball: the CMake install (release library, tests and examples off) into a
+/// staging prefix, without the separate debug info, packed with its top folder.
+fn c_tarball(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String> {
+    crate::cbuild::ensure_packages()?;
+    let target = steps::target_dir(root);
+    let build = target.join("dist-cmake");
+    let name = format!("wavg-{version}-{PLATFORM}");
+    let stage = target.join("dist-stage");
+    let prefix = stage.join(&name);
+    for dir in [&build, &stage] {
+        if dir.exists() {
+            std::fs::remove_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        }
+    }
+    let (root_s, build_s) = (root.to_string_lossy(), build.to_string_lossy());
+    steps::command(
+        root,
+        "cmake",
+        &[
+            "-S",
+            &root_s,
+            "-B",
+            &build_s,
+            "-DWAVG_BUILD_TESTS=OFF",
+            "-DWAVG_BUILD_EXAMPLES=OFF",
+            "-DWAVG_BUILD_HARNESS=OFF",
+            "-DWAVG_CARGO_PROFILE=release",
+            "-DCMAKE_INSTALL_LIBDIR=lib",
+            &format!("-DWAVG_CARGO_TARGET_DIR={}", target.display()),
+        ],
+    )?;
+    steps::command(root, "cmake", &["--build", &build_s, "-j2"])?;
+    steps::command(
+        root,
+        "cmake",
+        &["--install", &build_s, "--prefix", &prefix.to_string_lossy()],
+    )?;
+    let debug = prefix.join("lib").join("libwavg.so.0.debug");
+    std::fs::remove_file(&debug).map_err(|e| format!("{}: {e}", debug.display()))?;
+    let tarball = dist.join(format!("{name}.tar.gz"));
+    steps::command(
+        root,
+        "tar",
+        &[
+            "--sort=name",
+            "--owner=0",
+            "--group=0",
+            "--numeric-owner",
+            "-czf",
+            &tarball.to_string_lossy(),
+            "-C",
+            &stage.to_string_lossy(),
+            &name,
+        ],
+    )?;
+    Ok(tarball)
+}
+
+/// `cargo package --workspace` (each package verified by building it alone), the `.crate`
+/// files copied to `dist/crates/`.
+fn crates(root: &Path, dist: &Path) -> Result<(), String> {
+    let mut args = vec!["package", "--workspace", "--allow-dirty"];
+    for name in NOT_PACKAGED {
+        args.extend(["--exclude", name]);
+    }
+    steps::command(root, "cargo", &args)?;
+    let from = steps::target_dir(root).join("package");
+    let to = dist.join("crates");
+    std::fs::create_dir_all(&to).map_err(|e| format!("{}: {e}", to.display()))?;
+    let version = version::workspace(root)?;
+    let mut count = 0;
+    for entry in std::fs::read_dir(&from).map_err(|e| format!("{}: {e}", from.display()))? {
+        let path = entry.map_err(|e| e.to_string())?.path();
+        let name = path
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned();
+        if name.ends_with(&format!("-{version}.crate")) {
+            std::fs::copy(&path, to.join(&name)).map_err(|e| format!("{name}: {e}"))?;
+            count += 1;
+        }
+    }
+    eprintln!("    {count} crates in {}", to.display());
+    Ok(())
+}
+
+/// `SHA256SUMS` of every file under `dist` (paths relative to it), as `sha256sum -c` reads.
+fn checksums(dist: &Path) -> Result<(), String> {
+    let mut files = Vec::new();
+    list_files(dist, dist, &mut files)?;
+    files.sort();
+    let out = Command::new("sha256sum")
+        .args(&files)
+        .current_dir(dist)
+        .output()
+        .map_err(|e| format!("sha256sum: {e}"))?;
+    if !out.status.success() {
+        return Err(format!(
+            "sha256sum: {}",
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    let sums = dist.join("SHA256SUMS");
+    std::fs::write(&sums, &out.stdout).map_err(|e| format!("{}: {e}", sums.display()))
+}
+
+fn list_files(base: &Path, dir: &Path, out: &mut Vec<String>) -> Result<(), String> {
+    for entry in std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))? {
+        let path = entry.map_err(|e| e.to_string())?.path();
+        if path.is_dir() {
+            list_files(base, &path, out)?;
+        } else if let Ok(rel) = path.strip_prefix(base) {
+            out.push(rel.to_string_lossy().into_owned());
+        }
+    }
+    Ok(())
+}
