@@ -8,7 +8,6 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{s, wavg_ok};
 
 /// The script Blender runs: import, then one line `WAVG_RESULT {json}`.
 const SCRIPT: &str = r#"
@@ -92,21 +91,7 @@ fn file_vertices(glb: &Path) -> usize {
 #[test]
 fn a_textured_glb_imports_into_blender_with_its_texture() {
     let dir = tempfile::tempdir().unwrap();
-    let anchors = dir.path().join("a.txt");
-    let uv = dir.path().join("uv.txt");
-    std::fs::write(&anchors, "v 0\nv 1\nv 2\nv 3\n").unwrap();
-    std::fs::write(&uv, "0 0\n1 0\n1 1\n0 1\n").unwrap();
-    let glb = dir.path().join("decal.glb");
-    wavg_ok(&[
-        "decal",
-        "builtin:icosphere",
-        "--anchors",
-        &s(&anchors),
-        "--uv",
-        &s(&uv),
-        "-o",
-        &s(&glb),
-    ]);
+    let glb = common::decal_glb(dir.path());
     let Some(r) = import_in_blender(&glb) else {
         return;
     };

@@ -157,21 +157,7 @@ fn spline_writes_a_polyline() {
 #[test]
 fn decal_writes_its_uvs_and_texture() {
     let dir = tempfile::tempdir().unwrap();
-    let anchors = dir.path().join("a.txt");
-    let uv = dir.path().join("uv.txt");
-    std::fs::write(&anchors, "v 0\nv 1\nv 2\nv 3\n").unwrap();
-    std::fs::write(&uv, "0 0\n1 0\n1 1\n0 1\n").unwrap();
-    let out = dir.path().join("decal.glb");
-    wavg_ok(&[
-        "decal",
-        "builtin:icosphere",
-        "--anchors",
-        &s(&anchors),
-        "--uv",
-        &s(&uv),
-        "-o",
-        &s(&out),
-    ]);
+    let out = common::decal_glb(dir.path());
     wavg_testdata::keep_gltf(&out, "cli_decal");
     assert!(!dir.path().join("decal.mtl").exists());
     let (doc, blob) = read(&out);

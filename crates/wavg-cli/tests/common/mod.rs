@@ -212,3 +212,24 @@ pub fn remesh_on_sphere(base: &std::path::Path, out: &std::path::Path, extra: &[
     ];
     wavg(&[&args[..], extra].concat())
 }
+
+/// Runs `wavg decal` on the built-in icosphere with a square of four anchors and writes
+/// `DIR/decal.glb` (its UVs and the checkerboard texture): the glTF tests' textured file.
+pub fn decal_glb(dir: &std::path::Path) -> std::path::PathBuf {
+    let anchors = dir.join("a.txt");
+    let uv = dir.join("uv.txt");
+    std::fs::write(&anchors, "v 0\nv 1\nv 2\nv 3\n").unwrap();
+    std::fs::write(&uv, "0 0\n1 0\n1 1\n0 1\n").unwrap();
+    let glb = dir.join("decal.glb");
+    wavg_ok(&[
+        "decal",
+        "builtin:icosphere",
+        "--anchors",
+        &s(&anchors),
+        "--uv",
+        &s(&uv),
+        "-o",
+        &s(&glb),
+    ]);
+    glb
+}
