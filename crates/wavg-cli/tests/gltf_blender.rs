@@ -8,7 +8,6 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-
 /// The script Blender runs: import, then one line `WAVG_RESULT {json}`.
 const SCRIPT: &str = r#"
 import bpy, json, sys
