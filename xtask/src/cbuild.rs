@@ -116,7 +116,13 @@ pub fn steps(root: &Path, data_dir: &Path) -> Vec<(&'static str, String, Vec<Str
         (
             "ctest",
             "ctest".into(),
-            vec!["--test-dir".into(), build, "--output-on-failure".into()],
+            // Two at a time: the OpenMesh harness on igea takes most of the step alone.
+            vec![
+                "--test-dir".into(),
+                build,
+                "--output-on-failure".into(),
+                "-j2".into(),
+            ],
         ),
     ]
 }

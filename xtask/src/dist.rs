@@ -13,12 +13,15 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use crate::zig_env::Recorder;
 use crate::{blender, python, steps, version};
 
 /// The largest wheel a release ships (bytes).
 const MAX_WHEEL: u64 = 15 * 1024 * 1024;
 /// The oldest glibc the wheel supports, as a wheel platform tag.
 pub const MANYLINUX: &str = "manylinux_2_28";
+/// The target maturin's zig build compiles for (`--target`), which the C library shares.
+const ZIG_TRIPLE: &str = "x86_64-unknown-linux-gnu";
 /// The platform of the C tarball's name.
 const PLATFORM: &str = "linux-x86_64";
 /// The crates the release leaves out: automation, the lab and the fuzz targets (not
@@ -53,12 +56,14 @@ pub fn run(root: &Path) -> Result<Artifacts, String> {
         std::fs::remove_dir_all(&dist).map_err(|e| format!("{}: {e}", dist.display()))?;
     }
     std::fs::create_dir_all(&dist).map_err(|e| format!("{}: {e}", dist.display()))?;
-    let wheel = wheel(root, &dist, &version)?;
-    let sdist = sdist(root, &dist, &version)?;
+    let recorder = Recorder::new(root)?;
+    let wheel = timed("wheel", || wheel(root, &dist, &version, &recorder))?;
+    let sdist = timed("sdist", || sdist(root, &dist, &version))?;
     let blender_zip = dist.join(format!("wavg_blender-{version}-linux_x64.zip"));
-    blender::pack(root, &wheel, &blender_zip)?;
-    let c_tarball = c_tarball(root, &dist, &version)?;
-    crates(root, &dist)?;
+    timed("Blender zip", || blender::pack(root, &wheel, &blender_zip))?;
+    let zig_env = recorder.recorded()?;
+    let c_tarball = timed("C tarball", || c_tarball(root, &dist, &version, &zig_env))?;
+    timed("crates", || crates(root, &dist))?;
     checksums(&dist)?;
     eprintln!("==> {}: wavg {version}", dist.display());
     Ok(Artifacts {
@@ -68,6 +73,14 @@ pub fn run(root: &Path) -> Result<Artifacts, String> {
         blender_zip,
         c_tarball,
     })
+}
+
+/// Runs one artifact's build and prints its time (the step table shows only `dist`'s sum).
+fn timed<T>(name: &str, build: impl FnOnce() -> Result<T, String>) -> Result<T, String> {
+    let t = std::time::Instant::now();
+    let out = build()?;
+    eprintln!("    dist: {name} in {:.1} s", t.elapsed().as_secs_f64());
+    Ok(out)
 }
 
 /// The one file in `dir` whose name starts with `prefix` and ends with `suffix`.
@@ -96,11 +109,23 @@ fn only_file(dir: &Path, prefix: &str, suffix: &str) -> Result<PathBuf, String> 
 /// `ziglang` package), in the package's folder with cargo's target directory and the
 /// environment's `bin/` first on `PATH` (where maturin finds zig).
 fn maturin(root: &Path, args: &[&str]) -> Result<(), String> {
+    maturin_env(root, args, None, &[])
+}
+
+/// [`maturin`] with `first` (a folder) put before the environment's `bin/` on `PATH`, and
+/// extra variables.
+fn maturin_env(
+    root: &Path,
+    args: &[&str],
+    first: Option<&Path>,
+    env: &[(&str, &str)],
+) -> Result<(), String> {
     let py = python::ensure_venv(root)?;
     let bin = python::venv_dir(root).join("bin");
     let maturin = bin.join("maturin");
     let path = std::env::var_os("PATH").unwrap_or_default();
-    let path = std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(&path)))
+    let dirs = first.map(Path::to_path_buf).into_iter().chain([bin]);
+    let path = std::env::join_paths(dirs.chain(std::env::split_paths(&path)))
         .map_err(|e| format!("PATH: {e}"))?;
     let target = steps::target_dir(root);
     let mut all = args.to_vec();
@@ -108,14 +133,14 @@ fn maturin(root: &Path, args: &[&str]) -> Result<(), String> {
     if args.first() == Some(&"build") {
         all.extend(["--interpreter", &py_s]);
     }
+    let (target, path) = (target.to_string_lossy(), path.to_string_lossy());
+    let mut vars = vec![("CARGO_TARGET_DIR", &*target), ("PATH", &*path)];
+    vars.extend(env);
     steps::command_env(
         &root.join("python"),
         &maturin.to_string_lossy(),
         &all,
-        &[
-            ("CARGO_TARGET_DIR", &target.to_string_lossy()),
-            ("PATH", &path.to_string_lossy()),
-        ],
+        &vars,
     )
 }
 
@@ -124,9 +149,11 @@ fn maturin(root: &Path, args: &[&str]) -> Result<(), String> {
 /// [`MANYLINUX`] and checked again by `auditwheel show`; at most [`MAX_WHEEL`] bytes.
 /// (`--target` and zig put this build in `target/x86_64-unknown-linux-gnu/release/`,
 /// apart from the C library's.)
-fn wheel(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String> {
+fn wheel(root: &Path, dist: &Path, version: &str, recorder: &Recorder) -> Result<PathBuf, String> {
     let out = dist.to_string_lossy();
-    maturin(
+    let vars = recorder.vars();
+    let vars: Vec<(&str, &str)> = vars.iter().map(|(k, v)| (*k, v.as_str())).collect();
+    maturin_env(
         root,
         &[
             "build",
@@ -138,6 +165,8 @@ fn wheel(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String> {
             "--out",
             &out,
         ],
+        Some(recorder.dir()),
+        &vars,
     )?;
     let wheel = only_file(dist, &format!("wavg-{version}-"), ".whl")?;
     let name = wheel.file_name().unwrap_or_default().to_string_lossy();
@@ -185,8 +214,17 @@ fn sdist(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String> {
 }
 
 /// The C/C++ tarball: the CMake install (release library, tests and examples off) into a
-/// staging prefix, without the separate debug info, packed with its top folder.
-fn c_tarball(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String> {
+/// staging prefix, without the separate debug info, packed with its top folder. The
+/// library is built in `zig_env`, the wheel's environment (see [`crate::zig_env`]), for
+/// the wheel's target and together with the wheel's crate (so that the dependencies have
+/// the wheel's features: NumPy's turn on some of num-complex's): cargo compiles only
+/// `wavg-ffi` and the unstripped `wavg-py`.
+fn c_tarball(
+    root: &Path,
+    dist: &Path,
+    version: &str,
+    zig_env: &[(String, String)],
+) -> Result<PathBuf, String> {
     crate::cbuild::ensure_packages()?;
     let target = steps::target_dir(root);
     let build = target.join("dist-cmake");
@@ -211,11 +249,21 @@ fn c_tarball(root: &Path, dist: &Path, version: &str) -> Result<PathBuf, String>
             "-DWAVG_BUILD_EXAMPLES=OFF",
             "-DWAVG_BUILD_HARNESS=OFF",
             "-DWAVG_CARGO_PROFILE=release",
+            &format!("-DWAVG_CARGO_TARGET={ZIG_TRIPLE}"),
+            "-DWAVG_CARGO_BUILD_ARGS=--package;wavg-ffi;--package;wavg-py",
             "-DCMAKE_INSTALL_LIBDIR=lib",
             &format!("-DWAVG_CARGO_TARGET_DIR={}", target.display()),
         ],
     )?;
-    steps::command(root, "cmake", &["--build", &build_s, "-j2"])?;
+    let args = ["--build", &build_s, "-j2"];
+    eprintln!("    cmake {} (in the wheel's environment)", args.join(" "));
+    let mut cmake = Command::new("cmake");
+    cmake
+        .args(args)
+        .current_dir(root)
+        .env_clear()
+        .envs(zig_env.iter().map(|(k, v)| (k, v)));
+    steps::run("cmake", &args, &mut cmake)?;
     steps::command(
         root,
         "cmake",

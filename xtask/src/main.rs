@@ -23,6 +23,7 @@ mod steps;
 mod system;
 mod version;
 mod web;
+mod zig_env;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
