@@ -271,6 +271,7 @@ fn c_tarball(
     )?;
     let debug = prefix.join("lib").join("libwavg.so.0.debug");
     std::fs::remove_file(&debug).map_err(|e| format!("{}: {e}", debug.display()))?;
+    check_glibc(&prefix.join("lib").join("libwavg.so.0"))?;
     let tarball = dist.join(format!("{name}.tar.gz"));
     steps::command(
         root,
@@ -288,6 +289,42 @@ fn c_tarball(
         ],
     )?;
     Ok(tarball)
+}
+
+/// The newest glibc symbol version `lib` needs (`objdump -T`) must be at most the wheel's
+/// [`MANYLINUX`] glibc.
+fn check_glibc(lib: &Path) -> Result<(), String> {
+    let out = Command::new("objdump")
+        .arg("-T")
+        .arg(lib)
+        .output()
+        .map_err(|e| format!("objdump: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("objdump -T {}: {}", lib.display(), out.status));
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    let newest = text
+        .split("GLIBC_2.")
+        .skip(1)
+        .filter_map(|t| {
+            let digits: String = t.chars().take_while(char::is_ascii_digit).collect();
+            digits.parse::<u32>().ok()
+        })
+        .max()
+        .ok_or_else(|| format!("{}: no glibc symbols", lib.display()))?;
+    let limit: u32 = MANYLINUX
+        .rsplit('_')
+        .next()
+        .and_then(|m| m.parse().ok())
+        .ok_or("MANYLINUX names no glibc")?;
+    eprintln!("    {}: newest symbol GLIBC_2.{newest}", lib.display());
+    if newest > limit {
+        return Err(format!(
+            "{} needs GLIBC_2.{newest}, newer than {MANYLINUX}",
+            lib.display()
+        ));
+    }
+    Ok(())
 }
 
 /// `cargo package --workspace` (each package verified by building it alone), the `.crate`
