@@ -179,51 +179,82 @@ impl pulp::WithSimd for Weigh<'_, '_> {
 }
 
 impl System<'_> {
-    /// `v` of the anchors `c .. c + LANES`, coordinate by coordinate.
+    /// `v_k` of the anchors `c .. c + LANES`.
     #[inline(always)]
-    fn v<Q: Quad>(&self, q: Q, c: usize) -> [Q::V; DIM] {
-        std::array::from_fn(|k| {
-            let y = &self.anchors.dim(k)[c * LANES..(c + 1) * LANES];
-            q.sub(
-                q.load(y.try_into().expect("LANES long")),
-                q.splat(self.yhat[k]),
-            )
-        })
+    fn v_at<Q: Quad>(&self, q: Q, c: usize, k: usize) -> Q::V {
+        let y = &self.anchors.dim(k)[c * LANES..(c + 1) * LANES];
+        q.sub(
+            q.load(y.try_into().expect("LANES long")),
+            q.splat(self.yhat[k]),
+        )
     }
 
-    /// Fills in `t` and `vsv` (`s` and the rows already set).
+    /// `s_i` and `s_i c_i` of the anchors `c .. c + LANES`.
+    #[inline(always)]
+    fn sc<Q: Quad>(&self, q: Q, c: usize, nc: usize) -> (Q::V, [Q::V; 3]) {
+        let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
+        let s = q.load(&ss[c]);
+        (s, [q.mul(s, q.load(&a0[c])), q.mul(s, q.load(&a1[c])), s])
+    }
+
+    /// Fills in `t`, `vsv` and `csc` (`s` and the rows already set): one pass over the
+    /// anchors per row `K` of `vsv` and `t`, then one for `csc`, so that each pass's sums
+    /// stay in vector registers (all 66 at once spill to memory at every anchor). Each sum
+    /// adds the same products in the same order as one pass would.
     #[inline(always)]
     fn sums<Q: Quad>(&mut self, q: Q) {
+        self.row_sums::<0, Q>(q);
+        self.row_sums::<1, Q>(q);
+        self.row_sums::<2, Q>(q);
+        self.row_sums::<3, Q>(q);
+        self.row_sums::<4, Q>(q);
+        self.row_sums::<5, Q>(q);
+        self.row_sums::<6, Q>(q);
+        self.row_sums::<7, Q>(q);
         let zero = q.splat(0.0);
-        let mut t = [[zero; 3]; DIM];
-        let mut vsv = [[zero; DIM]; DIM];
-        let mut csc = [[zero; 3]; 3];
         let one = q.splat(1.0);
+        let mut csc = [[zero; 3]; 3];
         let nc = self.s.len() / LANES;
-        let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
+        let (a0, a1) = (quads(&self.a0, nc), quads(&self.a1, nc));
         for c in 0..nc {
-            let v = self.v(q, c);
-            let s = q.load(&ss[c]);
+            let (_, sc) = self.sc(q, c, nc);
             let cr = [q.load(&a0[c]), q.load(&a1[c]), one];
-            let sc = [q.mul(s, cr[0]), q.mul(s, cr[1]), s];
             for r in 0..3 {
                 for j in r..3 {
                     csc[r][j] = q.add(csc[r][j], q.mul(cr[r], sc[j]));
                 }
             }
-            for k in 0..DIM {
-                for j in 0..3 {
-                    t[k][j] = q.add(t[k][j], q.mul(v[k], sc[j]));
-                }
-                let sv = q.mul(s, v[k]);
-                for l in k..DIM {
-                    vsv[k][l] = q.add(vsv[k][l], q.mul(sv, v[l]));
-                }
+        }
+        self.csc = Matrix3::from_fn(|r, j| sum_lanes(q.lanes(csc[r.min(j)][r.max(j)])));
+    }
+
+    /// Row `K` of `t` (`sum s_i v_ik c_i`) and of `vsv` (`sum s_i v_ik v_il`, `l >= K`,
+    /// mirrored).
+    #[inline(always)]
+    fn row_sums<const K: usize, Q: Quad>(&mut self, q: Q) {
+        let zero = q.splat(0.0);
+        let mut t = [zero; 3];
+        let mut row = [zero; DIM];
+        let nc = self.s.len() / LANES;
+        for c in 0..nc {
+            let (s, sc) = self.sc(q, c, nc);
+            let vk = self.v_at(q, c, K);
+            for j in 0..3 {
+                t[j] = q.add(t[j], q.mul(vk, sc[j]));
+            }
+            let sv = q.mul(s, vk);
+            for (l, acc) in row.iter_mut().enumerate().skip(K) {
+                *acc = q.add(*acc, q.mul(sv, self.v_at(q, c, l)));
             }
         }
-        self.t = SMatrix::from_fn(|k, j| sum_lanes(q.lanes(t[k][j])));
-        self.vsv = SMatrix::from_fn(|k, l| sum_lanes(q.lanes(vsv[k.min(l)][k.max(l)])));
-        self.csc = Matrix3::from_fn(|r, j| sum_lanes(q.lanes(csc[r.min(j)][r.max(j)])));
+        for (j, x) in t.iter().enumerate() {
+            self.t[(K, j)] = sum_lanes(q.lanes(*x));
+        }
+        for (l, x) in row.iter().enumerate().skip(K) {
+            let x = sum_lanes(q.lanes(*x));
+            self.vsv[(K, l)] = x;
+            self.vsv[(l, K)] = x;
+        }
     }
 
     /// `out_i = s_i (c_i . z - v_i . g)` (zero in the padding); returns their sum.
@@ -475,6 +506,74 @@ mod tests {
                     "case {case}, lambda {lambda}: {err:e}"
                 );
             }
+        }
+    }
+
+    /// The sums as one pass over the anchors holding all of them (the order each sum's
+    /// products are added in, which the passes of `System::sums` keep).
+    fn one_pass_sums(
+        sys: &System<'_>,
+    ) -> (SMatrix<f64, DIM, 3>, SMatrix<f64, DIM, DIM>, Matrix3<f64>) {
+        let q = Plain;
+        let zero = q.splat(0.0);
+        let (mut t, mut vsv, mut csc) = ([[zero; 3]; DIM], [[zero; DIM]; DIM], [[zero; 3]; 3]);
+        let nc = sys.s.len() / LANES;
+        let (ss, a0, a1) = (quads(&sys.s, nc), quads(&sys.a0, nc), quads(&sys.a1, nc));
+        for c in 0..nc {
+            let v: [_; DIM] = std::array::from_fn(|k| sys.v_at(q, c, k));
+            let s = q.load(&ss[c]);
+            let cr = [q.load(&a0[c]), q.load(&a1[c]), q.splat(1.0)];
+            let sc = [q.mul(s, cr[0]), q.mul(s, cr[1]), s];
+            for r in 0..3 {
+                for j in r..3 {
+                    csc[r][j] = q.add(csc[r][j], q.mul(cr[r], sc[j]));
+                }
+            }
+            for k in 0..DIM {
+                for j in 0..3 {
+                    t[k][j] = q.add(t[k][j], q.mul(v[k], sc[j]));
+                }
+                let sv = q.mul(s, v[k]);
+                for l in k..DIM {
+                    vsv[k][l] = q.add(vsv[k][l], q.mul(sv, v[l]));
+                }
+            }
+        }
+        (
+            SMatrix::from_fn(|k, j| sum_lanes(q.lanes(t[k][j]))),
+            SMatrix::from_fn(|k, l| sum_lanes(q.lanes(vsv[k.min(l)][k.max(l)]))),
+            Matrix3::from_fn(|r, j| sum_lanes(q.lanes(csc[r.min(j)][r.max(j)]))),
+        )
+    }
+
+    #[test]
+    fn the_sums_by_row_equal_one_pass_bitwise() {
+        let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for case in 0..50 {
+            let n = 4 + case * 7 % 130;
+            let mut g = || r.random_range(-1.0..1.0);
+            let psi = Mat2x8::from_fn(|_, _| g());
+            let yhat = Vec8::from_fn(|_, _| g());
+            let ys: Vec<Vec8> = (0..n).map(|_| Vec8::from_fn(|_, _| 2.0 * g())).collect();
+            let anchors = AnchorCoords::from_points(&ys);
+            let PenaltySystem::Solve(sys) =
+                PenaltySystem::new(&psi, &yhat, &anchors, 10.0).unwrap()
+            else {
+                panic!("case {case}: no anchor at the point");
+            };
+            let (t, vsv, csc) = one_pass_sums(&sys);
+            let bits = |m: &[f64]| m.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(sys.t.as_slice()), bits(t.as_slice()), "case {case}");
+            assert_eq!(
+                bits(sys.vsv.as_slice()),
+                bits(vsv.as_slice()),
+                "case {case}"
+            );
+            assert_eq!(
+                bits(sys.csc.as_slice()),
+                bits(csc.as_slice()),
+                "case {case}"
+            );
         }
     }
 
