@@ -80,9 +80,7 @@ impl<'a> PenaltySystem<'a> {
             return Ok(Self::OneHot { n, i });
         }
         // Scale-free: D / d_ref, and the penalty scaled the same way.
-        let mut sorted = d[..n].to_vec();
-        let k = 3.min(n - 1);
-        let d_ref = *sorted.select_nth_unstable_by(k, f64::total_cmp).1;
+        let d_ref = nth_smallest(&d[..n], 3.min(n - 1));
         // Zero in the padding.
         d[n..].fill(f64::INFINITY);
         let s = d
@@ -120,6 +118,23 @@ impl<'a> PenaltySystem<'a> {
             Self::Solve(s) => s.weights(lambda),
         }
     }
+}
+
+/// The `k`-th smallest (from 0; `k < 4`, `k < xs.len()`) of the finite `xs`, in one pass
+/// keeping the `k + 1` smallest seen (no copy, no sort).
+fn nth_smallest(xs: &[f64], k: usize) -> f64 {
+    let mut low = [f64::INFINITY; 4];
+    for &x in xs {
+        if x < low[k] {
+            let mut j = k;
+            while j > 0 && low[j - 1] > x {
+                low[j] = low[j - 1];
+                j -= 1;
+            }
+            low[j] = x;
+        }
+    }
+    low[k]
 }
 
 /// [`offsets`] as one SIMD operation.
@@ -179,24 +194,6 @@ impl pulp::WithSimd for Weigh<'_, '_> {
 }
 
 impl System<'_> {
-    /// `v_k` of the anchors `c .. c + LANES`.
-    #[inline(always)]
-    fn v_at<Q: Quad>(&self, q: Q, c: usize, k: usize) -> Q::V {
-        let y = &self.anchors.dim(k)[c * LANES..(c + 1) * LANES];
-        q.sub(
-            q.load(y.try_into().expect("LANES long")),
-            q.splat(self.yhat[k]),
-        )
-    }
-
-    /// `s_i` and `s_i c_i` of the anchors `c .. c + LANES`.
-    #[inline(always)]
-    fn sc<Q: Quad>(&self, q: Q, c: usize, nc: usize) -> (Q::V, [Q::V; 3]) {
-        let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
-        let s = q.load(&ss[c]);
-        (s, [q.mul(s, q.load(&a0[c])), q.mul(s, q.load(&a1[c])), s])
-    }
-
     /// Fills in `t`, `vsv` and `csc` (`s` and the rows already set): one pass over the
     /// anchors per row `K` of `vsv` and `t`, then one for `csc`, so that each pass's sums
     /// stay in vector registers (all 66 at once spill to memory at every anchor). Each sum
@@ -215,10 +212,11 @@ impl System<'_> {
         let one = q.splat(1.0);
         let mut csc = [[zero; 3]; 3];
         let nc = self.s.len() / LANES;
-        let (a0, a1) = (quads(&self.a0, nc), quads(&self.a1, nc));
+        let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
         for c in 0..nc {
-            let (_, sc) = self.sc(q, c, nc);
+            let s = q.load(&ss[c]);
             let cr = [q.load(&a0[c]), q.load(&a1[c]), one];
+            let sc = [q.mul(s, cr[0]), q.mul(s, cr[1]), s];
             for r in 0..3 {
                 for j in r..3 {
                     csc[r][j] = q.add(csc[r][j], q.mul(cr[r], sc[j]));
@@ -236,15 +234,20 @@ impl System<'_> {
         let mut t = [zero; 3];
         let mut row = [zero; DIM];
         let nc = self.s.len() / LANES;
+        let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
+        let ys: [&[[f64; LANES]]; DIM] = std::array::from_fn(|k| quads(self.anchors.dim(k), nc));
+        let yhat: [Q::V; DIM] = std::array::from_fn(|k| q.splat(self.yhat[k]));
         for c in 0..nc {
-            let (s, sc) = self.sc(q, c, nc);
-            let vk = self.v_at(q, c, K);
+            let s = q.load(&ss[c]);
+            let sc = [q.mul(s, q.load(&a0[c])), q.mul(s, q.load(&a1[c])), s];
+            let vk = q.sub(q.load(&ys[K][c]), yhat[K]);
             for j in 0..3 {
                 t[j] = q.add(t[j], q.mul(vk, sc[j]));
             }
             let sv = q.mul(s, vk);
-            for (l, acc) in row.iter_mut().enumerate().skip(K) {
-                *acc = q.add(*acc, q.mul(sv, self.v_at(q, c, l)));
+            for l in K..DIM {
+                let vl = q.sub(q.load(&ys[l][c]), yhat[l]);
+                row[l] = q.add(row[l], q.mul(sv, vl));
             }
         }
         for (j, x) in t.iter().enumerate() {
@@ -520,7 +523,10 @@ mod tests {
         let nc = sys.s.len() / LANES;
         let (ss, a0, a1) = (quads(&sys.s, nc), quads(&sys.a0, nc), quads(&sys.a1, nc));
         for c in 0..nc {
-            let v: [_; DIM] = std::array::from_fn(|k| sys.v_at(q, c, k));
+            let v: [_; DIM] = std::array::from_fn(|k| {
+                let y = &sys.anchors.dim(k)[c * LANES..(c + 1) * LANES];
+                q.sub(q.load(y.try_into().unwrap()), q.splat(sys.yhat[k]))
+            });
             let s = q.load(&ss[c]);
             let cr = [q.load(&a0[c]), q.load(&a1[c]), q.splat(1.0)];
             let sc = [q.mul(s, cr[0]), q.mul(s, cr[1]), s];
@@ -574,6 +580,27 @@ mod tests {
                 bits(csc.as_slice()),
                 "case {case}"
             );
+        }
+    }
+
+    #[test]
+    fn nth_smallest_is_the_order_statistic() {
+        let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for case in 0..300 {
+            let n = 1 + case % 40;
+            // Few distinct values, so ties are common.
+            let xs: Vec<f64> = (0..n)
+                .map(|_| f64::from(r.random_range(0..6u8)) * 0.5)
+                .collect();
+            for k in 0..4.min(n) {
+                let mut sorted = xs.clone();
+                sorted.sort_by(f64::total_cmp);
+                assert_eq!(
+                    nth_smallest(&xs, k),
+                    sorted[k],
+                    "case {case}, k {k}: {xs:?}"
+                );
+            }
         }
     }
 
