@@ -269,26 +269,35 @@ impl Assembly {
         // Positions first: their accessor's count is then known to be backed by bytes.
         read_accessor::vec3(src, &positions, &mut self.positions)
             .map_err(|e| format!("{what}: {e}"))?;
-        let idx = match prim.indices() {
-            Some(a) => read_accessor::indices(src, &a).map_err(|e| format!("{what}: {e}"))?,
-            None => (0..u32::try_from(count).map_err(|_| format!("{what}: too many vertices"))?)
-                .collect(),
-        };
         let first = self.triangles.len();
-        match prim.mode() {
-            Mode::Triangles => self
-                .triangles
-                .extend(idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]])),
-            mode => match triangles(mode, &idx) {
-                Some(tris) => self.triangles.extend(tris),
-                None => {
-                    self.positions.truncate(start);
-                    self.skipped_primitives += 1;
-                    return Ok(());
+        let too_many = || format!("{what}: too many vertices");
+        match (prim.indices(), prim.mode()) {
+            (Some(a), Mode::Triangles) => {
+                read_accessor::triangle_list(src, &a, &mut self.triangles)
+                    .map_err(|e| format!("{what}: {e}"))?;
+            }
+            (None, Mode::Triangles) => {
+                let n = u32::try_from(count).map_err(|_| too_many())? / 3;
+                self.triangles
+                    .extend((0..n).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]));
+            }
+            (indices, mode) => {
+                let idx = match indices {
+                    Some(a) => {
+                        read_accessor::indices(src, &a).map_err(|e| format!("{what}: {e}"))?
+                    }
+                    None => (0..u32::try_from(count).map_err(|_| too_many())?).collect(),
+                };
+                match triangles(mode, &idx) {
+                    Some(tris) => self.triangles.extend(tris),
+                    None => {
+                        self.positions.truncate(start);
+                        self.skipped_primitives += 1;
+                        return Ok(());
+                    }
                 }
-            },
+            }
         }
-        drop(idx);
         let linear = world.fixed_view::<3, 3>(0, 0).into_owned();
         let shift = world.fixed_view::<3, 1>(0, 3).into_owned();
         // A mirroring transform turns counter-clockwise triangles clockwise.
@@ -359,37 +368,39 @@ impl Assembly {
         }
         let gathered = self.positions.len();
         let map = weld::weld(&mut self.positions);
-        let welded = gathered - self.positions.len();
         let mut notes = LoadNotes {
             polygons: self.triangles.len(),
-            welded_vertices: welded,
+            welded_vertices: gathered - self.positions.len(),
             skipped_primitives: self.skipped_primitives,
             ..LoadNotes::default()
         };
-        let mut uv = None;
-        let triangles = if self.textured == 0 && welded == 0 {
-            // Nothing merged: every index already is its welded one.
-            self.triangles
-        } else {
-            let welded_triangles = self
-                .triangles
-                .iter()
-                .map(|t| t.map(|i| map[i as usize]))
-                .collect();
-            if self.textured > 0 {
-                let mut faces = self.triangles;
-                for r in self.untextured {
-                    faces[r].fill([NONE; 3]);
-                }
-                let coords = std::mem::take(&mut self.uv);
-                if self.textured == faces.len() {
-                    uv = Some(TexCoords { coords, faces });
-                } else {
-                    notes.uv_dropped = true;
-                    notes.partial_uv = Some(TexCoords { coords, faces });
-                }
+        // Without a merge every index already is its welded one.
+        let welded = |t: &[[u32; 3]]| -> Vec<[u32; 3]> {
+            match &map {
+                Some(map) => t.iter().map(|t| t.map(|i| map[i as usize])).collect(),
+                None => t.to_vec(),
             }
-            welded_triangles
+        };
+        let mut uv = None;
+        let triangles = if self.textured == 0 {
+            match &map {
+                Some(_) => welded(&self.triangles),
+                None => self.triangles,
+            }
+        } else {
+            let triangles = welded(&self.triangles);
+            let mut faces = self.triangles;
+            for r in self.untextured {
+                faces[r].fill([NONE; 3]);
+            }
+            let coords = std::mem::take(&mut self.uv);
+            if self.textured == faces.len() {
+                uv = Some(TexCoords { coords, faces });
+            } else {
+                notes.uv_dropped = true;
+                notes.partial_uv = Some(TexCoords { coords, faces });
+            }
+            triangles
         };
         notes.texture = self.texture.filter(|_| uv.is_some() || notes.uv_dropped);
         Ok((

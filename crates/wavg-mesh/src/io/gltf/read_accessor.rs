@@ -243,3 +243,50 @@ pub(crate) fn indices(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<u32>
     decode_into(src, acc, &mut out, 0, |b| unsigned(b, size))?;
     Ok(out)
 }
+
+/// Appends the triangles of a `TRIANGLES` primitive's index accessor to `out` (a
+/// trailing incomplete triangle is dropped): straight from the buffer in the common
+/// case of tightly packed indices without sparse values.
+pub(crate) fn triangle_list(
+    src: &mut Source,
+    acc: &gltf::Accessor,
+    out: &mut Vec<[u32; 3]>,
+) -> Result<(), String> {
+    let packed = acc.sparse().is_none()
+        && acc.dimensions() == Dimensions::Scalar
+        && acc
+            .view()
+            .is_some_and(|v| v.stride().is_none_or(|s| s == acc.size()));
+    let view = match acc.view() {
+        Some(view) if packed => view,
+        _ => {
+            let idx = indices(src, acc)?;
+            out.extend(idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+            return Ok(());
+        }
+    };
+    let size = match acc.data_type() {
+        DataType::U8 => 1,
+        DataType::U16 => 2,
+        DataType::U32 => 4,
+        _ => return indices(src, acc).map(|_| ()),
+    };
+    let name = what(acc);
+    let count = acc.count();
+    let s = strided(&src.buffers, &view, acc.offset(), count, size, &name)?;
+    src.budget.take(count as u64, &name)?;
+    let bytes = &s.bytes[..count / 3 * 3 * size];
+    out.reserve(count / 3);
+    match size {
+        4 => out.extend(bytes.chunks_exact(12).map(|c| {
+            let at = |k: usize| u32::from_le_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
+            [at(0), at(4), at(8)]
+        })),
+        _ => out.extend(
+            bytes
+                .chunks_exact(3 * size)
+                .map(|c| [0, 1, 2].map(|k| unsigned(&c[k * size..], size))),
+        ),
+    }
+    Ok(())
+}

@@ -3,27 +3,26 @@
 //! copies are merged again.
 //!
 //! One open-addressing table of `u64` slots (a hash tag and the welded index), at most
-//! half full, probed linearly: a lookup costs about one cache miss, and the positions
+//! two thirds full, probed linearly: a lookup costs about one cache miss, and the positions
 //! themselves are touched only when the tags agree. (A `HashMap` keyed by the bits took
 //! most of the time of reading a large file.)
 
 use nalgebra::Vector3;
 
 /// Welds `positions` in place: they become the first copies, in order of first
-/// appearance. Returns, for every input vertex, its welded index. Equal means equal as
+/// appearance. Returns, for every input vertex, its welded index, or `None` when nothing
+/// was merged (every vertex keeps its index). Equal means equal as
 /// numbers (`-0.0 == 0.0`); a vertex with a NaN coordinate is never welded, so validation
 /// still names it. At most `u32::MAX - 1` positions (the readers' limit).
-pub(crate) fn weld(positions: &mut Vec<Vector3<f64>>) -> Vec<u32> {
+pub(crate) fn weld(positions: &mut Vec<Vector3<f64>>) -> Option<Vec<u32>> {
     let n = positions.len();
-    let bits = n
-        .saturating_mul(2)
-        .max(2)
-        .next_power_of_two()
-        .trailing_zeros();
+    let slots = n.saturating_add(n / 2).max(2).next_power_of_two();
+    let bits = slots.trailing_zeros();
     let mask = (1usize << bits) - 1;
     // A slot holds `tag << 32 | (index + 1)`; 0 is empty.
     let mut table = vec![0u64; mask + 1];
-    let mut map = Vec::with_capacity(n);
+    // Filled from the first merge on: until then every vertex is its own.
+    let mut map = Vec::new();
     let mut next = 0usize;
     for i in 0..n {
         let p = positions[i];
@@ -50,11 +49,16 @@ pub(crate) fn weld(positions: &mut Vec<Vector3<f64>>) -> Vec<u32> {
         if id == next {
             positions[next] = p;
             next += 1;
+        } else if map.is_empty() {
+            map.reserve_exact(n);
+            map.extend(0..i as u32);
         }
-        map.push(id as u32);
+        if !map.is_empty() {
+            map.push(id as u32);
+        }
     }
     positions.truncate(next);
-    map
+    (next < n).then_some(map)
 }
 
 /// Spreads every bit of `x` over the whole word (a bijection).
@@ -87,12 +91,25 @@ mod tests {
             v(1.0, 0.0),
         ];
         let mut out = input.to_vec();
-        let map = weld(&mut out);
+        let map = weld(&mut out).unwrap();
         assert_eq!(map, [0, 1, 0, 2, 3, 4, 1]);
         assert_eq!(out.len(), 5);
         assert_eq!(out[0], v(0.0, 0.0));
         assert!(out[2].x.is_nan() && out[3].x.is_nan());
         assert_eq!(out[4], v(1.0, 1e-300));
+    }
+
+    #[test]
+    fn without_equal_positions_nothing_is_mapped() {
+        let mut v = vec![
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(f64::NAN, 0.0, 0.0),
+            Vector3::new(f64::NAN, 0.0, 0.0),
+            Vector3::new(0.0, 0.0, 1.0),
+        ];
+        assert_eq!(weld(&mut v), None);
+        assert_eq!(v.len(), 4);
+        assert_eq!(weld(&mut Vec::new()), None);
     }
 
     #[test]
@@ -118,7 +135,7 @@ mod tests {
             })
             .collect();
         let mut out = input.clone();
-        let map = weld(&mut out);
+        let map = weld(&mut out).unwrap();
         assert_eq!(map, expected);
         assert_eq!(out, input[..3000]);
     }
