@@ -394,12 +394,7 @@ impl Assembly {
                 faces[r].fill([NONE; 3]);
             }
             let coords = std::mem::take(&mut self.uv);
-            if self.textured == faces.len() {
-                uv = Some(TexCoords { coords, faces });
-            } else {
-                notes.uv_dropped = true;
-                notes.partial_uv = Some(TexCoords { coords, faces });
-            }
+            uv = notes.corner_uv(TexCoords { coords, faces }, self.textured);
             triangles
         };
         notes.texture = self.texture.filter(|_| uv.is_some() || notes.uv_dropped);
