@@ -184,8 +184,13 @@ pub(crate) fn vec3(
             acc.data_type()
         ));
     }
+    // An element has its 12 bytes (checked by `strided`); as an array they decode
+    // without a bounds check per byte.
     decode_into(src, acc, out, Vector3::zeros(), |b| {
-        Vector3::new(f32_at(b, 0), f32_at(b, 1), f32_at(b, 2)).cast()
+        match b.first_chunk::<12>() {
+            Some(c) => Vector3::new(f32_at(c, 0), f32_at(c, 1), f32_at(c, 2)).cast(),
+            None => Vector3::zeros(),
+        }
     })
 }
 
