@@ -76,6 +76,7 @@ use wavg_mesh::{TriMesh, ValidMesh};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 
 mod collapse;
+mod first_pass;
 mod heap;
 mod quadric;
 
@@ -108,7 +109,17 @@ pub struct DecimateOptions {
     /// Relax the normal bounds when they block the target (see the module docs); without
     /// it, an unreachable target is an error.
     pub relax: bool,
+    /// Meshes with more than twice this many vertices (and more than twice the target
+    /// and every snapshot) first go through meshoptimizer's simplifier down to about this
+    /// many, cleaned up into a valid mesh of the same topology on original vertices; the
+    /// quadric decimation continues from there (falling back to the full mesh when the
+    /// cleanup fails). 0 turns the first pass off. Default [`FIRST_PASS_VERTICES`].
+    pub first_pass_vertices: usize,
 }
+
+/// Vertices left by the first pass of large decimations by default: meshes up to twice
+/// this size are decimated exactly as without a first pass.
+pub const FIRST_PASS_VERTICES: usize = 500_000;
 
 impl Default for DecimateOptions {
     fn default() -> Self {
@@ -119,6 +130,7 @@ impl Default for DecimateOptions {
             max_aspect_ratio: None,
             locked: Vec::new(),
             relax: true,
+            first_pass_vertices: FIRST_PASS_VERTICES,
         }
     }
 }
@@ -209,6 +221,44 @@ pub fn decimate_with_snapshots(
             opts.target
         )));
     }
+    let keep =
+        (snapshots.iter().copied()).fold(opts.first_pass_vertices.max(opts.target), usize::max);
+    if opts.first_pass_vertices > 0 && n > 2 * keep {
+        check_cancel(progress)?;
+        progress.report(Stage::Decimate, 0.0);
+        if let Some(r) = first_pass::first_pass(mesh, keep, &opts.locked) {
+            let lift = |d: Decimated| Decimated {
+                landmarks: d
+                    .landmarks
+                    .iter()
+                    .map(|&v| r.original[v as usize])
+                    .collect(),
+                ..d
+            };
+            let inner = DecimateOptions {
+                locked: (opts.locked.iter())
+                    .filter_map(|l| r.original.binary_search(l).ok().map(|i| i as u32))
+                    .collect(),
+                first_pass_vertices: 0,
+                ..opts.clone()
+            };
+            if snapshots.iter().all(|&s| s <= r.mesh.n_vertices()) {
+                let (fin, snaps) = decimate_exact(&r.mesh, &inner, snapshots, progress)?;
+                return Ok((lift(fin), snaps.into_iter().map(lift).collect()));
+            }
+        }
+    }
+    decimate_exact(mesh, opts, snapshots, progress)
+}
+
+/// [`decimate_with_snapshots`] by quadric collapses alone, its arguments checked.
+fn decimate_exact(
+    mesh: &ValidMesh,
+    opts: &DecimateOptions,
+    snapshots: &[usize],
+    progress: &dyn Progress,
+) -> Result<(Decimated, Vec<Decimated>), EmbedError> {
+    let n = mesh.n_vertices();
     let mut d = Decimator::new(mesh, opts);
     let mut snaps: Vec<Option<Decimated>> = vec![None; snapshots.len()];
     let take = |d: &Decimator, snaps: &mut Vec<Option<Decimated>>| {
