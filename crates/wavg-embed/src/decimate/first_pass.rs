@@ -326,39 +326,44 @@ mod tests {
         }
     }
 
-    /// A pinched vertex (two fans on one vertex) is split, the copy taking a fresh original
-    /// vertex near its fan, and the result validates.
+    /// A vertex collapsed onto one three rings away (the simplifier's pinch: two fans on
+    /// one vertex) is split, and its copy takes the nearest unused
+    /// original vertex, here the collapsed one itself: the input comes back.
     #[test]
     fn pinched_vertices_take_fresh_original_ids() {
         let mesh = valid(procedural::icosphere(3));
-        // Two caps of the sphere glued at vertex 0 as a stand-in for the simplifier's
-        // output: all faces around vertex 0 and the faces around a far vertex rewired
-        // onto 0 would not be a mesh; instead check the split path on a bow tie.
-        let p = |x: f64, y: f64| nalgebra::Vector3::new(x, y, 0.0);
-        let bow = TriMesh::new(
-            vec![
-                p(0., 0.),
-                p(1., 1.),
-                p(1., -1.),
-                p(-1., 1.),
-                p(-1., -1.),
-                p(1.2, 0.),
-                p(-1.2, 0.),
-            ],
-            vec![[0, 2, 1], [0, 3, 4], [1, 2, 5], [4, 3, 6]],
+        // `a` three rings from `b`: the two fans share no vertex but `b`.
+        let (b, topo) = (0u32, mesh.topology());
+        let mut near: Vec<u32> = vec![b];
+        for _ in 0..2 {
+            let next: Vec<u32> = near.iter().flat_map(|&u| topo.ring(u).to_vec()).collect();
+            near.extend(next);
+        }
+        let a = (near.iter())
+            .flat_map(|&u| topo.ring(u).to_vec())
+            .find(|w| !near.contains(w))
+            .unwrap();
+        let pinched: Vec<[u32; 3]> = (mesh.triangles.iter())
+            .map(|t| t.map(|v| if v == a { b } else { v }))
+            .collect();
+        let broken = TriMesh::new(mesh.positions.clone(), pinched.clone());
+        assert!(
+            ValidMesh::new(broken).is_err(),
+            "the pinch is not a valid mesh"
         );
-        let bow = ValidMesh::new(bow.clone()).err().map(|_| bow);
-        assert!(bow.is_some(), "a bow tie is not a valid mesh");
-        // A grid's first pass with the split path forced: duplicate one corner use.
+        let r = clean(&mesh, pinched, &[]).unwrap();
+        assert_eq!(
+            r.original,
+            (0..mesh.n_vertices() as u32).collect::<Vec<_>>()
+        );
+        assert_eq!(r.mesh.n_faces(), mesh.n_faces());
+        assert_eq!(r.mesh.topology().genus(), 0);
+        // A face set the simplifier left intact comes back unchanged.
         let grid = valid(procedural::grid(20, 20, 1.0, 1.0));
-        let mut faces = grid.triangles.clone();
-        // Detach the faces of one vertex's upper half onto... keep it simple: the
-        // clean-up of an unchanged face set is the identity.
-        let r = clean(&grid, std::mem::take(&mut faces), &[]).unwrap();
+        let r = clean(&grid, grid.triangles.clone(), &[]).unwrap();
         assert_eq!(
             r.original,
             (0..grid.n_vertices() as u32).collect::<Vec<_>>()
         );
-        drop(mesh);
     }
 }

@@ -499,6 +499,53 @@ mod tests {
         }
     }
 
+    /// Below twice `first_pass_vertices` the decimation is the exact one; above, the
+    /// first pass runs and the result keeps every invariant (target, topology, locked
+    /// vertices, nested snapshots on original vertices).
+    #[test]
+    fn first_pass_threshold() {
+        let mesh = valid(procedural::with_noise(
+            procedural::torus(120, 50, 1.0, 0.3),
+            0.2,
+            4,
+        ));
+        let n = mesh.n_vertices();
+        let exact = DecimateOptions {
+            first_pass_vertices: 0,
+            ..opts(80)
+        };
+        let below = DecimateOptions {
+            first_pass_vertices: n / 2,
+            ..opts(80)
+        };
+        let a = decimate(&mesh, &exact, &NoProgress).unwrap();
+        let b = decimate(&mesh, &below, &NoProgress).unwrap();
+        assert_eq!(a.landmarks, b.landmarks);
+        assert_eq!(a.mesh.triangles, b.mesh.triangles);
+        assert_eq!(
+            decimate(&mesh, &opts(80), &NoProgress).unwrap().landmarks,
+            a.landmarks,
+            "the default first pass leaves small meshes alone"
+        );
+        let locked = vec![5, 999, 4000];
+        let above = DecimateOptions {
+            first_pass_vertices: n / 2 - 1,
+            locked: locked.clone(),
+            ..opts(80)
+        };
+        let (fin, snaps) =
+            decimate_with_snapshots(&mesh, &above, &[1000, 300], &NoProgress).unwrap();
+        check(&mesh, &fin, 80);
+        assert_ne!(fin.landmarks, a.landmarks, "the first pass ran");
+        for l in locked {
+            assert!(fin.coarse_index(l).is_some(), "{l}");
+        }
+        for (s, want) in snaps.iter().zip([1000, 300]) {
+            check(&mesh, s, want);
+            assert!(fin.landmarks.iter().all(|l| s.coarse_index(*l).is_some()));
+        }
+    }
+
     #[test]
     fn deterministic() {
         let mesh = valid(procedural::with_noise(
