@@ -31,7 +31,9 @@ mod scaled;
 mod simd;
 
 // The precomputation and its settings.
-pub use decimate::{Bounds, DecimateOptions, Decimated, decimate, select_landmarks};
+pub use decimate::{
+    Bounds, DecimateOptions, Decimated, FIRST_PASS_VERTICES, decimate, select_landmarks,
+};
 pub use mds::MdsOptions;
 pub use pipeline::{LANDMARK_ASPECT_RATIO, PrecomputeOptions, Report, StageSeconds};
 pub use scaled::precompute;
