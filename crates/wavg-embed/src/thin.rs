@@ -23,12 +23,17 @@ use crate::lsmesh::two_level::LsMeshExtension;
 /// landmark spacing drops below 0.1.
 pub(crate) const COLLAPSED_SCALE: f64 = 0.5;
 
-/// Landmarks are added only to meshes where some face shrinks below this
-/// ([`COLLAPSED_SCALE`] then marks what to cover): a clear collapse, which the meshes
-/// of the test data never show, while their curved regions may dip below
-/// [`COLLAPSED_SCALE`] in a few faces, and pairs of vertices two edges apart on scans,
-/// where such a pair may be far closer than its edges, below the trigger too.
+/// Landmarks are added only to meshes where at least [`COLLAPSE_TRIGGER_FACES`] faces
+/// shrink below this ([`COLLAPSED_SCALE`] then marks what to cover): a clear collapse of
+/// a part, which the meshes of the test data never show (at most one sliver), while
+/// their curved regions may dip below [`COLLAPSED_SCALE`] in a few faces, and pairs of
+/// vertices two edges apart on scans, where such a pair may be far closer than its
+/// edges, below the trigger too.
 pub(crate) const COLLAPSE_TRIGGER_SCALE: f64 = 0.1;
+
+/// Faces below [`COLLAPSE_TRIGGER_SCALE`] that start the additions: one ring around a
+/// tube of 8 vertices around.
+pub(crate) const COLLAPSE_TRIGGER_FACES: usize = 16;
 
 /// The smaller singular value of the affine map taking triangle `p` onto triangle `q`
 /// (any dimension): how much the map shrinks the triangle in its most shrunk direction.
@@ -63,9 +68,9 @@ fn min_stretch(p: [[f64; 3]; 3], q: [&[f64]; 3]) -> f64 {
 }
 
 /// Vertices of faces and pairs that the least-squares extension of the landmarks' 3D
-/// positions collapses ([`COLLAPSED_SCALE`]), landmarks excluded; none unless some
-/// face shrinks below [`COLLAPSE_TRIGGER_SCALE`] or `triggered` (an earlier round added
-/// landmarks).
+/// positions collapses ([`COLLAPSED_SCALE`]), landmarks excluded; none unless
+/// [`COLLAPSE_TRIGGER_FACES`] faces shrink below [`COLLAPSE_TRIGGER_SCALE`] or
+/// `triggered` (an earlier round added landmarks).
 pub(crate) fn collapsed_vertices(
     mesh: &ValidMesh,
     landmarks: &[u32],
@@ -85,14 +90,14 @@ pub(crate) fn collapsed_vertices(
         .collect();
     let x = solver.solve(&values, 3, progress)?;
     let mut out = vec![false; mesh.n_vertices()];
-    let mut worst = f64::INFINITY;
+    let mut below_trigger = 0;
     for t in &mesh.triangles {
         let p = t.map(|v| {
             let q = pos[v as usize];
             [q.x, q.y, q.z]
         });
         let s = min_stretch(p, t.map(|v| &x[v as usize][..3]));
-        worst = worst.min(s);
+        below_trigger += usize::from(s < COLLAPSE_TRIGGER_SCALE);
         if s < COLLAPSED_SCALE {
             for &v in t {
                 out[v as usize] = true;
@@ -124,7 +129,7 @@ pub(crate) fn collapsed_vertices(
             }
         }
     }
-    if !triggered && !(worst < COLLAPSE_TRIGGER_SCALE) {
+    if !triggered && below_trigger < COLLAPSE_TRIGGER_FACES {
         out.fill(false);
     }
     for &l in landmarks {
