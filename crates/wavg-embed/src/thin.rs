@@ -54,8 +54,8 @@ fn min_stretch(p: [[f64; 3]; 3], q: [&[f64]; 3]) -> f64 {
     }
     // Columns of the map's matrix: J = [qa qb] [[la, bx], [0, by]]^-1.
     let (mut g00, mut g01, mut g11) = (0.0, 0.0, 0.0);
-    for k in 0..q[0].len() {
-        let (qa, qb) = (q[1][k] - q[0][k], q[2][k] - q[0][k]);
+    for ((&q0, &q1), &q2) in q[0].iter().zip(q[1]).zip(q[2]) {
+        let (qa, qb) = (q1 - q0, q2 - q0);
         let c0 = qa / la;
         let c1 = (qb - qa * bx / la) / by;
         g00 += c0 * c0;
