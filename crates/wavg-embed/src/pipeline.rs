@@ -345,13 +345,28 @@ pub(crate) fn precompute_unscaled(
         if more.is_empty() {
             break (landmarks, q, solver, coarse, ls_coarse);
         }
+        let mut locked = landmarks.clone();
+        locked.extend(&more);
+        locked.sort_unstable();
+        // Locking every landmark may leave a vertex that no legal collapse removes; a
+        // few more landmarks then get around it, and failing that, the landmarks so far
+        // stay.
+        let next = [0, 1, 8]
+            .into_iter()
+            .filter(|extra| locked.len() + extra <= n)
+            .find_map(|extra| match select(locked.len() + extra, &locked) {
+                Err(EmbedError::InvalidArgument(_)) => None,
+                other => Some(other),
+            });
+        match next {
+            Some(next) => {
+                drop((q, solver, coarse, ls_coarse));
+                selected = next?;
+            }
+            None => break (landmarks, q, solver, coarse, ls_coarse),
+        }
         added += more.len();
         round += 1;
-        let mut locked = landmarks;
-        locked.extend(more);
-        locked.sort_unstable();
-        drop((q, solver, coarse, ls_coarse));
-        selected = select(locked.len(), &locked)?;
         check_cancel(progress)?;
     };
     let q = match q {
