@@ -6,7 +6,8 @@ import bpy
 import numpy as np
 
 import scene
-from cases import UNDO, check_undo, decal_setup, expect_error, precompute, spline_controls, wavg
+from cases import (UNDO, check_undo, decal_setup, expect_error, precompute, spline_controls,
+                   surface, wavg)
 
 AXES = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
 DIAGONALS = [(x, y, z) for x in (1, -1) for y in (1, -1) for z in (1, -1)]
@@ -245,5 +246,65 @@ def test_precompute_beside_blend(ctx):
     assert [e["path"] for e in wavg().cache_entries(os.path.dirname(blend))] == [path]
 
 
+def check_decal(obj, anchors):
+    """The decal UV layer and ``wavg_invalid`` group of ``obj`` are wavg.decal's on
+    ``anchors`` and their ``wavg_uv`` values."""
+    me = obj.data
+    flat = np.empty(len(me.vertices) * 2, dtype=np.float32)
+    me.attributes["wavg_uv"].data.foreach_get("vector", flat)
+    uv_attr = flat.reshape(-1, 2).astype(np.float64)
+    uv_ref, valid_ref = wavg().decal(surface(obj), np.array(anchors), uv_attr[anchors])
+    invalid = np.flatnonzero(~np.asarray(valid_ref)).tolist()
+    assert scene.group_ids(obj, "wavg_invalid") == invalid, "wavg_invalid is not wavg.decal's"
+    uv_ref = np.asarray(uv_ref)
+    expect = np.where(np.isfinite(uv_ref), uv_ref, 0.0)
+    loop_uv = np.empty(len(me.loops) * 2, dtype=np.float32)
+    me.uv_layers["wavg_decal"].data.foreach_get("uv", loop_uv)
+    lv = np.empty(len(me.loops), dtype=np.int32)
+    me.loops.foreach_get("vertex_index", lv)
+    err = np.abs(loop_uv.reshape(-1, 2) - expect[lv]).max()
+    assert err <= 1e-6 * max(1.0, float(np.abs(expect).max())), f"UV layer off by {err:.2e}"
+
+
+def test_decal_anchor_cache(ctx):
+    """A decal run again on unchanged anchors reads them from memory; every edit of the
+    anchor group (a member removed, one added, a weight set to 0) is seen."""
+    from wavg_blender import group_cache
+
+    ico = scene.icosphere("ico", subdivisions=3)
+    precompute(ico)
+    anchors, _uv = decal_setup(ico)
+    scene.activate(ico)
+    bpy.ops.wavg.decal_uv()
+    check_decal(ico, anchors)
+    hits = group_cache.HITS[0]
+    bpy.ops.wavg.decal_uv()
+    assert group_cache.HITS[0] == hits + 1, "the unchanged anchor group was read again"
+    check_decal(ico, anchors)
+    group = ico.vertex_groups["wavg_anchors"]
+    group.remove([anchors[0]])
+    added = scene.nearest_vertices(ico, [(0.3, 0.2, 1.0)])[0]
+    assert added not in anchors
+    group.add([added], 0.5, 'REPLACE')
+    me = ico.data
+    flat = np.empty(len(me.vertices) * 2, dtype=np.float32)
+    me.attributes["wavg_uv"].data.foreach_get("vector", flat)
+    flat[2 * added:2 * added + 2] = (0.5, 0.5)
+    me.attributes["wavg_uv"].data.foreach_set("vector", flat)
+    anchors = sorted(anchors[1:] + [added])
+    for step in ("member removed and one added", "weight set to 0"):
+        hits = group_cache.HITS[0]
+        bpy.ops.wavg.decal_uv()
+        assert group_cache.HITS[0] == hits, f"stale anchors after: {step}"
+        check_decal(ico, anchors)
+        group.add([anchors[-1]], 0.0, 'REPLACE')
+        anchors = anchors[:-1]
+    bpy.ops.ed.undo_push(message="before decal")
+    bpy.ops.wavg.decal_uv(*UNDO)
+    assert group_cache._ENTRIES, "the anchors read were not kept"
+    bpy.ops.ed.undo()
+    assert not group_cache._ENTRIES, "entries survived an undo"
+
+
 TESTS = [test_transfer, test_precompute_cancel, test_undo, test_bad_inputs,
-         test_precompute_beside_blend]
+         test_precompute_beside_blend, test_decal_anchor_cache]

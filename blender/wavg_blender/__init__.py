@@ -13,8 +13,8 @@ bl_info = {
 
 import bpy
 
-from . import (common, errors, live, meshdata, op_decal, op_point, op_precompute,
-               op_spline, op_transfer, surfaces, transfer_data, ui)
+from . import (common, errors, group_cache, live, meshdata, op_decal, op_point,
+               op_precompute, op_spline, op_transfer, surfaces, transfer_data, ui)
 
 OPERATORS = (
     op_precompute.WAVG_OT_precompute,
@@ -31,9 +31,11 @@ def register():
         bpy.utils.register_class(cls)
     ui.register()
     live.register()
+    group_cache.register()
 
 
 def unregister():
+    group_cache.unregister()
     live.unregister()
     ui.unregister()
     for cls in reversed(OPERATORS):

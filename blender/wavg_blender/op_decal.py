@@ -5,10 +5,10 @@ vertex group ``wavg_invalid``."""
 import bpy
 import numpy as np
 
-from . import surfaces
+from . import group_cache, surfaces
 from .common import ActiveMeshOperator, active_mesh, object_mode
 from .errors import AddonError, describe, wavg
-from .meshdata import group_members, point_attribute_2d, vertex_group
+from .meshdata import point_attribute_2d, vertex_group
 
 INVALID_GROUP = "wavg_invalid"
 MAX_UV_LAYERS = 8
@@ -69,7 +69,7 @@ class WAVG_OT_decal_uv(ActiveMeshOperator, bpy.types.Operator):
         if not self.uv_layer:
             raise AddonError("give the name of the UV layer to write")
         surface, _mesh = surfaces.surface_of(obj)
-        anchors, _ = group_members(obj, vertex_group(obj, self.group))
+        anchors, weights = group_cache.members(context, obj, vertex_group(obj, self.group))
         if len(anchors) < 3:
             raise AddonError(
                 f"too few anchors: vertex group '{self.group}' holds {len(anchors)} "
@@ -89,6 +89,8 @@ class WAVG_OT_decal_uv(ActiveMeshOperator, bpy.types.Operator):
         with object_mode(context):
             set_uv_layer(obj, self.uv_layer, np.where(np.isfinite(uv), uv, 0.0))
             set_invalid_group(obj, np.flatnonzero(~valid))
+        if self.group != INVALID_GROUP:
+            group_cache.keep(context, obj, self.group, anchors, weights)
         fraction = float(valid.mean())
         self.report(
             {'INFO'},

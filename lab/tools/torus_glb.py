@@ -1,7 +1,7 @@
 """Writes a GLB of a torus cut along both UV seams, as glTF exporters write a closed model:
 (NU + 1) x (NV + 1) vertices, NU x NV once welded, 2 NU NV triangles, TEXCOORD_0.
-For the load benchmark (BENCHMARKS.md): `python3 lab/tools/torus_glb.py NU NV OUT.glb`.
-Needs numpy."""
+For the load benchmark (BENCHMARKS.md): `python3 lab/tools/torus_glb.py NU NV OUT.glb`;
+web/tests/test_gltf.py imports `torus_glb`. Needs numpy."""
 
 import json
 import struct

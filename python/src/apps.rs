@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use crate::pool::DetachRun;
 use wavg::apps::{
     CorrespondOptions, Image, SplineKind, TransferOptions, ValidityTest, correspond_vertices,
-    decal_vertices, evaluate_spline,
+    decal_vertex_uv, evaluate_spline,
 };
 
 use crate::args::{Int, array, data, finite, par, reals};
@@ -261,13 +261,13 @@ fn decal<'py>(
     let pairs: Vec<[f64; 2]> = data(&ua).chunks_exact(2).map(|c| [c[0], c[1]]).collect();
     let par = par(threads)?;
     let d = py
-        .detach_run(|| par.install(|| decal_vertices(&solver, &pairs, max_negative)))
+        .detach_run(|| par.install(|| decal_vertex_uv(&solver, &pairs, max_negative)))
         .map_err(lib(py))?
         .map_err(lib(py))?;
-    let n = d.uv.uv.len();
+    let n = d.uv.len();
     let mut out = Vec::with_capacity(2 * n);
     let mut valid = Vec::with_capacity(n);
-    for (p, &m) in d.uv.uv.iter().zip(&d.uv.marked) {
+    for (p, &m) in d.uv.iter().zip(&d.marked) {
         if m {
             out.extend([f64::NAN; 2]);
         } else {

@@ -1,53 +1,21 @@
 """`wavg serve scene.glb`: the page loads a glTF file (a torus cut along its UV seams, as
 exporters write it) as one welded surface and draws it."""
 
-import json
-import struct
-
-import numpy as np
+import sys
+from pathlib import Path
 
 from conftest import Page, Server
 from test_page import SNAP
 
-
-def seamed_torus_glb(nu, nv):
-    """A GLB of a torus split at its seams: (nu + 1) x (nv + 1) vertices, nu x nv welded."""
-    i, j = np.meshgrid(np.arange(nu + 1), np.arange(nv + 1), indexing="ij")
-    u, v = 2 * np.pi * (i % nu) / nu, 2 * np.pi * (j % nv) / nv
-    r = 1.0 + 0.35 * np.cos(v)
-    V = np.stack([r * np.cos(u), r * np.sin(u), 0.35 * np.sin(v)], -1).reshape(-1, 3).astype("<f4")
-    UV = np.stack([i / nu, 1 - j / nv], -1).reshape(-1, 2).astype("<f4")
-    a = i[:-1, :-1] * (nv + 1) + j[:-1, :-1]
-    F = np.concatenate([np.stack([a, a + nv + 1, a + nv + 2], -1).reshape(-1, 3),
-                        np.stack([a, a + nv + 2, a + 1], -1).reshape(-1, 3)]).astype("<u4")
-    blobs = [V.tobytes(), UV.tobytes(), F.tobytes()]
-    offsets = np.cumsum([0] + [len(b) for b in blobs]).tolist()
-    doc = {
-        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [{"name": "Torus", "primitives": [
-            {"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2}]}],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": len(V), "type": "VEC3",
-             "min": V.min(0).tolist(), "max": V.max(0).tolist()},
-            {"bufferView": 1, "componentType": 5126, "count": len(V), "type": "VEC2"},
-            {"bufferView": 2, "componentType": 5125, "count": F.size, "type": "SCALAR"}],
-        "bufferViews": [{"buffer": 0, "byteOffset": o, "byteLength": len(b)}
-                        for o, b in zip(offsets, blobs)],
-        "buffers": [{"byteLength": offsets[-1]}],
-    }
-    js = json.dumps(doc).encode()
-    js += b" " * (-len(js) % 4)
-    body = b"".join(blobs)
-    total = 12 + 8 + len(js) + 8 + len(body)
-    return (struct.pack("<4sII", b"glTF", 2, total) + struct.pack("<II", len(js), 0x4E4F534A) + js
-            + struct.pack("<II", len(body), 0x004E4942) + body)
+# The seamed torus is lab/tools/torus_glb.py's (also the glTF load benchmark's file).
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "lab" / "tools"))
+from torus_glb import torus_glb  # noqa: E402
 
 
 def test_the_page_loads_a_glb_as_one_welded_surface(browser, tmp_path):
     nu, nv = 32, 12
     path = tmp_path / "torus.glb"
-    path.write_bytes(seamed_torus_glb(nu, nv))
+    path.write_bytes(torus_glb(nu, nv))
     server = Server(f"{path}#Torus")
     try:
         page = Page(browser, server)

@@ -3,13 +3,14 @@
 //! vary continuously over the surface) gets `uv = sum_i w_i uv_i`. Where the weights are not
 //! meaningful (they do not return to the point through the forward problem, or one is
 //! strongly negative) the coordinates are still computed but the point is marked; a point
-//! whose weighted sum overflows (huge anchor coordinates) is marked with (0, 0).
+//! whose weighted sum overflows (huge anchor coordinates) is marked with (0, 0). A point
+//! its weights already mark skips its forward problem (the marks stay the same).
 
 use nalgebra::Vector3;
 use wavg_mesh::SurfacePoint;
-use wavg_solve::{SolveError, Solver};
+use wavg_solve::{ForwardOptions, SolveError, Solver};
 
-use crate::correspond::{paper_round_trip, vertex_points};
+use crate::correspond::{ROUND_TRIP_TOLERANCE, vertex_points};
 use crate::metrics::{Distortion, distortion};
 
 /// Default most negative weight a decal point's weights may hold before it is marked, in
@@ -65,9 +66,11 @@ pub fn decal_uv(
             "max_negative must be finite, got {max_negative}"
         )));
     }
-    let (batch, trips) = paper_round_trip(solver, points);
+    let batch = solver.inverse_batch(points);
     let (mut out, mut marked) = (Vec::with_capacity(points.len()), Vec::new());
-    for (w, trip) in batch.iter().zip(trips) {
+    // Points not marked by their weights alone; only these need their forward problem.
+    let mut check = Vec::new();
+    for (i, w) in batch.iter().enumerate() {
         match w {
             Ok(w) => {
                 let mut p = [0.0; 2];
@@ -79,12 +82,26 @@ pub fn decal_uv(
                 // Huge (u, v) can overflow the weighted sum: such a point is not usable.
                 let finite = p.iter().all(|x| x.is_finite());
                 out.push(if finite { p } else { [0.0, 0.0] });
-                marked.push(!trip || min < max_negative || !finite);
+                let bad = min < max_negative || !finite;
+                marked.push(bad);
+                if !bad {
+                    check.push(i);
+                }
             }
             Err(_) => {
                 out.push([0.0, 0.0]);
                 marked.push(true);
             }
+        }
+    }
+    let rows: Vec<&[f64]> = check.iter().map(|&i| batch.get(i).unwrap_or(&[])).collect();
+    let back = solver.forward_batch(&rows, &ForwardOptions::default());
+    let mesh = solver.mesh();
+    let tol = ROUND_TRIP_TOLERANCE * solver.mean_edge_length();
+    for (&i, b) in check.iter().zip(&back) {
+        let p = points[i].position(mesh);
+        if !b.as_ref().is_ok_and(|b| (b.position - p).norm() <= tol) {
+            marked[i] = true;
         }
     }
     Ok(DecalUv { uv: out, marked })
@@ -137,6 +154,16 @@ impl Decal {
     }
 }
 
+/// [`decal_uv`] at every vertex of the solver's mesh (without the distortion
+/// [`decal_vertices`] adds).
+pub fn decal_vertex_uv(
+    solver: &Solver,
+    uv: &[[f64; 2]],
+    max_negative: f64,
+) -> Result<DecalUv, SolveError> {
+    decal_uv(solver, uv, &vertex_points(solver.mesh()), max_negative)
+}
+
 /// [`decal_uv`] at every vertex of the solver's mesh, with the map's [`Distortion`].
 pub fn decal_vertices(
     solver: &Solver,
@@ -144,7 +171,7 @@ pub fn decal_vertices(
     max_negative: f64,
 ) -> Result<Decal, SolveError> {
     let mesh = solver.mesh();
-    let d = decal_uv(solver, uv, &vertex_points(mesh), max_negative)?;
+    let d = decal_vertex_uv(solver, uv, max_negative)?;
     let plane: Vec<Option<Vector3<f64>>> =
         d.uv.iter()
             .zip(&d.marked)
@@ -224,6 +251,73 @@ mod tests {
         let mirrored: Vec<[f64; 2]> = uv.iter().map(|p| [-p[0], p[1]]).collect();
         let m = decal_vertices(&solver, &mirrored, -0.1).unwrap();
         assert_eq!(m.distortion.flipped_faces, 0);
+    }
+
+    /// The marks as they were before points marked by their weights skipped their forward
+    /// problem: every point's round trip checked.
+    fn marks_checking_every_point(
+        solver: &Solver,
+        uv: &[[f64; 2]],
+        points: &[SurfacePoint],
+        max_negative: f64,
+    ) -> Vec<bool> {
+        let (batch, trips) = crate::correspond::paper_round_trip(solver, points);
+        batch
+            .iter()
+            .zip(trips)
+            .map(|(w, trip)| match w {
+                Ok(w) => {
+                    let min = w.iter().copied().fold(f64::INFINITY, f64::min);
+                    let p = w
+                        .iter()
+                        .zip(uv)
+                        .fold([0.0; 2], |p, (wi, c)| [p[0] + wi * c[0], p[1] + wi * c[1]]);
+                    !trip || min < max_negative || !p.iter().all(|x| x.is_finite())
+                }
+                Err(_) => true,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn skipping_the_forward_problem_of_marked_points_keeps_every_mark() {
+        // A small generator (splitmix64) for the anchors and their coordinates.
+        let mut state = 3u64;
+        let mut next = move || {
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            z ^ (z >> 31)
+        };
+        let mesh = Arc::new(ValidMesh::new(wavg_mesh::procedural::icosphere(4)).unwrap());
+        let proj =
+            Arc::new(Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh.clone()))).unwrap());
+        let mut checked = 0;
+        for case in 0..6 {
+            let k = 4 + 3 * case;
+            let ids: Vec<u32> = (0..k)
+                .map(|_| (next() % mesh.n_vertices() as u64) as u32)
+                .collect();
+            let Ok(solver) = Solver::new(proj.clone(), ids.iter().map(|&v| Anchor::Vertex(v)))
+            else {
+                continue;
+            };
+            let mut unit = || (next() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+            let uv: Vec<[f64; 2]> = (0..k).map(|_| [unit(), unit()]).collect();
+            let points = vertex_points(&mesh);
+            for max_negative in [-0.1, -0.5, -1e9] {
+                let d = decal_uv(&solver, &uv, &points, max_negative).unwrap();
+                let want = marks_checking_every_point(&solver, &uv, &points, max_negative);
+                assert_eq!(d.marked, want, "case {case}, max_negative {max_negative}");
+                checked += 1;
+                // Some points are marked by their weights and some by their round trip.
+                if max_negative == -0.1 {
+                    assert!(d.marked.iter().any(|m| *m) && d.marked.iter().any(|m| !*m));
+                }
+            }
+        }
+        assert!(checked >= 12, "{checked}");
     }
 
     #[test]

@@ -48,7 +48,9 @@ mod decal;
 mod decal_obj;
 mod morph;
 
-pub use decal::{DEFAULT_MAX_NEGATIVE, Decal, DecalReport, DecalUv, decal_uv, decal_vertices};
+pub use decal::{
+    DEFAULT_MAX_NEGATIVE, Decal, DecalReport, DecalUv, decal_uv, decal_vertex_uv, decal_vertices,
+};
 pub use decal_obj::{DECAL_MATERIAL, PLAIN_MATERIAL, untextured_faces, write_decal_obj};
 pub use morph::{MorphReport, harmonic_fill, morph_frames};
 mod error;

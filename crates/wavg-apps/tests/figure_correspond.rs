@@ -8,7 +8,7 @@ use std::sync::Arc;
 use wavg_apps::{CorrespondOptions, correspond_vertices};
 use wavg_embed::{NoProgress, PrecomputeOptions, precompute};
 use wavg_mesh::ValidMesh;
-use wavg_mesh::procedural::{FigureShape, figure};
+use wavg_mesh::procedural::{FigureShape, body, figure};
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
 use wavg_solve::{Anchor, EmbeddedMesh, Projector, Solver, Vec8};
 
@@ -26,18 +26,35 @@ fn solver(mesh: ValidMesh, anchors: &[u32]) -> Solver {
 
 #[test]
 fn body_shapes_correspond_with_a_mask_that_keeps_what_is_right() {
-    let slim = ValidMesh::new(figure(&FigureShape::SLIM)).unwrap();
-    let heavy = ValidMesh::new(figure(&FigureShape::HEAVY)).unwrap();
+    correspond_shapes(figure, 40);
+}
+
+/// The same with ears and toes (`procedural::body`): more thin parts, close to others,
+/// where more of the kept images are wrong (at most 1 in 20 vertices).
+#[test]
+fn bodies_with_ears_and_toes_correspond() {
+    correspond_shapes(body, 20);
+}
+
+/// Corresponds the slim and heavy shapes of `build` both ways and checks the default
+/// mask keeps at least 95% of the vertices, with a mean error of at most 1% of the
+/// diagonal, rejects at most 1 right image in 20 vertices and keeps at most 1 wrong one
+/// in `wrong_kept_per` vertices.
+fn correspond_shapes(build: fn(&FigureShape) -> wavg_mesh::TriMesh, wrong_kept_per: usize) {
+    let slim = ValidMesh::new(build(&FigureShape::SLIM)).unwrap();
+    let heavy = ValidMesh::new(build(&FigureShape::HEAVY)).unwrap();
     let anchors = farthest_point_vertices(&slim, 93, 1, FpsMetric::EdgeGraph).unwrap();
     let (a, b) = (solver(slim, &anchors), solver(heavy, &anchors));
     for (src, tgt, name) in [(&a, &b, "slim -> heavy"), (&b, &a, "heavy -> slim")] {
+        let t0 = std::time::Instant::now();
         let c = correspond_vertices(src, tgt, &CorrespondOptions::default()).unwrap();
+        let secs = t0.elapsed().as_secs_f64();
         let t = c.ground_truth_errors(src.mesh(), tgt.mesh()).unwrap();
         let n = src.mesh().n_vertices();
         let wrong = t.answered.count - t.rejected_correct - c.valid() + t.accepted_wrong;
         eprintln!(
             "{name}: valid {:.4}, mean {:.5}, p95 {:.5}, max {:.5}; answered mean {:.5}; \
-             rejected correct {}, accepted wrong {} of {wrong} wrong; {:?}",
+             rejected correct {}, accepted wrong {} of {wrong} wrong; {:?}; {:.0} vertices/s",
             c.valid_fraction(),
             t.valid.mean,
             t.valid.p95,
@@ -45,7 +62,8 @@ fn body_shapes_correspond_with_a_mask_that_keeps_what_is_right() {
             t.answered.mean,
             t.rejected_correct,
             t.accepted_wrong,
-            c.reason_counts()
+            c.reason_counts(),
+            n as f64 / secs
         );
         assert!(
             c.valid_fraction() >= 0.95,
@@ -56,6 +74,6 @@ fn body_shapes_correspond_with_a_mask_that_keeps_what_is_right() {
         // Few right images are rejected and few wrong ones kept (the wrong ones left are
         // smooth displacements of whole finger tips, invisible to a local test).
         assert!(t.rejected_correct * 20 <= n, "{name}: {t:?}");
-        assert!(t.accepted_wrong * 40 <= n, "{name}: {t:?}");
+        assert!(t.accepted_wrong * wrong_kept_per <= n, "{name}: {t:?}");
     }
 }

@@ -26,7 +26,8 @@ use crate::common::load_mesh;
 #[derive(clap::Args)]
 #[command(after_long_help = "\
 Computes the 8-D embedding (1000 landmarks by decimation, keeping coarse triangles round so
-thin parts such as fingers and tails keep landmarks all around; fast-marching geodesics on
+thin parts such as fingers and tails keep landmarks all around, plus more where a part is
+thinner than their spacing and would collapse; fast-marching geodesics on
 an intermediate mesh of at most 10k vertices with close pairs refined on the full mesh,
 --geodesic-vertices 0 for full resolution; metric MDS; least-squares mesh) and writes the
 .wavg file (format: crates/wavg-embed/FORMAT.md). The mesh must be a valid manifold with

@@ -29,11 +29,16 @@ mod pipeline;
 mod quality;
 mod scaled;
 mod simd;
+mod thin;
 
 // The precomputation and its settings.
-pub use decimate::{Bounds, DecimateOptions, Decimated, decimate, select_landmarks};
+pub use decimate::{
+    Bounds, DecimateOptions, Decimated, FIRST_PASS_VERTICES, decimate, select_landmarks,
+};
 pub use mds::MdsOptions;
-pub use pipeline::{LANDMARK_ASPECT_RATIO, PrecomputeOptions, Report, StageSeconds};
+pub use pipeline::{
+    LANDMARK_ASPECT_RATIO, PrecomputeOptions, Report, StageSeconds, THIN_PART_ROUNDS,
+};
 pub use scaled::precompute;
 
 // Its result (saved and loaded by the `file` module).

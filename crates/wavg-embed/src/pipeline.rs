@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use wavg_mesh::ValidMesh;
 
-use crate::decimate::{DecimateOptions, decimate_with_snapshots, select_landmarks};
+use crate::decimate::{DecimateOptions, Decimated, decimate_with_snapshots, select_landmarks};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
 use crate::geodesic::{FastMarching, GeodesicOptions, landmark_distances};
@@ -12,6 +12,7 @@ use crate::lsmesh::LsMeshSolver;
 use crate::lsmesh::two_level::{CgOptions, LsMeshExtension, TwoLevelLsMesh};
 use crate::mds::{MdsOptions, metric_mds};
 use crate::quality::{QualityOptions, QualityPairs};
+use crate::thin;
 use crate::{Embedding, EmbeddingParams};
 
 /// Settings of [`precompute`](crate::precompute).
@@ -59,7 +60,17 @@ pub struct PrecomputeOptions {
     pub lsmesh_direct_max: usize,
     /// Vertices of the coarse level of the two-level least-squares mesh (default 150 000).
     pub lsmesh_coarse_vertices: usize,
+    /// Add landmarks where parts thinner than the landmark spacing (fingers, toes, ears)
+    /// would collapse in the embedding (default on): the least-squares extension of the
+    /// landmarks' own positions shows where, and up to [`THIN_PART_ROUNDS`] rounds add at
+    /// most `landmarks` more in all. Meshes without such parts are unchanged.
+    pub cover_thin_parts: bool,
 }
+
+/// Rounds of landmark additions around thin parts at most
+/// ([`PrecomputeOptions::cover_thin_parts`]): each halves the distance from the collapsed
+/// region to its landmarks.
+pub const THIN_PART_ROUNDS: usize = 8;
 
 /// Aspect-ratio bound of the landmark decimation by default (raised to twice the input's
 /// 90th-percentile ratio where that is larger). Quadric errors alone let thin parts
@@ -109,6 +120,7 @@ impl Default for PrecomputeOptions {
             quality_sources: 16,
             lsmesh_direct_max: 300_000,
             lsmesh_coarse_vertices: 150_000,
+            cover_thin_parts: true,
         }
     }
 }
@@ -202,43 +214,43 @@ pub(crate) fn precompute_unscaled(
     }
     let mut stages = StageSeconds::default();
     let secs = |t: Instant| t.elapsed().as_secs_f64();
-    let use_coarse =
-        opts.landmarks < n && opts.geodesic_vertices > opts.landmarks && opts.geodesic_vertices < n;
-    let two_level = n > opts.lsmesh_direct_max
-        && opts.lsmesh_coarse_vertices > opts.landmarks
-        && opts.lsmesh_coarse_vertices < n;
-
-    // 1. Landmarks (and, for large meshes, an intermediate mesh for the geodesics), while
-    //    the quality check's fast marching on the full mesh runs alongside (it does not
-    //    depend on the embedding).
+    // 1. Landmarks (and, for large meshes, intermediate meshes for the geodesics and the
+    //    least-squares mesh): `target` of them, keeping `locked`.
+    let select = |target: usize, locked: &[u32]| -> Result<_, EmbedError> {
+        let t = Instant::now();
+        if target >= n {
+            return Ok(((0..n as u32).collect::<Vec<u32>>(), None, None, secs(t)));
+        }
+        let use_coarse = opts.geodesic_vertices > target && opts.geodesic_vertices < n;
+        let two_level = n > opts.lsmesh_direct_max
+            && opts.lsmesh_coarse_vertices > target
+            && opts.lsmesh_coarse_vertices < n;
+        let d = DecimateOptions {
+            target,
+            max_aspect_ratio: landmark_aspect_bound(mesh, opts.decimate.max_aspect_ratio),
+            locked: locked.to_vec(),
+            ..opts.decimate.clone()
+        };
+        let (landmarks, coarse, ls_coarse) = if use_coarse || two_level {
+            let sizes: Vec<usize> = [
+                (use_coarse, opts.geodesic_vertices),
+                (two_level, opts.lsmesh_coarse_vertices),
+            ]
+            .iter()
+            .filter_map(|&(on, s)| on.then_some(s))
+            .collect();
+            let (fin, mut snaps) = decimate_with_snapshots(mesh, &d, &sizes, progress)?;
+            let ls = if two_level { snaps.pop() } else { None };
+            (fin.landmarks, snaps.pop(), ls)
+        } else {
+            (select_landmarks(mesh, &d, progress)?, None, None)
+        };
+        Ok((landmarks, coarse, ls_coarse, secs(t)))
+    };
+    // The first selection runs while the quality check's fast marching on the full mesh
+    // runs alongside (it does not depend on the embedding).
     let (landmark_result, quality_result) = rayon::join(
-        || -> Result<_, EmbedError> {
-            let t = Instant::now();
-            let (landmarks, coarse, ls_coarse) = if opts.landmarks >= n {
-                ((0..n as u32).collect::<Vec<u32>>(), None, None)
-            } else {
-                let d = DecimateOptions {
-                    target: opts.landmarks,
-                    max_aspect_ratio: landmark_aspect_bound(mesh, opts.decimate.max_aspect_ratio),
-                    ..opts.decimate.clone()
-                };
-                if use_coarse || two_level {
-                    let sizes: Vec<usize> = [
-                        (use_coarse, opts.geodesic_vertices),
-                        (two_level, opts.lsmesh_coarse_vertices),
-                    ]
-                    .iter()
-                    .filter_map(|&(on, s)| on.then_some(s))
-                    .collect();
-                    let (fin, mut snaps) = decimate_with_snapshots(mesh, &d, &sizes, progress)?;
-                    let ls = if two_level { snaps.pop() } else { None };
-                    (fin.landmarks, snaps.pop(), ls)
-                } else {
-                    (select_landmarks(mesh, &d, progress)?, None, None)
-                }
-            };
-            Ok((landmarks, coarse, ls_coarse, secs(t)))
-        },
+        || select(opts.landmarks, &opts.decimate.locked),
         || -> Result<_, EmbedError> {
             let t = Instant::now();
             if opts.quality_pairs == 0 {
@@ -258,55 +270,116 @@ pub(crate) fn precompute_unscaled(
             Ok((Some(fm), Some(pairs), secs(t)))
         },
     );
-    let (landmarks, coarse, ls_coarse, t_decimate) = landmark_result?;
+    let mut selected = landmark_result?;
     let (mut fm, quality_pairs, t_quality) = quality_result?;
-    stages.decimate = t_decimate;
     stages.quality = t_quality;
     check_cancel(progress)?;
 
     // 2. Geodesic distances between landmarks (parallel), while the least-squares system,
     //    which depends only on the mesh and the landmarks, is factored alongside
-    //    (sequential): this fills the second core during the geodesics' tail.
+    //    (sequential): this fills the second core during the geodesics' tail. Then, where
+    //    the landmarks leave a thin part uncovered (see `thin`), the landmarks so far are
+    //    locked, more are added, and steps 1 and 2 run again (at most `THIN_PART_ROUNDS`
+    //    times, adding at most as many landmarks as asked for in all).
     let fine = fm.get_or_insert_with(|| FastMarching::new(mesh));
-    let (q, solver) = rayon::join(
-        || -> Result<_, EmbedError> {
-            let t = Instant::now();
-            let mut geo = GeodesicOptions::new().fast_marching(fine);
-            if let Some(c) = &coarse {
-                // All pairs on the intermediate mesh, close pairs corrected on the full mesh.
-                geo = geo.coarse_mesh(c).refine_near_pairs(opts.refine_near_pairs);
-                if let Some(mid) = &ls_coarse {
-                    geo = geo.refine_on(mid);
-                }
+    let geodesics = |landmarks: &[u32], coarse: Option<&Decimated>, mid: Option<&Decimated>| {
+        let t = Instant::now();
+        let mut geo = GeodesicOptions::new().fast_marching(fine);
+        if let Some(c) = coarse {
+            // All pairs on the intermediate mesh, close pairs corrected on the full mesh.
+            geo = geo.coarse_mesh(c).refine_near_pairs(opts.refine_near_pairs);
+            if let Some(mid) = mid {
+                geo = geo.refine_on(mid);
             }
-            let q = landmark_distances(mesh, &landmarks, &geo, progress)?;
-            Ok((q, secs(t)))
-        },
-        || {
+        }
+        let q = landmark_distances(mesh, landmarks, &geo, progress)?;
+        Ok::<_, EmbedError>((q, secs(t)))
+    };
+    let factor = |landmarks: &[u32], mid: Option<&Decimated>| {
+        let t = Instant::now();
+        let solver = match mid {
+            Some(c) => LsMeshExtension::TwoLevel(Box::new(TwoLevelLsMesh::new(
+                mesh,
+                c,
+                landmarks,
+                CgOptions::default(),
+                progress,
+            )?)),
+            None => {
+                LsMeshExtension::Direct(Box::new(LsMeshSolver::new(mesh, landmarks, progress)?))
+            }
+        };
+        Ok::<_, EmbedError>((solver, secs(t)))
+    };
+    let mut added = 0;
+    let mut round = 0;
+    let (landmarks, q, solver, coarse, ls_coarse) = loop {
+        let (landmarks, coarse, ls_coarse, t_decimate) = selected;
+        stages.decimate += t_decimate;
+        // Later rounds only need the factorisation; the geodesics wait for the last.
+        let (q, solver) = if round == 0 {
+            let (q, solver) = rayon::join(
+                || geodesics(&landmarks, coarse.as_ref(), ls_coarse.as_ref()),
+                || factor(&landmarks, ls_coarse.as_ref()),
+            );
+            let (q, t_geodesics) = q?;
+            stages.geodesics += t_geodesics;
+            (Some(q), solver?)
+        } else {
+            (None, factor(&landmarks, ls_coarse.as_ref())?)
+        };
+        let (solver, t_factor) = solver;
+        stages.lsmesh += t_factor;
+        check_cancel(progress)?;
+        let more = if opts.cover_thin_parts && round < THIN_PART_ROUNDS {
             let t = Instant::now();
-            let solver = match &ls_coarse {
-                Some(c) => LsMeshExtension::TwoLevel(Box::new(TwoLevelLsMesh::new(
-                    mesh,
-                    c,
-                    &landmarks,
-                    CgOptions::default(),
-                    progress,
-                )?)),
-                None => LsMeshExtension::Direct(Box::new(LsMeshSolver::new(
-                    mesh, &landmarks, progress,
-                )?)),
-            };
-            Ok((solver, secs(t)))
-        },
-    );
-    let (q, t_geodesics) = q?;
-    let (solver, t_factor) = solver?;
-    drop(fm);
+            let collapsed =
+                thin::collapsed_vertices(mesh, &landmarks, &solver, round > 0, progress)?;
+            let limit = (opts.landmarks - added).min(n - landmarks.len());
+            let more = thin::landmarks_to_add(mesh, &landmarks, &collapsed, limit);
+            stages.decimate += secs(t);
+            more
+        } else {
+            Vec::new()
+        };
+        if more.is_empty() {
+            break (landmarks, q, solver, coarse, ls_coarse);
+        }
+        let mut locked = landmarks.clone();
+        locked.extend(&more);
+        locked.sort_unstable();
+        // Locking every landmark may leave a vertex that no legal collapse removes; a
+        // few more landmarks then get around it, and failing that, the landmarks so far
+        // stay.
+        let next = [0, 1, 8]
+            .into_iter()
+            .filter(|extra| locked.len() + extra <= n)
+            .find_map(|extra| match select(locked.len() + extra, &locked) {
+                Err(EmbedError::InvalidArgument(_)) => None,
+                other => Some(other),
+            });
+        match next {
+            Some(next) => {
+                drop((q, solver, coarse, ls_coarse));
+                selected = next?;
+            }
+            None => break (landmarks, q, solver, coarse, ls_coarse),
+        }
+        added += more.len();
+        round += 1;
+        check_cancel(progress)?;
+    };
+    let q = match q {
+        Some(q) => q,
+        None => {
+            let (q, t_geodesics) = geodesics(&landmarks, coarse.as_ref(), ls_coarse.as_ref())?;
+            stages.geodesics += t_geodesics;
+            q
+        }
+    };
     let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
-    drop(coarse);
-    drop(ls_coarse);
-    stages.geodesics = t_geodesics;
-    check_cancel(progress)?;
+    drop((coarse, ls_coarse));
+    drop(fm);
 
     // 3. MDS of the landmarks.
     let t = Instant::now();
@@ -320,7 +393,7 @@ pub(crate) fn precompute_unscaled(
     let coords = solver.solve(&mds.points, dim, progress)?;
     drop(solver);
     progress.report(Stage::LsMesh, 1.0);
-    stages.lsmesh = t_factor + secs(t);
+    stages.lsmesh += secs(t);
     check_cancel(progress)?;
 
     // 5. Quality.
@@ -421,6 +494,39 @@ mod tests {
             quality_pairs: 512,
             ..Default::default()
         }
+    }
+
+    /// A mesh whose landmarks cover every part gets none added: the embedding is the one
+    /// without the check. A part thinner than the landmark spacing (a thin tube with few
+    /// landmarks) gets more, at most as many again as asked for.
+    #[test]
+    fn landmarks_are_added_only_around_thin_parts() {
+        let run = |mesh: &ValidMesh, landmarks: usize, cover_thin_parts: bool| {
+            let o = PrecomputeOptions {
+                quality_pairs: 0,
+                cover_thin_parts,
+                ..opts(landmarks)
+            };
+            precompute(mesh, &o, &NoProgress).unwrap().0
+        };
+        let round = ValidMesh::new(procedural::with_noise(
+            procedural::torus(40, 20, 1.0, 0.4),
+            0.2,
+            3,
+        ))
+        .unwrap();
+        let (a, b) = (run(&round, 80, true), run(&round, 80, false));
+        assert_eq!(a.landmarks, b.landmarks);
+        assert_eq!(a.coords, b.coords);
+        let thin = ValidMesh::new(procedural::torus(200, 12, 1.0, 0.02)).unwrap();
+        let (a, b) = (run(&thin, 60, true), run(&thin, 60, false));
+        assert_eq!(b.landmarks.len(), 60);
+        assert!(
+            a.landmarks.len() > 60 && a.landmarks.len() <= 120,
+            "{} landmarks",
+            a.landmarks.len()
+        );
+        assert!(b.landmarks.iter().all(|l| a.landmarks.contains(l)));
     }
 
     fn check(mesh: TriMesh, landmarks: usize, p50: f64, p90: f64) -> (Embedding, Report) {

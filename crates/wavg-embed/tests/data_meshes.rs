@@ -12,13 +12,22 @@ fn load(test: &str, rel: &str) -> Option<ValidMesh> {
 }
 
 fn embed(mesh: &ValidMesh, landmarks: usize) -> wavg_embed::Report {
+    let r = embed_with(mesh, landmarks, true);
+    assert_eq!(r.landmarks, landmarks);
+    r
+}
+
+/// [`embed`], with or without landmarks added around thin parts, whatever the number of
+/// landmarks used ([`wavg_embed::Report::landmarks`]).
+fn embed_with(mesh: &ValidMesh, landmarks: usize, cover_thin_parts: bool) -> wavg_embed::Report {
     let opts = PrecomputeOptions {
         landmarks,
         quality_pairs: 512,
+        cover_thin_parts,
         ..Default::default()
     };
     let (emb, report) = precompute(mesh, &opts, &NoProgress).unwrap();
-    assert_eq!(emb.landmarks.len(), landmarks);
+    assert_eq!(emb.landmarks.len(), report.landmarks);
     emb.validate(mesh.n_vertices()).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("m.wavg");
@@ -41,15 +50,25 @@ fn genus_zero_higher_genus_and_open_meshes_embed() {
         assert_eq!(mesh.topology().genus(), genus, "{rel}");
         assert_eq!(!mesh.topology().boundary_loops().is_empty(), open, "{rel}");
         let landmarks = 200.min(mesh.n_vertices() / 2);
-        let r = embed(&mesh, landmarks);
-        eprintln!(
-            "{rel}: {} vertices, {landmarks} landmarks, stress {:.4}, p50 {:.4}, p90 {:.4}",
-            r.vertices, r.stress, r.geodesic_rel_err_p50, r.geodesic_rel_err_p90
-        );
-        assert!(
-            r.geodesic_rel_err_p50 < 0.1 && r.geodesic_rel_err_p90 < 0.25,
-            "{rel}: {r:?}"
-        );
+        // With and without landmarks around thin parts (at 200 landmarks, parts of the
+        // camel head are thinner than their spacing: more are added there).
+        for cover in [false, true] {
+            let r = embed_with(&mesh, landmarks, cover);
+            if cover {
+                assert!((landmarks..=2 * landmarks).contains(&r.landmarks), "{r:?}");
+            } else {
+                assert_eq!(r.landmarks, landmarks);
+            }
+            eprintln!(
+                "{rel}: {} vertices, {landmarks} landmarks asked, {} used, stress {:.4}, \
+                 p50 {:.4}, p90 {:.4}",
+                r.vertices, r.landmarks, r.stress, r.geodesic_rel_err_p50, r.geodesic_rel_err_p90
+            );
+            assert!(
+                r.geodesic_rel_err_p50 < 0.1 && r.geodesic_rel_err_p90 < 0.25,
+                "{rel}: {r:?}"
+            );
+        }
     }
 }
 

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use wavg_mesh::io::gltf::TextureSource;
 use wavg_mesh::{Format, LoadNotes, MeshError, TriMesh, ValidMesh, analyze, io};
-use wavg_testdata::gltf::{Gltf, prim, seamed_torus, torus_glb};
+use wavg_testdata::gltf::{Gltf, prim, seamed_torus, split_at_seams, torus_glb};
 
 fn read(bytes: &[u8], name: &str) -> Result<(TriMesh, LoadNotes), MeshError> {
     let format = Format::from_path(Path::new(name)).unwrap().0;
@@ -235,4 +235,69 @@ fn base64(b: &[u8]) -> String {
         }
     }
     s
+}
+
+#[test]
+fn every_index_layout_gives_the_same_triangles() {
+    let (g, bytes) = torus_glb(6, 4, "Torus");
+    let (expected, _) = read(&bytes, "t.glb").unwrap();
+    let (pos, tris, uvs) = seamed_torus(6, 4);
+    let (_, _, idx) = split_at_seams(&pos, &tris, &uvs);
+    assert!(idx.len() == 144 && idx.iter().all(|&i| i < 256));
+    // Accessor 2 (the indices) replaced by `json` over `bytes`, its view's index as {v}.
+    let with = |bytes: &[u8], json: &str| {
+        let mut g = g.clone();
+        let v = g.view(bytes);
+        g.accessors[2] = json.replace("{v}", &v.to_string());
+        g
+    };
+    let le = |size: usize, stride: usize| -> Vec<u8> {
+        idx.iter()
+            .flat_map(|&i| {
+                let mut e = i.to_le_bytes()[..size].to_vec();
+                e.resize(stride, 0xAB);
+                e
+            })
+            .collect()
+    };
+    let u8s = with(
+        &le(1, 1),
+        r#"{"bufferView":{v},"componentType":5121,"count":144,"type":"SCALAR"}"#,
+    );
+    let u16s = with(
+        &le(2, 2),
+        r#"{"bufferView":{v},"componentType":5123,"count":144,"type":"SCALAR"}"#,
+    );
+    // A trailing index that makes no triangle is ignored.
+    let mut extra = le(4, 4);
+    extra.extend(7u32.to_le_bytes());
+    let trailing = with(
+        &extra,
+        r#"{"bufferView":{v},"componentType":5125,"count":145,"type":"SCALAR"}"#,
+    );
+    let mut strided = with(
+        &le(4, 8),
+        r#"{"bufferView":{v},"componentType":5125,"count":144,"type":"SCALAR"}"#,
+    );
+    let last = strided.views.len() - 1;
+    strided.views[last] = strided.views[last].replace('}', r#","byteStride":8}"#);
+    // Every index first written as 0, then set back by sparse values.
+    let mut sparse = g.clone();
+    let zeros = sparse.view(&vec![0u8; 4 * 144]);
+    let at: Vec<u8> = (0..144u32).flat_map(|k| k.to_le_bytes()).collect();
+    let (at, values) = (sparse.view(&at), sparse.view(&le(4, 4)));
+    sparse.accessors[2] = format!(
+        r#"{{"bufferView":{zeros},"componentType":5125,"count":144,"type":"SCALAR","sparse":{{"count":144,"indices":{{"bufferView":{at},"componentType":5125}},"values":{{"bufferView":{values}}}}}}}"#
+    );
+    for (name, g) in [
+        ("u8", u8s),
+        ("u16", u16s),
+        ("trailing", trailing),
+        ("strided", strided),
+        ("sparse", sparse),
+    ] {
+        let (mesh, notes) = read(&g.glb(), "t.glb").unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(mesh, expected, "{name}");
+        assert_eq!(notes.welded_vertices, 35 - 24, "{name}");
+    }
 }

@@ -80,9 +80,7 @@ impl<'a> PenaltySystem<'a> {
             return Ok(Self::OneHot { n, i });
         }
         // Scale-free: D / d_ref, and the penalty scaled the same way.
-        let mut sorted = d[..n].to_vec();
-        let k = 3.min(n - 1);
-        let d_ref = *sorted.select_nth_unstable_by(k, f64::total_cmp).1;
+        let d_ref = nth_smallest(&d[..n], 3.min(n - 1));
         // Zero in the padding.
         d[n..].fill(f64::INFINITY);
         let s = d
@@ -120,6 +118,23 @@ impl<'a> PenaltySystem<'a> {
             Self::Solve(s) => s.weights(lambda),
         }
     }
+}
+
+/// The `k`-th smallest (from 0; `k < 4`, `k < xs.len()`) of the finite `xs`, in one pass
+/// keeping the `k + 1` smallest seen (no copy, no sort).
+fn nth_smallest(xs: &[f64], k: usize) -> f64 {
+    let mut low = [f64::INFINITY; 4];
+    for &x in xs {
+        if x < low[k] {
+            let mut j = k;
+            while j > 0 && low[j - 1] > x {
+                low[j] = low[j - 1];
+                j -= 1;
+            }
+            low[j] = x;
+        }
+    }
+    low[k]
 }
 
 /// [`offsets`] as one SIMD operation.
@@ -179,30 +194,26 @@ impl pulp::WithSimd for Weigh<'_, '_> {
 }
 
 impl System<'_> {
-    /// `v` of the anchors `c .. c + LANES`, coordinate by coordinate.
-    #[inline(always)]
-    fn v<Q: Quad>(&self, q: Q, c: usize) -> [Q::V; DIM] {
-        std::array::from_fn(|k| {
-            let y = &self.anchors.dim(k)[c * LANES..(c + 1) * LANES];
-            q.sub(
-                q.load(y.try_into().expect("LANES long")),
-                q.splat(self.yhat[k]),
-            )
-        })
-    }
-
-    /// Fills in `t` and `vsv` (`s` and the rows already set).
+    /// Fills in `t`, `vsv` and `csc` (`s` and the rows already set): one pass over the
+    /// anchors per row `K` of `vsv` and `t`, then one for `csc`, so that each pass's sums
+    /// stay in vector registers (all 66 at once spill to memory at every anchor). Each sum
+    /// adds the same products in the same order as one pass would.
     #[inline(always)]
     fn sums<Q: Quad>(&mut self, q: Q) {
+        self.row_sums::<0, Q>(q);
+        self.row_sums::<1, Q>(q);
+        self.row_sums::<2, Q>(q);
+        self.row_sums::<3, Q>(q);
+        self.row_sums::<4, Q>(q);
+        self.row_sums::<5, Q>(q);
+        self.row_sums::<6, Q>(q);
+        self.row_sums::<7, Q>(q);
         let zero = q.splat(0.0);
-        let mut t = [[zero; 3]; DIM];
-        let mut vsv = [[zero; DIM]; DIM];
-        let mut csc = [[zero; 3]; 3];
         let one = q.splat(1.0);
+        let mut csc = [[zero; 3]; 3];
         let nc = self.s.len() / LANES;
         let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
         for c in 0..nc {
-            let v = self.v(q, c);
             let s = q.load(&ss[c]);
             let cr = [q.load(&a0[c]), q.load(&a1[c]), one];
             let sc = [q.mul(s, cr[0]), q.mul(s, cr[1]), s];
@@ -211,19 +222,42 @@ impl System<'_> {
                     csc[r][j] = q.add(csc[r][j], q.mul(cr[r], sc[j]));
                 }
             }
-            for k in 0..DIM {
-                for j in 0..3 {
-                    t[k][j] = q.add(t[k][j], q.mul(v[k], sc[j]));
-                }
-                let sv = q.mul(s, v[k]);
-                for l in k..DIM {
-                    vsv[k][l] = q.add(vsv[k][l], q.mul(sv, v[l]));
-                }
+        }
+        self.csc = Matrix3::from_fn(|r, j| sum_lanes(q.lanes(csc[r.min(j)][r.max(j)])));
+    }
+
+    /// Row `K` of `t` (`sum s_i v_ik c_i`) and of `vsv` (`sum s_i v_ik v_il`, `l >= K`,
+    /// mirrored).
+    #[inline(always)]
+    fn row_sums<const K: usize, Q: Quad>(&mut self, q: Q) {
+        let zero = q.splat(0.0);
+        let mut t = [zero; 3];
+        let mut row = [zero; DIM];
+        let nc = self.s.len() / LANES;
+        let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
+        let ys: [&[[f64; LANES]]; DIM] = std::array::from_fn(|k| quads(self.anchors.dim(k), nc));
+        let yhat: [Q::V; DIM] = std::array::from_fn(|k| q.splat(self.yhat[k]));
+        for c in 0..nc {
+            let s = q.load(&ss[c]);
+            let sc = [q.mul(s, q.load(&a0[c])), q.mul(s, q.load(&a1[c])), s];
+            let vk = q.sub(q.load(&ys[K][c]), yhat[K]);
+            for j in 0..3 {
+                t[j] = q.add(t[j], q.mul(vk, sc[j]));
+            }
+            let sv = q.mul(s, vk);
+            for l in K..DIM {
+                let vl = q.sub(q.load(&ys[l][c]), yhat[l]);
+                row[l] = q.add(row[l], q.mul(sv, vl));
             }
         }
-        self.t = SMatrix::from_fn(|k, j| sum_lanes(q.lanes(t[k][j])));
-        self.vsv = SMatrix::from_fn(|k, l| sum_lanes(q.lanes(vsv[k.min(l)][k.max(l)])));
-        self.csc = Matrix3::from_fn(|r, j| sum_lanes(q.lanes(csc[r.min(j)][r.max(j)])));
+        for (j, x) in t.iter().enumerate() {
+            self.t[(K, j)] = sum_lanes(q.lanes(*x));
+        }
+        for (l, x) in row.iter().enumerate().skip(K) {
+            let x = sum_lanes(q.lanes(*x));
+            self.vsv[(K, l)] = x;
+            self.vsv[(l, K)] = x;
+        }
     }
 
     /// `out_i = s_i (c_i . z - v_i . g)` (zero in the padding); returns their sum.
@@ -473,6 +507,98 @@ mod tests {
                 assert!(
                     err <= 1e-10 * scale,
                     "case {case}, lambda {lambda}: {err:e}"
+                );
+            }
+        }
+    }
+
+    /// The sums as one pass over the anchors holding all of them (the order each sum's
+    /// products are added in, which the passes of `System::sums` keep).
+    fn one_pass_sums(
+        sys: &System<'_>,
+    ) -> (SMatrix<f64, DIM, 3>, SMatrix<f64, DIM, DIM>, Matrix3<f64>) {
+        let q = Plain;
+        let zero = q.splat(0.0);
+        let (mut t, mut vsv, mut csc) = ([[zero; 3]; DIM], [[zero; DIM]; DIM], [[zero; 3]; 3]);
+        let nc = sys.s.len() / LANES;
+        let (ss, a0, a1) = (quads(&sys.s, nc), quads(&sys.a0, nc), quads(&sys.a1, nc));
+        for c in 0..nc {
+            let v: [_; DIM] = std::array::from_fn(|k| {
+                let y = &sys.anchors.dim(k)[c * LANES..(c + 1) * LANES];
+                q.sub(q.load(y.try_into().unwrap()), q.splat(sys.yhat[k]))
+            });
+            let s = q.load(&ss[c]);
+            let cr = [q.load(&a0[c]), q.load(&a1[c]), q.splat(1.0)];
+            let sc = [q.mul(s, cr[0]), q.mul(s, cr[1]), s];
+            for r in 0..3 {
+                for j in r..3 {
+                    csc[r][j] = q.add(csc[r][j], q.mul(cr[r], sc[j]));
+                }
+            }
+            for k in 0..DIM {
+                for j in 0..3 {
+                    t[k][j] = q.add(t[k][j], q.mul(v[k], sc[j]));
+                }
+                let sv = q.mul(s, v[k]);
+                for l in k..DIM {
+                    vsv[k][l] = q.add(vsv[k][l], q.mul(sv, v[l]));
+                }
+            }
+        }
+        (
+            SMatrix::from_fn(|k, j| sum_lanes(q.lanes(t[k][j]))),
+            SMatrix::from_fn(|k, l| sum_lanes(q.lanes(vsv[k.min(l)][k.max(l)]))),
+            Matrix3::from_fn(|r, j| sum_lanes(q.lanes(csc[r.min(j)][r.max(j)]))),
+        )
+    }
+
+    #[test]
+    fn the_sums_by_row_equal_one_pass_bitwise() {
+        let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for case in 0..50 {
+            let n = 4 + case * 7 % 130;
+            let mut g = || r.random_range(-1.0..1.0);
+            let psi = Mat2x8::from_fn(|_, _| g());
+            let yhat = Vec8::from_fn(|_, _| g());
+            let ys: Vec<Vec8> = (0..n).map(|_| Vec8::from_fn(|_, _| 2.0 * g())).collect();
+            let anchors = AnchorCoords::from_points(&ys);
+            let PenaltySystem::Solve(sys) =
+                PenaltySystem::new(&psi, &yhat, &anchors, 10.0).unwrap()
+            else {
+                panic!("case {case}: no anchor at the point");
+            };
+            let (t, vsv, csc) = one_pass_sums(&sys);
+            let bits = |m: &[f64]| m.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(sys.t.as_slice()), bits(t.as_slice()), "case {case}");
+            assert_eq!(
+                bits(sys.vsv.as_slice()),
+                bits(vsv.as_slice()),
+                "case {case}"
+            );
+            assert_eq!(
+                bits(sys.csc.as_slice()),
+                bits(csc.as_slice()),
+                "case {case}"
+            );
+        }
+    }
+
+    #[test]
+    fn nth_smallest_is_the_order_statistic() {
+        let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for case in 0..300 {
+            let n = 1 + case % 40;
+            // Few distinct values, so ties are common.
+            let xs: Vec<f64> = (0..n)
+                .map(|_| f64::from(r.random_range(0..6u8)) * 0.5)
+                .collect();
+            for k in 0..4.min(n) {
+                let mut sorted = xs.clone();
+                sorted.sort_by(f64::total_cmp);
+                assert_eq!(
+                    nth_smallest(&xs, k),
+                    sorted[k],
+                    "case {case}, k {k}: {xs:?}"
                 );
             }
         }

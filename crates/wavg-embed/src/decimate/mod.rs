@@ -46,6 +46,12 @@
 //!   illegal (OpenMesh's flipping test lets it through at 90 degrees, since the normal of
 //!   a degenerate face is the zero vector).
 //! * A closed component that is a tetrahedron is never collapsed further.
+//! * **First pass on large meshes** (`first_pass.rs`): above twice
+//!   [`DecimateOptions::first_pass_vertices`] vertices, meshoptimizer's simplifier first
+//!   reduces the mesh to about that many vertices (its collapses also keep original
+//!   vertices), its output is cleaned into a valid mesh of the same topology, and the
+//!   collapses above continue from there; the full mesh is decimated when the cleanup fails.
+//!   The sequential quadric collapses cost about ten times the simplifier's per vertex.
 //! * **Relaxation**: OpenMesh stops when the heap is empty. Here, if the target is not yet
 //!   reached, every vertex is first re-evaluated (vertices whose popped collapse had become
 //!   illegal left the heap, but may have another legal one); if that finds nothing, the
@@ -76,6 +82,7 @@ use wavg_mesh::{TriMesh, ValidMesh};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 
 mod collapse;
+mod first_pass;
 mod heap;
 mod quadric;
 
@@ -108,7 +115,17 @@ pub struct DecimateOptions {
     /// Relax the normal bounds when they block the target (see the module docs); without
     /// it, an unreachable target is an error.
     pub relax: bool,
+    /// Meshes with more than twice this many vertices (and more than twice the target
+    /// and every snapshot) first go through meshoptimizer's simplifier down to about this
+    /// many, cleaned up into a valid mesh of the same topology on original vertices; the
+    /// quadric decimation continues from there (falling back to the full mesh when the
+    /// cleanup fails). 0 turns the first pass off. Default [`FIRST_PASS_VERTICES`].
+    pub first_pass_vertices: usize,
 }
+
+/// Vertices left by the first pass of large decimations by default: meshes up to twice
+/// this size are decimated exactly as without a first pass.
+pub const FIRST_PASS_VERTICES: usize = 500_000;
 
 impl Default for DecimateOptions {
     fn default() -> Self {
@@ -119,6 +136,7 @@ impl Default for DecimateOptions {
             max_aspect_ratio: None,
             locked: Vec::new(),
             relax: true,
+            first_pass_vertices: FIRST_PASS_VERTICES,
         }
     }
 }
@@ -209,6 +227,44 @@ pub fn decimate_with_snapshots(
             opts.target
         )));
     }
+    let keep =
+        (snapshots.iter().copied()).fold(opts.first_pass_vertices.max(opts.target), usize::max);
+    if opts.first_pass_vertices > 0 && n > 2 * keep {
+        check_cancel(progress)?;
+        progress.report(Stage::Decimate, 0.0);
+        if let Some(r) = first_pass::first_pass(mesh, keep, &opts.locked) {
+            let lift = |d: Decimated| Decimated {
+                landmarks: d
+                    .landmarks
+                    .iter()
+                    .map(|&v| r.original[v as usize])
+                    .collect(),
+                ..d
+            };
+            let inner = DecimateOptions {
+                locked: (opts.locked.iter())
+                    .filter_map(|l| r.original.binary_search(l).ok().map(|i| i as u32))
+                    .collect(),
+                first_pass_vertices: 0,
+                ..opts.clone()
+            };
+            if snapshots.iter().all(|&s| s <= r.mesh.n_vertices()) {
+                let (fin, snaps) = decimate_exact(&r.mesh, &inner, snapshots, progress)?;
+                return Ok((lift(fin), snaps.into_iter().map(lift).collect()));
+            }
+        }
+    }
+    decimate_exact(mesh, opts, snapshots, progress)
+}
+
+/// [`decimate_with_snapshots`] by quadric collapses alone, its arguments checked.
+fn decimate_exact(
+    mesh: &ValidMesh,
+    opts: &DecimateOptions,
+    snapshots: &[usize],
+    progress: &dyn Progress,
+) -> Result<(Decimated, Vec<Decimated>), EmbedError> {
+    let n = mesh.n_vertices();
     let mut d = Decimator::new(mesh, opts);
     let mut snaps: Vec<Option<Decimated>> = vec![None; snapshots.len()];
     let take = |d: &Decimator, snaps: &mut Vec<Option<Decimated>>| {
@@ -446,6 +502,53 @@ mod tests {
                 mesh.topology().boundary_loops().len(),
                 d.relaxations
             );
+        }
+    }
+
+    /// Below twice `first_pass_vertices` the decimation is the exact one; above, the
+    /// first pass runs and the result keeps every invariant (target, topology, locked
+    /// vertices, nested snapshots on original vertices).
+    #[test]
+    fn first_pass_threshold() {
+        let mesh = valid(procedural::with_noise(
+            procedural::torus(120, 50, 1.0, 0.3),
+            0.2,
+            4,
+        ));
+        let n = mesh.n_vertices();
+        let exact = DecimateOptions {
+            first_pass_vertices: 0,
+            ..opts(80)
+        };
+        let below = DecimateOptions {
+            first_pass_vertices: n / 2,
+            ..opts(80)
+        };
+        let a = decimate(&mesh, &exact, &NoProgress).unwrap();
+        let b = decimate(&mesh, &below, &NoProgress).unwrap();
+        assert_eq!(a.landmarks, b.landmarks);
+        assert_eq!(a.mesh.triangles, b.mesh.triangles);
+        assert_eq!(
+            decimate(&mesh, &opts(80), &NoProgress).unwrap().landmarks,
+            a.landmarks,
+            "the default first pass leaves small meshes alone"
+        );
+        let locked = vec![5, 999, 4000];
+        let above = DecimateOptions {
+            first_pass_vertices: n / 2 - 1,
+            locked: locked.clone(),
+            ..opts(80)
+        };
+        let (fin, snaps) =
+            decimate_with_snapshots(&mesh, &above, &[1000, 300], &NoProgress).unwrap();
+        check(&mesh, &fin, 80);
+        assert_ne!(fin.landmarks, a.landmarks, "the first pass ran");
+        for l in locked {
+            assert!(fin.coarse_index(l).is_some(), "{l}");
+        }
+        for (s, want) in snaps.iter().zip([1000, 300]) {
+            check(&mesh, s, want);
+            assert!(fin.landmarks.iter().all(|l| s.coarse_index(*l).is_some()));
         }
     }
 

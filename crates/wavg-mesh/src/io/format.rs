@@ -37,6 +37,26 @@ pub struct LoadNotes {
 }
 
 impl LoadNotes {
+    /// The per-corner texture coordinates of a mesh whose `uv.faces` has one entry per
+    /// triangle, `textured` of them with coordinates (the others [`NONE`](crate::NONE)):
+    /// all of them when every triangle has some; otherwise none, and when only some do,
+    /// [`Self::uv_dropped`] set and the coordinates kept in [`Self::partial_uv`].
+    pub(crate) fn corner_uv(
+        &mut self,
+        uv: crate::TexCoords,
+        textured: usize,
+    ) -> Option<crate::TexCoords> {
+        if textured == 0 {
+            return None;
+        }
+        if textured == uv.faces.len() {
+            return Some(uv);
+        }
+        self.uv_dropped = true;
+        self.partial_uv = Some(uv);
+        None
+    }
+
     /// Records that the polygon just counted in `polygons` became `triangles` triangles.
     pub(crate) fn fan(&mut self, triangles: usize) {
         let id = u32::try_from(self.polygons.saturating_sub(1)).unwrap_or(u32::MAX);
@@ -102,5 +122,28 @@ impl Format {
             }
         };
         Ok((format, gz))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{NONE, TexCoords};
+    use nalgebra::Vector2;
+
+    #[test]
+    fn corner_uv_keeps_all_drops_some_and_ignores_none() {
+        let uv = TexCoords {
+            coords: vec![Vector2::new(0.5, 0.5)],
+            faces: vec![[0; 3], [NONE; 3]],
+        };
+        let mut n = LoadNotes::default();
+        assert_eq!(n.corner_uv(uv.clone(), 0), None);
+        assert!(!n.uv_dropped && n.partial_uv.is_none());
+        assert_eq!(n.corner_uv(uv.clone(), 1), None);
+        assert!(n.uv_dropped && n.partial_uv == Some(uv.clone()));
+        let mut n = LoadNotes::default();
+        assert_eq!(n.corner_uv(uv.clone(), 2), Some(uv));
+        assert!(!n.uv_dropped && n.partial_uv.is_none());
     }
 }

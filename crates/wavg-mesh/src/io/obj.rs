@@ -67,7 +67,6 @@ pub(crate) fn parse<R: Read>(lines: &mut TextLines<'_, R>) -> Result<(TriMesh, L
     let mut coords: Vec<Vector2<f64>> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut uv_faces: Vec<[u32; 3]> = Vec::new();
-    let mut faces_without_uv = 0usize;
     let mut textured = 0usize;
     let mut notes = LoadNotes::default();
     let mut poly: Vec<Corner> = Vec::new();
@@ -108,9 +107,6 @@ pub(crate) fn parse<R: Read>(lines: &mut TextLines<'_, R>) -> Result<(TriMesh, L
                     notes.non_triangles += 1;
                 }
                 let has_uv = poly.iter().all(|c| c.vt.is_some());
-                if !has_uv {
-                    faces_without_uv += 1;
-                }
                 for k in 1..poly.len() - 1 {
                     let (a, b, c) = (poly[0], poly[k], poly[k + 1]);
                     triangles.push([a.v, b.v, c.v]);
@@ -126,21 +122,13 @@ pub(crate) fn parse<R: Read>(lines: &mut TextLines<'_, R>) -> Result<(TriMesh, L
             _ => {} // vn, vp, o, g, s, usemtl, mtllib, l, p, curves: not needed.
         }
     }
-    let uv = if faces_without_uv == 0 && textured > 0 {
-        Some(TexCoords {
+    let uv = notes.corner_uv(
+        TexCoords {
             coords,
             faces: uv_faces,
-        })
-    } else {
-        notes.uv_dropped = faces_without_uv > 0 && textured > 0;
-        if notes.uv_dropped {
-            notes.partial_uv = Some(TexCoords {
-                coords,
-                faces: uv_faces,
-            });
-        }
-        None
-    };
+        },
+        textured,
+    );
     Ok((
         TriMesh {
             positions,

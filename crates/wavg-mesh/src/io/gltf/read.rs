@@ -1,6 +1,7 @@
 //! A glTF file read into one triangle mesh: the scene's mesh instances with their node
 //! transforms, each primitive's triangles, welded by position, with per-corner UVs.
 
+use std::ops::Range;
 use std::path::Path;
 
 use gltf::mesh::Mode;
@@ -233,21 +234,24 @@ fn triangles(mode: Mode, idx: &[u32]) -> Option<Vec<[u32; 3]>> {
 }
 
 /// The instances' primitives gathered before welding: positions in world space, corner
-/// indices into them, per-vertex UVs where primitives have them.
+/// indices into them, per-vertex UVs once a primitive has them.
 #[derive(Default)]
 struct Assembly {
     positions: Vec<Vector3<f64>>,
     triangles: Vec<[u32; 3]>,
-    /// glTF's (u, v) per gathered vertex (NaN where the primitive has none).
+    /// wavg's (u, v) per gathered vertex (NaN where the primitive has none); empty until
+    /// a primitive has `TEXCOORD_0`.
     uv: Vec<Vector2<f64>>,
     /// Triangles whose primitive has `TEXCOORD_0`.
     textured: usize,
-    uv_faces: Vec<bool>,
+    /// The ranges of `triangles` whose primitive has no `TEXCOORD_0`.
+    untextured: Vec<Range<usize>>,
     skipped_primitives: usize,
     texture: Option<TextureSource>,
 }
 
 impl Assembly {
+    /// Appends one primitive; the arrays are read straight into the gathered ones.
     fn primitive(
         &mut self,
         src: &mut Source,
@@ -261,23 +265,58 @@ impl Assembly {
             .get(&gltf::Semantic::Positions)
             .ok_or_else(|| format!("{what} has no POSITION attribute"))?;
         let count = positions.count();
+        let start = self.positions.len();
         // Positions first: their accessor's count is then known to be backed by bytes.
-        let p = read_accessor::vec3(src, &positions).map_err(|e| format!("{what}: {e}"))?;
-        let idx = match prim.indices() {
-            Some(a) => read_accessor::indices(src, &a).map_err(|e| format!("{what}: {e}"))?,
-            None => (0..u32::try_from(count).map_err(|_| format!("{what}: too many vertices"))?)
-                .collect(),
-        };
-        let Some(mut tris) = triangles(prim.mode(), &idx) else {
-            self.skipped_primitives += 1;
-            return Ok(());
-        };
-        drop(idx);
-        if let Some(bad) = tris.iter().flatten().find(|&&i| i as usize >= count) {
-            return Err(format!(
-                "{what}: index {bad} is out of range ({count} vertices)"
-            ));
+        read_accessor::vec3(src, &positions, &mut self.positions)
+            .map_err(|e| format!("{what}: {e}"))?;
+        let first = self.triangles.len();
+        let too_many = || format!("{what}: too many vertices");
+        match (prim.indices(), prim.mode()) {
+            (Some(a), Mode::Triangles) => {
+                read_accessor::triangle_list(src, &a, &mut self.triangles)
+                    .map_err(|e| format!("{what}: {e}"))?;
+            }
+            (None, Mode::Triangles) => {
+                let n = u32::try_from(count).map_err(|_| too_many())? / 3;
+                self.triangles
+                    .extend((0..n).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]));
+            }
+            (indices, mode) => {
+                let idx = match indices {
+                    Some(a) => {
+                        read_accessor::indices(src, &a).map_err(|e| format!("{what}: {e}"))?
+                    }
+                    None => (0..u32::try_from(count).map_err(|_| too_many())?).collect(),
+                };
+                match triangles(mode, &idx) {
+                    Some(tris) => self.triangles.extend(tris),
+                    None => {
+                        self.positions.truncate(start);
+                        self.skipped_primitives += 1;
+                        return Ok(());
+                    }
+                }
+            }
         }
+        let linear = world.fixed_view::<3, 3>(0, 0).into_owned();
+        let shift = world.fixed_view::<3, 1>(0, 3).into_owned();
+        // A mirroring transform turns counter-clockwise triangles clockwise.
+        let mirror = linear.determinant() < 0.0;
+        // Out-of-range indices are refused below, before `base` is known to fit; until
+        // then the sums may wrap.
+        let base = start as u32;
+        for t in &mut self.triangles[first..] {
+            if let Some(bad) = t.iter().find(|&&i| i as usize >= count) {
+                return Err(format!(
+                    "{what}: index {bad} is out of range ({count} vertices)"
+                ));
+            }
+            if mirror {
+                t.swap(1, 2);
+            }
+            *t = t.map(|i| i.wrapping_add(base));
+        }
+        let tris = self.triangles.len() - first;
         let uv = match prim.get(&gltf::Semantic::TexCoords(0)) {
             Some(a) if a.count() != count => {
                 return Err(format!(
@@ -285,54 +324,41 @@ impl Assembly {
                     a.count()
                 ));
             }
-            Some(a) => Some(read_accessor::vec2(src, &a).map_err(|e| format!("{what}: {e}"))?),
-            None => None,
+            Some(a) => {
+                self.uv.resize(start, Vector2::new(f64::NAN, f64::NAN));
+                read_accessor::vec2(src, &a, &mut self.uv).map_err(|e| format!("{what}: {e}"))?;
+                for c in &mut self.uv[start..] {
+                    c.y = super::flip_v(c.y);
+                }
+                true
+            }
+            None => false,
         };
-        let base = u32::try_from(self.positions.len())
+        u32::try_from(start)
             .ok()
             .filter(|b| b.checked_add(count as u32).is_some_and(|e| e < NONE))
             .ok_or_else(|| format!("{what}: more than 2^32 - 1 vertices in all"))?;
-        let linear = world.fixed_view::<3, 3>(0, 0).into_owned();
-        let shift = world.fixed_view::<3, 1>(0, 3).into_owned();
-        if *world == Matrix4::identity() {
-            self.positions.extend(
-                p.iter()
-                    .map(|q| Vector3::new(q[0] as f64, q[1] as f64, q[2] as f64)),
-            );
+        if *world != Matrix4::identity() {
+            for q in &mut self.positions[start..] {
+                *q = linear * *q + shift;
+            }
+        }
+        if uv {
+            self.textured += tris;
+            if self.texture.is_none() {
+                self.texture = read_texture::base_colour(&prim.material(), &src.buffers, file)?;
+            }
         } else {
-            self.positions.extend(
-                p.iter()
-                    .map(|q| linear * Vector3::new(q[0] as f64, q[1] as f64, q[2] as f64) + shift),
-            );
-        }
-        // A mirroring transform turns counter-clockwise triangles clockwise.
-        let mirror = linear.determinant() < 0.0;
-        for t in &mut tris {
-            if mirror {
-                t.swap(1, 2);
-            }
-            *t = t.map(|i| i + base);
-        }
-        match &uv {
-            Some(uv) => {
+            if !self.uv.is_empty() {
                 self.uv
-                    .extend(uv.iter().map(|c| Vector2::new(c[0] as f64, c[1] as f64)));
-                self.textured += tris.len();
-                if self.texture.is_none() {
-                    self.texture = read_texture::base_colour(&prim.material(), &src.buffers, file)?;
-                }
+                    .resize(start + count, Vector2::new(f64::NAN, f64::NAN));
             }
-            None => self
-                .uv
-                .extend(std::iter::repeat_n(Vector2::new(f64::NAN, f64::NAN), count)),
+            self.untextured.push(first..first + tris);
         }
-        self.uv_faces
-            .extend(std::iter::repeat_n(uv.is_some(), tris.len()));
-        self.triangles.extend(tris);
         Ok(())
     }
 
-    fn finish(self) -> Result<(TriMesh, LoadNotes), String> {
+    fn finish(mut self) -> Result<(TriMesh, LoadNotes), String> {
         if self.triangles.is_empty() && self.skipped_primitives > 0 {
             return Err(format!(
                 "no triangles: the {} primitives read are points or lines (mode POINTS, \
@@ -340,43 +366,41 @@ impl Assembly {
                 self.skipped_primitives
             ));
         }
-        let (positions, map) = weld::weld(&self.positions);
-        let triangles: Vec<[u32; 3]> = self
-            .triangles
-            .iter()
-            .map(|t| t.map(|i| map[i as usize]))
-            .collect();
+        let gathered = self.positions.len();
+        let map = weld::weld(&mut self.positions);
         let mut notes = LoadNotes {
-            polygons: triangles.len(),
-            welded_vertices: self.positions.len() - positions.len(),
+            polygons: self.triangles.len(),
+            welded_vertices: gathered - self.positions.len(),
             skipped_primitives: self.skipped_primitives,
             ..LoadNotes::default()
         };
-        let coords: Vec<Vector2<f64>> = self
-            .uv
-            .iter()
-            .map(|c| Vector2::new(c.x, super::flip_v(c.y)))
-            .collect();
-        let faces: Vec<[u32; 3]> = self
-            .triangles
-            .iter()
-            .zip(&self.uv_faces)
-            .map(|(t, &has)| if has { *t } else { [NONE; 3] })
-            .collect();
-        let all = self.textured == triangles.len() && self.textured > 0;
-        let uv = if all {
-            Some(TexCoords { coords, faces })
-        } else {
-            if self.textured > 0 {
-                notes.uv_dropped = true;
-                notes.partial_uv = Some(TexCoords { coords, faces });
+        // Without a merge every index already is its welded one.
+        let welded = |t: &[[u32; 3]]| -> Vec<[u32; 3]> {
+            match &map {
+                Some(map) => t.iter().map(|t| t.map(|i| map[i as usize])).collect(),
+                None => t.to_vec(),
             }
-            None
+        };
+        let mut uv = None;
+        let triangles = if self.textured == 0 {
+            match &map {
+                Some(_) => welded(&self.triangles),
+                None => self.triangles,
+            }
+        } else {
+            let triangles = welded(&self.triangles);
+            let mut faces = self.triangles;
+            for r in self.untextured {
+                faces[r].fill([NONE; 3]);
+            }
+            let coords = std::mem::take(&mut self.uv);
+            uv = notes.corner_uv(TexCoords { coords, faces }, self.textured);
+            triangles
         };
         notes.texture = self.texture.filter(|_| uv.is_some() || notes.uv_dropped);
         Ok((
             TriMesh {
-                positions,
+                positions: self.positions,
                 triangles,
                 uv,
             },

@@ -5,6 +5,7 @@
 use std::borrow::Cow;
 
 use gltf::accessor::{DataType, Dimensions};
+use nalgebra::{Vector2, Vector3};
 
 use super::read_limits::Budget;
 
@@ -86,32 +87,37 @@ fn strided<'b>(
     }
 }
 
-/// Decodes an accessor's elements with `decode` (given an element's bytes, at least the
-/// element's size): from its buffer view, or zeros without one, then its sparse values.
-fn decode<T: Copy>(
+/// Appends an accessor's elements to `out`, decoded with `decode` (given an element's
+/// bytes, at least the element's size): from its buffer view, or zeros without one, then
+/// its sparse values.
+fn decode_into<T: Copy>(
     src: &mut Source,
     acc: &gltf::Accessor,
+    out: &mut Vec<T>,
     zero: T,
     decode: impl Fn(&[u8]) -> T,
-) -> Result<Vec<T>, String> {
+) -> Result<(), String> {
     let name = what(acc);
     let (count, size) = (acc.count(), acc.size());
-    let mut out = match acc.view() {
+    let start = out.len();
+    match acc.view() {
         Some(view) => {
             let s = strided(&src.buffers, &view, acc.offset(), count, size, &name)?;
             src.budget.take(count as u64, &name)?;
-            (0..s.count).map(|i| decode(s.element(i))).collect()
+            out.reserve(count);
+            out.extend(s.bytes.chunks(s.stride).take(s.count).map(&decode));
         }
         None if acc.sparse().is_some() => {
             src.budget.take(count as u64, &name)?;
-            vec![zero; count]
+            out.resize(start + count, zero);
         }
         None => {
             return Err(format!(
                 "{name} has neither a buffer view nor sparse values"
             ));
         }
-    };
+    }
+    let out = &mut out[start..];
     if let Some(sparse) = acc.sparse() {
         let n = sparse.count();
         let idx = sparse.indices();
@@ -149,7 +155,7 @@ fn decode<T: Copy>(
             *slot = decode(vs.element(k));
         }
     }
-    Ok(out)
+    Ok(())
 }
 
 fn unsigned(b: &[u8], size: usize) -> u32 {
@@ -164,8 +170,12 @@ fn f32_at(b: &[u8], k: usize) -> f32 {
     f32::from_le_bytes([b[4 * k], b[4 * k + 1], b[4 * k + 2], b[4 * k + 3]])
 }
 
-/// A `VEC3` float accessor (POSITION).
-pub(crate) fn vec3(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<[f32; 3]>, String> {
+/// Appends a `VEC3` float accessor (POSITION) to `out`.
+pub(crate) fn vec3(
+    src: &mut Source,
+    acc: &gltf::Accessor,
+    out: &mut Vec<Vector3<f64>>,
+) -> Result<(), String> {
     if acc.dimensions() != Dimensions::Vec3 || acc.data_type() != DataType::F32 {
         return Err(format!(
             "{}: positions must be VEC3 of FLOAT, not {:?} of {:?}",
@@ -174,13 +184,23 @@ pub(crate) fn vec3(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<[f32; 3
             acc.data_type()
         ));
     }
-    decode(src, acc, [0.0; 3], |b| {
-        [f32_at(b, 0), f32_at(b, 1), f32_at(b, 2)]
+    // An element has its 12 bytes (checked by `strided`); as an array they decode
+    // without a bounds check per byte.
+    decode_into(src, acc, out, Vector3::zeros(), |b| {
+        match b.first_chunk::<12>() {
+            Some(c) => Vector3::new(f32_at(c, 0), f32_at(c, 1), f32_at(c, 2)).cast(),
+            None => Vector3::zeros(),
+        }
     })
 }
 
-/// A `VEC2` texture-coordinate accessor: float, or normalised unsigned byte or short.
-pub(crate) fn vec2(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<[f32; 2]>, String> {
+/// Appends a `VEC2` texture-coordinate accessor to `out`: float, or normalised unsigned
+/// byte or short.
+pub(crate) fn vec2(
+    src: &mut Source,
+    acc: &gltf::Accessor,
+    out: &mut Vec<Vector2<f64>>,
+) -> Result<(), String> {
     if acc.dimensions() != Dimensions::Vec2 {
         return Err(format!(
             "{}: texture coordinates must be VEC2, not {:?}",
@@ -189,15 +209,18 @@ pub(crate) fn vec2(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<[f32; 2
         ));
     }
     match (acc.data_type(), acc.normalized()) {
-        (DataType::F32, _) => decode(src, acc, [0.0; 2], |b| [f32_at(b, 0), f32_at(b, 1)]),
-        (DataType::U8, true) => decode(src, acc, [0.0; 2], |b| {
-            [b[0] as f32 / 255.0, b[1] as f32 / 255.0]
+        (DataType::F32, _) => decode_into(src, acc, out, Vector2::zeros(), |b| {
+            Vector2::new(f32_at(b, 0), f32_at(b, 1)).cast()
         }),
-        (DataType::U16, true) => decode(src, acc, [0.0; 2], |b| {
-            [
+        (DataType::U8, true) => decode_into(src, acc, out, Vector2::zeros(), |b| {
+            Vector2::new(b[0] as f32 / 255.0, b[1] as f32 / 255.0).cast()
+        }),
+        (DataType::U16, true) => decode_into(src, acc, out, Vector2::zeros(), |b| {
+            Vector2::new(
                 u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
                 u16::from_le_bytes([b[2], b[3]]) as f32 / 65535.0,
-            ]
+            )
+            .cast()
         }),
         (t, n) => Err(format!(
             "{}: texture coordinates of {t:?}{} (glTF allows FLOAT and normalised \
@@ -210,6 +233,7 @@ pub(crate) fn vec2(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<[f32; 2
 
 /// A `SCALAR` unsigned index accessor.
 pub(crate) fn indices(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<u32>, String> {
+    let mut out = Vec::new();
     let size = match (acc.dimensions(), acc.data_type()) {
         (Dimensions::Scalar, DataType::U8) => 1,
         (Dimensions::Scalar, DataType::U16) => 2,
@@ -221,5 +245,53 @@ pub(crate) fn indices(src: &mut Source, acc: &gltf::Accessor) -> Result<Vec<u32>
             ));
         }
     };
-    decode(src, acc, 0, |b| unsigned(b, size))
+    decode_into(src, acc, &mut out, 0, |b| unsigned(b, size))?;
+    Ok(out)
+}
+
+/// Appends the triangles of a `TRIANGLES` primitive's index accessor to `out` (a
+/// trailing incomplete triangle is dropped): straight from the buffer in the common
+/// case of tightly packed indices without sparse values.
+pub(crate) fn triangle_list(
+    src: &mut Source,
+    acc: &gltf::Accessor,
+    out: &mut Vec<[u32; 3]>,
+) -> Result<(), String> {
+    let packed = acc.sparse().is_none()
+        && acc.dimensions() == Dimensions::Scalar
+        && acc
+            .view()
+            .is_some_and(|v| v.stride().is_none_or(|s| s == acc.size()));
+    let view = match acc.view() {
+        Some(view) if packed => view,
+        _ => {
+            let idx = indices(src, acc)?;
+            out.extend(idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+            return Ok(());
+        }
+    };
+    let size = match acc.data_type() {
+        DataType::U8 => 1,
+        DataType::U16 => 2,
+        DataType::U32 => 4,
+        _ => return indices(src, acc).map(|_| ()),
+    };
+    let name = what(acc);
+    let count = acc.count();
+    let s = strided(&src.buffers, &view, acc.offset(), count, size, &name)?;
+    src.budget.take(count as u64, &name)?;
+    let bytes = &s.bytes[..count / 3 * 3 * size];
+    out.reserve(count / 3);
+    match size {
+        4 => out.extend(bytes.chunks_exact(12).map(|c| {
+            let at = |k: usize| u32::from_le_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
+            [at(0), at(4), at(8)]
+        })),
+        _ => out.extend(
+            bytes
+                .chunks_exact(3 * size)
+                .map(|c| [0, 1, 2].map(|k| unsigned(&c[k * size..], size))),
+        ),
+    }
+    Ok(())
 }
