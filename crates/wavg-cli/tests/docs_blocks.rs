@@ -484,7 +484,13 @@ fn every_code_block_in_the_docs_runs_or_says_why_not() {
             if langs.as_ref().is_some_and(|l| !l.contains(&b.lang)) {
                 continue;
             }
-            match check(&b, fixtures.path(), data.as_deref()) {
+            let started = std::time::Instant::now();
+            let result = check(&b, fixtures.path(), data.as_deref());
+            let secs = started.elapsed().as_secs_f64();
+            if secs > 2.0 {
+                eprintln!("{:.1} s: {}:{} ({})", secs, b.file, b.line, b.lang);
+            }
+            match result {
                 Ok(None) => ran += 1,
                 Ok(Some(why)) => {
                     skipped += 1;
