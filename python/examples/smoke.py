@@ -2,7 +2,7 @@
 
     python smoke.py
 
-Builds a torus in code, precomputes its embedding, solves forward and inverse problems
+Builds a torus in code (`_mesh.py`, beside it, as for the other examples), precomputes its embedding, solves forward and inverse problems
 with NumPy arrays in and out, and checks that they agree and that bad input raises the
 package's exceptions. Prints one line and exits 0 when everything holds; an assertion
 names what does not. `cargo xtask test` runs it against the release wheel in every
@@ -14,23 +14,11 @@ import sys
 import numpy as np
 
 import wavg
-
-
-def torus(n=32, m=12, R=1.0, r=0.35):
-    """A closed genus-1 triangle mesh: vertices (n*m, 3) float64, faces (2*n*m, 3) int64."""
-    u, v = np.meshgrid(np.arange(n) * 2 * np.pi / n, np.arange(m) * 2 * np.pi / m, indexing="ij")
-    V = np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u),
-                  r * np.sin(v)], -1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
-    a, b = i * m + j, ((i + 1) % n) * m + j
-    c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
-    F = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3),
-                        np.stack([a, c, d], -1).reshape(-1, 3)])
-    return V, F
+from _mesh import torus
 
 
 def main():
-    V, F = torus()
+    V, F = torus(n=32, m=12)
     # float32 vertices and int32 faces: the package takes any float and integer dtype.
     S = wavg.Surface(V.astype(np.float32), F.astype(np.int32))
     report = S.precompute(progress=False)
