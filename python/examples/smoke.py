@@ -2,9 +2,9 @@
 
     python smoke.py
 
-Builds a torus in code (`_mesh.py`, beside it, as for the other examples), precomputes its embedding, solves forward and inverse problems
-with NumPy arrays in and out, and checks that they agree and that bad input raises the
-package's exceptions. Prints one line and exits 0 when everything holds; an assertion
+Builds a torus in code (`_mesh.py`, beside it, as for the other examples), precomputes
+its embedding, solves forward and inverse problems with NumPy arrays in and out, and
+checks that they agree and that bad input raises the package's exceptions. Prints one line and exits 0 when everything holds; an assertion
 names what does not. `cargo xtask test` runs it against the release wheel in every
 CPython and NumPy it installs the wheel with.
 """
