@@ -166,7 +166,14 @@ pub fn docs_blocks(root: &Path, data_dir: &Path) -> Result<(), String> {
         &[
             &["test", "--workspace"],
             steps::EXCLUDED,
-            &["--test", "docs_blocks", "--", "every_code_block"],
+            // --nocapture: the runner's lines naming blocks over 2 s show in the log.
+            &[
+                "--test",
+                "docs_blocks",
+                "--",
+                "every_code_block",
+                "--nocapture",
+            ],
         ]
         .concat(),
         &[
