@@ -25,7 +25,9 @@ static void run_mesh(const char *path) {
   CHECK_OK(wavg_surface_precompute(s, NULL, NULL, NULL));
   size_t nl = 0;
   CHECK_OK(wavg_surface_landmarks(s, NULL, 0, &nl));
-  CHECK(nl == 1000);
+  /* The 1000 asked for, plus those around thin parts (the armadillo's fingers): at most as
+     many again. */
+  CHECK(nl >= 1000 && nl <= 2000);
   uint32_t *lm = malloc(sizeof(uint32_t) * nl);
   CHECK_OK(wavg_surface_landmarks(s, lm, nl, &nl));
 
