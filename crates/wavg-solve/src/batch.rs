@@ -21,7 +21,7 @@ pub struct ForwardScratch {
 }
 
 /// Weight rows one parallel task reads.
-const PREPARE_CHUNK: usize = 256;
+pub(crate) const PREPARE_CHUNK: usize = 256;
 /// Sorted queries one parallel task solves.
 const SEARCH_CHUNK: usize = 64;
 /// Points one parallel task of the inverse batch handles.

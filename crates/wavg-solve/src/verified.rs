@@ -17,7 +17,7 @@ use wavg_mesh::SurfacePoint;
 
 use wavg_project::Par;
 
-use crate::batch::BatchWeights;
+use crate::batch::{BatchWeights, PREPARE_CHUNK};
 use crate::error::SolveError;
 use crate::penalty::PenaltySystem;
 use crate::points::check_point;
@@ -164,8 +164,8 @@ impl Solver {
     /// [`Solver::inverse_verified_batch`] into existing buffers, with explicit parallelism
     /// (the results do not depend on it): row `i` of `weights` and `round_trips[i]` belong
     /// to `points[i]` (both carry the error when it failed). In stages, each a batch: the
-    /// paper's weights for all points, each prepared for its forward problem while still in
-    /// cache; the forward problems in the Morton order of their averages (as
+    /// paper's weights for all points, then each row prepared for its forward problem; the
+    /// forward problems in the Morton order of their averages (as
     /// [`Solver::forward_batch_into`]), each reduced to whether it returns to its point;
     /// then the points still not returned, each up the penalty ladder on its own (the
     /// lambda-independent part of its problem set up once).
@@ -210,25 +210,22 @@ impl Solver {
         let mesh = self.mesh();
         let tol = tolerance * self.mean_edge_length();
         let opts = ForwardOptions::default();
-        // The paper's weights, each prepared for its forward problem while in cache.
-        let n = self.n_anchors();
-        weights.n = n;
-        weights.data.resize(points.len() * n.max(1), 0.0);
-        let mut prepared = Vec::with_capacity(points.len());
-        weights.status.clear();
-        for (status, p) in self.inverse_rows_then(
-            points,
-            |p| *p,
-            &mut weights.data,
-            par,
-            |r| match r {
-                Ok(row) => (Ok(()), self.prepare_keyed(row, &opts)),
-                Err(e) => (Err(e.clone()), (u64::MAX, Err(e))),
+        // The paper's weights, then each row prepared for its forward problem, as
+        // `inverse_batch_into` and `forward_batch_into` do: per-point results stay small
+        // (a prepared query carried along with its inverse's outcome costs a copy of a few
+        // hundred bytes per point through the parallel collection).
+        self.inverse_batch_into(points, weights, par)?;
+        let paper = &*weights;
+        let mut prepared = Vec::new();
+        par.map_range(
+            points.len(),
+            PREPARE_CHUNK,
+            &mut prepared,
+            |i| match paper.get(i) {
+                Ok(row) => self.prepare_keyed(row, &opts),
+                Err(e) => (u64::MAX, Err(e.clone())),
             },
-        )? {
-            weights.status.push(status);
-            prepared.push(p);
-        }
+        )?;
         // Their forward problems, reduced to whether each returns to its point.
         let (mut order, mut pos, mut done, mut back) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
