@@ -71,7 +71,6 @@ impl<'a> PenaltySystem<'a> {
             a1: &mut a1,
             d: &mut d,
         });
-        let d = &mut d[..];
         if let Some(x) = d[..n].iter().find(|x| !x.is_finite()) {
             return Err(distance_overflow(x.is_nan(), gamma));
         }
@@ -81,15 +80,13 @@ impl<'a> PenaltySystem<'a> {
         }
         // Scale-free: D / d_ref, and the penalty scaled the same way.
         let d_ref = nth_smallest(&d[..n], 3.min(n - 1));
-        // Zero in the padding.
+        // Zero in the padding; `s` in place of `D` (one buffer fewer).
         d[n..].fill(f64::INFINITY);
-        let s = d
-            .iter()
-            .map(|&x| {
-                let r = d_ref / x;
-                r * r
-            })
-            .collect();
+        for x in &mut d {
+            let r = d_ref / *x;
+            *x = r * r;
+        }
+        let s = d;
         let mut system = System {
             anchors,
             yhat: *ctx.yhat(),
@@ -108,14 +105,25 @@ impl<'a> PenaltySystem<'a> {
 
     /// The weights for penalty `lambda` (finite, non-negative).
     pub(crate) fn weights(&self, lambda: f64) -> Result<Vec<f64>, SolveError> {
+        let mut w = Vec::new();
+        self.weights_into(lambda, &mut w)?;
+        Ok(w)
+    }
+
+    /// [`PenaltySystem::weights`] into `out` (its memory reused from rung to rung).
+    pub(crate) fn weights_into(&self, lambda: f64, out: &mut Vec<f64>) -> Result<(), SolveError> {
         if !(lambda.is_finite() && lambda >= 0.0) {
             return Err(SolveError::InvalidParameter(format!(
                 "lambda must be finite and non-negative, got {lambda}"
             )));
         }
         match self {
-            Self::OneHot { n, i } => Ok((0..*n).map(|j| if j == *i { 1.0 } else { 0.0 }).collect()),
-            Self::Solve(s) => s.weights(lambda),
+            Self::OneHot { n, i } => {
+                out.clear();
+                out.extend((0..*n).map(|j| if j == *i { 1.0 } else { 0.0 }));
+                Ok(())
+            }
+            Self::Solve(s) => s.weights_into(lambda, out),
         }
     }
 }
@@ -288,7 +296,7 @@ impl System<'_> {
         sum_lanes(q.lanes(sum))
     }
 
-    fn weights(&self, lambda: f64) -> Result<Vec<f64>, SolveError> {
+    fn weights_into(&self, lambda: f64, w: &mut Vec<f64>) -> Result<(), SolveError> {
         let solve3 = |gm: Matrix3<f64>| {
             gm.lu()
                 .solve(&Vector3::new(0.0, 0.0, 1.0))
@@ -346,21 +354,22 @@ impl System<'_> {
                 ([0.0, 0.0], z[2], g)
             }
         };
-        let mut w = vec![0.0; self.s.len()];
+        w.clear();
+        w.resize(self.s.len(), 0.0);
         let sum = dispatch(Weigh {
             system: self,
             z: [a[0], a[1], b],
             g: std::array::from_fn(|k| g[k]),
-            out: &mut w,
+            out: w,
         });
         if !(sum.is_finite() && sum.abs() > 1e-12) {
             return Err(SolveError::DegenerateTangentPlane);
         }
         w.truncate(self.anchors.len());
-        for x in &mut w {
+        for x in w.iter_mut() {
             *x /= sum;
         }
-        Ok(w)
+        Ok(())
     }
 }
 

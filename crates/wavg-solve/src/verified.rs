@@ -119,8 +119,9 @@ impl Solver {
         let (psi, yhat) = self.tangent_plane(p);
         let system = PenaltySystem::new(&psi, &yhat, self.anchors().coords(), self.gamma())?;
         let opts = ForwardOptions::default();
+        let mut w = Vec::with_capacity(self.anchors().coords().padded());
         for lambda in PENALTY_LADDER {
-            let w = system.weights(lambda)?;
+            system.weights_into(lambda, &mut w)?;
             if self
                 .forward(&w, &opts)
                 .is_ok_and(|r| (r.position - target).norm() <= tol)
