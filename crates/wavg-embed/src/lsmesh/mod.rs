@@ -20,6 +20,7 @@ use wavg_mesh::{TriMesh, ValidMesh, geometry};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
 
+mod cg;
 mod ordering;
 pub(crate) mod two_level;
 

@@ -20,8 +20,9 @@ use rayon::prelude::*;
 use wavg_mesh::{ValidMesh, geometry};
 
 use super::LsMeshSolver;
+use super::cg::FreeOperator;
 use crate::decimate::Decimated;
-use crate::error::{EmbedError, Progress, Stage, check_cancel};
+use crate::error::{EmbedError, Progress, check_cancel};
 use crate::file::MAX_DIM;
 
 type Row = [f64; MAX_DIM];
@@ -170,7 +171,13 @@ impl TwoLevelLsMesh {
             x[s as usize] = *v;
             x[s as usize][dim..].fill(0.0);
         }
-        self.conjugate_gradients(&mut x, dim, progress)?;
+        let op = FreeOperator {
+            stiffness: &self.stiffness,
+            inv_mass: &self.inv_mass,
+            inv_diag: &self.inv_diag,
+            fixed: &self.fixed,
+        };
+        op.solve(&self.landmarks, &mut x, dim, self.cg, progress)?;
         if x.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
             return Err(EmbedError::Numerical(
                 "least-squares mesh produced non-finite coordinates".into(),
@@ -242,147 +249,6 @@ impl TwoLevelLsMesh {
             }
         }
         x
-    }
-
-    /// `y = L x` (rows in parallel; `L` symmetric, so its columns are its rows).
-    fn stiffness_times(&self, x: &[Row], y: &mut [Row]) {
-        let (sym, vals) = self.stiffness.parts();
-        y.par_iter_mut().enumerate().for_each(|(j, yj)| {
-            let mut acc = [0.0; MAX_DIM];
-            for k in sym.col_range(j) {
-                let (a, xi) = (vals[k], &x[sym.row_idx()[k]]);
-                for c in 0..MAX_DIM {
-                    acc[c] += a * xi[c];
-                }
-            }
-            *yj = acc;
-        });
-    }
-
-    /// `y = A x` with `A = L M⁻¹ L`, using `t` as scratch; rows of fixed vertices of `y`
-    /// are zeroed (the free rows of the system).
-    fn apply(&self, x: &[Row], t: &mut [Row], y: &mut [Row]) {
-        self.stiffness_times(x, t);
-        t.par_iter_mut()
-            .zip(&self.inv_mass)
-            .for_each(|(ti, &w)| *ti = ti.map(|c| c * w));
-        self.stiffness_times(t, y);
-        y.par_iter_mut()
-            .zip(&self.fixed)
-            .filter(|(_, f)| **f)
-            .for_each(|(yi, _)| *yi = [0.0; MAX_DIM]);
-    }
-
-    /// Per-column dot products of two blocks.
-    fn dots(a: &[Row], b: &[Row]) -> Row {
-        a.par_chunks(8192)
-            .zip(b.par_chunks(8192))
-            .map(|(a, b)| {
-                let mut s = [0.0; MAX_DIM];
-                for (u, v) in a.iter().zip(b) {
-                    for c in 0..MAX_DIM {
-                        s[c] += u[c] * v[c];
-                    }
-                }
-                s
-            })
-            .reduce(
-                || [0.0; MAX_DIM],
-                |mut s, t| {
-                    for c in 0..MAX_DIM {
-                        s[c] += t[c];
-                    }
-                    s
-                },
-            )
-    }
-
-    /// Jacobi-preconditioned conjugate gradients on the free rows, all columns at once
-    /// (each with its own step lengths), from the iterate `x` (whose fixed rows hold the
-    /// landmark values and stay unchanged).
-    fn conjugate_gradients(
-        &self,
-        x: &mut [Row],
-        dim: usize,
-        progress: &dyn Progress,
-    ) -> Result<(), EmbedError> {
-        let n = x.len();
-        let mut t = vec![[0.0; MAX_DIM]; n];
-        // Right-hand side norms: b = -(A x_S) on the free rows.
-        let mut r = vec![[0.0; MAX_DIM]; n];
-        {
-            let mut xs = vec![[0.0; MAX_DIM]; n];
-            for &s in &self.landmarks {
-                xs[s as usize] = x[s as usize];
-            }
-            self.apply(&xs, &mut t, &mut r);
-        }
-        let b2 = Self::dots(&r, &r);
-        // r = b - A_FF x_F = -(A x) on the free rows.
-        self.apply(x, &mut t, &mut r);
-        r.par_iter_mut().for_each(|ri| *ri = ri.map(|c| -c));
-        let precondition = |r: &[Row], z: &mut [Row]| {
-            z.par_iter_mut()
-                .zip(r.par_iter().zip(&self.inv_diag))
-                .for_each(|(zi, (ri, &d))| *zi = ri.map(|c| c * d));
-        };
-        let mut z = vec![[0.0; MAX_DIM]; n];
-        precondition(&r, &mut z);
-        let mut p = z.clone();
-        let mut rz = Self::dots(&r, &z);
-        let mut q = vec![[0.0; MAX_DIM]; n];
-        let tol2 = self.cg.tolerance * self.cg.tolerance;
-        let mut active: Vec<bool> = (0..MAX_DIM).map(|c| c < dim && b2[c] > 0.0).collect();
-        for it in 0..self.cg.max_iterations {
-            let r2 = Self::dots(&r, &r);
-            for c in 0..MAX_DIM {
-                active[c] &= r2[c] > tol2 * b2[c];
-            }
-            if !active.iter().any(|&a| a) {
-                break;
-            }
-            if it % 16 == 0 {
-                check_cancel(progress)?;
-                progress.report(
-                    Stage::LsMesh,
-                    0.9 + 0.1 * it as f64 / self.cg.max_iterations as f64,
-                );
-            }
-            self.apply(&p, &mut t, &mut q);
-            let pq = Self::dots(&p, &q);
-            let alpha: Row = std::array::from_fn(|c| {
-                if active[c] && pq[c] > 0.0 {
-                    rz[c] / pq[c]
-                } else {
-                    0.0
-                }
-            });
-            x.par_iter_mut()
-                .zip(r.par_iter_mut())
-                .zip(p.par_iter().zip(&q))
-                .for_each(|((xi, ri), (pi, qi))| {
-                    for c in 0..MAX_DIM {
-                        xi[c] += alpha[c] * pi[c];
-                        ri[c] -= alpha[c] * qi[c];
-                    }
-                });
-            precondition(&r, &mut z);
-            let rz_new = Self::dots(&r, &z);
-            let beta: Row = std::array::from_fn(|c| {
-                if active[c] && rz[c] > 0.0 {
-                    rz_new[c] / rz[c]
-                } else {
-                    0.0
-                }
-            });
-            rz = rz_new;
-            p.par_iter_mut().zip(&z).for_each(|(pi, zi)| {
-                for c in 0..MAX_DIM {
-                    pi[c] = zi[c] + beta[c] * pi[c];
-                }
-            });
-        }
-        Ok(())
     }
 }
 

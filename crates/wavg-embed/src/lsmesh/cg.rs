@@ -1,0 +1,272 @@
+//! Jacobi-preconditioned conjugate gradients on the free rows of `A = L M⁻¹ L`, all
+//! columns at once (each with its own step lengths), for the two-level least-squares mesh.
+//!
+//! The iteration is memory-bound (a few multiply-adds per byte read), so each pass over
+//! the vertices does as much as it can: the mass scaling goes into the first product with
+//! `L`, the fixed rows' zeroing and the `p·Ap` dot products into the second, the update of
+//! the iterate and residual, the preconditioning and both residual dot products into one
+//! pass, and the preconditioned residual is never stored. The vectors hold only as many
+//! columns as are solved for (4 for up to 4, else 8), so the thin-part check's 3-column
+//! solve reads half the bytes. Dot products are summed per fixed-size chunk and the chunks
+//! in order, so the result does not depend on the thread schedule.
+
+use faer::sparse::SparseColMat;
+use rayon::prelude::*;
+
+use super::two_level::CgOptions;
+use crate::error::{EmbedError, Progress, Stage, check_cancel};
+use crate::file::MAX_DIM;
+
+type Row = [f64; MAX_DIM];
+
+/// Vertices per chunk of a dot product (the unit of parallel work and of summation order).
+const CHUNK: usize = 4096;
+
+/// The operator of the full system: `A = L M⁻¹ L` restricted to the free rows, and its
+/// Jacobi preconditioner.
+pub(super) struct FreeOperator<'a> {
+    /// Cotangent stiffness `L` (symmetric, both triangles stored).
+    pub stiffness: &'a SparseColMat<usize, f64>,
+    /// `1 / m_i`, the lumped mass inverted.
+    pub inv_mass: &'a [f64],
+    /// Inverse diagonal of `A`; 0 at fixed vertices.
+    pub inv_diag: &'a [f64],
+    /// Whether each vertex is a landmark (fixed row).
+    pub fixed: &'a [bool],
+}
+
+/// Sums per-chunk column sums in chunk order.
+fn sum_chunks<const C: usize>(parts: Vec<[f64; C]>) -> [f64; C] {
+    parts.into_iter().fold([0.0; C], |mut s, t| {
+        for c in 0..C {
+            s[c] += t[c];
+        }
+        s
+    })
+}
+
+impl FreeOperator<'_> {
+    /// `t = M⁻¹ L x`.
+    fn scaled_stiffness<const C: usize>(&self, x: &[[f64; C]], t: &mut [[f64; C]]) {
+        let (sym, vals) = self.stiffness.parts();
+        let rows = sym.row_idx();
+        t.par_iter_mut()
+            .with_min_len(1024)
+            .enumerate()
+            .for_each(|(j, tj)| {
+                let mut acc = [0.0; C];
+                for k in sym.col_range(j) {
+                    let (a, xi) = (vals[k], &x[rows[k]]);
+                    for c in 0..C {
+                        acc[c] += a * xi[c];
+                    }
+                }
+                let w = self.inv_mass[j];
+                *tj = acc.map(|v| v * w);
+            });
+    }
+
+    /// `y = L t` on the free rows, 0 on the fixed ones (so `y = A x` for `t = M⁻¹ L x`),
+    /// and the per-column dot products `p·y`.
+    fn free_stiffness_dot<const C: usize>(
+        &self,
+        t: &[[f64; C]],
+        y: &mut [[f64; C]],
+        p: &[[f64; C]],
+    ) -> [f64; C] {
+        let (sym, vals) = self.stiffness.parts();
+        let rows = sym.row_idx();
+        let parts = y
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(ci, ys)| {
+                let mut s = [0.0; C];
+                for (i, yj) in ys.iter_mut().enumerate() {
+                    let j = ci * CHUNK + i;
+                    if self.fixed[j] {
+                        *yj = [0.0; C];
+                        continue;
+                    }
+                    let mut acc = [0.0; C];
+                    for k in sym.col_range(j) {
+                        let (a, ti) = (vals[k], &t[rows[k]]);
+                        for c in 0..C {
+                            acc[c] += a * ti[c];
+                        }
+                    }
+                    *yj = acc;
+                    for c in 0..C {
+                        s[c] += p[j][c] * acc[c];
+                    }
+                }
+                s
+            })
+            .collect();
+        sum_chunks(parts)
+    }
+
+    /// `y = A x` on the free rows (0 on the fixed ones) and `x·y`, with `t` as scratch.
+    fn apply<const C: usize>(
+        &self,
+        x: &[[f64; C]],
+        t: &mut [[f64; C]],
+        y: &mut [[f64; C]],
+    ) -> [f64; C] {
+        self.scaled_stiffness(x, t);
+        self.free_stiffness_dot(t, y, x)
+    }
+
+    /// Conjugate gradients from the iterate `x` (whose fixed rows hold the landmark values
+    /// and stay unchanged) on the first `dim` columns, until every column's residual norm
+    /// is at most `cg.tolerance` times its right-hand side's or `cg.max_iterations` pass.
+    pub(super) fn solve(
+        &self,
+        landmarks: &[u32],
+        x: &mut [Row],
+        dim: usize,
+        cg: CgOptions,
+        progress: &dyn Progress,
+    ) -> Result<(), EmbedError> {
+        if dim <= 4 {
+            self.solve_width::<4>(landmarks, x, dim, cg, progress)
+        } else {
+            self.solve_width::<MAX_DIM>(landmarks, x, dim, cg, progress)
+        }
+    }
+
+    /// [`Self::solve`] with vectors of `C >= dim` columns.
+    fn solve_width<const C: usize>(
+        &self,
+        landmarks: &[u32],
+        x_out: &mut [Row],
+        dim: usize,
+        cg: CgOptions,
+        progress: &dyn Progress,
+    ) -> Result<(), EmbedError> {
+        let n = x_out.len();
+        let mut x: Vec<[f64; C]> = x_out
+            .par_iter()
+            .map(|v| std::array::from_fn(|c| v[c]))
+            .collect();
+        let mut t = vec![[0.0; C]; n];
+        let mut r = vec![[0.0; C]; n];
+        // Right-hand side norms: b = -(A x_S) on the free rows.
+        let b2 = {
+            let mut xs = vec![[0.0; C]; n];
+            for &s in landmarks {
+                xs[s as usize] = x[s as usize];
+            }
+            self.apply(&xs, &mut t, &mut r);
+            let parts = r
+                .par_chunks(CHUNK)
+                .map(|rs| {
+                    let mut s = [0.0; C];
+                    for ri in rs {
+                        for c in 0..C {
+                            s[c] += ri[c] * ri[c];
+                        }
+                    }
+                    s
+                })
+                .collect();
+            sum_chunks(parts)
+        };
+        // r = b - A_FF x_F = -(A x) on the free rows; p = z = D r.
+        self.apply(&x, &mut t, &mut r);
+        let mut p = vec![[0.0; C]; n];
+        let parts: Vec<([f64; C], [f64; C])> = r
+            .par_chunks_mut(CHUNK)
+            .zip(p.par_chunks_mut(CHUNK))
+            .enumerate()
+            .map(|(ci, (rs, ps))| {
+                let (mut rz, mut rr) = ([0.0; C], [0.0; C]);
+                for (i, (ri, pi)) in rs.iter_mut().zip(ps).enumerate() {
+                    let d = self.inv_diag[ci * CHUNK + i];
+                    for c in 0..C {
+                        ri[c] = -ri[c];
+                        pi[c] = ri[c] * d;
+                        rz[c] += ri[c] * pi[c];
+                        rr[c] += ri[c] * ri[c];
+                    }
+                }
+                (rz, rr)
+            })
+            .collect();
+        let (rz_parts, rr_parts): (Vec<_>, Vec<_>) = parts.into_iter().unzip();
+        let (mut rz, mut r2) = (sum_chunks(rz_parts), sum_chunks(rr_parts));
+        let mut q = vec![[0.0; C]; n];
+        let tol2 = cg.tolerance * cg.tolerance;
+        let mut active: [bool; C] = std::array::from_fn(|c| c < dim && b2[c] > 0.0);
+        for it in 0..cg.max_iterations {
+            for c in 0..C {
+                active[c] &= r2[c] > tol2 * b2[c];
+            }
+            if !active.iter().any(|&a| a) {
+                break;
+            }
+            if it % 16 == 0 {
+                check_cancel(progress)?;
+                progress.report(
+                    Stage::LsMesh,
+                    0.9 + 0.1 * it as f64 / cg.max_iterations as f64,
+                );
+            }
+            let pq = self.apply(&p, &mut t, &mut q);
+            let alpha: [f64; C] = std::array::from_fn(|c| {
+                if active[c] && pq[c] > 0.0 {
+                    rz[c] / pq[c]
+                } else {
+                    0.0
+                }
+            });
+            // x += alpha p, r -= alpha q, and the dot products of the new r with D r and r.
+            let parts: Vec<([f64; C], [f64; C])> = x
+                .par_chunks_mut(CHUNK)
+                .zip(r.par_chunks_mut(CHUNK))
+                .zip(p.par_chunks(CHUNK).zip(q.par_chunks(CHUNK)))
+                .enumerate()
+                .map(|(ci, ((xs, rs), (ps, qs)))| {
+                    let (mut rz, mut rr) = ([0.0; C], [0.0; C]);
+                    for (i, ((xi, ri), (pi, qi))) in
+                        xs.iter_mut().zip(rs).zip(ps.iter().zip(qs)).enumerate()
+                    {
+                        let d = self.inv_diag[ci * CHUNK + i];
+                        for c in 0..C {
+                            xi[c] += alpha[c] * pi[c];
+                            ri[c] -= alpha[c] * qi[c];
+                            rz[c] += ri[c] * ri[c] * d;
+                            rr[c] += ri[c] * ri[c];
+                        }
+                    }
+                    (rz, rr)
+                })
+                .collect();
+            let (rz_parts, rr_parts): (Vec<_>, Vec<_>) = parts.into_iter().unzip();
+            let rz_new = sum_chunks(rz_parts);
+            r2 = sum_chunks(rr_parts);
+            let beta: [f64; C] = std::array::from_fn(|c| {
+                if active[c] && rz[c] > 0.0 {
+                    rz_new[c] / rz[c]
+                } else {
+                    0.0
+                }
+            });
+            rz = rz_new;
+            // p = D r + beta p.
+            p.par_iter_mut()
+                .with_min_len(1024)
+                .zip(&r)
+                .zip(self.inv_diag)
+                .for_each(|((pi, ri), &d)| {
+                    for c in 0..C {
+                        pi[c] = ri[c] * d + beta[c] * pi[c];
+                    }
+                });
+        }
+        x_out
+            .par_iter_mut()
+            .zip(&x)
+            .for_each(|(o, v)| o[..C].copy_from_slice(v));
+        Ok(())
+    }
+}
