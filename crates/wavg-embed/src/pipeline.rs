@@ -48,9 +48,10 @@ pub struct PrecomputeOptions {
     /// Vertex pairs for the quality check; 0 skips it (errors are then NaN).
     pub quality_pairs: usize,
     /// Fast-marching runs the quality pairs are spread over, at most
-    /// `max(8, 16 000 000 / vertices)`: on large meshes fewer runs carry the same number of
-    /// pairs, which bounds the check's cost while the pairs' distances stay exact full-mesh
-    /// geodesics (the default 16 is used in full up to 1M vertices).
+    /// `max(2, 16 000 000 / vertices)`: on large meshes fewer runs carry the same number of
+    /// pairs, so the check visits about 16M vertices whatever the mesh's size (it is a
+    /// check, not an output) while the pairs' distances stay exact full-mesh geodesics.
+    /// The default 16 is used in full up to 1M vertices; 8 at 2M, 5 at 3M, 2 from 8M on.
     pub quality_sources: usize,
     /// Meshes with more vertices than this solve the least-squares mesh in two levels
     /// (a direct solve on the landmark decimation's state with
@@ -103,6 +104,17 @@ fn landmark_aspect_bound(mesh: &ValidMesh, asked: Option<f64>) -> Option<f64> {
 
 /// Vertex visits (sources x vertices) above which the quality check uses fewer sources.
 pub(crate) const QUALITY_SOURCE_VERTICES: usize = 16_000_000;
+
+/// Fewest quality-check sources on large meshes: two regions of the surface rather than one.
+const QUALITY_MIN_SOURCES: usize = 2;
+
+/// Fast-marching runs of the quality check on an `n`-vertex mesh for `asked` sources and
+/// `pairs` pairs ([`PrecomputeOptions::quality_sources`]).
+fn quality_sources(asked: usize, n: usize, pairs: usize) -> usize {
+    asked
+        .min((QUALITY_SOURCE_VERTICES / n.max(1)).max(QUALITY_MIN_SOURCES))
+        .clamp(1, pairs.max(1))
+}
 
 impl Default for PrecomputeOptions {
     fn default() -> Self {
@@ -257,10 +269,7 @@ pub(crate) fn precompute_unscaled(
                 return Ok((None, None, 0.0));
             }
             let fm = FastMarching::new(mesh);
-            let sources = opts
-                .quality_sources
-                .min((QUALITY_SOURCE_VERTICES / n).max(8))
-                .clamp(1, opts.quality_pairs);
+            let sources = quality_sources(opts.quality_sources, n, opts.quality_pairs);
             let qo = QualityOptions {
                 pairs: opts.quality_pairs,
                 sources,
@@ -550,6 +559,20 @@ mod tests {
         let back = crate::file::decode(&bytes, &mesh, std::path::Path::new("x")).unwrap();
         assert_eq!(back.coords, emb.coords);
         (emb, r)
+    }
+
+    /// The quality check's runs: as asked up to 1M vertices, then about 16M vertex visits
+    /// in all, never fewer than two runs.
+    #[test]
+    fn quality_sources_bound_the_check() {
+        assert_eq!(quality_sources(16, 134_345, 1024), 16);
+        assert_eq!(quality_sources(16, 1_000_000, 1024), 16);
+        assert_eq!(quality_sources(16, 2_149_490, 1024), 7);
+        assert_eq!(quality_sources(16, 3_102_914, 1024), 5);
+        assert_eq!(quality_sources(16, 8_597_954, 1024), 2);
+        assert_eq!(quality_sources(16, 40_000_000, 1024), 2);
+        assert_eq!(quality_sources(16, 1000, 4), 4);
+        assert_eq!(quality_sources(32, 100, 1024), 32);
     }
 
     /// The landmark decimation's aspect bound is the one asked for on well-shaped meshes
