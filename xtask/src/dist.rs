@@ -328,9 +328,16 @@ fn check_glibc(lib: &Path) -> Result<(), String> {
 }
 
 /// `cargo package --workspace` (each package verified by building it alone), the `.crate`
-/// files copied to `dist/crates/`.
+/// files copied to `dist/crates/`. The verification builds without debug info: whether a
+/// package builds does not depend on it, and it costs compile and link time.
 fn crates(root: &Path, dist: &Path) -> Result<(), String> {
-    let mut args = vec!["package", "--workspace", "--allow-dirty"];
+    let mut args = vec![
+        "package",
+        "--workspace",
+        "--allow-dirty",
+        "--config",
+        "profile.dev.debug=0",
+    ];
     for name in NOT_PACKAGED {
         args.extend(["--exclude", name]);
     }

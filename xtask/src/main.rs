@@ -193,13 +193,14 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         steps::cargo_workspace_env(root, &["test"], &[], &[(gltf::DIR_VAR, &gltf_dir)])
     }) && log.run(
         &format!(
-            "source policy (files over {} lines, forbid(unsafe_code), module style, the map, one version)",
+            "source policy (files over {} lines, forbid(unsafe_code), module style, one test binary per crate, the map, one version)",
             lines::MAX_LINES
         ),
         || {
             lines::run(root)
                 .and_then(|()| policy::check_unsafe(root))
                 .and_then(|()| policy::check_module_style(root))
+                .and_then(|()| policy::check_test_binaries(root))
                 .and_then(|()| map::check(root))
                 .and_then(|()| version::check(root))
         },

@@ -1,7 +1,8 @@
 //! Source policy checked by `cargo xtask test`: `unsafe` code only in the crates that need
 //! it (SIMD and prefetch hints in `wavg-project`, the C ABI in `wavg-ffi`); every other
 //! crate root says `#![forbid(unsafe_code)]`. One module style: a module with submodules
-//! is `name/mod.rs`, never `name.rs` beside a `name/` folder.
+//! is `name/mod.rs`, never `name.rs` beside a `name/` folder. One integration test binary
+//! per crate: each binary links the whole library again, and cargo runs them one by one.
 
 use std::path::Path;
 
@@ -58,7 +59,7 @@ pub fn check_unsafe(root: &Path) -> Result<(), String> {
 
 /// `Err` names every `name.rs` under [`STYLE_DIRS`] that sits beside a folder `name/`
 /// holding Rust files: the workspace writes such a module as `name/mod.rs` (the style most
-/// of its modules had, and the one `tests/common/mod.rs` needs anyway).
+/// of its modules had).
 pub fn check_module_style(root: &Path) -> Result<(), String> {
     let mut files = Vec::new();
     for dir in STYLE_DIRS {
@@ -86,6 +87,47 @@ pub fn check_module_style(root: &Path) -> Result<(), String> {
                 .map(|f| format!("{f} to {}/mod.rs", f.trim_end_matches(".rs")))
                 .collect::<Vec<_>>()
                 .join(", ")
+        ))
+    }
+}
+
+/// `Err` names every crate under `crates/` (and `python`, `xtask`, `lab`, `fuzz`) with more
+/// than one integration test target (`tests/NAME.rs` or `tests/NAME/main.rs`): its tests
+/// belong in one binary, `tests/NAME/main.rs` with one module per file.
+pub fn check_test_binaries(root: &Path) -> Result<(), String> {
+    let mut dirs: Vec<_> = std::fs::read_dir(root.join("crates"))
+        .map_err(|e| format!("crates: {e}"))?
+        .flatten()
+        .map(|e| e.path())
+        .collect();
+    dirs.extend(["python", "xtask", "lab", "fuzz"].map(|d| root.join(d)));
+    dirs.sort();
+    let mut many = Vec::new();
+    for dir in dirs {
+        let Ok(entries) = std::fs::read_dir(dir.join("tests")) else {
+            continue;
+        };
+        let mut targets: Vec<String> = entries
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| {
+                p.extension().is_some_and(|x| x == "rs") && p.is_file()
+                    || p.join("main.rs").is_file()
+            })
+            .map(|p| p.strip_prefix(root).unwrap_or(&p).display().to_string())
+            .collect();
+        if targets.len() > 1 {
+            targets.sort();
+            many.push(targets.join(", "));
+        }
+    }
+    if many.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "one integration test binary per crate (tests/NAME/main.rs, a module per file); \
+             merge {}",
+            many.join("; ")
         ))
     }
 }
@@ -153,9 +195,34 @@ mod tests {
     }
 
     #[test]
+    fn a_crate_with_two_test_binaries_is_named() {
+        let root = std::env::temp_dir().join(format!("xtask-tests-{}", std::process::id()));
+        let write = |rel: &str| {
+            let p = root.join(rel);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, "//! x\n").unwrap();
+        };
+        write("crates/a/tests/a/main.rs");
+        write("crates/a/tests/a/one.rs");
+        write("crates/a/tests/a/common.rs");
+        write("crates/a/tests/data/mesh.obj");
+        write("crates/b/tests/header.rs");
+        write("crates/c/src/lib.rs");
+        assert_eq!(check_test_binaries(&root), Ok(()));
+        write("crates/a/tests/two.rs");
+        let err = check_test_binaries(&root).unwrap_err();
+        assert!(
+            err.contains("crates/a/tests/a, crates/a/tests/two.rs") && !err.contains("crates/b"),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
     fn this_workspace_follows_the_policy() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
         assert_eq!(check_unsafe(root), Ok(()));
         assert_eq!(check_module_style(root), Ok(()));
+        assert_eq!(check_test_binaries(root), Ok(()));
     }
 }

@@ -154,9 +154,10 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
         .map_err(|e| format!("{e} (pytest exit 5 means no tests ran)"))
 }
 
-/// The `python` code blocks of `README.md` and `docs/`, run by the CLI's `docs_blocks` test
-/// with the environment's interpreter (the package just installed): there a block that
-/// cannot import what it needs fails instead of being skipped.
+/// The `python` code blocks of `README.md` and `docs/`, run by the CLI's test
+/// `docs_blocks::every_code_block` with the environment's interpreter (the package just
+/// installed): there a block that cannot import what it needs fails instead of being
+/// skipped.
 pub fn docs_blocks(root: &Path, data_dir: &Path) -> Result<(), String> {
     let py = python(root);
     let (py_s, data) = (py.to_string_lossy(), data_dir.to_string_lossy());
@@ -169,9 +170,9 @@ pub fn docs_blocks(root: &Path, data_dir: &Path) -> Result<(), String> {
             // --nocapture: the runner's lines naming blocks over 2 s show in the log.
             &[
                 "--test",
-                "docs_blocks",
+                "cli",
                 "--",
-                "every_code_block",
+                "docs_blocks::every_code_block",
                 "--nocapture",
             ],
         ]

@@ -1,6 +1,6 @@
 //! The examples of every command: shown at the end of `wavg COMMAND --help`, and written
 //! into `docs/cli.md` as `sh` blocks, which the docs test runs (in a folder holding the
-//! files they name: `crates/wavg-cli/tests/docs_blocks.rs`).
+//! files they name: `crates/wavg-cli/tests/cli/docs_blocks.rs`).
 
 /// One command's examples: its path below `wavg` (`["bench", "load"]`), the command lines
 /// (`#` comments allowed), and why the docs test must not run them, if it must not.

@@ -52,7 +52,7 @@ between) takes their bilinear interpolation; every other covered texel is solved
 
 Spot onto itself (same anchors) reproduces its texture with a mean colour error of 0.06 (of
 255) over the covered texels, and onto a stretched, bent copy 3.6 (cargo test -p wavg-apps
---test transfer).")]
+--test apps transfer).")]
 pub struct Args {
     #[command(flatten)]
     pub pair: PairArgs,

@@ -1,0 +1,95 @@
+//! Library errors reach the exit status through the CLI's one table: the caller's input
+//! (unreadable or malformed files, bad values) exits 2, a failure that is not the input's
+//! (a file that cannot be written) exits 1; either way one line on stderr.
+
+use crate::common;
+
+use common::wavg;
+
+/// The exit status and stderr of a failed run; stderr must be one line.
+fn failed(args: &[&str]) -> (Option<i32>, String) {
+    let out = wavg(args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    (out.status.code(), err)
+}
+
+#[test]
+fn library_input_errors_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let junk = dir.path().join("junk.wavg");
+    std::fs::write(&junk, b"not an embedding").unwrap();
+    let junk = junk.to_str().unwrap();
+    // A corrupt embedding file (the embedding layer's error).
+    let (code, err) = failed(&[
+        "anchors",
+        "builtin:torus",
+        "--count",
+        "4",
+        "--embedding",
+        junk,
+        "-o",
+        "-",
+    ]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("junk.wavg"), "{err}");
+    // An unknown builtin mesh (the mesh layer's argument error).
+    let (code, err) = failed(&["info", "builtin:no-such-mesh"]);
+    assert_eq!(code, Some(2), "{err}");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_failed_write_exits_1() {
+    if !std::path::Path::new("/dev/full").exists() {
+        eprintln!("skipped: no /dev/full");
+        return;
+    }
+    // An output that exists and is a device is written in place: /dev/full refuses it.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("fixed.obj");
+    std::os::unix::fs::symlink("/dev/full", &out).unwrap();
+    let (code, err) = failed(&["repair", "builtin:torus", "-o", out.to_str().unwrap()]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("fixed.obj") && err.contains("No space"),
+        "{err}"
+    );
+}
+
+/// A precomputation the machine's memory cannot hold is refused before it starts (exit
+/// 1, not the input's fault), with the estimate and the available memory, and nothing is
+/// written; the environment override stands in for a small machine.
+#[test]
+fn a_precomputation_beyond_the_available_memory_is_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.wavg");
+    let run = |available: &str| {
+        common::wavg_command()
+            .env("WAVG_MEMORY_AVAILABLE", available)
+            .args(["precompute", "builtin:torus", "-o", out.to_str().unwrap()])
+            .output()
+            .unwrap()
+    };
+    let t = std::time::Instant::now();
+    let refused = run("1M");
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("needs about") && err.contains("0.00 GB are available"),
+        "{err}"
+    );
+    assert!(err.contains("WAVG_MEMORY_AVAILABLE"), "{err}");
+    assert!(!out.exists());
+    assert!(t.elapsed().as_secs() < 30, "refused up front");
+    // The same with room: computed.
+    let ok = run("64G");
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    assert!(out.exists());
+}

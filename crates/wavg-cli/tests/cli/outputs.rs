@@ -1,0 +1,164 @@
+//! Outputs checked before any work: a missing folder, `--json` with `-o -`, two outputs
+//! that are one file, an output that is an input, and a file type the command cannot
+//! write; each is an input error (status 2) that writes nothing.
+
+use crate::common;
+
+use common::wavg;
+
+fn refused(args: &[&str], words: &str) {
+    let out = wavg(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(stderr.contains(words), "{args:?}: {stderr}");
+    assert!(out.stdout.is_empty(), "{args:?} printed to stdout");
+}
+
+#[test]
+fn bad_outputs_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let mesh = d("m.obj");
+    let torus = wavg(&["subdivide", "builtin:torus", "--levels", "0", "-o", &mesh]);
+    assert!(
+        torus.status.success(),
+        "{}",
+        String::from_utf8_lossy(&torus.stderr)
+    );
+    let before = std::fs::read(&mesh).unwrap();
+    let control = d("c.txt");
+    std::fs::write(&control, "v 0\nv 300\nv 600\nv 900\n").unwrap();
+    refused(
+        &["subdivide", &mesh, "-o", &d("nodir/x.obj")],
+        "does not exist",
+    );
+    let spline = |out: &str| {
+        let args = [
+            "spline",
+            &mesh,
+            "--embedding",
+            "none",
+            "--control",
+            &control,
+            "-o",
+            out,
+        ];
+        args.map(str::to_owned).to_vec()
+    };
+    let mut json = spline("-");
+    json.push("--json".into());
+    refused(
+        &json.iter().map(String::as_str).collect::<Vec<_>>(),
+        "--json",
+    );
+    refused(
+        &["repair", &mesh, "-o", &d("r.obj"), "--map", &d("r.obj")],
+        "name the same file",
+    );
+    refused(&["subdivide", &mesh, "-o", &mesh], "is an input");
+    refused(
+        &[
+            "precompute",
+            &mesh,
+            "-o",
+            &d("m.wavg"),
+            "--repaired-mesh",
+            &mesh,
+        ],
+        "is an input",
+    );
+    refused(
+        &spline(&control)
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+        "is an input",
+    );
+    refused(
+        &[
+            "decal",
+            &mesh,
+            "--embedding",
+            "none",
+            "--anchors",
+            &control,
+            "--uv",
+            &control,
+            "-o",
+            &d("t.off"),
+        ],
+        "ending in .obj",
+    );
+    assert_eq!(
+        std::fs::read(&mesh).unwrap(),
+        before,
+        "the input mesh changed"
+    );
+    assert!(!dir.path().join("r.obj").exists() && !dir.path().join("m.wavg").exists());
+}
+
+/// Outputs that name an input another way: a file not yet written under two spellings,
+/// the anchors or the embedding, a hard link, a folder; a symbolic link is written
+/// through, never replaced.
+#[test]
+fn outputs_named_another_way() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let mesh = d("m.obj");
+    let torus = wavg(&["subdivide", "builtin:torus", "--levels", "0", "-o", &mesh]);
+    assert!(torus.status.success());
+    let anchors = d("a.txt");
+    std::fs::write(&anchors, "v 0\nv 300\nv 600\n").unwrap();
+    let weights = d("w.txt");
+    std::fs::write(&weights, "0.2 0.3 0.5\n").unwrap();
+    let forward = |out: &str| {
+        wavg(&[
+            "forward",
+            &mesh,
+            "--embedding",
+            "none",
+            "--anchors",
+            &anchors,
+            "--weights",
+            &weights,
+            "-o",
+            out,
+        ])
+    };
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let twice = format!("{}/../r.obj", sub.display());
+    refused(
+        &["repair", &mesh, "-o", &d("r.obj"), "--map", &twice],
+        "name the same file",
+    );
+    for out in [anchors.clone(), d("sub")] {
+        let r = forward(&out);
+        assert_eq!(
+            r.status.code(),
+            Some(2),
+            "{out}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+    }
+    #[cfg(unix)]
+    {
+        let hard = d("hard.txt");
+        std::fs::hard_link(&weights, &hard).unwrap();
+        assert_eq!(forward(&hard).status.code(), Some(2));
+        let (target, link) = (d("t.txt"), d("link.txt"));
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        assert!(forward(&link).status.success());
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read_to_string(&target).unwrap().lines().count(), 1);
+    }
+    assert_eq!(
+        std::fs::read_to_string(&anchors).unwrap(),
+        "v 0\nv 300\nv 600\n"
+    );
+}

@@ -1,0 +1,11 @@
+//! The integration tests of `wavg-solve` as one test binary: each file here is a module
+//! (a test's name is `FILE::TEST`), so the library is linked once for all of them
+//! and their tests run in parallel with one another.
+
+mod aimed;
+mod common;
+mod every_vertex;
+mod kernel;
+mod solver;
+mod start;
+mod verified;
