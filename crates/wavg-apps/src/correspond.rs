@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use wavg_mesh::{SurfacePoint, ValidMesh};
 use wavg_solve::{BatchWeights, ForwardOptions, ForwardResult, Par, RoundTrip, SolveError, Solver};
 
-use crate::metrics::{Distortion, distortion};
+use crate::metrics::{Distortion, distortion, flipped_faces};
 
 /// Round-trip tolerance of the paper's weights, in mean edge lengths of the source.
 pub const ROUND_TRIP_TOLERANCE: f64 = 1e-3;
@@ -357,13 +357,14 @@ pub fn correspond_vertices(
             Ok(_) => Validity::Valid,
         })
         .collect();
-    let normals = mapped_normals(mesh, target.mesh(), &mapped);
+    let target_normals = vertex_normals(target.mesh());
+    let normals = mapped_normals(mesh, target.mesh(), &mapped, &target_normals);
     if opts.test == ValidityTest::Local {
         let answered: Vec<Option<Vector3<f64>>> = mapped
             .iter()
             .map(|m| m.target.as_ref().ok().map(|t| t.position))
             .collect();
-        let smooth = smooth_normals(mesh, target.mesh(), &mapped, &normals);
+        let smooth = smooth_normals(mesh, target.mesh(), &mapped, &normals, &target_normals);
         let inconsistent = inconsistent_vertices(mesh, &answered, &smooth, opts.max_stretch);
         for (v, bad) in validity.iter_mut().zip(inconsistent) {
             if bad && *v == Validity::Valid {
@@ -404,7 +405,7 @@ pub fn inconsistent_vertices(
     max_stretch: f64,
 ) -> Vec<bool> {
     let topo = mesh.topology();
-    let flipped = distortion(&mesh.positions, &mesh.triangles, answered, normals).flipped;
+    let flipped = flipped_faces(&mesh.positions, &mesh.triangles, answered, normals);
     let ratio = |a: u32, b: u32| -> Option<f64> {
         let (pa, pb) = (
             answered.get(a as usize)?.as_ref()?,
@@ -467,14 +468,15 @@ pub fn vertex_points(mesh: &ValidMesh) -> Vec<SurfacePoint> {
 }
 
 /// Per source face: the target's normal where its corners land (the sum of the target's
-/// area-weighted vertex normals interpolated at the three images, which is smooth across
-/// the target's edges, unlike face normals at creases), `None` when a corner has no image.
+/// area-weighted vertex normals `normals` interpolated at the three images, which is smooth
+/// across the target's edges, unlike face normals at creases), `None` when a corner has no
+/// image.
 fn mapped_normals(
     source: &ValidMesh,
     target: &ValidMesh,
     mapped: &[Mapped],
+    normals: &[Vector3<f64>],
 ) -> Vec<Option<Vector3<f64>>> {
-    let normals = vertex_normals(target);
     source
         .triangles
         .par_iter()
@@ -482,7 +484,7 @@ fn mapped_normals(
             let mut n = Vector3::zeros();
             for &v in t {
                 let p = mapped.get(v as usize)?.target.as_ref().ok()?.point;
-                n += p.interpolate(target, &normals);
+                n += p.interpolate(target, normals);
             }
             Some(n)
         })
@@ -490,7 +492,8 @@ fn mapped_normals(
 }
 
 /// `normals` where the target is smooth at the scale of its edges around the three images
-/// (their interpolated vertex normals within [`SMOOTH_DEGREES`] of their sum), `None`
+/// (their interpolated vertex normals, from the target's `vn`, within [`SMOOTH_DEGREES`]
+/// of their sum), `None`
 /// elsewhere: on thin parts (fingers) an image a fraction of an edge off flips triangles
 /// while landing close to the truth, so flips there are no evidence of a wrong image.
 fn smooth_normals(
@@ -498,8 +501,8 @@ fn smooth_normals(
     target: &ValidMesh,
     mapped: &[Mapped],
     normals: &[Option<Vector3<f64>>],
+    vn: &[Vector3<f64>],
 ) -> Vec<Option<Vector3<f64>>> {
-    let vn = vertex_normals(target);
     let min_cos = SMOOTH_DEGREES.to_radians().cos();
     source
         .triangles
@@ -509,7 +512,7 @@ fn smooth_normals(
             let sum = (*n)?.normalize();
             for &v in t {
                 let p = mapped.get(v as usize)?.target.as_ref().ok()?.point;
-                let c = p.interpolate(target, &vn).normalize();
+                let c = p.interpolate(target, vn).normalize();
                 let cos = c.dot(&sum);
                 if cos.is_nan() || cos < min_cos {
                     return None;
@@ -653,7 +656,7 @@ mod tests {
             .iter()
             .map(|m| m.target.as_ref().ok().map(|t| t.position))
             .collect();
-        let normals = mapped_normals(mesh, mesh, &c.mapped);
+        let normals = mapped_normals(mesh, mesh, &c.mapped, &vertex_normals(mesh));
         let before = inconsistent_vertices(mesh, &answered, &normals, 4.0);
         assert!(before.iter().all(|b| !b));
         // Send vertex 1000's image to the far side of the sphere.

@@ -18,6 +18,7 @@
 //! left out of the stretch, which would otherwise be infinite or meaningless there.
 
 use nalgebra::Vector3;
+use rayon::prelude::*;
 
 /// Distortion of a map (see the module docs). With the `serde` feature it serialises its
 /// totals (not the per-face vectors) to the keys of `wavg correspond --json`, the stretches
@@ -122,47 +123,30 @@ pub fn distortion(
     mapped: &[Option<Vector3<f64>>],
     reference_normal: &[Option<Vector3<f64>>],
 ) -> Distortion {
+    let judged: Vec<Face> = (0..triangles.len())
+        .into_par_iter()
+        .with_min_len(FACE_CHUNK)
+        .map(|f| judge_face(positions, triangles, mapped, reference_normal, f))
+        .collect();
     let nf = triangles.len();
     let mut flipped = vec![false; nf];
     let mut per: Vec<Option<FaceStretch>> = vec![None; nf];
     let (mut measured, mut area_measured, mut area_flipped) = (0usize, 0.0f64, 0.0f64);
-    for (f, t) in triangles.iter().enumerate() {
-        let get = |k: usize| positions.get(t[k] as usize).copied();
-        let map = |k: usize| mapped.get(t[k] as usize).copied().flatten();
-        let (Some(p0), Some(p1), Some(p2)) = (get(0), get(1), get(2)) else {
-            continue;
-        };
-        let (Some(q0), Some(q1), Some(q2)) = (map(0), map(1), map(2)) else {
-            continue;
-        };
-        let area = (p1 - p0).cross(&(p2 - p0)).norm() / 2.0;
-        if !(area > 0.0 && area.is_finite()) {
-            continue;
-        }
-        measured += 1;
-        area_measured += area;
-        let n = (q1 - q0).cross(&(q2 - q0));
-        let mapped_area = n.norm() / 2.0;
-        let reversed = reference_normal
-            .get(f)
-            .copied()
-            .flatten()
-            .is_some_and(|r| n.dot(&r) <= 0.0);
-        let sv = singular_values([p0, p1, p2], [q0, q1, q2]);
-        match sv {
-            Some((big, small)) if !reversed && small > 0.0 && mapped_area > 0.0 => {
-                per[f] = Some(FaceStretch {
-                    area,
-                    mapped_area,
-                    forward_sq: (big * big + small * small) / 2.0,
-                    inverse_sq: (1.0 / (big * big) + 1.0 / (small * small)) / 2.0,
-                });
-            }
-            _ => {
+    // Sums in face order, as one loop would: the totals do not depend on the threads.
+    for (f, j) in judged.into_iter().enumerate() {
+        match j {
+            Face::Unmeasured => continue,
+            Face::Flipped(area) => {
                 flipped[f] = true;
                 area_flipped += area;
+                area_measured += area;
+            }
+            Face::Stretch(s) => {
+                per[f] = Some(s);
+                area_measured += s.area;
             }
         }
+        measured += 1;
     }
     let ok: Vec<FaceStretch> = per.iter().flatten().copied().collect();
     let (stretch, scale) = symmetric(&ok);
@@ -186,6 +170,82 @@ pub fn distortion(
         stretch,
         stretch_best95: symmetric(&best).0,
     }
+}
+
+/// Faces one parallel task judges.
+const FACE_CHUNK: usize = 1024;
+
+/// One face of a map.
+#[derive(Clone, Copy)]
+enum Face {
+    /// A corner is missing or not mapped, or the source face has no area.
+    Unmeasured,
+    /// Flipped (see the module docs), with its source area.
+    Flipped(f64),
+    /// Measured unflipped.
+    Stretch(FaceStretch),
+}
+
+/// Judges face `f` of the map (arguments as [`distortion`]'s).
+#[inline]
+fn judge_face(
+    positions: &[Vector3<f64>],
+    triangles: &[[u32; 3]],
+    mapped: &[Option<Vector3<f64>>],
+    reference_normal: &[Option<Vector3<f64>>],
+    f: usize,
+) -> Face {
+    let t = &triangles[f];
+    let get = |k: usize| positions.get(t[k] as usize).copied();
+    let map = |k: usize| mapped.get(t[k] as usize).copied().flatten();
+    let (Some(p0), Some(p1), Some(p2)) = (get(0), get(1), get(2)) else {
+        return Face::Unmeasured;
+    };
+    let (Some(q0), Some(q1), Some(q2)) = (map(0), map(1), map(2)) else {
+        return Face::Unmeasured;
+    };
+    let area = (p1 - p0).cross(&(p2 - p0)).norm() / 2.0;
+    if !(area > 0.0 && area.is_finite()) {
+        return Face::Unmeasured;
+    }
+    let n = (q1 - q0).cross(&(q2 - q0));
+    let mapped_area = n.norm() / 2.0;
+    let reversed = reference_normal
+        .get(f)
+        .copied()
+        .flatten()
+        .is_some_and(|r| n.dot(&r) <= 0.0);
+    match singular_values([p0, p1, p2], [q0, q1, q2]) {
+        Some((big, small)) if !reversed && small > 0.0 && mapped_area > 0.0 => {
+            Face::Stretch(FaceStretch {
+                area,
+                mapped_area,
+                forward_sq: (big * big + small * small) / 2.0,
+                inverse_sq: (1.0 / (big * big) + 1.0 / (small * small)) / 2.0,
+            })
+        }
+        _ => Face::Flipped(area),
+    }
+}
+
+/// Per face, whether the map flips it: [`Distortion::flipped`] of [`distortion`] with the
+/// same arguments, without the stretch.
+pub(crate) fn flipped_faces(
+    positions: &[Vector3<f64>],
+    triangles: &[[u32; 3]],
+    mapped: &[Option<Vector3<f64>>],
+    reference_normal: &[Option<Vector3<f64>>],
+) -> Vec<bool> {
+    (0..triangles.len())
+        .into_par_iter()
+        .with_min_len(FACE_CHUNK)
+        .map(|f| {
+            matches!(
+                judge_face(positions, triangles, mapped, reference_normal, f),
+                Face::Flipped(_)
+            )
+        })
+        .collect()
 }
 
 /// The symmetrised stretch of a set of faces and the global scale
@@ -291,6 +351,41 @@ mod tests {
     }
 
     proptest! {
+        /// The flips alone are the full distortion's, on random maps of a sphere (some
+        /// corners unmapped, some reference normals missing or reversed, images scattered
+        /// so that faces fold and collapse).
+        #[test]
+        fn flipped_faces_are_the_distortions(seed in any::<u64>(), spread in 0.0f64..0.3) {
+            use rand::{Rng, SeedableRng};
+            let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let mesh = procedural::icosphere(2);
+            let q: Vec<_> = mesh
+                .positions
+                .iter()
+                .map(|&p| {
+                    let jitter = Vector3::new(r.random(), r.random(), r.random()) * spread;
+                    // One vertex in 20 unmapped; one in 20 collapsed onto the origin.
+                    match r.random_range(0..20) {
+                        0 => None,
+                        1 => Some(Vector3::zeros()),
+                        _ => Some(p + jitter),
+                    }
+                })
+                .collect();
+            let reference: Vec<_> = normals(&mesh, 1.0)
+                .into_iter()
+                .map(|n| match r.random_range(0..10) {
+                    0 => None,
+                    1 => n.map(|n| -n),
+                    _ => n,
+                })
+                .collect();
+            let d = distortion(&mesh.positions, &mesh.triangles, &q, &reference);
+            let f = flipped_faces(&mesh.positions, &mesh.triangles, &q, &reference);
+            prop_assert_eq!(&f, &d.flipped);
+            prop_assert!(f.iter().any(|&x| x));
+        }
+
         /// Scaling by `s` along one axis of a planar grid: both directions measure
         /// `sqrt((1 + s^2) / (2 s))` (singular values `s` and 1 on every face).
         #[test]
