@@ -241,6 +241,7 @@ impl Projector {
             faces,
             bvh,
             cones: std::sync::OnceLock::new(),
+            unfiltered: std::sync::atomic::AtomicUsize::new(0),
             mesh_mean_edge: std::sync::OnceLock::new(),
             reach,
             walk_origin,

@@ -82,8 +82,11 @@ pub struct Projector {
     frame_kinds: [usize; 4],
     faces: Vec<Face>,
     bvh: Bvh,
-    /// Built on first use: most workloads' searches end before they would ask.
+    /// Built when the global searches need them (see `cone::keep_filter`): most
+    /// workloads' searches end before they would.
     cones: std::sync::OnceLock<Cones>,
+    /// Nodes the global searches popped before the cone bounds were built.
+    unfiltered: std::sync::atomic::AtomicUsize,
     /// Mean 3-D edge length of the mesh, computed on first use.
     mesh_mean_edge: std::sync::OnceLock<f64>,
     /// Per-vertex reach, filled on first use.
@@ -142,6 +145,14 @@ impl Projector {
     fn cones(&self) -> &Cones {
         self.cones
             .get_or_init(|| Cones::new(&self.bvh, &self.faces, &self.verts))
+    }
+
+    /// Counts one node a global search popped without cone bounds (they are not built);
+    /// whether the projector's searches have popped at most as many as the hierarchy has
+    /// nodes so (see [`cone::keep_filter`]).
+    fn count_unfiltered(&self) -> bool {
+        use std::sync::atomic::Ordering::Relaxed;
+        self.unfiltered.fetch_add(1, Relaxed) < self.bvh.n_nodes()
     }
 
     fn face_frames(&self, f: FaceId) -> [&Frame32; 3] {
