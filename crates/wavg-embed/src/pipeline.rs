@@ -11,6 +11,7 @@ use crate::geodesic::{FastMarching, GeodesicOptions, landmark_distances};
 use crate::lsmesh::LsMeshSolver;
 use crate::lsmesh::two_level::{CgOptions, LsMeshExtension, TwoLevelLsMesh};
 use crate::mds::{MdsOptions, metric_mds};
+use crate::memtrace::mark;
 use crate::quality::{QualityOptions, QualityPairs};
 use crate::thin;
 use crate::{Embedding, EmbeddingParams};
@@ -224,6 +225,7 @@ pub(crate) fn precompute_unscaled(
             "embedding dimension {dim} not in 1..={MAX_DIM}"
         )));
     }
+    mark("before the precomputation");
     let mut stages = StageSeconds::default();
     let secs = |t: Instant| t.elapsed().as_secs_f64();
     // 1. Landmarks (and, for large meshes, intermediate meshes for the geodesics and the
@@ -280,7 +282,18 @@ pub(crate) fn precompute_unscaled(
         },
     );
     let mut selected = landmark_result?;
-    let (mut fm, quality_pairs, t_quality) = quality_result?;
+    let (fm, quality_pairs, t_quality) = quality_result?;
+    // The full mesh's fast marching (about 400 bytes a vertex) is kept only where the
+    // landmark geodesics use it: with an intermediate mesh whose close pairs are refined on
+    // the least-squares mesh's coarse level, they never do (`landmark_distances` builds one
+    // itself should a later round need it).
+    let needs_fine = selected.1.is_none() || (opts.refine_near_pairs && selected.2.is_none());
+    let fm = match fm {
+        Some(fm) if needs_fine => Some(fm),
+        _ if needs_fine => Some(FastMarching::new(mesh)),
+        _ => None,
+    };
+    mark("decimation + quality geodesics");
     stages.quality = t_quality;
     check_cancel(progress)?;
 
@@ -290,10 +303,12 @@ pub(crate) fn precompute_unscaled(
     //    the landmarks leave a thin part uncovered (see `thin`), the landmarks so far are
     //    locked, more are added, and steps 1 and 2 run again (at most `THIN_PART_ROUNDS`
     //    times, adding at most as many landmarks as asked for in all).
-    let fine = fm.get_or_insert_with(|| FastMarching::new(mesh));
     let geodesics = |landmarks: &[u32], coarse: Option<&Decimated>, mid: Option<&Decimated>| {
         let t = Instant::now();
-        let mut geo = GeodesicOptions::new().fast_marching(fine);
+        let mut geo = GeodesicOptions::new();
+        if let Some(fine) = &fm {
+            geo = geo.fast_marching(fine);
+        }
         if let Some(c) = coarse {
             // All pairs on the intermediate mesh, close pairs corrected on the full mesh.
             geo = geo.coarse_mesh(c).refine_near_pairs(opts.refine_near_pairs);
@@ -339,6 +354,11 @@ pub(crate) fn precompute_unscaled(
         };
         let (solver, t_factor) = solver;
         stages.lsmesh += t_factor;
+        mark(if round == 0 {
+            "geodesics + lsmesh factorisation"
+        } else {
+            "thin parts: lsmesh factorisation"
+        });
         check_cancel(progress)?;
         let more = if opts.cover_thin_parts && round < THIN_PART_ROUNDS {
             let t = Instant::now();
@@ -371,6 +391,7 @@ pub(crate) fn precompute_unscaled(
             Some(next) => {
                 drop((q, solver, coarse, ls_coarse));
                 selected = next?;
+                mark("thin parts: decimation");
             }
             None => break (landmarks, q, solver, coarse, ls_coarse),
         }
@@ -389,18 +410,21 @@ pub(crate) fn precompute_unscaled(
     let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
     drop((coarse, ls_coarse));
     drop(fm);
+    mark("landmark geodesics (if redone)");
 
     // 3. MDS of the landmarks.
     let t = Instant::now();
     let mds = metric_mds(&q, landmarks.len(), &opts.mds, progress)?;
     drop(q);
     stages.mds = secs(t);
+    mark("mds");
     check_cancel(progress)?;
 
     // 4. Least-squares mesh: the landmarks' MDS positions extended to every vertex.
     let t = Instant::now();
     let coords = solver.solve(&mds.points, dim, progress)?;
     drop(solver);
+    mark("lsmesh solve");
     progress.report(Stage::LsMesh, 1.0);
     stages.lsmesh += secs(t);
     check_cancel(progress)?;
@@ -415,6 +439,7 @@ pub(crate) fn precompute_unscaled(
         progress.report(Stage::Quality, 1.0);
     }
     stages.quality += secs(t);
+    mark("quality evaluation");
 
     let (p50, p90) = quality
         .as_ref()

@@ -232,7 +232,7 @@ pub fn decimate_with_snapshots(
     if opts.first_pass_vertices > 0 && n > 2 * keep {
         check_cancel(progress)?;
         progress.report(Stage::Decimate, 0.0);
-        if let Some(r) = first_pass::first_pass(mesh, keep, &opts.locked) {
+        if let Some(r) = first_pass::first_pass(mesh, keep, &opts.locked, progress)? {
             let lift = |d: Decimated| Decimated {
                 landmarks: d
                     .landmarks
