@@ -105,16 +105,22 @@ impl Surface {
         if let Some(e) = &embedding {
             require_file(e)?;
         }
-        let (mut inner, notes) = py
+        // With an embedding, the surface is built once, on it: no projector of the 3-D
+        // positions is built first and then replaced (at 10M vertices, gigabytes).
+        let (inner, notes) = py
             .detach_run(|| {
                 let (mesh, notes) = wavg::mesh::io::load_with_notes(&path)?;
-                wavg::Surface::from_mesh(mesh).map(|s| (s, notes))
+                let surface = match &embedding {
+                    None => wavg::Surface::from_mesh(mesh)?,
+                    Some(e) => {
+                        let mesh = wavg::ValidMesh::new(mesh)?;
+                        let emb = wavg::embed::file::load(e, &mesh)?;
+                        wavg::Surface::from_valid_with_embedding(mesh, emb)?
+                    }
+                };
+                Ok::<_, wavg::Error>((surface, notes))
             })
             .map_err(|e| to_py(py, e))?;
-        if let Some(e) = embedding {
-            py.detach_run(|| inner.load_embedding(&e))
-                .map_err(|e| to_py(py, e))?;
-        }
         Ok(Self {
             inner,
             polygons: std::sync::Arc::new(notes.polygon_of),

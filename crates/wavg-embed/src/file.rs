@@ -3,7 +3,7 @@
 //!
 #![doc = include_str!("../FORMAT.md")]
 
-use std::io::Read;
+use std::io::{Read, Write};
 use std::path::Path;
 
 use wavg_mesh::TriMesh;
@@ -71,25 +71,33 @@ fn file_len(n_vertices: u64, dim: u64, n_landmarks: u64) -> Option<u64> {
         .checked_add(8)
 }
 
-/// Serialises `emb` for `mesh` into the version-1 byte layout.
-///
-/// Errors if the embedding does not satisfy [`Embedding::validate`] for this mesh.
-pub fn encode(emb: &Embedding, mesh: &TriMesh) -> Result<Vec<u8>, EmbedError> {
+/// Rows of coordinates converted and checksummed per block when writing or reading (1 MiB
+/// at 8 dimensions): the file is streamed, never held in memory beside the embedding.
+const BLOCK_ROWS: usize = 1 << 14;
+
+/// Checks `emb` against `mesh` and returns the exact file length.
+fn checked_len(emb: &Embedding, mesh: &TriMesh) -> Result<usize, EmbedError> {
     emb.validate(mesh.n_vertices())
         .map_err(|m| EmbedError::InvalidArgument(format!("cannot save embedding: {m}")))?;
-    let n = mesh.n_vertices() as u64;
-    let k = emb.landmarks.len() as u64;
-    let len = file_len(n, emb.dim as u64, k)
-        .and_then(|l| usize::try_from(l).ok())
-        .ok_or_else(|| EmbedError::InvalidArgument("embedding too large".into()))?;
-    let mut b = Vec::with_capacity(len);
+    file_len(
+        mesh.n_vertices() as u64,
+        emb.dim as u64,
+        emb.landmarks.len() as u64,
+    )
+    .and_then(|l| usize::try_from(l).ok())
+    .ok_or_else(|| EmbedError::InvalidArgument("embedding too large".into()))
+}
+
+/// The fixed header of `emb` for `mesh`.
+fn header(emb: &Embedding, mesh: &TriMesh) -> Vec<u8> {
+    let mut b = Vec::with_capacity(HEADER_LEN);
     b.extend_from_slice(&MAGIC);
     b.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
     b.extend_from_slice(&(emb.dim as u32).to_le_bytes());
-    b.extend_from_slice(&n.to_le_bytes());
+    b.extend_from_slice(&(mesh.n_vertices() as u64).to_le_bytes());
     b.extend_from_slice(&(mesh.n_faces() as u64).to_le_bytes());
     b.extend_from_slice(&mesh_hash(mesh).to_le_bytes());
-    b.extend_from_slice(&k.to_le_bytes());
+    b.extend_from_slice(&(emb.landmarks.len() as u64).to_le_bytes());
     let p = &emb.params;
     b.extend_from_slice(&p.landmarks_requested.to_le_bytes());
     b.extend_from_slice(&p.seed.to_le_bytes());
@@ -101,19 +109,44 @@ pub fn encode(emb: &Embedding, mesh: &TriMesh) -> Result<Vec<u8>, EmbedError> {
     b.extend_from_slice(&emb.geodesic_rel_err_p90.to_le_bytes());
     b.extend_from_slice(&[0u8; 16]);
     debug_assert_eq!(b.len(), HEADER_LEN);
-    for c in &emb.coords {
-        for x in &c[..emb.dim] {
-            b.extend_from_slice(&x.to_le_bytes());
-        }
+    b
+}
+
+/// Writes the version-1 bytes of `emb` (already checked by [`checked_len`]) to `w`, a
+/// block at a time, with the running checksum.
+fn write_embedding(emb: &Embedding, mesh: &TriMesh, w: &mut dyn Write) -> std::io::Result<()> {
+    let head = header(emb, mesh);
+    let mut sum = fnv1a64(FNV_OFFSET, &head);
+    w.write_all(&head)?;
+    let mut buf = Vec::with_capacity(BLOCK_ROWS * emb.dim * 8);
+    for block in emb.coords.chunks(BLOCK_ROWS) {
+        buf.clear();
+        buf.extend(
+            block
+                .iter()
+                .flat_map(|c| &c[..emb.dim])
+                .flat_map(|x| x.to_le_bytes()),
+        );
+        sum = fnv1a64(sum, &buf);
+        w.write_all(&buf)?;
     }
-    for l in &emb.landmarks {
-        b.extend_from_slice(&l.to_le_bytes());
+    buf.clear();
+    buf.extend(emb.landmarks.iter().flat_map(|l| l.to_le_bytes()));
+    if emb.landmarks.len() % 2 == 1 {
+        buf.extend_from_slice(&[0u8; 4]);
     }
-    if k % 2 == 1 {
-        b.extend_from_slice(&[0u8; 4]);
-    }
-    let sum = fnv1a64(FNV_OFFSET, &b);
-    b.extend_from_slice(&sum.to_le_bytes());
+    sum = fnv1a64(sum, &buf);
+    w.write_all(&buf)?;
+    w.write_all(&sum.to_le_bytes())
+}
+
+/// Serialises `emb` for `mesh` into the version-1 byte layout.
+///
+/// Errors if the embedding does not satisfy [`Embedding::validate`] for this mesh.
+pub fn encode(emb: &Embedding, mesh: &TriMesh) -> Result<Vec<u8>, EmbedError> {
+    let len = checked_len(emb, mesh)?;
+    let mut b = Vec::with_capacity(len);
+    write_embedding(emb, mesh, &mut b).map_err(|e| EmbedError::Numerical(e.to_string()))?;
     debug_assert_eq!(b.len(), len);
     Ok(b)
 }
@@ -234,29 +267,127 @@ fn parse_header(head: &[u8], total: u64) -> Result<Header, Fault> {
     })
 }
 
-/// Parses and fully checks a `.wavg` image held in memory against `mesh`.
-fn decode_inner(b: &[u8], mesh: &TriMesh) -> Result<Embedding, Fault> {
-    let h = parse_header(&b[..b.len().min(HEADER_LEN)], b.len() as u64)?;
-    let body = b.len() - 8;
-    let stored = u64::from_le_bytes(b[body..].try_into().expect("8 bytes"));
-    if fnv1a64(FNV_OFFSET, &b[..body]) != stored {
-        return Err(Fault::Bad("corrupt: checksum mismatch".into()));
+/// Why reading a `.wavg` stream failed: its content, or the reading itself.
+enum ReadFault {
+    Fault(Fault),
+    Io(std::io::Error),
+}
+
+impl From<Fault> for ReadFault {
+    fn from(f: Fault) -> Self {
+        Self::Fault(f)
     }
-    if h.n_vertices != mesh.n_vertices() as u64 || h.n_faces != mesh.n_faces() as u64 {
+}
+
+impl From<std::io::Error> for ReadFault {
+    fn from(e: std::io::Error) -> Self {
+        Self::Io(e)
+    }
+}
+
+/// Reads into `buf` until it is full or the stream ends; the bytes read.
+fn read_up_to(r: &mut dyn Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut got = 0;
+    while got < buf.len() {
+        match r.read(&mut buf[got..]) {
+            Ok(0) => break,
+            Ok(k) => got += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(got)
+}
+
+/// The body of a `.wavg` stream after its header: checksum over everything before the
+/// stored one, that stored checksum, the coordinates (only when the vertex count is the
+/// mesh's; otherwise the file is refused anyway) and the landmark bytes with padding.
+struct Body {
+    sum: u64,
+    stored: u64,
+    coords: Vec<[f64; MAX_DIM]>,
+    tail: Vec<u8>,
+}
+
+/// Reads the body announced by `h` a block at a time, checksumming as it goes.
+fn read_body(
+    r: &mut (dyn Read + Send),
+    head: &[u8],
+    h: &Header,
+    keep: bool,
+) -> std::io::Result<Body> {
+    let dim = h.dim as usize;
+    let mut sum = fnv1a64(FNV_OFFSET, head);
+    let mut coords = Vec::new();
+    if keep {
+        coords.reserve_exact(h.n_vertices as usize);
+    }
+    let mut buf = vec![0u8; BLOCK_ROWS * dim * 8];
+    let mut left = h.n_vertices;
+    while left > 0 {
+        let rows = left.min(BLOCK_ROWS as u64) as usize;
+        let block = &mut buf[..rows * dim * 8];
+        r.read_exact(block)?;
+        sum = fnv1a64(sum, block);
+        if keep {
+            coords.extend(block.chunks_exact(dim * 8).map(|row| {
+                let mut c = [0.0; MAX_DIM];
+                for (x, b) in c.iter_mut().zip(row.chunks_exact(8)) {
+                    *x = f64::from_le_bytes(b.try_into().unwrap_or_default());
+                }
+                c
+            }));
+        }
+        left -= rows as u64;
+    }
+    let k = h.n_landmarks as usize;
+    let mut tail = vec![0u8; k * 4 + if k % 2 == 1 { 4 } else { 0 }];
+    r.read_exact(&mut tail)?;
+    sum = fnv1a64(sum, &tail);
+    let mut stored = [0u8; 8];
+    r.read_exact(&mut stored)?;
+    Ok(Body {
+        sum,
+        stored: u64::from_le_bytes(stored),
+        coords,
+        tail,
+    })
+}
+
+/// Reads and fully checks a `.wavg` stream of `total` bytes against `mesh`. The mesh's
+/// fingerprint is computed beside the reading (both are byte-serial checksums).
+fn read_embedding(
+    r: &mut (dyn Read + Send),
+    total: u64,
+    mesh: &TriMesh,
+) -> Result<Embedding, ReadFault> {
+    let mut head = [0u8; HEADER_LEN];
+    let got = read_up_to(r, &mut head)?;
+    let head = &head[..got];
+    let h = parse_header(head, total)?;
+    let keep = h.n_vertices == mesh.n_vertices() as u64;
+    let (fingerprint, body) = rayon::join(|| mesh_hash(mesh), || read_body(r, head, &h, keep));
+    let body = body?;
+    if body.sum != body.stored {
+        return Err(Fault::Bad("corrupt: checksum mismatch".into()).into());
+    }
+    if !keep || h.n_faces != mesh.n_faces() as u64 {
         return Err(Fault::Mesh(format!(
             "file is for {} vertices / {} faces, mesh has {} / {}",
             h.n_vertices,
             h.n_faces,
             mesh.n_vertices(),
             mesh.n_faces()
-        )));
+        ))
+        .into());
     }
-    if h.hash != mesh_hash(mesh) {
+    if h.hash != fingerprint {
         return Err(Fault::Mesh(
             "same counts but different positions or faces (fingerprint mismatch)".into(),
-        ));
+        )
+        .into());
     }
-    let mut r = Reader { b, at: 48 };
+    let mut r = Reader { b: head, at: 48 };
     let params = EmbeddingParams {
         landmarks_requested: r.u64(),
         seed: r.u64(),
@@ -267,41 +398,37 @@ fn decode_inner(b: &[u8], mesh: &TriMesh) -> Result<Embedding, Fault> {
     let stress = r.f64();
     let p50 = r.f64();
     let p90 = r.f64();
-    if b[112..HEADER_LEN].iter().any(|&x| x != 0) {
-        return Err(Fault::Bad(
-            "corrupt: reserved header bytes are not zero".into(),
-        ));
+    if head[112..HEADER_LEN].iter().any(|&x| x != 0) {
+        return Err(Fault::Bad("corrupt: reserved header bytes are not zero".into()).into());
     }
-    r.at = HEADER_LEN;
-    let dim = h.dim as usize;
-    let n = mesh.n_vertices();
-    let mut coords = vec![[0.0; MAX_DIM]; n];
-    for c in &mut coords {
-        for x in &mut c[..dim] {
-            *x = r.f64();
-        }
-    }
-    let landmarks: Vec<u32> = (0..h.n_landmarks).map(|_| r.u32()).collect();
-    if b[r.at..body].iter().any(|&x| x != 0) {
-        return Err(Fault::Bad("corrupt: padding bytes are not zero".into()));
+    let k = h.n_landmarks as usize;
+    let landmarks: Vec<u32> = (body.tail[..k * 4].chunks_exact(4))
+        .map(|b| u32::from_le_bytes(b.try_into().unwrap_or_default()))
+        .collect();
+    if body.tail[k * 4..].iter().any(|&x| x != 0) {
+        return Err(Fault::Bad("corrupt: padding bytes are not zero".into()).into());
     }
     let emb = Embedding {
-        dim,
-        coords,
+        dim: h.dim as usize,
+        coords: body.coords,
         landmarks,
         params,
         stress,
         geodesic_rel_err_p50: p50,
         geodesic_rel_err_p90: p90,
     };
-    emb.validate(n)
+    emb.validate(mesh.n_vertices())
         .map_err(|m| Fault::Bad(format!("corrupt: {m}")))?;
     Ok(emb)
 }
 
 /// Parses a `.wavg` image held in memory; `path` only labels errors.
 pub fn decode(bytes: &[u8], mesh: &TriMesh, path: &Path) -> Result<Embedding, EmbedError> {
-    decode_inner(bytes, mesh).map_err(|f| f.at(path))
+    read_embedding(&mut &bytes[..], bytes.len() as u64, mesh).map_err(|f| match f {
+        ReadFault::Fault(f) => f.at(path),
+        // The header was checked against the slice's length: reading cannot fail.
+        ReadFault::Io(e) => Fault::Bad(format!("unreadable: {e}")).at(path),
+    })
 }
 
 /// Writes `emb` (computed for `mesh`) to `path` atomically.
@@ -328,11 +455,15 @@ pub fn decode(bytes: &[u8], mesh: &TriMesh, path: &Path) -> Result<Embedding, Em
 /// assert_eq!(load(&path, &mesh).unwrap().coords, emb.coords);
 /// ```
 pub fn save(path: &Path, emb: &Embedding, mesh: &TriMesh) -> Result<(), EmbedError> {
-    let bytes = encode(emb, mesh)?;
-    wavg_mesh::io::write_atomic(path, |w| w.write_all(&bytes)).map_err(|source| EmbedError::Write {
-        path: path.to_path_buf(),
-        source,
-    })
+    checked_len(emb, mesh)?;
+    wavg_mesh::io::write_atomic(path, |w| write_embedding(emb, mesh, w)).map_err(|source| {
+        EmbedError::Write {
+            path: path.to_path_buf(),
+            source,
+        }
+    })?;
+    crate::memtrace::mark(".wavg written");
+    Ok(())
 }
 
 /// Reads and checks a `.wavg` file for `mesh`.
@@ -341,32 +472,22 @@ pub fn save(path: &Path, emb: &Embedding, mesh: &TriMesh) -> Result<(), EmbedErr
 /// version-1 file; with [`EmbedError::UnsupportedVersion`] a file from a newer format; with
 /// [`EmbedError::MeshMismatch`] a file computed for another mesh. The header is checked
 /// against the real file length before the body is read, so a corrupt header never causes
-/// a large allocation.
+/// a large allocation. The file is streamed a block at a time into the embedding.
 pub fn load(path: &Path, mesh: &TriMesh) -> Result<Embedding, EmbedError> {
     let io = |source| EmbedError::Io {
         path: path.to_path_buf(),
         source,
     };
-    let mut f = std::fs::File::open(path).map_err(io)?;
+    let f = std::fs::File::open(path).map_err(io)?;
     let total = f.metadata().map_err(io)?.len();
-    let mut head = Vec::with_capacity(HEADER_LEN);
-    (&mut f)
-        .take(HEADER_LEN as u64)
-        .read_to_end(&mut head)
-        .map_err(io)?;
-    parse_header(&head, total).map_err(|e| e.at(path))?;
-    // The length now matches the header exactly; read the rest.
-    let len = usize::try_from(total)
-        .map_err(|_| Fault::Bad("file too large for this platform".into()).at(path))?;
-    let mut bytes = head;
-    bytes.reserve_exact(len - bytes.len());
-    f.take(total - HEADER_LEN as u64)
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
-    if bytes.len() != len {
-        return Err(Fault::Bad("file changed size while being read".into()).at(path));
-    }
-    decode(&bytes, mesh, path)
+    let mut r = std::io::BufReader::with_capacity(1 << 16, f);
+    read_embedding(&mut r, total, mesh).map_err(|e| match e {
+        ReadFault::Fault(f) => f.at(path),
+        ReadFault::Io(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+            Fault::Bad("file changed size while being read".into()).at(path)
+        }
+        ReadFault::Io(e) => io(e),
+    })
 }
 
 #[cfg(test)]

@@ -25,6 +25,7 @@ pub mod file;
 mod geodesic;
 mod lsmesh;
 mod mds;
+pub mod memtrace;
 mod pipeline;
 mod quality;
 mod scaled;

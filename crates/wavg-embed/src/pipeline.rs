@@ -4,13 +4,14 @@ use std::time::Instant;
 
 use wavg_mesh::ValidMesh;
 
-use crate::decimate::{DecimateOptions, Decimated, decimate_with_snapshots, select_landmarks};
+use crate::decimate::{DecimateOptions, Decimated, decimate_beside};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
 use crate::geodesic::{FastMarching, GeodesicOptions, landmark_distances};
 use crate::lsmesh::LsMeshSolver;
 use crate::lsmesh::two_level::{CgOptions, LsMeshExtension, TwoLevelLsMesh};
 use crate::mds::{MdsOptions, metric_mds};
+use crate::memtrace::mark;
 use crate::quality::{QualityOptions, QualityPairs};
 use crate::thin;
 use crate::{Embedding, EmbeddingParams};
@@ -101,6 +102,10 @@ fn landmark_aspect_bound(mesh: &ValidMesh, asked: Option<f64>) -> Option<f64> {
     let (_, p90, _) = ratios.select_nth_unstable_by(k, f64::total_cmp);
     Some(asked.max(2.0 * *p90))
 }
+
+/// What the quality check's first part yields: the full mesh's fast marching, the pairs
+/// with their geodesic distances, and its seconds.
+type QualityOut = Result<(Option<FastMarching>, Option<QualityPairs>, f64), EmbedError>;
 
 /// Vertex visits (sources x vertices) above which the quality check uses fewer sources.
 pub(crate) const QUALITY_SOURCE_VERTICES: usize = 16_000_000;
@@ -224,14 +229,19 @@ pub(crate) fn precompute_unscaled(
             "embedding dimension {dim} not in 1..={MAX_DIM}"
         )));
     }
+    mark("before the precomputation");
     let mut stages = StageSeconds::default();
     let secs = |t: Instant| t.elapsed().as_secs_f64();
     // 1. Landmarks (and, for large meshes, intermediate meshes for the geodesics and the
-    //    least-squares mesh): `target` of them, keeping `locked`.
-    let select = |target: usize, locked: &[u32]| -> Result<_, EmbedError> {
+    //    least-squares mesh): `target` of them, keeping `locked`, with `alongside` run
+    //    beside the decimation's collapses (after its first pass).
+    type Alongside<'a> = Box<dyn FnOnce() -> QualityOut + Send + 'a>;
+    let select = |target: usize, locked: &[u32], alongside: Option<Alongside<'_>>| {
         let t = Instant::now();
+        let run = move || alongside.map(|f| f());
         if target >= n {
-            return Ok(((0..n as u32).collect::<Vec<u32>>(), None, None, secs(t)));
+            let all = ((0..n as u32).collect::<Vec<u32>>(), None, None, secs(t));
+            return (Ok(all), run());
         }
         let use_coarse = opts.geodesic_vertices > target && opts.geodesic_vertices < n;
         let two_level = n > opts.lsmesh_direct_max
@@ -243,44 +253,61 @@ pub(crate) fn precompute_unscaled(
             locked: locked.to_vec(),
             ..opts.decimate.clone()
         };
-        let (landmarks, coarse, ls_coarse) = if use_coarse || two_level {
-            let sizes: Vec<usize> = [
-                (use_coarse, opts.geodesic_vertices),
-                (two_level, opts.lsmesh_coarse_vertices),
-            ]
-            .iter()
-            .filter_map(|&(on, s)| on.then_some(s))
-            .collect();
-            let (fin, mut snaps) = decimate_with_snapshots(mesh, &d, &sizes, progress)?;
+        let sizes: Vec<usize> = [
+            (use_coarse, opts.geodesic_vertices),
+            (two_level, opts.lsmesh_coarse_vertices),
+        ]
+        .iter()
+        .filter_map(|&(on, s)| on.then_some(s))
+        .collect();
+        let (res, other, end) = decimate_beside(mesh, &d, &sizes, progress, run);
+        let res = res.map(|(fin, mut snaps)| {
             let ls = if two_level { snaps.pop() } else { None };
-            (fin.landmarks, snaps.pop(), ls)
-        } else {
-            (select_landmarks(mesh, &d, progress)?, None, None)
-        };
-        Ok((landmarks, coarse, ls_coarse, secs(t)))
+            let coarse = if use_coarse { snaps.pop() } else { None };
+            (fin.landmarks, coarse, ls, (end - t).as_secs_f64())
+        });
+        (res, other.flatten())
     };
-    // The first selection runs while the quality check's fast marching on the full mesh
-    // runs alongside (it does not depend on the embedding).
-    let (landmark_result, quality_result) = rayon::join(
-        || select(opts.landmarks, &opts.decimate.locked),
-        || -> Result<_, EmbedError> {
-            let t = Instant::now();
-            if opts.quality_pairs == 0 {
-                return Ok((None, None, 0.0));
-            }
-            let fm = FastMarching::new(mesh);
-            let sources = quality_sources(opts.quality_sources, n, opts.quality_pairs);
-            let qo = QualityOptions {
-                pairs: opts.quality_pairs,
-                sources,
-                seed: opts.seed,
-            };
-            let pairs = QualityPairs::compute(mesh, &fm, &qo, progress)?;
-            Ok((Some(fm), Some(pairs), secs(t)))
-        },
+    // The quality check's fast marching on the full mesh (it does not depend on the
+    // embedding) runs beside the first selection's collapses, after the decimation's
+    // first pass: the two largest transient allocations of the stage do not overlap.
+    let quality = || -> QualityOut {
+        let t = Instant::now();
+        if opts.quality_pairs == 0 {
+            return Ok((None, None, 0.0));
+        }
+        check_cancel(progress)?;
+        let fm = FastMarching::new(mesh);
+        let sources = quality_sources(opts.quality_sources, n, opts.quality_pairs);
+        let qo = QualityOptions {
+            pairs: opts.quality_pairs,
+            sources,
+            seed: opts.seed,
+        };
+        let pairs = QualityPairs::compute(mesh, &fm, &qo, progress)?;
+        Ok((Some(fm), Some(pairs), secs(t)))
+    };
+    let (landmark_result, quality_result) = select(
+        opts.landmarks,
+        &opts.decimate.locked,
+        Some(Box::new(quality)),
     );
+    // The quality check does not run when the decimation failed before its collapses.
+    let quality_result = quality_result.unwrap_or(Err(EmbedError::Cancelled));
     let mut selected = landmark_result?;
-    let (mut fm, quality_pairs, t_quality) = quality_result?;
+    let (fm, quality_pairs, t_quality) = quality_result?;
+    // The full mesh's fast marching (about 400 bytes a vertex) is kept only where the
+    // landmark geodesics use it: with an intermediate mesh whose close pairs are refined on
+    // the least-squares mesh's coarse level, they never do (`landmark_distances` builds one
+    // itself should a later round need it).
+    let needs_fine = selected.1.is_none() || (opts.refine_near_pairs && selected.2.is_none());
+    // (Matched as a tuple that owns it, so that the unused one is dropped here.)
+    let fm = match (fm, needs_fine) {
+        (Some(fm), true) => Some(fm),
+        (None, true) => Some(FastMarching::new(mesh)),
+        (_, false) => None,
+    };
+    mark("decimation + quality geodesics");
     stages.quality = t_quality;
     check_cancel(progress)?;
 
@@ -290,10 +317,12 @@ pub(crate) fn precompute_unscaled(
     //    the landmarks leave a thin part uncovered (see `thin`), the landmarks so far are
     //    locked, more are added, and steps 1 and 2 run again (at most `THIN_PART_ROUNDS`
     //    times, adding at most as many landmarks as asked for in all).
-    let fine = fm.get_or_insert_with(|| FastMarching::new(mesh));
     let geodesics = |landmarks: &[u32], coarse: Option<&Decimated>, mid: Option<&Decimated>| {
         let t = Instant::now();
-        let mut geo = GeodesicOptions::new().fast_marching(fine);
+        let mut geo = GeodesicOptions::new();
+        if let Some(fine) = &fm {
+            geo = geo.fast_marching(fine);
+        }
         if let Some(c) = coarse {
             // All pairs on the intermediate mesh, close pairs corrected on the full mesh.
             geo = geo.coarse_mesh(c).refine_near_pairs(opts.refine_near_pairs);
@@ -339,6 +368,11 @@ pub(crate) fn precompute_unscaled(
         };
         let (solver, t_factor) = solver;
         stages.lsmesh += t_factor;
+        mark(if round == 0 {
+            "geodesics + lsmesh factorisation"
+        } else {
+            "thin parts: lsmesh factorisation"
+        });
         check_cancel(progress)?;
         let more = if opts.cover_thin_parts && round < THIN_PART_ROUNDS {
             let t = Instant::now();
@@ -357,22 +391,32 @@ pub(crate) fn precompute_unscaled(
         let mut locked = landmarks.clone();
         locked.extend(&more);
         locked.sort_unstable();
+        // The factorisation and the distances go before the next decimation allocates;
+        // should no decimation be possible, they are computed again.
+        drop((q, solver));
         // Locking every landmark may leave a vertex that no legal collapse removes; a
         // few more landmarks then get around it, and failing that, the landmarks so far
         // stay.
         let next = [0, 1, 8]
             .into_iter()
             .filter(|extra| locked.len() + extra <= n)
-            .find_map(|extra| match select(locked.len() + extra, &locked) {
-                Err(EmbedError::InvalidArgument(_)) => None,
-                other => Some(other),
-            });
+            .find_map(
+                |extra| match select(locked.len() + extra, &locked, None).0 {
+                    Err(EmbedError::InvalidArgument(_)) => None,
+                    other => Some(other),
+                },
+            );
         match next {
             Some(next) => {
-                drop((q, solver, coarse, ls_coarse));
+                drop((coarse, ls_coarse));
                 selected = next?;
+                mark("thin parts: decimation");
             }
-            None => break (landmarks, q, solver, coarse, ls_coarse),
+            None => {
+                let (solver, t_factor) = factor(&landmarks, ls_coarse.as_ref())?;
+                stages.lsmesh += t_factor;
+                break (landmarks, None, solver, coarse, ls_coarse);
+            }
         }
         added += more.len();
         round += 1;
@@ -389,18 +433,21 @@ pub(crate) fn precompute_unscaled(
     let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
     drop((coarse, ls_coarse));
     drop(fm);
+    mark("landmark geodesics (if redone)");
 
     // 3. MDS of the landmarks.
     let t = Instant::now();
     let mds = metric_mds(&q, landmarks.len(), &opts.mds, progress)?;
     drop(q);
     stages.mds = secs(t);
+    mark("mds");
     check_cancel(progress)?;
 
     // 4. Least-squares mesh: the landmarks' MDS positions extended to every vertex.
     let t = Instant::now();
     let coords = solver.solve(&mds.points, dim, progress)?;
     drop(solver);
+    mark("lsmesh solve");
     progress.report(Stage::LsMesh, 1.0);
     stages.lsmesh += secs(t);
     check_cancel(progress)?;
@@ -415,6 +462,7 @@ pub(crate) fn precompute_unscaled(
         progress.report(Stage::Quality, 1.0);
     }
     stages.quality += secs(t);
+    mark("quality evaluation");
 
     let (p50, p90) = quality
         .as_ref()

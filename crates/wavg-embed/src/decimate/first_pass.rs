@@ -19,9 +19,23 @@
 //!    every reduced vertex is a distinct original vertex and landmarks stay distinct;
 //! 4. keeps the result only if it validates and has the input's genus, boundary loops and
 //!    components (and every locked vertex); otherwise the caller decimates the full mesh.
+//!
+//! The simplifier cannot stop partway (about 15 s at 3M vertices), so it runs on a thread
+//! of its own while the caller polls for cancellation every [`CANCEL_POLL`]: a cancelled
+//! precomputation returns within that, and the abandoned simplification finishes in the
+//! background and frees its memory (an exiting `wavg` ends it at once). Cancellation is
+//! also checked before and after the clean-up (about 4 s at 3M vertices).
+
+use std::sync::mpsc;
+use std::time::Duration;
 
 use nalgebra::Vector3;
 use wavg_mesh::{RepairOptions, TriMesh, ValidMesh, repair};
+
+use crate::error::{EmbedError, Progress, check_cancel};
+
+/// How often the caller looks for cancellation while the simplifier runs.
+pub(super) const CANCEL_POLL: Duration = Duration::from_millis(50);
 
 /// The result of the first pass: a valid mesh on original vertices.
 pub(super) struct Reduced {
@@ -35,24 +49,36 @@ pub(super) struct Reduced {
 const FRESH_RINGS: usize = 3;
 
 /// Simplifies `mesh` to about `keep` vertices with `locked` vertices kept, then cleans up;
-/// `None` when the cleaned result is not a valid mesh of the input's topology.
-pub(super) fn first_pass(mesh: &ValidMesh, keep: usize, locked: &[u32]) -> Option<Reduced> {
-    let raw = simplify(mesh, keep, locked);
+/// `None` when the cleaned result is not a valid mesh of the input's topology, and
+/// [`EmbedError::Cancelled`] within about [`CANCEL_POLL`] of `progress` asking.
+pub(super) fn first_pass(
+    mesh: &ValidMesh,
+    keep: usize,
+    locked: &[u32],
+    progress: &dyn Progress,
+) -> Result<Option<Reduced>, EmbedError> {
+    let raw = simplify(mesh, keep, locked, progress)?;
+    check_cancel(progress)?;
     let raw = cancel_duplicate_faces(raw);
-    clean(mesh, raw, locked).ok()
+    let reduced = clean(mesh, raw, locked).ok();
+    check_cancel(progress)?;
+    Ok(reduced)
 }
 
 /// meshoptimizer's simplifier towards `keep` vertices (`2 keep` faces), borders and
-/// `locked` vertices kept: the surviving faces, in original vertex ids.
-fn simplify(mesh: &ValidMesh, keep: usize, locked: &[u32]) -> Vec<[u32; 3]> {
+/// `locked` vertices kept: the surviving faces, in original vertex ids. It runs on a
+/// thread of its own, abandoned when `progress` cancels (module documentation).
+fn simplify(
+    mesh: &ValidMesh,
+    keep: usize,
+    locked: &[u32],
+    progress: &dyn Progress,
+) -> Result<Vec<[u32; 3]>, EmbedError> {
     let n = mesh.n_vertices();
     let bytes: Vec<u8> = (mesh.positions.iter())
         .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
         .flat_map(f32::to_le_bytes)
         .collect();
-    let Ok(adapter) = meshopt::VertexDataAdapter::new(&bytes, 12, 0) else {
-        return mesh.triangles.clone();
-    };
     let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
     let mut lock = vec![false; n];
     for &l in locked {
@@ -60,16 +86,41 @@ fn simplify(mesh: &ValidMesh, keep: usize, locked: &[u32]) -> Vec<[u32; 3]> {
     }
     // Faces of a closed mesh are about twice its vertices.
     let target = (2 * keep).min(mesh.n_faces()) * 3;
-    let out = meshopt::simplify_with_locks(
-        &indices,
-        &adapter,
-        &lock,
-        target,
-        1.0,
-        meshopt::SimplifyOptions::LockBorder,
-        None,
-    );
-    out.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect()
+    let run = move || -> Option<Vec<u32>> {
+        let adapter = meshopt::VertexDataAdapter::new(&bytes, 12, 0).ok()?;
+        Some(meshopt::simplify_with_locks(
+            &indices,
+            &adapter,
+            &lock,
+            target,
+            1.0,
+            meshopt::SimplifyOptions::LockBorder,
+            None,
+        ))
+    };
+    let (tx, rx) = mpsc::channel();
+    let spawned = std::thread::Builder::new()
+        .name("wavg-simplify".into())
+        .spawn(move || {
+            // The receiver is gone when the caller was cancelled: nothing to deliver.
+            let _ = tx.send(run());
+        });
+    let out = match spawned {
+        Ok(_) => loop {
+            match rx.recv_timeout(CANCEL_POLL) {
+                Ok(out) => break out,
+                Err(mpsc::RecvTimeoutError::Timeout) => check_cancel(progress)?,
+                // The simplifier panicked: as if it had reduced nothing.
+                Err(mpsc::RecvTimeoutError::Disconnected) => break None,
+            }
+        },
+        // No thread to be had: nothing to simplify with.
+        Err(_) => None,
+    };
+    Ok(match out {
+        Some(out) => out.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+        None => mesh.triangles.clone(),
+    })
 }
 
 /// Of the faces on one vertex triple, faces of opposite orientation cancel in pairs and at
@@ -243,6 +294,7 @@ fn fresh_vertex(mesh: &ValidMesh, v: u32, centre: Vector3<f64>, used: &[bool]) -
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::NoProgress;
     use wavg_mesh::procedural;
 
     fn valid(m: TriMesh) -> ValidMesh {
@@ -256,7 +308,7 @@ mod tests {
         let path = std::env::var("WAVG_FIRST_PASS_MESH").unwrap();
         let mesh = valid(wavg_mesh::io::load(path.as_ref()).unwrap());
         let t = std::time::Instant::now();
-        let raw = simplify(&mesh, FIRST_PASS_VERTICES_FOR_TEST, &[]);
+        let raw = simplify(&mesh, FIRST_PASS_VERTICES_FOR_TEST, &[], &NoProgress).unwrap();
         let ts = t.elapsed().as_secs_f64();
         let n_raw = raw.len();
         let raw = cancel_duplicate_faces(raw);
@@ -274,6 +326,30 @@ mod tests {
             ),
             Err(e) => eprintln!("clean failed: {e}"),
         }
+    }
+
+    /// A cancellation while the simplifier runs returns within a poll, without waiting
+    /// for the simplification (about a second on this mesh) to end.
+    #[test]
+    fn the_simplifier_is_abandoned_when_cancelled() {
+        struct Cancelled;
+        impl Progress for Cancelled {
+            fn report(&self, _: crate::Stage, _: f64) {}
+            fn cancelled(&self) -> bool {
+                true
+            }
+        }
+        let mesh = valid(procedural::icosphere(7));
+        let t = std::time::Instant::now();
+        let r = simplify(&mesh, 1000, &[], &Cancelled);
+        let latency = t.elapsed();
+        eprintln!("cancelled after {latency:?}");
+        assert!(matches!(r, Err(EmbedError::Cancelled)), "{r:?}");
+        assert!(latency < 20 * CANCEL_POLL, "{latency:?}");
+        assert!(matches!(
+            first_pass(&mesh, 1000, &[], &Cancelled),
+            Err(EmbedError::Cancelled)
+        ));
     }
 
     const FIRST_PASS_VERTICES_FOR_TEST: usize = super::super::FIRST_PASS_VERTICES;
@@ -312,7 +388,9 @@ mod tests {
         ] {
             let mesh = valid(m);
             let locked = [3, 77, 500];
-            let r = first_pass(&mesh, keep, &locked).unwrap_or_else(|| panic!("{name}"));
+            let r = first_pass(&mesh, keep, &locked, &NoProgress)
+                .unwrap()
+                .unwrap_or_else(|| panic!("{name}"));
             let n = r.mesh.n_vertices();
             assert!(n < mesh.n_vertices() / 2 && n > keep / 2, "{name}: {n}");
             assert!(r.original.windows(2).all(|w| w[0] < w[1]), "{name}");

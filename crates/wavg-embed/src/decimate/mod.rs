@@ -219,20 +219,55 @@ pub fn decimate_with_snapshots(
     snapshots: &[usize],
     progress: &dyn Progress,
 ) -> Result<(Decimated, Vec<Decimated>), EmbedError> {
+    decimate_beside(mesh, opts, snapshots, progress, || ()).0
+}
+
+/// What [`decimate_beside`] returns: the decimation's result, `alongside`'s (when it ran)
+/// and the moment the decimation ended.
+pub(crate) type Beside<R> = (
+    Result<(Decimated, Vec<Decimated>), EmbedError>,
+    Option<R>,
+    std::time::Instant,
+);
+
+/// [`decimate_with_snapshots`], running `alongside` beside its quadric collapses, after
+/// the first pass (if any): the first pass's working memory is freed before `alongside`
+/// allocates its own, and the collapses, which take longer, still overlap it. `alongside`
+/// does not run when the decimation fails before its collapses (cancelled, bad options).
+pub(crate) fn decimate_beside<R: Send>(
+    mesh: &ValidMesh,
+    opts: &DecimateOptions,
+    snapshots: &[usize],
+    progress: &dyn Progress,
+    alongside: impl FnOnce() -> R + Send,
+) -> Beside<R> {
+    let now = std::time::Instant::now;
     let n = mesh.n_vertices();
-    check_options(n, opts)?;
+    if let Err(e) = check_options(n, opts) {
+        return (Err(e), None, now());
+    }
     if let Some(&s) = snapshots.iter().find(|&&s| s < opts.target || s > n) {
-        return Err(EmbedError::InvalidArgument(format!(
-            "snapshot at {s} vertices is outside {}..={n}",
-            opts.target
-        )));
+        return (
+            Err(EmbedError::InvalidArgument(format!(
+                "snapshot at {s} vertices is outside {}..={n}",
+                opts.target
+            ))),
+            None,
+            now(),
+        );
     }
     let keep =
         (snapshots.iter().copied()).fold(opts.first_pass_vertices.max(opts.target), usize::max);
     if opts.first_pass_vertices > 0 && n > 2 * keep {
-        check_cancel(progress)?;
-        progress.report(Stage::Decimate, 0.0);
-        if let Some(r) = first_pass::first_pass(mesh, keep, &opts.locked) {
+        let first = check_cancel(progress).and_then(|()| {
+            progress.report(Stage::Decimate, 0.0);
+            first_pass::first_pass(mesh, keep, &opts.locked, progress)
+        });
+        let reduced = match first {
+            Ok(r) => r,
+            Err(e) => return (Err(e), None, now()),
+        };
+        if let Some(r) = reduced.filter(|r| snapshots.iter().all(|&s| s <= r.mesh.n_vertices())) {
             let lift = |d: Decimated| Decimated {
                 landmarks: d
                     .landmarks
@@ -248,13 +283,19 @@ pub fn decimate_with_snapshots(
                 first_pass_vertices: 0,
                 ..opts.clone()
             };
-            if snapshots.iter().all(|&s| s <= r.mesh.n_vertices()) {
-                let (fin, snaps) = decimate_exact(&r.mesh, &inner, snapshots, progress)?;
-                return Ok((lift(fin), snaps.into_iter().map(lift).collect()));
-            }
+            let ((res, end), other) = rayon::join(
+                || (decimate_exact(&r.mesh, &inner, snapshots, progress), now()),
+                alongside,
+            );
+            let res = res.map(|(fin, snaps)| (lift(fin), snaps.into_iter().map(lift).collect()));
+            return (res, Some(other), end);
         }
     }
-    decimate_exact(mesh, opts, snapshots, progress)
+    let ((res, end), other) = rayon::join(
+        || (decimate_exact(mesh, opts, snapshots, progress), now()),
+        alongside,
+    );
+    (res, Some(other), end)
 }
 
 /// [`decimate_with_snapshots`] by quadric collapses alone, its arguments checked.

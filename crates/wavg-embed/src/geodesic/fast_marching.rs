@@ -206,6 +206,9 @@ impl FastMarching {
         for v in 0..n {
             entries[offsets[v] as usize..offsets[v + 1] as usize].sort_by_key(|e| e.x);
         }
+        // The stencils (40 bytes each, about six a vertex) go before the near field's
+        // copy of the mesh is built.
+        drop((stencils, virtual_edges, fill));
         let near = NearField::new(mesh);
         Self {
             n,

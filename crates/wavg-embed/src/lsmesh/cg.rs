@@ -10,8 +10,9 @@
 //! solve reads half the bytes. Dot products are summed per fixed-size chunk and the chunks
 //! in order, so the result does not depend on the thread schedule.
 
-use faer::sparse::SparseColMat;
 use rayon::prelude::*;
+
+use super::stiffness::Stiffness;
 
 use super::two_level::CgOptions;
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
@@ -26,7 +27,7 @@ const CHUNK: usize = 4096;
 /// Jacobi preconditioner.
 pub(super) struct FreeOperator<'a> {
     /// Cotangent stiffness `L` (symmetric, both triangles stored).
-    pub stiffness: &'a SparseColMat<usize, f64>,
+    pub stiffness: &'a Stiffness,
     /// `1 / m_i`, the lumped mass inverted.
     pub inv_mass: &'a [f64],
     /// Inverse diagonal of `A`; 0 at fixed vertices.
@@ -48,15 +49,14 @@ fn sum_chunks<const C: usize>(parts: Vec<[f64; C]>) -> [f64; C] {
 impl FreeOperator<'_> {
     /// `t = M⁻¹ L x`.
     fn scaled_stiffness<const C: usize>(&self, x: &[[f64; C]], t: &mut [[f64; C]]) {
-        let (sym, vals) = self.stiffness.parts();
-        let rows = sym.row_idx();
+        let sym = self.stiffness;
         t.par_iter_mut()
             .with_min_len(1024)
             .enumerate()
             .for_each(|(j, tj)| {
                 let mut acc = [0.0; C];
                 for k in sym.col_range(j) {
-                    let (a, xi) = (vals[k], &x[rows[k]]);
+                    let (a, xi) = (sym.val(k), &x[sym.row(k)]);
                     for c in 0..C {
                         acc[c] += a * xi[c];
                     }
@@ -74,8 +74,7 @@ impl FreeOperator<'_> {
         y: &mut [[f64; C]],
         p: &[[f64; C]],
     ) -> [f64; C] {
-        let (sym, vals) = self.stiffness.parts();
-        let rows = sym.row_idx();
+        let sym = self.stiffness;
         let parts = y
             .par_chunks_mut(CHUNK)
             .enumerate()
@@ -89,7 +88,7 @@ impl FreeOperator<'_> {
                     }
                     let mut acc = [0.0; C];
                     for k in sym.col_range(j) {
-                        let (a, ti) = (vals[k], &t[rows[k]]);
+                        let (a, ti) = (sym.val(k), &t[sym.row(k)]);
                         for c in 0..C {
                             acc[c] += a * ti[c];
                         }

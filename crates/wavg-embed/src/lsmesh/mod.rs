@@ -22,6 +22,7 @@ use crate::file::MAX_DIM;
 
 mod cg;
 mod ordering;
+mod stiffness;
 pub(crate) mod two_level;
 
 /// The bi-Laplacian `A = L M⁻¹ L` of a mesh (n x n, symmetric positive semidefinite,

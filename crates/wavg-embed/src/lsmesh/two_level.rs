@@ -15,12 +15,12 @@
 //! `A = L M⁻¹ L` is applied as two products with the cotangent stiffness `L` and never
 //! assembled, so the memory is a few vectors per vertex on top of the coarse factor.
 
-use faer::sparse::SparseColMat;
 use rayon::prelude::*;
 use wavg_mesh::{ValidMesh, geometry};
 
 use super::LsMeshSolver;
 use super::cg::FreeOperator;
+use super::stiffness::Stiffness;
 use crate::decimate::Decimated;
 use crate::error::{EmbedError, Progress, check_cancel};
 use crate::file::MAX_DIM;
@@ -81,7 +81,7 @@ pub(crate) struct TwoLevelLsMesh {
     coarse_ids: Vec<u32>,
     coarse: LsMeshSolver,
     /// Cotangent stiffness of the full mesh (symmetric, both triangles stored).
-    stiffness: SparseColMat<usize, f64>,
+    stiffness: Stiffness,
     inv_mass: Vec<f64>,
     /// Inverse diagonal of `A` (Jacobi preconditioner); 0 at fixed vertices.
     inv_diag: Vec<f64>,
@@ -118,8 +118,7 @@ impl TwoLevelLsMesh {
         let coarse_solver = LsMeshSolver::new(&coarse_mesh, &coarse_landmarks, progress)?;
         check_cancel(progress)?;
 
-        let stiffness = geometry::cotan_stiffness(mesh)
-            .map_err(|e| EmbedError::InvalidArgument(e.to_string()))?;
+        let stiffness = Stiffness::cotan(mesh)?;
         let mass = geometry::lumped_mass(mesh);
         if let Some(v) = mass.iter().position(|&m| !(m > 0.0 && m.is_finite())) {
             return Err(EmbedError::InvalidArgument(format!(
@@ -129,16 +128,14 @@ impl TwoLevelLsMesh {
         }
         let inv_mass: Vec<f64> = mass.iter().map(|m| 1.0 / m).collect();
         // diag(L M⁻¹ L)_j = sum_k L_kj² / m_k.
-        let (sym, vals) = stiffness.parts();
         let inv_diag: Vec<f64> = (0..n)
             .into_par_iter()
             .map(|j| {
                 if fixed[j] {
                     return 0.0;
                 }
-                let d: f64 = sym
-                    .col_range(j)
-                    .map(|k| vals[k] * vals[k] * inv_mass[sym.row_idx()[k]])
+                let d: f64 = (stiffness.col_range(j))
+                    .map(|k| stiffness.val(k) * stiffness.val(k) * inv_mass[stiffness.row(k)])
                     .sum();
                 if d > 0.0 { 1.0 / d } else { 0.0 }
             })
@@ -192,11 +189,9 @@ impl TwoLevelLsMesh {
     fn prolongate(&self, coarse: &[Row]) -> Vec<Row> {
         const SWEEPS: usize = 4;
         let n = self.fixed.len();
-        let (sym, _) = self.stiffness.parts();
         let neighbours = |v: usize| {
-            sym.row_idx()[sym.col_range(v)]
-                .iter()
-                .copied()
+            (self.stiffness.col_rows(v).iter())
+                .map(|&u| u as usize)
                 .filter(move |&u| u != v)
         };
         let mut x = vec![[0.0; MAX_DIM]; n];
