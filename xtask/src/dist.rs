@@ -330,19 +330,31 @@ fn check_glibc(lib: &Path) -> Result<(), String> {
 /// `cargo package --workspace` (each package verified by building it alone), the `.crate`
 /// files copied to `dist/crates/`. The verification builds without debug info: whether a
 /// package builds does not depend on it, and it costs compile and link time.
+///
+/// Cargo verifies a package against its workspace dependencies unpacked from their own
+/// `.crate` files as if from a registry, and takes a registry crate of a name and version as
+/// immutable: it keeps the sources unpacked by an earlier run and the artifacts compiled
+/// from them. So the verification gets a target directory of its own, and both the
+/// unpacked workspace crates and their artifacts there are removed first; otherwise a
+/// crate using a new item of another would be verified against that crate's old source.
 fn crates(root: &Path, dist: &Path) -> Result<(), String> {
+    let verify = steps::target_dir(root).join("package-verify");
+    forget_packaged(&verify)?;
+    let verify_arg = verify.to_string_lossy().into_owned();
     let mut args = vec![
         "package",
         "--workspace",
         "--allow-dirty",
         "--config",
         "profile.dev.debug=0",
+        "--target-dir",
+        &verify_arg,
     ];
     for name in NOT_PACKAGED {
         args.extend(["--exclude", name]);
     }
     steps::command(root, "cargo", &args)?;
-    let from = steps::target_dir(root).join("package");
+    let from = verify.join("package");
     let to = dist.join("crates");
     std::fs::create_dir_all(&to).map_err(|e| format!("{}: {e}", to.display()))?;
     let version = version::workspace(root)?;
@@ -361,6 +373,54 @@ fn crates(root: &Path, dist: &Path) -> Result<(), String> {
     }
     eprintln!("    {count} crates in {}", to.display());
     Ok(())
+}
+
+/// Removes what an earlier `cargo package` left of the workspace's own crates: their
+/// sources unpacked under cargo's home (the local registries, whose folder names start
+/// with `-`) and everything compiled from them in the verification's target directory.
+fn forget_packaged(verify: &Path) -> Result<(), String> {
+    let home = std::env::var_os("CARGO_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")));
+    let mut doomed = Vec::new();
+    if let Some(src) = home.map(|h| h.join("registry").join("src")) {
+        for registry in entries(&src) {
+            if file_name(&registry).starts_with('-') {
+                doomed.extend(entries(&registry));
+            }
+        }
+    }
+    for sub in [".fingerprint", "deps", "build", "incremental"] {
+        doomed.extend(entries(&verify.join("debug").join(sub)));
+    }
+    doomed.extend(entries(&verify.join("package")));
+    for path in doomed {
+        let name = file_name(&path);
+        if !(name.starts_with("wavg") || name.starts_with("libwavg")) {
+            continue;
+        }
+        let removed = if path.is_dir() {
+            std::fs::remove_dir_all(&path)
+        } else {
+            std::fs::remove_file(&path)
+        };
+        removed.map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// The entries of `dir`; none when it does not exist or cannot be read.
+fn entries(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .map(|it| it.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default()
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .into_owned()
 }
 
 /// `SHA256SUMS` of every file under `dist` (paths relative to it), as `sha256sum -c` reads.
