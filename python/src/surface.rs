@@ -105,20 +105,11 @@ impl Surface {
         if let Some(e) = &embedding {
             require_file(e)?;
         }
-        // With an embedding, the surface is built once, on it: no projector of the 3-D
-        // positions is built first and then replaced (at 10M vertices, gigabytes).
         let (inner, notes) = py
             .detach_run(|| {
                 let (mesh, notes) = wavg::mesh::io::load_with_notes(&path)?;
-                let surface = match &embedding {
-                    None => wavg::Surface::from_mesh(mesh)?,
-                    Some(e) => {
-                        let mesh = wavg::ValidMesh::new(mesh)?;
-                        let emb = wavg::embed::file::load(e, &mesh)?;
-                        wavg::Surface::from_valid_with_embedding(mesh, emb)?
-                    }
-                };
-                Ok::<_, wavg::Error>((surface, notes))
+                let mesh = wavg::ValidMesh::new(mesh)?;
+                wavg::Surface::from_valid_and_file(mesh, embedding.as_deref()).map(|s| (s, notes))
             })
             .map_err(|e| to_py(py, e))?;
         Ok(Self {

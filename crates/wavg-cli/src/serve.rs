@@ -61,15 +61,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         .embedding
         .clone()
         .or_else(|| crate::cache::existing(&mesh, args.cache.no_cache));
-    // With an embedding, the surface is built once, on it: no projector of the 3-D
-    // positions is built first and then replaced (at 10M vertices, gigabytes).
-    let surface = match &embedding {
-        Some(path) => {
-            let e = wavg::embed::file::load(path, &mesh)?;
-            Surface::from_valid_with_embedding(mesh, e)?
-        }
-        None => Surface::from_valid(mesh)?,
-    };
+    let surface = Surface::from_valid_and_file(mesh, embedding.as_deref())?;
     let (n, m) = (surface.n_vertices(), surface.n_faces());
     let app = wavg_serve::App::new(surface);
     let addr = std::net::SocketAddr::new(args.host, args.port);

@@ -94,6 +94,23 @@ impl Surface {
         })
     }
 
+    /// A surface on an already validated mesh, with the embedding read from the `.wavg`
+    /// file `embedding` when one is given: the projector is built once, on the embedding,
+    /// never first on the 3-D positions (at 10M vertices that would be gigabytes).
+    pub fn from_valid_and_file(
+        mesh: impl Into<Arc<ValidMesh>>,
+        embedding: Option<&Path>,
+    ) -> Result<Self> {
+        let mesh = mesh.into();
+        match embedding {
+            None => Self::from_valid(mesh),
+            Some(path) => {
+                let e = wavg_embed::file::load(path, &mesh)?;
+                Self::from_valid_with_embedding(mesh, e)
+            }
+        }
+    }
+
     /// A surface from flat arrays: vertex positions and counter-clockwise triangles
     /// (0-based vertex indices). Out-of-range indices and non-finite coordinates are
     /// reported as an invalid mesh.

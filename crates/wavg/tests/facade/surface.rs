@@ -73,6 +73,17 @@ fn precompute_save_load_round_trip() {
     t.load_embedding(&path).unwrap();
     assert_eq!(t.embedding(), s.embedding());
     assert_eq!(t.embedded_coords(), s.embedded_coords());
+    // Built once on the file's embedding: the same surface as loading it afterwards.
+    let mesh = wavg::ValidMesh::new(procedural::torus(32, 12, 1.0, 0.35)).unwrap();
+    let once = Surface::from_valid_and_file(mesh.clone(), Some(&path)).unwrap();
+    assert_eq!(once.embedding(), s.embedding());
+    assert_eq!(once.embedded_coords(), s.embedded_coords());
+    assert!(
+        Surface::from_valid_and_file(mesh, None)
+            .unwrap()
+            .embedding()
+            .is_none()
+    );
 
     // Loading onto another mesh fails and leaves the surface as it was.
     let mut other = Surface::from_mesh(procedural::icosphere(2)).unwrap();
