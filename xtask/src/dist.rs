@@ -339,7 +339,7 @@ fn check_glibc(lib: &Path) -> Result<(), String> {
 /// crate using a new item of another would be verified against that crate's old source.
 fn crates(root: &Path, dist: &Path) -> Result<(), String> {
     let verify = steps::target_dir(root).join("package-verify");
-    forget_packaged(&verify)?;
+    forget_packaged(cargo_home().as_deref(), &verify)?;
     let verify_arg = verify.to_string_lossy().into_owned();
     let mut args = vec![
         "package",
@@ -375,13 +375,18 @@ fn crates(root: &Path, dist: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Removes what an earlier `cargo package` left of the workspace's own crates: their
-/// sources unpacked under cargo's home (the local registries, whose folder names start
-/// with `-`) and everything compiled from them in the verification's target directory.
-fn forget_packaged(verify: &Path) -> Result<(), String> {
-    let home = std::env::var_os("CARGO_HOME")
+/// Cargo's home: `$CARGO_HOME`, else `~/.cargo`.
+fn cargo_home() -> Option<PathBuf> {
+    std::env::var_os("CARGO_HOME")
         .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")));
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")))
+}
+
+/// Removes what an earlier `cargo package` left of the workspace's own crates: their
+/// sources unpacked under cargo's home `home` (in the local registries, whose folder names
+/// start with `-`) and everything compiled from them in the verification's target
+/// directory `verify`. Crates from crates.io and their artifacts stay.
+fn forget_packaged(home: Option<&Path>, verify: &Path) -> Result<(), String> {
     let mut doomed = Vec::new();
     if let Some(src) = home.map(|h| h.join("registry").join("src")) {
         for registry in entries(&src) {
@@ -453,4 +458,47 @@ fn list_files(base: &Path, dir: &Path, out: &mut Vec<String>) -> Result<(), Stri
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_workspace_crates_left_by_packaging_are_forgotten() {
+        let dir = std::env::temp_dir().join(format!("wavg-forget-test-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let (home, verify) = (dir.join("home"), dir.join("verify"));
+        let made = [
+            "home/registry/src/-0123/wavg-0.1.0/src/lib.rs",
+            "home/registry/src/-0123/wavg-mesh-0.1.0/Cargo.toml",
+            "home/registry/src/index.crates.io-99/wavg-other-1.0.0/Cargo.toml",
+            "home/registry/src/index.crates.io-99/faer-0.22.0/Cargo.toml",
+            "verify/debug/.fingerprint/wavg-mesh-abc/lib-wavg_mesh",
+            "verify/debug/.fingerprint/faer-abc/lib-faer",
+            "verify/debug/deps/libwavg_mesh-abc.rlib",
+            "verify/debug/deps/libfaer-abc.rlib",
+            "verify/debug/build/wavg-ffi-abc/output",
+            "verify/package/wavg-0.1.0.crate",
+        ];
+        for file in made {
+            let path = dir.join(file);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, "x").unwrap();
+        }
+        forget_packaged(Some(&home), &verify).unwrap();
+        let kept: Vec<_> = made.iter().filter(|f| dir.join(f).exists()).collect();
+        assert_eq!(
+            kept,
+            [
+                &"home/registry/src/index.crates.io-99/wavg-other-1.0.0/Cargo.toml",
+                &"home/registry/src/index.crates.io-99/faer-0.22.0/Cargo.toml",
+                &"verify/debug/.fingerprint/faer-abc/lib-faer",
+                &"verify/debug/deps/libfaer-abc.rlib",
+            ]
+        );
+        // Nothing to forget, or no cargo home at all, is fine.
+        forget_packaged(None, &dir.join("missing")).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
