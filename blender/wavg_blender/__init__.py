@@ -13,7 +13,7 @@ bl_info = {
 
 import bpy
 
-from . import (common, errors, group_cache, live, meshdata, op_decal, op_point,
+from . import (common, errors, group_cache, live, memo, meshdata, op_decal, op_point,
                op_precompute, op_spline, op_transfer, surfaces, transfer_data, ui)
 
 OPERATORS = (
@@ -31,11 +31,11 @@ def register():
         bpy.utils.register_class(cls)
     ui.register()
     live.register()
-    group_cache.register()
+    memo.register()
 
 
 def unregister():
-    group_cache.unregister()
+    memo.unregister()
     live.unregister()
     ui.unregister()
     for cls in reversed(OPERATORS):

@@ -4,6 +4,7 @@ selection order), vertex groups, point attributes and UV layers. Nothing here ch
 scene."""
 
 import hashlib
+from functools import cached_property
 
 import bmesh
 import numpy as np
@@ -51,9 +52,9 @@ class MeshInput:
             self._tri_loops = loops.reshape(-1, 3).astype(np.int64)
         return self._tri_loops
 
-    @property
+    @cached_property
     def diagonal(self):
-        """Length of the bounding-box diagonal (object space)."""
+        """Length of the bounding-box diagonal (object space; computed once)."""
         return float(np.linalg.norm(self.V.max(axis=0) - self.V.min(axis=0)))
 
 
@@ -72,32 +73,51 @@ def fingerprint(co, tris):
 def selected_vertices(obj, ordered=True):
     """``(ordered, selected)``: the selected vertices in selection order (the select
     history: ``bmesh`` in Edit mode, the order stored in the mesh in Object mode; empty when
-    ``ordered`` is false, which skips reading it) and all selected vertex ids by id."""
+    ``ordered`` is false, which skips reading it) and all selected vertex ids by id (a
+    NumPy array).
+
+    Read without visiting every vertex from Python: in Object mode the selection flags in
+    bulk; in Edit mode, when the history holds every selected vertex (they were
+    Shift-clicked), the history itself, else the flags of the mesh synced from Edit mode."""
     me = obj.data
-    if obj.mode != 'EDIT' and not ordered:
+    if obj.mode != 'EDIT':
         flags = np.zeros(len(me.vertices), dtype=bool)
         me.vertices.foreach_get("select", flags)
-        return [], np.flatnonzero(flags).tolist()
-    if obj.mode == 'EDIT':
+        selected = np.flatnonzero(flags)
+        if not ordered:
+            return [], selected
+        if len(selected) == 0:
+            return [], selected
+        bm = bmesh.new()
+        try:  # only the select history is read: no normals
+            bm.from_mesh(me, face_normals=False, vertex_normals=False)
+        except TypeError:
+            bm.from_mesh(me)
+        owned = True
+    else:
         bm = bmesh.from_edit_mesh(me)
         owned = False
-    else:
-        bm = bmesh.new()
-        bm.from_mesh(me)
-        owned = True
+        selected = None
     try:
         bm.verts.index_update()
-        selected = [v.index for v in bm.verts if v.select]
         history = []
         seen = set()
-        for elem in bm.select_history if ordered else ():
+        for elem in bm.select_history:
             if isinstance(elem, bmesh.types.BMVert) and elem.select and elem.index not in seen:
                 seen.add(elem.index)
                 history.append(elem.index)
+        if selected is None:
+            if len(history) == me.total_vert_sel:
+                selected = np.array(sorted(history), dtype=np.int64)
+            else:
+                obj.update_from_editmode()
+                flags = np.zeros(len(me.vertices), dtype=bool)
+                me.vertices.foreach_get("select", flags)
+                selected = np.flatnonzero(flags)
     finally:
         if owned:
             bm.free()
-    return history, selected
+    return history if ordered else [], selected
 
 
 def vertex_group(obj, name):

@@ -53,7 +53,7 @@ class WAVG_OT_place_point(ActiveMeshOperator, bpy.types.Operator):
         obj = active_mesh(context)
         surface, mesh = surfaces.surface_of(obj)
         _, selected = selected_vertices(obj, ordered=False)
-        if not selected:
+        if len(selected) == 0:
             raise AddonError("select at least one vertex of the mesh (in Edit mode)")
         anchors = np.array(selected, dtype=np.int64)
         weights = anchor_weights(obj, anchors, self.group)

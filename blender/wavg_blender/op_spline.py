@@ -120,6 +120,7 @@ class WAVG_OT_surface_spline(ActiveMeshOperator, bpy.types.Operator):
         curve_obj["wavg_bezier"] = self.bezier
         curve_obj["wavg_samples"] = len(pts.ok)
         store_control(curve_obj, faces, bary)
+        cvs = []
         for i, v in enumerate(control):
             cv = bpy.data.objects.new("wavg_cv", None)
             cv.empty_display_type = 'SPHERE'
@@ -130,6 +131,15 @@ class WAVG_OT_surface_spline(ActiveMeshOperator, bpy.types.Operator):
             cv.location = mesh.V[v]
             cv["wavg_curve"] = curve_obj
             cv["wavg_index"] = i
+            cvs.append(cv)
+        # The control points sit on their vertices: the live update that follows the new
+        # Empties finds them snapped already and the curve evaluated for them.
+        _SNAPS[curve_obj.name] = (
+            mesh.key,
+            [tuple(c.location) for c in cvs],
+            (np.asarray(faces, dtype=np.int64), np.asarray(bary, dtype=np.float64),
+             mesh.V[control], np.zeros(len(control))),
+        )
         ok = int(np.count_nonzero(pts.ok))
         self.report({'INFO'}, f"{curve_obj.name}: {ok} of {len(pts.ok)} samples on the surface")
         return {'FINISHED'}

@@ -8,7 +8,8 @@ command line and Python find them too) while the ``.blend`` is unsaved. The opti
 precompute used are kept on the object (custom properties ``wavg_landmarks``, 0 for the
 library's choice, and ``wavg_seed``), so a lookup uses the same key. Loaded surfaces are
 kept in memory by the mesh's fingerprint, so moving a control point does not read the file
-again.
+again, and the mesh read from an object is kept until its geometry changes (:mod:`.memo`),
+so an operator run again neither reads nor hashes it.
 """
 
 import os
@@ -17,6 +18,7 @@ import bpy
 import numpy as np
 from mathutils.bvhtree import BVHTree
 
+from . import memo
 from .errors import AddonError, describe, wavg
 from .meshdata import MeshInput
 
@@ -24,6 +26,8 @@ from .meshdata import MeshInput
 _SURFACES = {}
 # Positions, triangles and BVH tree of each surface (see `geometry`), by mesh fingerprint.
 _TREES = {}
+# Object pointer -> (key, MeshInput): the mesh read last from each object.
+_MESHES = memo.store()
 
 
 def user_cache_dir():
@@ -128,11 +132,25 @@ def cached(key):
     return _SURFACES.get(key)
 
 
+def mesh_input(obj):
+    """The :class:`MeshInput` of the mesh object ``obj``, from memory while the object, its
+    mode and its geometry are those it was read with."""
+    if obj is None or obj.type != 'MESH':
+        return MeshInput(obj)  # says why not
+    memo.settle(bpy.context)
+    entry = _MESHES.get(obj.as_pointer())
+    if entry is not None and entry[0] == memo.identity(obj):
+        return entry[1]
+    mesh = MeshInput(obj)
+    _MESHES[obj.as_pointer()] = (memo.identity(obj), mesh)
+    return mesh
+
+
 def surface_of(obj):
     """``(surface, mesh)`` for the mesh object ``obj``: the mesh as arrays and its
     ``wavg.Surface`` with the embedding from memory or the cache. An object without
     embedding is an :class:`AddonError` telling to run wavg.precompute."""
-    mesh = MeshInput(obj)
+    mesh = mesh_input(obj)
     s = _SURFACES.get(mesh.key)
     if s is not None:
         return s, mesh
@@ -161,9 +179,10 @@ def geometry(key, surface):
 
 
 def forget_all():
-    """Drops the in-memory surfaces (e.g. when the add-on is disabled)."""
+    """Drops the in-memory surfaces and meshes (e.g. when the add-on is disabled)."""
     _SURFACES.clear()
     _TREES.clear()
+    _MESHES.clear()
 
 
 def textured(mesh, uv):
