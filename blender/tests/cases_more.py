@@ -2,8 +2,10 @@
 
 import os
 
+import bmesh
 import bpy
 import numpy as np
+from mathutils import Vector
 
 import scene
 from cases import (UNDO, check_undo, decal_setup, expect_error, precompute, spline_controls,
@@ -306,5 +308,61 @@ def test_decal_anchor_cache(ctx):
     assert not group_cache._ENTRIES, "entries survived an undo"
 
 
+def bmesh_edit_move(obj, v, offset):
+    """Moves vertex ``v`` of ``obj`` (in Edit mode) by ``offset`` as a tool does."""
+    bm = bmesh.from_edit_mesh(obj.data)
+    bm.verts.ensure_lookup_table()
+    bm.verts[v].co += Vector(offset)
+    bmesh.update_edit_mesh(obj.data)
+
+
+def test_mesh_memo(ctx):
+    """An operator run again reuses the mesh it read (no read, no hash); every edit of the
+    geometry, in Object and Edit mode, and undo are seen: an edited mesh has no embedding,
+    and the mesh restored has its own again."""
+    from wavg_blender import surfaces
+
+    ico = scene.icosphere("ico", subdivisions=3)
+    precompute(ico)
+    ico = bpy.data.objects["ico"]
+    scene.select_in_order(ico, [0, 5, 9], edit=False)
+    first = surfaces.mesh_input(ico)
+    assert surfaces.mesh_input(ico) is first, "an unchanged mesh was read again"
+    bpy.ops.wavg.place_point()
+    assert surfaces.mesh_input(ico) is first, "placing a point made the mesh be read again"
+
+    me = ico.data
+    co = me.vertices[7].co.copy()
+    me.vertices[7].co.x += 0.05
+    me.update()
+    expect_error("point on a moved vertex", bpy.ops.wavg.place_point, "has no embedding")
+    me.vertices[7].co = co
+    me.update()
+    bpy.ops.wavg.place_point()
+
+    scene.select_in_order(ico, [0, 5, 9], edit=True)
+    edit = surfaces.mesh_input(ico)
+    assert surfaces.mesh_input(ico) is edit, "an unchanged mesh was read again in Edit mode"
+    bpy.ops.wavg.place_point()
+    bmesh_edit_move(ico, 7, (0.05, 0.0, 0.0))
+    moved = surfaces.mesh_input(ico)  # synced out of Edit mode: the snapshot sees the move
+    assert moved is not edit and moved.key != edit.key, "a move in Edit mode was not seen"
+    expect_error("point on a vertex moved in Edit mode", bpy.ops.wavg.place_point,
+                 "has no embedding")
+    bmesh_edit_move(ico, 7, (-0.05, 0.0, 0.0))
+    bpy.ops.wavg.place_point()
+    bpy.ops.object.mode_set(mode='OBJECT')
+
+    bpy.ops.ed.undo_push(message="before the move")
+    me = bpy.data.objects["ico"].data
+    me.vertices[7].co.x += 0.05
+    me.update()
+    bpy.ops.ed.undo_push(message="moved")
+    expect_error("point on a moved vertex", bpy.ops.wavg.place_point, "has no embedding")
+    bpy.ops.ed.undo()
+    scene.select_in_order(bpy.data.objects["ico"], [0, 5, 9], edit=False)
+    bpy.ops.wavg.place_point()
+
+
 TESTS = [test_transfer, test_precompute_cancel, test_undo, test_bad_inputs,
-         test_precompute_beside_blend, test_decal_anchor_cache]
+         test_precompute_beside_blend, test_decal_anchor_cache, test_mesh_memo]

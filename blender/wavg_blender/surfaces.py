@@ -142,6 +142,8 @@ def mesh_input(obj):
     if entry is not None and entry[0] == memo.identity(obj):
         return entry[1]
     mesh = MeshInput(obj)
+    if obj.mode == 'EDIT':
+        memo.settle(bpy.context)  # the sync out of Edit mode tagged the mesh: not an edit
     _MESHES[obj.as_pointer()] = (memo.identity(obj), mesh)
     return mesh
 
