@@ -301,6 +301,16 @@ def test_decal_anchor_cache(ctx):
         check_decal(ico, anchors)
         group.add([anchors[-1]], 0.0, 'REPLACE')
         anchors = anchors[:-1]
+    from wavg_blender import surfaces
+
+    read = surfaces.mesh_input(ico)
+    bpy.ops.wavg.decal_uv()
+    assert surfaces.mesh_input(ico) is read, "the decal's own writes made the mesh be read again"
+    invalid = scene.group_ids(ico, "wavg_invalid")
+    assert invalid, "this decal marks no vertex"
+    ico.vertex_groups["wavg_invalid"].remove(invalid[:1])
+    bpy.ops.wavg.decal_uv()
+    check_decal(ico, anchors)  # the edited wavg_invalid written again
     bpy.ops.ed.undo_push(message="before decal")
     bpy.ops.wavg.decal_uv(*UNDO)
     assert group_cache._ENTRIES, "the anchors read were not kept"

@@ -36,9 +36,15 @@ def check_uv_layer_room(obj, name):
         )
 
 
-def set_invalid_group(obj, ids):
-    """Vertex group ``wavg_invalid`` of ``obj`` holds exactly ``ids`` (weight 1)."""
+def set_invalid_group(obj, ids, known=None):
+    """Vertex group ``wavg_invalid`` of ``obj`` holds exactly ``ids`` (weight 1); nothing
+    is written when ``known`` (its members as :func:`.group_cache.known` gives them) says it
+    does already."""
     old = obj.vertex_groups.get(INVALID_GROUP)
+    if old is not None and known is not None and np.array_equal(known[0], ids) and np.all(
+        known[1] == 1.0
+    ):
+        return
     if old is not None:
         obj.vertex_groups.remove(old)
     group = obj.vertex_groups.new(name=INVALID_GROUP)
@@ -68,8 +74,11 @@ class WAVG_OT_decal_uv(ActiveMeshOperator, bpy.types.Operator):
         obj = active_mesh(context)
         if not self.uv_layer:
             raise AddonError("give the name of the UV layer to write")
-        surface, _mesh = surfaces.surface_of(obj)
+        surface, mesh = surfaces.surface_of(obj)
         anchors, weights = group_cache.members(context, obj, vertex_group(obj, self.group))
+        old_invalid = obj.vertex_groups.get(INVALID_GROUP)
+        if old_invalid is not None:
+            old_invalid = group_cache.known(obj, old_invalid)
         if len(anchors) < 3:
             raise AddonError(
                 f"too few anchors: vertex group '{self.group}' holds {len(anchors)} "
@@ -88,9 +97,14 @@ class WAVG_OT_decal_uv(ActiveMeshOperator, bpy.types.Operator):
         valid = np.asarray(valid, dtype=bool)
         with object_mode(context):
             set_uv_layer(obj, self.uv_layer, np.where(np.isfinite(uv), uv, 0.0))
-            set_invalid_group(obj, np.flatnonzero(~valid))
+            invalid = np.flatnonzero(~valid)
+            set_invalid_group(obj, invalid, old_invalid)
+        # What was written is known; neither write changed the geometry read.
+        kept = {INVALID_GROUP: (invalid, np.ones(len(invalid)))}
         if self.group != INVALID_GROUP:
-            group_cache.keep(context, obj, self.group, anchors, weights)
+            kept[self.group] = (anchors, weights)
+        group_cache.keep(context, obj, kept)
+        surfaces.keep_mesh(obj, mesh)
         fraction = float(valid.mean())
         self.report(
             {'INFO'},

@@ -148,6 +148,14 @@ def mesh_input(obj):
     return mesh
 
 
+def keep_mesh(obj, mesh):
+    """After an operator wrote data of ``obj``'s mesh other than its positions and faces
+    (UV layers, vertex groups) and evaluated those writes: ``mesh`` is still what
+    :func:`mesh_input` would read (Object mode only)."""
+    if obj.mode == 'OBJECT' and mesh.obj == obj:
+        _MESHES[obj.as_pointer()] = (memo.identity(obj), mesh)
+
+
 def surface_of(obj):
     """``(surface, mesh)`` for the mesh object ``obj``: the mesh as arrays and its
     ``wavg.Surface`` with the embedding from memory or the cache. An object without
