@@ -75,7 +75,7 @@ class Table:
 
 def test_bench(ctx):
     w = wavg()
-    from wavg_blender import op_spline, surfaces
+    from wavg_blender import op_point, op_spline, surfaces
 
     table = Table()
     big = scene.uv_sphere("big", u=256, v=100)
@@ -88,6 +88,14 @@ def test_bench(ctx):
     table.add("`wavg.precompute` again (the cached entry read; shows progress)",
               measure(lambda i: bpy.ops.wavg.precompute(*UNDO), 3))
     s = surfaces.surface_of(big)[0]
+    scene.select_in_order(big, [0], edit=False)
+
+    def forget(i):
+        surfaces.forget_all()
+
+    table.add("`wavg.place_point`, the first operator on the mesh in the session (the "
+              "embedding read from the cache)",
+              measure(lambda i: bpy.ops.wavg.place_point(*UNDO), 3, forget))
 
     dirs = [(1, 0, 0.3), (0.5, 0.8, 0.1), (-0.5, 0.8, -0.2), (-1, 0, 0.2), (-0.4, -0.9, 0.3),
             (0.6, -0.7, -0.1)]
@@ -111,6 +119,8 @@ def test_bench(ctx):
     table.add("`wavg.surface_spline`, Edit mode",
               measure(lambda i: bpy.ops.wavg.surface_spline(*UNDO, samples=SAMPLES), CLICKS),
               CLICK_MS)
+    table.add("`wavg.place_point`, Edit mode, without the undo step (Blender's mesh copy)",
+              measure(lambda i: bpy.ops.wavg.place_point(), CLICKS))
     bpy.ops.object.mode_set(mode='OBJECT')
 
     anchors, uv = decal_inputs(big)
@@ -144,8 +154,8 @@ def test_bench(ctx):
         a = 2 * math.pi * i / DRAGS
         cv.location = base + r * np.array([math.cos(a), math.sin(a), 0.3])
 
-    drag(0)
-    bpy.context.view_layer.update()  # the first move builds the closest-point tree
+    table.add("live spline: the first move of a control point",
+              measure(lambda i: bpy.context.view_layer.update(), 1, drag))
     table.add("live spline: a control point dragged, through the depsgraph handler "
               "(`view_layer.update`, Blender's own evaluation included)",
               measure(lambda i: bpy.context.view_layer.update(), DRAGS, lambda i: drag(i + 1)),
@@ -174,6 +184,8 @@ def test_bench(ctx):
               "handler", measure(lambda i: bpy.context.view_layer.update(), DRAGS // 2, paint),
               DRAG_MS)
     assert tuple(point.location) != before, "the point did not follow its weights"
+    table.add("of which the add-on's update (`follow_weights`)",
+              measure(lambda i: op_point.follow_weights(point), DRAGS // 2, lambda i: paint(i + 1)))
 
     # The transfer onto a copy of the mesh (its embedding is the same cache entry).
     dst = big.copy()

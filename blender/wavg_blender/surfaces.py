@@ -122,9 +122,12 @@ def new_surface(mesh):
 
 
 def remember(key, surface):
-    """Keeps ``surface`` (with its embedding) in memory under ``key``."""
+    """Keeps ``surface`` (with its embedding) in memory under ``key``, with its
+    closest-point tree: built here, in the one-off of loading or computing the embedding
+    (~40 ms on 25k vertices), not at the first move of a spline's control point."""
     _SURFACES[key] = surface
     _TREES.pop(key, None)
+    geometry(key, surface)
 
 
 def cached(key):
