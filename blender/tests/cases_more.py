@@ -374,5 +374,35 @@ def test_mesh_memo(ctx):
     bpy.ops.wavg.place_point()
 
 
+def test_read_ahead(ctx):
+    """The embedding recorded on a mesh is read in a worker thread when the mesh becomes
+    active: the first operator on it takes that surface instead of reading it, with the
+    same result; a mesh without embedding starts no read, nor does a second activation."""
+    from wavg_blender import activation, background, surfaces
+
+    ico = scene.icosphere("ico", subdivisions=3)
+    precompute(ico)
+    ico = bpy.data.objects["ico"]
+    other = scene.icosphere("other", subdivisions=1)
+    surfaces.forget_all()
+    started = background.STARTED[0]
+    scene.activate(other)
+    assert not activation.read_active(), "a read started for a mesh without embedding"
+    scene.select_in_order(ico, [0, 5, 9], edit=False)
+    assert activation.read_active(), "no read started for the active mesh"
+    assert not activation.read_active(), "a second read of the same mesh started"
+    assert background.STARTED[0] == started + 1
+    loads = surfaces.LOADS[0]
+    bpy.ops.wavg.place_point()
+    assert surfaces.LOADS[0] == loads, "the operator read the embedding again"
+    ahead = np.array(bpy.context.view_layer.objects["wavg_point"].location)
+    surfaces.forget_all()
+    bpy.ops.wavg.place_point()
+    assert surfaces.LOADS[0] > loads, "the embedding was not read without the read ahead"
+    again = np.array(bpy.context.view_layer.objects["wavg_point.001"].location)
+    assert np.array_equal(ahead, again), f"read ahead {ahead}, read by the operator {again}"
+
+
 TESTS = [test_transfer, test_precompute_cancel, test_undo, test_bad_inputs,
-         test_precompute_beside_blend, test_decal_anchor_cache, test_mesh_memo]
+         test_precompute_beside_blend, test_decal_anchor_cache, test_mesh_memo,
+         test_read_ahead]

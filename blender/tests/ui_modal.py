@@ -1,5 +1,7 @@
 """The interactive precompute in a real Blender window (not background mode): its modal
-operator runs wavg in a worker thread, shows progress in the status bar, and Esc cancels.
+operator runs wavg in a worker thread, shows progress in the status bar, and Esc cancels;
+then making the mesh active reads its embedding ahead (a subscription to the active object,
+which only a window's event loop delivers).
 Needs a display (Xvfb is enough) and Blender's event simulation:
 
     xvfb-run -a blender --factory-startup --enable-event-simulate \\
@@ -140,6 +142,23 @@ def step():
             stem = entry[: -len(".wavg")] if entry.endswith(".wavg") else entry
             check("precompute finishes and writes the cache", entry and files == [stem + ".json", entry],
                   str(files))
+            from wavg_blender import surfaces
+
+            # Made active again (as a click does), the mesh's embedding is read ahead.
+            surfaces.forget_all()
+            bpy.context.view_layer.objects.active = None
+            bpy.context.view_layer.objects.active = obj
+            STATE.update(phase="ahead", t=time.time())
+            return 0.2
+        if phase == "ahead":
+            from wavg_blender import background
+
+            read = background._READS.get(obj["wavg_key"])
+            if (read is None or read.thread.is_alive()) and time.time() - STATE["t"] < 60:
+                return 0.2
+            check("making the mesh active reads its embedding ahead",
+                  read is not None and read.result is not None,
+                  f"(after {time.time() - STATE['t']:.1f} s)")
             finish()
     except Exception:
         traceback.print_exc()

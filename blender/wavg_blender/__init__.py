@@ -13,8 +13,9 @@ bl_info = {
 
 import bpy
 
-from . import (common, errors, group_cache, live, memo, meshdata, op_decal, op_point,
-               op_precompute, op_spline, op_transfer, surfaces, transfer_data, ui)
+from . import (activation, background, common, errors, group_cache, live, memo, meshdata,
+               op_decal, op_point, op_precompute, op_spline, op_transfer, surfaces,
+               transfer_data, ui)
 
 OPERATORS = (
     op_precompute.WAVG_OT_precompute,
@@ -32,9 +33,11 @@ def register():
     ui.register()
     live.register()
     memo.register()
+    activation.register()
 
 
 def unregister():
+    activation.unregister()
     memo.unregister()
     live.unregister()
     ui.unregister()
