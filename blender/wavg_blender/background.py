@@ -34,8 +34,11 @@ class _Read:
             self.result = None
 
 
-# Mesh fingerprint -> its read, started and not yet taken.
+# Mesh fingerprint -> its read, started and not yet taken (oldest first).
 _READS = {}
+#: Reads kept waiting to be taken: activating many meshes in turn does not keep all of them
+#: in memory.
+MAX_READS = 4
 # Reads started (for tests).
 STARTED = [0]
 
@@ -45,6 +48,8 @@ def start(mesh, options, dirs):
     from the folders ``dirs``; False when a read of that mesh is under way already."""
     if mesh.key in _READS:
         return False
+    while len(_READS) >= MAX_READS:
+        del _READS[next(iter(_READS))]  # a running read ends on its own, unused
     read = _Read(mesh, options, dirs)
     _READS[mesh.key] = read
     read.thread.start()
