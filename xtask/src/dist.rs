@@ -24,9 +24,16 @@ pub const MANYLINUX: &str = "manylinux_2_28";
 const ZIG_TRIPLE: &str = "x86_64-unknown-linux-gnu";
 /// The platform of the C tarball's name.
 const PLATFORM: &str = "linux-x86_64";
-/// The crates the release leaves out: automation, the lab and the fuzz targets (not
-/// published) and the Python extension's crate (shipped as the wheel).
-const NOT_PACKAGED: &[&str] = &["xtask", "wavg-lab", "wavg-fuzz", "wavg-py", "wavg-testdata"];
+/// The crates the release leaves out: automation, the lab, the fuzz targets, test and
+/// build support (not published) and the Python extension's crate (shipped as the wheel).
+pub const NOT_PACKAGED: &[&str] = &[
+    "xtask",
+    "wavg-lab",
+    "wavg-fuzz",
+    "wavg-py",
+    "wavg-testdata",
+    "wavg-hack",
+];
 
 /// The artifacts of one `dist` run.
 pub struct Artifacts {

@@ -8,6 +8,7 @@ mod cbuild;
 mod cli_docs;
 mod dist;
 mod examples;
+mod features;
 mod fuzz;
 mod gltf;
 mod installed;
@@ -193,7 +194,7 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
         steps::cargo_workspace_env(root, &["test"], &[], &[(gltf::DIR_VAR, &gltf_dir)])
     }) && log.run(
         &format!(
-            "source policy (files over {} lines, forbid(unsafe_code), module style, one test binary per crate, the map, one version)",
+            "source policy (files over {} lines, forbid(unsafe_code), module style, one test binary per crate, the map, one version, one build of each dependency)",
             lines::MAX_LINES
         ),
         || {
@@ -203,6 +204,7 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
                 .and_then(|()| policy::check_test_binaries(root))
                 .and_then(|()| map::check(root))
                 .and_then(|()| version::check(root))
+                .and_then(|()| features::check(root))
         },
     ) && log.run("docs (cargo doc, warnings as errors)", || {
         steps::command_env(
