@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use wavg_mesh::ValidMesh;
 
-use crate::decimate::{DecimateOptions, Decimated, decimate_beside};
+use crate::decimate::{DecimateOptions, Decimated, decimate_beside, decimate_with_snapshots};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
 use crate::geodesic::{FastMarching, GeodesicOptions, landmark_distances};
@@ -236,6 +236,24 @@ pub(crate) fn precompute_unscaled(
     //    least-squares mesh): `target` of them, keeping `locked`, with `alongside` run
     //    beside the decimation's collapses (after its first pass).
     type Alongside<'a> = Box<dyn FnOnce() -> QualityOut + Send + 'a>;
+    // The intermediate meshes' sizes for `target` landmarks: the geodesics' and the
+    // two-level least-squares mesh's, each if used.
+    let snapshot_sizes = |target: usize| {
+        let use_coarse = opts.geodesic_vertices > target && opts.geodesic_vertices < n;
+        let two_level = n > opts.lsmesh_direct_max
+            && opts.lsmesh_coarse_vertices > target
+            && opts.lsmesh_coarse_vertices < n;
+        [
+            use_coarse.then_some(opts.geodesic_vertices),
+            two_level.then_some(opts.lsmesh_coarse_vertices),
+        ]
+    };
+    let decimate_options = |target: usize, locked: Vec<u32>| DecimateOptions {
+        target,
+        max_aspect_ratio: landmark_aspect_bound(mesh, opts.decimate.max_aspect_ratio),
+        locked,
+        ..opts.decimate.clone()
+    };
     let select = |target: usize, locked: &[u32], alongside: Option<Alongside<'_>>| {
         let t = Instant::now();
         let run = move || alongside.map(|f| f());
@@ -243,30 +261,60 @@ pub(crate) fn precompute_unscaled(
             let all = ((0..n as u32).collect::<Vec<u32>>(), None, None, secs(t));
             return (Ok(all), run());
         }
-        let use_coarse = opts.geodesic_vertices > target && opts.geodesic_vertices < n;
-        let two_level = n > opts.lsmesh_direct_max
-            && opts.lsmesh_coarse_vertices > target
-            && opts.lsmesh_coarse_vertices < n;
-        let d = DecimateOptions {
-            target,
-            max_aspect_ratio: landmark_aspect_bound(mesh, opts.decimate.max_aspect_ratio),
-            locked: locked.to_vec(),
-            ..opts.decimate.clone()
-        };
-        let sizes: Vec<usize> = [
-            (use_coarse, opts.geodesic_vertices),
-            (two_level, opts.lsmesh_coarse_vertices),
-        ]
-        .iter()
-        .filter_map(|&(on, s)| on.then_some(s))
-        .collect();
+        let [coarse_size, ls_size] = snapshot_sizes(target);
+        let d = decimate_options(target, locked.to_vec());
+        let sizes: Vec<usize> = [coarse_size, ls_size].into_iter().flatten().collect();
         let (res, other, end) = decimate_beside(mesh, &d, &sizes, progress, run);
         let res = res.map(|(fin, mut snaps)| {
-            let ls = if two_level { snaps.pop() } else { None };
-            let coarse = if use_coarse { snaps.pop() } else { None };
+            let ls = if ls_size.is_some() { snaps.pop() } else { None };
+            let coarse = if coarse_size.is_some() {
+                snaps.pop()
+            } else {
+                None
+            };
             (fin.landmarks, coarse, ls, (end - t).as_secs_f64())
         });
         (res, other.flatten())
+    };
+    // A later round's selection, restarted from `base`, the finest intermediate mesh of
+    // the round before (which holds every locked vertex): the full mesh is not decimated
+    // again.
+    let reselect = |base: &Decimated, target: usize, locked: &[u32]| {
+        let t = Instant::now();
+        let sizes = snapshot_sizes(target);
+        let nb = base.landmarks.len();
+        let local = (locked.iter())
+            .map(|&l| base.coarse_index(l))
+            .collect::<Option<Vec<u32>>>();
+        let (Some(local), true) = (local, sizes.iter().flatten().all(|&s| s <= nb)) else {
+            return select(target, locked, None).0;
+        };
+        let base_mesh = ValidMesh::new(base.mesh.clone())
+            .map_err(|e| EmbedError::InvalidArgument(format!("intermediate mesh: {e}")))?;
+        let d = DecimateOptions {
+            first_pass_vertices: 0,
+            ..decimate_options(target, local)
+        };
+        let smaller: Vec<usize> = sizes
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&s| s < nb)
+            .collect();
+        let (fin, snaps) = decimate_with_snapshots(&base_mesh, &d, &smaller, progress)?;
+        let lift = |d: Decimated| Decimated {
+            landmarks: (d.landmarks.iter())
+                .map(|&v| base.landmarks[v as usize])
+                .collect(),
+            ..d
+        };
+        let mut snaps = snaps.into_iter().map(lift);
+        let [coarse, ls] = sizes.map(|s| match s {
+            Some(s) if s < nb => snaps.next(),
+            Some(_) => Some(base.clone()),
+            None => None,
+        });
+        Ok((lift(fin).landmarks, coarse, ls, secs(t)))
     };
     // The quality check's fast marching on the full mesh (it does not depend on the
     // embedding) runs beside the first selection's collapses, after the decimation's
@@ -315,8 +363,10 @@ pub(crate) fn precompute_unscaled(
     //    which depends only on the mesh and the landmarks, is factored alongside
     //    (sequential): this fills the second core during the geodesics' tail. Then, where
     //    the landmarks leave a thin part uncovered (see `thin`), the landmarks so far are
-    //    locked, more are added, and steps 1 and 2 run again (at most `THIN_PART_ROUNDS`
-    //    times, adding at most as many landmarks as asked for in all).
+    //    locked, more are added (on the finest intermediate mesh, when there is one),
+    //    and steps 1 and 2 run again (at most `THIN_PART_ROUNDS` times, adding at most as
+    //    many landmarks as asked for in all): the decimation restarts from that
+    //    intermediate mesh, not from the full one.
     let geodesics = |landmarks: &[u32], coarse: Option<&Decimated>, mid: Option<&Decimated>| {
         let t = Instant::now();
         let mut geo = GeodesicOptions::new();
@@ -374,10 +424,17 @@ pub(crate) fn precompute_unscaled(
             "thin parts: lsmesh factorisation"
         });
         check_cancel(progress)?;
+        // The finest intermediate mesh: later rounds restart from it.
+        let base = ls_coarse.as_ref().or(coarse.as_ref());
         let more = if opts.cover_thin_parts && round < THIN_PART_ROUNDS {
             let t = Instant::now();
-            let collapsed =
+            let mut collapsed =
                 thin::collapsed_vertices(mesh, &landmarks, &solver, round > 0, progress)?;
+            if let Some(b) = base {
+                let mut on_base = vec![false; n];
+                b.landmarks.iter().for_each(|&v| on_base[v as usize] = true);
+                collapsed.iter_mut().zip(on_base).for_each(|(c, b)| *c &= b);
+            }
             let limit = (opts.landmarks - added).min(n - landmarks.len());
             let more = thin::landmarks_to_add(mesh, &landmarks, &collapsed, limit);
             stages.decimate += secs(t);
@@ -400,12 +457,17 @@ pub(crate) fn precompute_unscaled(
         let next = [0, 1, 8]
             .into_iter()
             .filter(|extra| locked.len() + extra <= n)
-            .find_map(
-                |extra| match select(locked.len() + extra, &locked, None).0 {
+            .find_map(|extra| {
+                let target = locked.len() + extra;
+                let next = match base {
+                    Some(b) => reselect(b, target, &locked),
+                    None => select(target, &locked, None).0,
+                };
+                match next {
                     Err(EmbedError::InvalidArgument(_)) => None,
                     other => Some(other),
-                },
-            );
+                }
+            });
         match next {
             Some(next) => {
                 drop((coarse, ls_coarse));
@@ -584,6 +646,39 @@ mod tests {
             a.landmarks.len()
         );
         assert!(b.landmarks.iter().all(|l| a.landmarks.contains(l)));
+    }
+
+    /// Later thin-part rounds restart from the finest intermediate mesh of the first one
+    /// (the geodesics' mesh, or the two-level least-squares mesh's coarse level, where the
+    /// check also runs): every landmark, added ones included, is a vertex of it.
+    #[test]
+    fn thin_part_rounds_restart_from_the_intermediate_mesh() {
+        let tube = ValidMesh::new(procedural::torus(200, 12, 1.0, 0.02)).unwrap();
+        let tube = ValidMesh::new(wavg_mesh::subdivide::loop_subdivide(&tube).unwrap()).unwrap();
+        let geodesics_only = PrecomputeOptions {
+            quality_pairs: 0,
+            geodesic_vertices: 3000,
+            ..opts(60)
+        };
+        let two_level = PrecomputeOptions {
+            lsmesh_direct_max: 5000,
+            lsmesh_coarse_vertices: 4000,
+            ..geodesics_only.clone()
+        };
+        for (o, finest) in [(geodesics_only, 3000), (two_level, 4000)] {
+            let (emb, _) = precompute(&tube, &o, &NoProgress).unwrap();
+            assert!(emb.landmarks.len() > 60, "{}", emb.landmarks.len());
+            let d = DecimateOptions {
+                target: 60,
+                max_aspect_ratio: landmark_aspect_bound(&tube, o.decimate.max_aspect_ratio),
+                ..o.decimate.clone()
+            };
+            let (_, snaps) = decimate_with_snapshots(&tube, &d, &[finest], &NoProgress).unwrap();
+            let outside = (emb.landmarks.iter())
+                .filter(|&&l| snaps[0].coarse_index(l).is_none())
+                .count();
+            assert_eq!(outside, 0, "landmarks off the {finest}-vertex mesh");
+        }
     }
 
     fn check(mesh: TriMesh, landmarks: usize, p50: f64, p90: f64) -> (Embedding, Report) {

@@ -12,7 +12,7 @@ use std::collections::BinaryHeap;
 
 use wavg_mesh::ValidMesh;
 
-use crate::error::{EmbedError, Progress};
+use crate::error::{EmbedError, Progress, check_cancel};
 use crate::file::MAX_DIM;
 use crate::lsmesh::two_level::LsMeshExtension;
 
@@ -23,16 +23,23 @@ use crate::lsmesh::two_level::LsMeshExtension;
 /// landmark spacing drops below 0.1.
 pub(crate) const COLLAPSED_SCALE: f64 = 0.5;
 
-/// Landmarks are added only to meshes where at least [`COLLAPSE_TRIGGER_FACES`] faces
-/// shrink below this ([`COLLAPSED_SCALE`] then marks what to cover): a clear collapse of
+/// Landmarks are added only to meshes where faces of [`COLLAPSE_TRIGGER_AREA`] and at
+/// least [`COLLAPSE_TRIGGER_FACES`] shrink below this ([`COLLAPSED_SCALE`] then marks what to cover): a clear collapse of
 /// a part, which the meshes of the test data never show (at most one sliver), while
 /// their curved regions may dip below [`COLLAPSED_SCALE`] in a few faces, and pairs of
 /// vertices two edges apart on scans, where such a pair may be far closer than its
 /// edges, below the trigger too.
 pub(crate) const COLLAPSE_TRIGGER_SCALE: f64 = 0.1;
 
-/// Faces below [`COLLAPSE_TRIGGER_SCALE`] that start the additions: one ring around a
-/// tube of 8 vertices around.
+/// Area of the faces below [`COLLAPSE_TRIGGER_SCALE`] that starts the additions, in
+/// landmark spacings (the mesh's area over the landmark count): an area, not a face
+/// count, so that a mesh and its subdivisions agree. Thin parts measure 4-9 spacings
+/// (bodies' fingers and toes) to 45 (a tube 50 times thinner than its ring); smooth
+/// scans 0.02-0.06 whatever their resolution (horse, and its Loop subdivisions).
+pub(crate) const COLLAPSE_TRIGGER_AREA: f64 = 0.5;
+
+/// And at least this many faces below [`COLLAPSE_TRIGGER_SCALE`]: on coarse meshes, where
+/// a landmark spacing is a handful of faces, a single sliver is no thin part.
 pub(crate) const COLLAPSE_TRIGGER_FACES: usize = 16;
 
 /// The smaller singular value of the affine map taking triangle `p` onto triangle `q`
@@ -68,15 +75,54 @@ fn min_stretch(p: [[f64; 3]; 3], q: [&[f64]; 3]) -> f64 {
 }
 
 /// Vertices of faces and pairs that the least-squares extension of the landmarks' 3D
-/// positions collapses ([`COLLAPSED_SCALE`]), landmarks excluded; none unless
-/// [`COLLAPSE_TRIGGER_FACES`] faces shrink below [`COLLAPSE_TRIGGER_SCALE`] or
-/// `triggered` (an earlier round added landmarks).
+/// positions collapses ([`COLLAPSED_SCALE`]), landmarks excluded; none unless faces
+/// covering [`COLLAPSE_TRIGGER_AREA`] landmark spacings (and [`COLLAPSE_TRIGGER_FACES`])
+/// shrink below [`COLLAPSE_TRIGGER_SCALE`] or `triggered` (an earlier round added
+/// landmarks).
+///
+/// The check runs where the extension is exact: on the full mesh with a direct
+/// factorisation, on the coarse level of a two-level one (whose full-mesh solution stops
+/// early and keeps small-scale ripples of its prolongation that shrink faces of no
+/// part), marking coarse vertices only.
 pub(crate) fn collapsed_vertices(
     mesh: &ValidMesh,
     landmarks: &[u32],
     solver: &LsMeshExtension,
     triggered: bool,
     progress: &dyn Progress,
+) -> Result<Vec<bool>, EmbedError> {
+    match solver {
+        LsMeshExtension::Direct(s) => {
+            collapsed_on(mesh, landmarks, triggered, |values| s.solve(values, 3))
+        }
+        LsMeshExtension::TwoLevel(t) => {
+            let (coarse, ids, s) = t.coarse_level();
+            let local = landmarks
+                .iter()
+                .map(|&l| {
+                    ids.binary_search(&l).map(|i| i as u32).map_err(|_| {
+                        EmbedError::InvalidArgument(format!("landmark {l} is not a coarse vertex"))
+                    })
+                })
+                .collect::<Result<Vec<u32>, _>>()?;
+            check_cancel(progress)?;
+            let marks = collapsed_on(coarse, &local, triggered, |values| s.solve(values, 3))?;
+            let mut out = vec![false; mesh.n_vertices()];
+            for (&id, m) in ids.iter().zip(marks) {
+                out[id as usize] = m;
+            }
+            Ok(out)
+        }
+    }
+}
+
+/// [`collapsed_vertices`] on `mesh`, whose exact extension of the landmarks' values is
+/// `extend`.
+fn collapsed_on(
+    mesh: &ValidMesh,
+    landmarks: &[u32],
+    triggered: bool,
+    extend: impl FnOnce(&[[f64; MAX_DIM]]) -> Result<Vec<[f64; MAX_DIM]>, EmbedError>,
 ) -> Result<Vec<bool>, EmbedError> {
     let pos = &mesh.positions;
     let values: Vec<[f64; MAX_DIM]> = landmarks
@@ -88,21 +134,32 @@ pub(crate) fn collapsed_vertices(
             v
         })
         .collect();
-    let x = solver.solve(&values, 3, progress)?;
+    let x = extend(&values)?;
     let mut out = vec![false; mesh.n_vertices()];
-    let mut below_trigger = 0;
+    let (mut area, mut area_below_trigger, mut below_trigger) = (0.0, 0.0, 0);
     for t in &mesh.triangles {
         let p = t.map(|v| {
             let q = pos[v as usize];
             [q.x, q.y, q.z]
         });
         let s = min_stretch(p, t.map(|v| &x[v as usize][..3]));
-        below_trigger += usize::from(s < COLLAPSE_TRIGGER_SCALE);
+        let [a, b, c] = t.map(|v| pos[v as usize]);
+        let face_area = (b - a).cross(&(c - a)).norm() / 2.0;
+        area += face_area;
+        if s < COLLAPSE_TRIGGER_SCALE {
+            area_below_trigger += face_area;
+            below_trigger += 1;
+        }
         if s < COLLAPSED_SCALE {
             for &v in t {
                 out[v as usize] = true;
             }
         }
+    }
+    let spacings = area_below_trigger / (area / landmarks.len().max(1) as f64);
+    let trigger = spacings >= COLLAPSE_TRIGGER_AREA && below_trigger >= COLLAPSE_TRIGGER_FACES;
+    if !(triggered || trigger) {
+        return Ok(vec![false; mesh.n_vertices()]);
     }
     // Folds that keep every face's shape but bring two sides of a part together show
     // in the distances of vertices two edges apart.
@@ -128,9 +185,6 @@ pub(crate) fn collapsed_vertices(
                 }
             }
         }
-    }
-    if !triggered && below_trigger < COLLAPSE_TRIGGER_FACES {
-        out.fill(false);
     }
     for &l in landmarks {
         out[l as usize] = false;

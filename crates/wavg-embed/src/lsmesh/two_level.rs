@@ -80,6 +80,8 @@ pub(crate) struct TwoLevelLsMesh {
     /// Original ids of the coarse vertices, in coarse order.
     coarse_ids: Vec<u32>,
     coarse: LsMeshSolver,
+    /// The coarse mesh (vertex `i` is original vertex `coarse_ids[i]`).
+    coarse_mesh: ValidMesh,
     /// Cotangent stiffness of the full mesh (symmetric, both triangles stored).
     stiffness: Stiffness,
     inv_mass: Vec<f64>,
@@ -145,11 +147,19 @@ impl TwoLevelLsMesh {
             fixed,
             coarse_ids: coarse.landmarks.clone(),
             coarse: coarse_solver,
+            coarse_mesh,
             stiffness,
             inv_mass,
             inv_diag,
             cg,
         })
+    }
+
+    /// The coarse level: its mesh, the original ids of its vertices (ascending) and its
+    /// factored system, whose landmarks are the full system's in the same order. Its
+    /// solution is exact on the coarse mesh, where the full one stops early.
+    pub(crate) fn coarse_level(&self) -> (&ValidMesh, &[u32], &LsMeshSolver) {
+        (&self.coarse_mesh, &self.coarse_ids, &self.coarse)
     }
 
     /// One point per vertex, equal to `values[k]` at vertex `landmarks[k]` and (to the

@@ -193,3 +193,69 @@ fn close_pairs(mesh: &ValidMesh) -> Vec<(usize, usize)> {
     }
     pairs
 }
+
+/// Loop subdivisions of `mesh`, `levels` times.
+fn subdivided(mesh: ValidMesh, levels: usize) -> ValidMesh {
+    (0..levels).fold(mesh, |m, _| {
+        ValidMesh::new(wavg_mesh::subdivide::loop_subdivide(&m).unwrap()).unwrap()
+    })
+}
+
+/// The landmark count of the default precomputation.
+fn landmarks_used(mesh: &ValidMesh, landmarks: usize) -> usize {
+    let opts = PrecomputeOptions {
+        landmarks,
+        quality_pairs: 0,
+        ..Default::default()
+    };
+    precompute(mesh, &opts, &NoProgress)
+        .unwrap()
+        .0
+        .landmarks
+        .len()
+}
+
+/// Thin parts are found by the area that collapses, not by the number of faces: a thin
+/// tube and its Loop subdivisions get landmarks added (up to as many again, and a few to
+/// get around a vertex no collapse removes), a smooth noisy torus and its subdivisions
+/// none.
+#[test]
+fn a_mesh_and_its_subdivisions_agree_on_thin_parts() {
+    for levels in 0..=2 {
+        let tube = subdivided(
+            ValidMesh::new(procedural::torus(200, 12, 1.0, 0.02)).unwrap(),
+            levels,
+        );
+        let used = landmarks_used(&tube, 60);
+        assert!(
+            (61..=128).contains(&used),
+            "level {levels}: {used} landmarks"
+        );
+        let round = subdivided(
+            ValidMesh::new(procedural::with_noise(
+                procedural::torus(40, 20, 1.0, 0.4),
+                0.2,
+                3,
+            ))
+            .unwrap(),
+            levels,
+        );
+        assert_eq!(landmarks_used(&round, 80), 80, "level {levels}");
+    }
+}
+
+/// A scanned smooth shape (the horse, whose sharp little features shrink in a few faces)
+/// and its Loop subdivision get no landmark added: the shrunken faces are about 16 times
+/// as many once subdivided, their area is the same.
+#[test]
+fn a_smooth_scan_and_its_subdivision_get_no_landmark_added() {
+    let Some(path) = wavg_testdata::require_data_file(
+        "a_smooth_scan_and_its_subdivision_get_no_landmark_added",
+        "meshes/horse.off.gz",
+    ) else {
+        return;
+    };
+    let horse = ValidMesh::new(wavg_mesh::io::load(&path).unwrap()).unwrap();
+    assert_eq!(landmarks_used(&horse, 1000), 1000);
+    assert_eq!(landmarks_used(&subdivided(horse, 1), 1000), 1000);
+}
