@@ -383,17 +383,22 @@ pub(crate) fn precompute_unscaled(
         let q = landmark_distances(mesh, landmarks, &geo, progress)?;
         Ok::<_, EmbedError>((q, secs(t)))
     };
-    let factor = |landmarks: &[u32], mid: Option<&Decimated>| {
+    // The least-squares system; a later round's two-level system keeps the full mesh's
+    // operator of the round before (`previous`).
+    let factor = |landmarks: &[u32], mid: Option<&Decimated>, previous: Option<LsMeshExtension>| {
         let t = Instant::now();
-        let solver = match mid {
-            Some(c) => LsMeshExtension::TwoLevel(Box::new(TwoLevelLsMesh::new(
+        let solver = match (mid, previous) {
+            (Some(c), Some(LsMeshExtension::TwoLevel(p))) => {
+                LsMeshExtension::TwoLevel(Box::new(p.with_landmarks(c, landmarks, progress)?))
+            }
+            (Some(c), _) => LsMeshExtension::TwoLevel(Box::new(TwoLevelLsMesh::new(
                 mesh,
                 c,
                 landmarks,
                 CgOptions::default(),
                 progress,
             )?)),
-            None => {
+            (None, _) => {
                 LsMeshExtension::Direct(Box::new(LsMeshSolver::new(mesh, landmarks, progress)?))
             }
         };
@@ -401,6 +406,7 @@ pub(crate) fn precompute_unscaled(
     };
     let mut added = 0;
     let mut round = 0;
+    let mut previous: Option<LsMeshExtension> = None;
     let (landmarks, q, solver, coarse, ls_coarse) = loop {
         let (landmarks, coarse, ls_coarse, t_decimate) = selected;
         stages.decimate += t_decimate;
@@ -408,13 +414,16 @@ pub(crate) fn precompute_unscaled(
         let (q, solver) = if round == 0 {
             let (q, solver) = rayon::join(
                 || geodesics(&landmarks, coarse.as_ref(), ls_coarse.as_ref()),
-                || factor(&landmarks, ls_coarse.as_ref()),
+                || factor(&landmarks, ls_coarse.as_ref(), None),
             );
             let (q, t_geodesics) = q?;
             stages.geodesics += t_geodesics;
             (Some(q), solver?)
         } else {
-            (None, factor(&landmarks, ls_coarse.as_ref())?)
+            (
+                None,
+                factor(&landmarks, ls_coarse.as_ref(), previous.take())?,
+            )
         };
         let (solver, t_factor) = solver;
         stages.lsmesh += t_factor;
@@ -448,9 +457,18 @@ pub(crate) fn precompute_unscaled(
         let mut locked = landmarks.clone();
         locked.extend(&more);
         locked.sort_unstable();
-        // The factorisation and the distances go before the next decimation allocates;
-        // should no decimation be possible, they are computed again.
-        drop((q, solver));
+        // The factorisation and the distances go before the next decimation allocates
+        // (should no decimation be possible, they are computed again); a two-level
+        // system's full-mesh operator stays for the next round when the decimation
+        // restarts from an intermediate mesh (a small one).
+        drop(q);
+        previous = match solver {
+            LsMeshExtension::TwoLevel(t) if base.is_some() => Some(LsMeshExtension::TwoLevel(t)),
+            other => {
+                drop(other);
+                None
+            }
+        };
         // Locking every landmark may leave a vertex that no legal collapse removes; a
         // few more landmarks then get around it, and failing that, the landmarks so far
         // stay.
@@ -475,7 +493,7 @@ pub(crate) fn precompute_unscaled(
                 mark("thin parts: decimation");
             }
             None => {
-                let (solver, t_factor) = factor(&landmarks, ls_coarse.as_ref())?;
+                let (solver, t_factor) = factor(&landmarks, ls_coarse.as_ref(), previous.take())?;
                 stages.lsmesh += t_factor;
                 break (landmarks, None, solver, coarse, ls_coarse);
             }

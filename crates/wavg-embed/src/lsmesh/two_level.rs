@@ -102,22 +102,7 @@ impl TwoLevelLsMesh {
     ) -> Result<Self, EmbedError> {
         let n = mesh.n_vertices();
         let fixed = super::fixed_mask(n, landmarks)?;
-        let coarse_landmarks = landmarks
-            .iter()
-            .map(|&s| {
-                coarse.coarse_index(s).ok_or_else(|| {
-                    EmbedError::InvalidArgument(format!("landmark {s} is not a coarse vertex"))
-                })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        if coarse.landmarks.iter().any(|&v| v as usize >= n) {
-            return Err(EmbedError::InvalidArgument(
-                "the coarse mesh is not a decimation of this mesh".into(),
-            ));
-        }
-        let coarse_mesh = ValidMesh::new(coarse.mesh.clone())
-            .map_err(|e| EmbedError::InvalidArgument(format!("coarse mesh: {e}")))?;
-        let coarse_solver = LsMeshSolver::new(&coarse_mesh, &coarse_landmarks, progress)?;
+        let (coarse_mesh, coarse_solver) = coarse_system(n, coarse, landmarks, progress)?;
         check_cancel(progress)?;
 
         let stiffness = Stiffness::cotan(mesh)?;
@@ -129,8 +114,56 @@ impl TwoLevelLsMesh {
             )));
         }
         let inv_mass: Vec<f64> = mass.iter().map(|m| 1.0 / m).collect();
+        let full = FullOperator {
+            stiffness,
+            inv_mass,
+        };
+        Ok(Self::assemble(
+            landmarks,
+            fixed,
+            coarse,
+            (coarse_mesh, coarse_solver),
+            full,
+            cg,
+        ))
+    }
+
+    /// The same system with other landmarks, each a vertex of `coarse` (a decimation state
+    /// of the same mesh): the full mesh's stiffness and masses, which do not depend on the
+    /// landmarks, are kept; the coarse level is factored again.
+    pub(crate) fn with_landmarks(
+        self,
+        coarse: &Decimated,
+        landmarks: &[u32],
+        progress: &dyn Progress,
+    ) -> Result<Self, EmbedError> {
+        let n = self.fixed.len();
+        let fixed = super::fixed_mask(n, landmarks)?;
+        let (cg, full) = (
+            self.cg,
+            FullOperator {
+                stiffness: self.stiffness,
+                inv_mass: self.inv_mass,
+            },
+        );
+        let level = coarse_system(n, coarse, landmarks, progress)?;
+        Ok(Self::assemble(landmarks, fixed, coarse, level, full, cg))
+    }
+
+    /// The system from its parts: the Jacobi preconditioner of the free vertices added.
+    fn assemble(
+        landmarks: &[u32],
+        fixed: Vec<bool>,
+        coarse: &Decimated,
+        (coarse_mesh, coarse_solver): (ValidMesh, LsMeshSolver),
+        FullOperator {
+            stiffness,
+            inv_mass,
+        }: FullOperator,
+        cg: CgOptions,
+    ) -> Self {
         // diag(L M⁻¹ L)_j = sum_k L_kj² / m_k.
-        let inv_diag: Vec<f64> = (0..n)
+        let inv_diag: Vec<f64> = (0..fixed.len())
             .into_par_iter()
             .map(|j| {
                 if fixed[j] {
@@ -142,7 +175,7 @@ impl TwoLevelLsMesh {
                 if d > 0.0 { 1.0 / d } else { 0.0 }
             })
             .collect();
-        Ok(Self {
+        Self {
             landmarks: landmarks.to_vec(),
             fixed,
             coarse_ids: coarse.landmarks.clone(),
@@ -152,7 +185,7 @@ impl TwoLevelLsMesh {
             inv_mass,
             inv_diag,
             cg,
-        })
+        }
     }
 
     /// The coarse level: its mesh, the original ids of its vertices (ascending) and its
@@ -257,6 +290,39 @@ impl TwoLevelLsMesh {
     }
 }
 
+/// The full mesh's part of the system that does not depend on the landmarks.
+struct FullOperator {
+    stiffness: Stiffness,
+    inv_mass: Vec<f64>,
+}
+
+/// The coarse mesh of a two-level system on a mesh of `n` vertices and its factored
+/// system, with `landmarks` (original ids) as its fixed vertices.
+fn coarse_system(
+    n: usize,
+    coarse: &Decimated,
+    landmarks: &[u32],
+    progress: &dyn Progress,
+) -> Result<(ValidMesh, LsMeshSolver), EmbedError> {
+    let coarse_landmarks = landmarks
+        .iter()
+        .map(|&s| {
+            coarse.coarse_index(s).ok_or_else(|| {
+                EmbedError::InvalidArgument(format!("landmark {s} is not a coarse vertex"))
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    if coarse.landmarks.iter().any(|&v| v as usize >= n) {
+        return Err(EmbedError::InvalidArgument(
+            "the coarse mesh is not a decimation of this mesh".into(),
+        ));
+    }
+    let coarse_mesh = ValidMesh::new(coarse.mesh.clone())
+        .map_err(|e| EmbedError::InvalidArgument(format!("coarse mesh: {e}")))?;
+    let solver = LsMeshSolver::new(&coarse_mesh, &coarse_landmarks, progress)?;
+    Ok((coarse_mesh, solver))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -313,6 +379,38 @@ mod tests {
     fn noisy_torus(n: u32, m: u32, seed: u64) -> ValidMesh {
         let torus = procedural::torus(n, m, 1.0, 0.35);
         ValidMesh::new(procedural::with_noise(torus, 0.002, seed)).unwrap()
+    }
+
+    /// A system moved to other landmarks keeps only what does not depend on them: it
+    /// solves exactly as one built for those landmarks.
+    #[test]
+    fn other_landmarks_solve_as_a_new_system() {
+        let mesh = noisy_torus(60, 30, 5);
+        let opts = |target| DecimateOptions {
+            target,
+            ..Default::default()
+        };
+        let (fin, mut snaps) =
+            decimate_with_snapshots(&mesh, &opts(80), &[600], &NoProgress).unwrap();
+        let snap = snaps.pop().unwrap();
+        let first: Vec<u32> = fin.landmarks[..60].to_vec();
+        let cg = CgOptions::default();
+        let moved = TwoLevelLsMesh::new(&mesh, &snap, &first, cg, &NoProgress)
+            .unwrap()
+            .with_landmarks(&snap, &fin.landmarks, &NoProgress)
+            .unwrap();
+        let fresh = TwoLevelLsMesh::new(&mesh, &snap, &fin.landmarks, cg, &NoProgress).unwrap();
+        let values: Vec<Row> = (fin.landmarks.iter())
+            .map(|&l| std::array::from_fn(|k| ((l as usize * 7 + k) % 13) as f64))
+            .collect();
+        let a = moved.solve(&values, MAX_DIM, &NoProgress).unwrap();
+        let b = fresh.solve(&values, MAX_DIM, &NoProgress).unwrap();
+        assert_eq!(a, b);
+        // A landmark off the coarse mesh is refused, as by `new`.
+        let off = (0..mesh.n_vertices() as u32)
+            .find(|&v| snap.coarse_index(v).is_none())
+            .unwrap();
+        assert!(fresh.with_landmarks(&snap, &[off], &NoProgress).is_err());
     }
 
     #[test]
