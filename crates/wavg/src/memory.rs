@@ -8,9 +8,9 @@ use crate::error::{Error, Result};
 
 /// Bytes of the precomputation's peak per mesh vertex (faces included, about two per
 /// vertex), above about 0.5M vertices: the peaks measured with the stage trace
-/// (`WAVG_MEMORY_TRACE`) after the memory changes of issue 44 are 2.50 GB at 3.1M vertices
-/// (806 B a vertex) and 7.43 GB at 10.3M (722 B a vertex), a slope of 687 B a vertex
-/// between them, rounded up (`BENCHMARKS.md`).
+/// (`WAVG_MEMORY_TRACE`) after the memory changes of issue 44 are 1.88 GB at 2.15M
+/// vertices, 2.50 GB at 3.1M (806 B a vertex) and 7.43 GB at 10.3M (722 B a vertex), a
+/// slope of 687 B a vertex from 3.1M to 10.3M, rounded up (`BENCHMARKS.md`).
 pub const PEAK_BYTES_PER_VERTEX: u64 = 700;
 /// Bytes of the peak whatever the mesh (the landmark stages' dense matrices, the
 /// program): with [`PEAK_BYTES_PER_VERTEX`], it covers the measured peaks with a margin
@@ -169,7 +169,10 @@ mod tests {
         assert!(check_fits(3_000_000, None).is_ok());
         // Small meshes follow the lower line: 320 MB for 10,000 vertices.
         assert_eq!(precompute_peak_bytes(10_000), 320_000_000);
-        assert_eq!(precompute_peak_bytes(3_000_000), 1_000_000_000 + 2_100_000_000);
+        assert_eq!(
+            precompute_peak_bytes(3_000_000),
+            1_000_000_000 + 2_100_000_000
+        );
         // The estimate covers the peaks measured at 3.1M and 10.3M vertices (722 B a
         // vertex at 10.3M), and a 10.3M-vertex mesh fits a machine with 8.5 GB free.
         assert!(precompute_peak_bytes(3_102_914) > 2_502_500_000);
