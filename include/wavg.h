@@ -92,7 +92,8 @@ typedef struct wavg_remesher wavg_remesher;
 typedef struct wavg_solver wavg_solver;
 
 // A validated triangle mesh with its 8-D embedding. Create it with
-// `wavg_surface_open` or `wavg_surface_from_arrays`, free it with `wavg_surface_free`.
+// `wavg_surface_open`, `wavg_surface_open_with_embedding` or `wavg_surface_from_arrays`,
+// free it with `wavg_surface_free`.
 //
 // Thread safety: calls taking a `const wavg_surface *` may run on one surface from many
 // threads at once; `wavg_surface_precompute` and `wavg_surface_load_embedding` need the
@@ -472,6 +473,22 @@ enum wavg_status wavg_inverse(const struct wavg_solver *solver,
 // `mesh_path` must be NULL or NUL-terminated; `out` NULL or writable.
 enum wavg_status wavg_surface_open(const char *mesh_path,
                                    struct wavg_surface **out);
+
+// Loads a mesh file as `wavg_surface_open` does and, when `embedding_path` is not NULL,
+// the `.wavg` embedding file computed for that mesh, in one call: the surface is built
+// once, on the file's embedding, without first building one on the vertex positions as
+// `wavg_surface_open` followed by `wavg_surface_load_embedding` does (at 10M vertices that
+// first build costs seconds and gigabytes). `embedding_path` NULL gives the same surface
+// as `wavg_surface_open`. On success `*out` is a new surface; on failure it is left
+// unchanged. Errors: `WAVG_STATUS_IO` (a missing or unreadable file; an embedding file
+// that is corrupt or made for another mesh), `WAVG_STATUS_INVALID_MESH`.
+//
+// # Safety
+// `mesh_path` must be NULL or NUL-terminated, `embedding_path` NULL or NUL-terminated;
+// `out` NULL or writable.
+enum wavg_status wavg_surface_open_with_embedding(const char *mesh_path,
+                                                  const char *embedding_path,
+                                                  struct wavg_surface **out);
 
 // Makes a surface from arrays: `xyz` holds `3 * n_vertices` coordinates (x, y, z per
 // vertex), `triangles` holds `3 * n_triangles` 0-based vertex indices, counter-clockwise

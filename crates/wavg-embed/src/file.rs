@@ -8,56 +8,19 @@ use std::path::Path;
 
 use wavg_mesh::TriMesh;
 
+pub use crate::checksum::{FNV_OFFSET, WordHash, fnv1a64, mesh_fingerprint, mesh_hash};
 use crate::error::EmbedError;
 use crate::{Embedding, EmbeddingParams};
 
 /// The magic bytes that start every `.wavg` file.
 pub const MAGIC: [u8; 8] = *b"WAVGEMB\0";
-/// The format version this build writes and the highest it reads.
-pub const FORMAT_VERSION: u32 = 1;
+/// The format version this build writes and the highest it reads (it reads every version
+/// from 1 up).
+pub const FORMAT_VERSION: u32 = 2;
 /// Maximum embedding dimension (coordinates are stored in `[f64; MAX_DIM]` in memory).
 pub const MAX_DIM: usize = 8;
 /// Size of the fixed header in bytes.
 pub const HEADER_LEN: usize = 128;
-
-/// FNV-1a 64 of `bytes`, continuing from state `h` (start with [`FNV_OFFSET`]).
-#[inline]
-pub fn fnv1a64(mut h: u64, bytes: &[u8]) -> u64 {
-    for &b in bytes {
-        h = (h ^ u64::from(b)).wrapping_mul(FNV_PRIME);
-    }
-    h
-}
-
-/// FNV-1a 64 initial state.
-pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
-const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
-
-/// The mesh fingerprint stored in the file (see the module documentation for the exact bytes).
-///
-/// ```
-/// use wavg_embed::file::mesh_hash;
-/// let a = wavg_mesh::procedural::icosphere(1);
-/// let mut b = a.clone();
-/// b.positions[0].x += 1e-12;
-/// assert_ne!(mesh_hash(&a), mesh_hash(&b));
-/// ```
-pub fn mesh_hash(mesh: &TriMesh) -> u64 {
-    let mut h = FNV_OFFSET;
-    h = fnv1a64(h, &(mesh.n_vertices() as u64).to_le_bytes());
-    h = fnv1a64(h, &(mesh.n_faces() as u64).to_le_bytes());
-    for p in &mesh.positions {
-        for c in [p.x, p.y, p.z] {
-            h = fnv1a64(h, &c.to_le_bytes());
-        }
-    }
-    for t in &mesh.triangles {
-        for i in t {
-            h = fnv1a64(h, &i.to_le_bytes());
-        }
-    }
-    h
-}
 
 /// Exact file length for the given counts, or `None` on overflow.
 fn file_len(n_vertices: u64, dim: u64, n_landmarks: u64) -> Option<u64> {
@@ -88,7 +51,8 @@ fn checked_len(emb: &Embedding, mesh: &TriMesh) -> Result<usize, EmbedError> {
     .ok_or_else(|| EmbedError::InvalidArgument("embedding too large".into()))
 }
 
-/// The fixed header of `emb` for `mesh`.
+/// The fixed header of `emb` for `mesh` (version 2: the fingerprint is
+/// [`mesh_fingerprint`]).
 fn header(emb: &Embedding, mesh: &TriMesh) -> Vec<u8> {
     let mut b = Vec::with_capacity(HEADER_LEN);
     b.extend_from_slice(&MAGIC);
@@ -96,7 +60,7 @@ fn header(emb: &Embedding, mesh: &TriMesh) -> Vec<u8> {
     b.extend_from_slice(&(emb.dim as u32).to_le_bytes());
     b.extend_from_slice(&(mesh.n_vertices() as u64).to_le_bytes());
     b.extend_from_slice(&(mesh.n_faces() as u64).to_le_bytes());
-    b.extend_from_slice(&mesh_hash(mesh).to_le_bytes());
+    b.extend_from_slice(&mesh_fingerprint(mesh).to_le_bytes());
     b.extend_from_slice(&(emb.landmarks.len() as u64).to_le_bytes());
     let p = &emb.params;
     b.extend_from_slice(&p.landmarks_requested.to_le_bytes());
@@ -112,22 +76,23 @@ fn header(emb: &Embedding, mesh: &TriMesh) -> Vec<u8> {
     b
 }
 
-/// Writes the version-1 bytes of `emb` (already checked by [`checked_len`]) to `w`, a
+/// Writes the version-2 bytes of `emb` (already checked by [`checked_len`]) to `w`, a
 /// block at a time, with the running checksum.
 fn write_embedding(emb: &Embedding, mesh: &TriMesh, w: &mut dyn Write) -> std::io::Result<()> {
     let head = header(emb, mesh);
-    let mut sum = fnv1a64(FNV_OFFSET, &head);
+    let mut sum = WordHash::new();
+    sum.bytes(&head);
     w.write_all(&head)?;
     let mut buf = Vec::with_capacity(BLOCK_ROWS * emb.dim * 8);
     for block in emb.coords.chunks(BLOCK_ROWS) {
         buf.clear();
-        buf.extend(
-            block
-                .iter()
-                .flat_map(|c| &c[..emb.dim])
-                .flat_map(|x| x.to_le_bytes()),
-        );
-        sum = fnv1a64(sum, &buf);
+        for c in block {
+            for x in &c[..emb.dim] {
+                let bits = x.to_bits();
+                sum.word(bits);
+                buf.extend_from_slice(&bits.to_le_bytes());
+            }
+        }
         w.write_all(&buf)?;
     }
     buf.clear();
@@ -135,12 +100,12 @@ fn write_embedding(emb: &Embedding, mesh: &TriMesh, w: &mut dyn Write) -> std::i
     if emb.landmarks.len() % 2 == 1 {
         buf.extend_from_slice(&[0u8; 4]);
     }
-    sum = fnv1a64(sum, &buf);
+    sum.bytes(&buf);
     w.write_all(&buf)?;
-    w.write_all(&sum.to_le_bytes())
+    w.write_all(&sum.finish().to_le_bytes())
 }
 
-/// Serialises `emb` for `mesh` into the version-1 byte layout.
+/// Serialises `emb` for `mesh` into the version-2 byte layout.
 ///
 /// Errors if the embedding does not satisfy [`Embedding::validate`] for this mesh.
 pub fn encode(emb: &Embedding, mesh: &TriMesh) -> Result<Vec<u8>, EmbedError> {
@@ -200,6 +165,7 @@ impl Reader<'_> {
 
 /// Parsed fixed header.
 struct Header {
+    version: u32,
     dim: u32,
     n_vertices: u64,
     n_faces: u64,
@@ -259,6 +225,7 @@ fn parse_header(head: &[u8], total: u64) -> Result<Header, Fault> {
         )));
     }
     Ok(Header {
+        version,
         dim,
         n_vertices,
         n_faces,
@@ -309,6 +276,68 @@ struct Body {
     tail: Vec<u8>,
 }
 
+/// A running checksum of either format version.
+enum Running {
+    /// Version 1: FNV-1a 64, a byte at a time.
+    Fnv(u64),
+    /// Version 2 and later: [`WordHash`].
+    Words(WordHash),
+}
+
+impl Running {
+    fn new(version: u32) -> Self {
+        if version == 1 {
+            Self::Fnv(FNV_OFFSET)
+        } else {
+            Self::Words(WordHash::new())
+        }
+    }
+    fn bytes(&mut self, b: &[u8]) {
+        match self {
+            Self::Fnv(h) => *h = fnv1a64(*h, b),
+            Self::Words(h) => h.bytes(b),
+        }
+    }
+    fn finish(&self) -> u64 {
+        match self {
+            Self::Fnv(h) => *h,
+            Self::Words(h) => h.finish(),
+        }
+    }
+}
+
+/// The mesh fingerprint a file of `version` stores.
+fn fingerprint(version: u32, mesh: &TriMesh) -> u64 {
+    if version == 1 {
+        mesh_hash(mesh)
+    } else {
+        mesh_fingerprint(mesh)
+    }
+}
+
+/// Appends the rows of `block` (`dim` little-endian `f64` each) to `coords`, feeding each
+/// word to the version-2 checksum `sum` on the way (one pass over the bytes).
+fn convert_block(
+    block: &[u8],
+    dim: usize,
+    mut sum: Option<&mut WordHash>,
+    coords: &mut Vec<[f64; MAX_DIM]>,
+) {
+    for row in block.chunks_exact(dim * 8) {
+        let mut c = [0.0; MAX_DIM];
+        for (x, b) in c.iter_mut().zip(row.chunks_exact(8)) {
+            let mut a = [0u8; 8];
+            a.copy_from_slice(b);
+            let w = u64::from_le_bytes(a);
+            if let Some(h) = sum.as_deref_mut() {
+                h.word(w);
+            }
+            *x = f64::from_bits(w);
+        }
+        coords.push(c);
+    }
+}
+
 /// Reads the body announced by `h` a block at a time, checksumming as it goes.
 fn read_body(
     r: &mut (dyn Read + Send),
@@ -317,7 +346,8 @@ fn read_body(
     keep: bool,
 ) -> std::io::Result<Body> {
     let dim = h.dim as usize;
-    let mut sum = fnv1a64(FNV_OFFSET, head);
+    let mut sum = Running::new(h.version);
+    sum.bytes(head);
     let mut coords = Vec::new();
     if keep {
         coords.reserve_exact(h.n_vertices as usize);
@@ -328,26 +358,24 @@ fn read_body(
         let rows = left.min(BLOCK_ROWS as u64) as usize;
         let block = &mut buf[..rows * dim * 8];
         r.read_exact(block)?;
-        sum = fnv1a64(sum, block);
-        if keep {
-            coords.extend(block.chunks_exact(dim * 8).map(|row| {
-                let mut c = [0.0; MAX_DIM];
-                for (x, b) in c.iter_mut().zip(row.chunks_exact(8)) {
-                    *x = f64::from_le_bytes(b.try_into().unwrap_or_default());
-                }
-                c
-            }));
+        match (&mut sum, keep) {
+            (Running::Words(w), true) => convert_block(block, dim, Some(w), &mut coords),
+            (_, true) => {
+                sum.bytes(block);
+                convert_block(block, dim, None, &mut coords);
+            }
+            (_, false) => sum.bytes(block),
         }
         left -= rows as u64;
     }
     let k = h.n_landmarks as usize;
     let mut tail = vec![0u8; k * 4 + if k % 2 == 1 { 4 } else { 0 }];
     r.read_exact(&mut tail)?;
-    sum = fnv1a64(sum, &tail);
+    sum.bytes(&tail);
     let mut stored = [0u8; 8];
     r.read_exact(&mut stored)?;
     Ok(Body {
-        sum,
+        sum: sum.finish(),
         stored: u64::from_le_bytes(stored),
         coords,
         tail,
@@ -355,7 +383,7 @@ fn read_body(
 }
 
 /// Reads and fully checks a `.wavg` stream of `total` bytes against `mesh`. The mesh's
-/// fingerprint is computed beside the reading (both are byte-serial checksums).
+/// fingerprint is computed beside the reading (both are serial checksums).
 fn read_embedding(
     r: &mut (dyn Read + Send),
     total: u64,
@@ -366,7 +394,10 @@ fn read_embedding(
     let head = &head[..got];
     let h = parse_header(head, total)?;
     let keep = h.n_vertices == mesh.n_vertices() as u64;
-    let (fingerprint, body) = rayon::join(|| mesh_hash(mesh), || read_body(r, head, &h, keep));
+    let (fingerprint, body) = rayon::join(
+        || fingerprint(h.version, mesh),
+        || read_body(r, head, &h, keep),
+    );
     let body = body?;
     if body.sum != body.stored {
         return Err(Fault::Bad("corrupt: checksum mismatch".into()).into());
@@ -469,7 +500,7 @@ pub fn save(path: &Path, emb: &Embedding, mesh: &TriMesh) -> Result<(), EmbedErr
 /// Reads and checks a `.wavg` file for `mesh`.
 ///
 /// Refuses (with [`EmbedError::BadFile`]) anything that is not a complete, uncorrupted
-/// version-1 file; with [`EmbedError::UnsupportedVersion`] a file from a newer format; with
+/// file of version 1 or 2; with [`EmbedError::UnsupportedVersion`] a file from a newer format; with
 /// [`EmbedError::MeshMismatch`] a file computed for another mesh. The header is checked
 /// against the real file length before the body is read, so a corrupt header never causes
 /// a large allocation. The file is streamed a block at a time into the embedding.
@@ -549,6 +580,74 @@ mod tests {
         Path::new("test.wavg")
     }
 
+    /// A version-1 file as the version-1 writer made it: the same layout, version 1, the
+    /// FNV-1a 64 fingerprint ([`mesh_hash`]) and FNV-1a 64 checksum.
+    fn encode_v1(emb: &Embedding, mesh: &TriMesh) -> Vec<u8> {
+        let mut b = encode(emb, mesh).unwrap();
+        b[8..12].copy_from_slice(&1u32.to_le_bytes());
+        b[32..40].copy_from_slice(&mesh_hash(mesh).to_le_bytes());
+        reseal(&mut b);
+        b
+    }
+
+    /// Version-1 files still open, bit-exact, through memory and the file system, and
+    /// refuse every truncation, single-byte change and other mesh as before.
+    #[test]
+    fn version_1_files_still_open_and_are_checked() {
+        let mesh = procedural::torus(12, 8, 1.0, 0.3);
+        let emb = sample(&mesh, 8, 7, 9);
+        let v1 = encode_v1(&emb, &mesh);
+        assert_eq!(bits(&decode(&v1, &mesh, p()).unwrap()), bits(&emb));
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("v1.wavg");
+        std::fs::write(&path, &v1).unwrap();
+        assert_eq!(bits(&load(&path, &mesh).unwrap()), bits(&emb));
+        // A version-2 checksum or fingerprint in a version-1 file is refused.
+        let mut v2 = encode(&emb, &mesh).unwrap();
+        v2[8..12].copy_from_slice(&1u32.to_le_bytes());
+        assert!(matches!(
+            decode(&v2, &mesh, p()),
+            Err(EmbedError::BadFile { .. })
+        ));
+        reseal(&mut v2);
+        assert!(matches!(
+            decode(&v2, &mesh, p()),
+            Err(EmbedError::MeshMismatch { .. })
+        ));
+        let small = procedural::icosphere(0);
+        let v1 = encode_v1(&sample(&small, 8, 5, 3), &small);
+        for cut in 0..v1.len() {
+            assert!(decode(&v1[..cut], &small, p()).is_err(), "cut {cut}");
+        }
+        for at in 0..v1.len() {
+            for x in [0x01u8, 0x80, 0xff] {
+                let mut c = v1.clone();
+                c[at] ^= x;
+                assert!(decode(&c, &small, p()).is_err(), "flip {x:#x} at {at}");
+            }
+        }
+        let mut moved = small.clone();
+        moved.positions[7].x = f64::from_bits(moved.positions[7].x.to_bits() + 1);
+        assert!(matches!(
+            decode(&v1, &moved, p()),
+            Err(EmbedError::MeshMismatch { .. })
+        ));
+    }
+
+    /// Every bit flipped anywhere in a version-2 file is refused.
+    #[test]
+    fn every_single_bit_flip_is_refused() {
+        let mesh = procedural::icosphere(0);
+        let b = encode(&sample(&mesh, 3, 3, 4), &mesh).unwrap();
+        for at in 0..b.len() {
+            for bit in 0..8 {
+                let mut c = b.clone();
+                c[at] ^= 1 << bit;
+                assert!(decode(&c, &mesh, p()).is_err(), "bit {bit} of byte {at}");
+            }
+        }
+    }
+
     #[test]
     fn round_trip_is_bit_exact_through_a_file() {
         let mesh = procedural::torus(12, 8, 1.0, 0.3);
@@ -575,13 +674,13 @@ mod tests {
         let emb = sample(&mesh, 8, 3, 1);
         let b = encode(&emb, &mesh).unwrap();
         assert_eq!(&b[..8], b"WAVGEMB\0");
-        assert_eq!(u32::from_le_bytes(b[8..12].try_into().unwrap()), 1);
+        assert_eq!(u32::from_le_bytes(b[8..12].try_into().unwrap()), 2);
         assert_eq!(u32::from_le_bytes(b[12..16].try_into().unwrap()), 8);
         assert_eq!(u64::from_le_bytes(b[16..24].try_into().unwrap()), 12);
         assert_eq!(u64::from_le_bytes(b[24..32].try_into().unwrap()), 20);
         assert_eq!(
             u64::from_le_bytes(b[32..40].try_into().unwrap()),
-            mesh_hash(&mesh)
+            mesh_fingerprint(&mesh)
         );
         assert_eq!(u64::from_le_bytes(b[40..48].try_into().unwrap()), 3);
         assert_eq!(
@@ -598,15 +697,19 @@ mod tests {
         let body = b.len() - 8;
         assert_eq!(body % 8, 0);
         let sum = u64::from_le_bytes(b[body..].try_into().unwrap());
-        assert_eq!(sum, fnv1a64(FNV_OFFSET, &b[..body]));
-    }
-
-    #[test]
-    fn fnv1a64_reference_values() {
-        // Published FNV-1a 64 test vectors.
-        assert_eq!(fnv1a64(FNV_OFFSET, b""), 0xcbf29ce484222325);
-        assert_eq!(fnv1a64(FNV_OFFSET, b"a"), 0xaf63dc4c8601ec8c);
-        assert_eq!(fnv1a64(FNV_OFFSET, b"foobar"), 0x85944171f73967e8);
+        let mut h = WordHash::new();
+        h.bytes(&b[..body]);
+        assert_eq!(sum, h.finish());
+        // Version 1 has the same layout, with FNV-1a 64 for the fingerprint and checksum.
+        let v1 = encode_v1(&emb, &mesh);
+        assert_eq!(u32::from_le_bytes(v1[8..12].try_into().unwrap()), 1);
+        assert_eq!(
+            u64::from_le_bytes(v1[32..40].try_into().unwrap()),
+            mesh_hash(&mesh)
+        );
+        let sum = u64::from_le_bytes(v1[body..].try_into().unwrap());
+        assert_eq!(sum, fnv1a64(FNV_OFFSET, &v1[..body]));
+        assert_eq!(v1[40..body], b[40..body]);
     }
 
     #[test]
@@ -702,10 +805,17 @@ mod tests {
         ));
     }
 
-    /// Rewrites the checksum after an edit, so the check under test is not the checksum.
+    /// Rewrites the checksum after an edit, so the check under test is not the checksum
+    /// (FNV-1a 64 for a version-1 file, else the word hash).
     fn reseal(b: &mut [u8]) {
         let body = b.len() - 8;
-        let s = fnv1a64(FNV_OFFSET, &b[..body]);
+        let s = if b[8..12] == 1u32.to_le_bytes() {
+            fnv1a64(FNV_OFFSET, &b[..body])
+        } else {
+            let mut h = WordHash::new();
+            h.bytes(&b[..body]);
+            h.finish()
+        };
         b[body..].copy_from_slice(&s.to_le_bytes());
     }
 
@@ -713,12 +823,12 @@ mod tests {
     fn future_version_is_refused_with_a_typed_error() {
         let mesh = procedural::icosphere(0);
         let mut b = encode(&sample(&mesh, 8, 2, 3), &mesh).unwrap();
-        b[8..12].copy_from_slice(&2u32.to_le_bytes());
+        b[8..12].copy_from_slice(&3u32.to_le_bytes());
         reseal(&mut b);
         match decode(&b, &mesh, p()) {
             Err(EmbedError::UnsupportedVersion {
-                found: 2,
-                supported: 1,
+                found: 3,
+                supported: 2,
                 ..
             }) => {}
             other => panic!("expected UnsupportedVersion, got {other:?}"),

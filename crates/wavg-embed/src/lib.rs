@@ -18,6 +18,7 @@
 #![deny(unreachable_pub)]
 #![forbid(unsafe_code)]
 
+mod checksum;
 mod decimate;
 mod embedding;
 mod error;

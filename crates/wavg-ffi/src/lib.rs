@@ -37,9 +37,9 @@ pub use solver::{
 pub use surface::{
     wavg_surface, wavg_surface_embedding, wavg_surface_face_count, wavg_surface_free,
     wavg_surface_from_arrays, wavg_surface_landmarks, wavg_surface_load_embedding,
-    wavg_surface_open, wavg_surface_positions, wavg_surface_precompute,
-    wavg_surface_save_embedding, wavg_surface_triangles, wavg_surface_vertex_count,
-    wavg_surface_vertex_point,
+    wavg_surface_open, wavg_surface_open_with_embedding, wavg_surface_positions,
+    wavg_surface_precompute, wavg_surface_save_embedding, wavg_surface_triangles,
+    wavg_surface_vertex_count, wavg_surface_vertex_point,
 };
 pub use transfer::wavg_transfer_texture;
 pub use types::{wavg_point, wavg_progress_fn, wavg_stage, wavg_status};

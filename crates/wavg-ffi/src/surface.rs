@@ -12,7 +12,8 @@ use crate::options::wavg_precompute_options;
 use crate::types::{wavg_point, wavg_progress_fn, wavg_stage, wavg_status};
 
 /// A validated triangle mesh with its 8-D embedding. Create it with
-/// `wavg_surface_open` or `wavg_surface_from_arrays`, free it with `wavg_surface_free`.
+/// `wavg_surface_open`, `wavg_surface_open_with_embedding` or `wavg_surface_from_arrays`,
+/// free it with `wavg_surface_free`.
 ///
 /// Thread safety: calls taking a `const wavg_surface *` may run on one surface from many
 /// threads at once; `wavg_surface_precompute` and `wavg_surface_load_embedding` need the
@@ -67,6 +68,41 @@ pub unsafe extern "C" fn wavg_surface_open(
         // SAFETY: per this function's contract.
         let (path, out) = unsafe { (path_arg(mesh_path)?, handle_mut(out, "out")?) };
         give(out, wavg::Surface::open(path)?);
+        Ok(())
+    })
+}
+
+/// Loads a mesh file as `wavg_surface_open` does and, when `embedding_path` is not NULL,
+/// the `.wavg` embedding file computed for that mesh, in one call: the surface is built
+/// once, on the file's embedding, without first building one on the vertex positions as
+/// `wavg_surface_open` followed by `wavg_surface_load_embedding` does (at 10M vertices that
+/// first build costs seconds and gigabytes). `embedding_path` NULL gives the same surface
+/// as `wavg_surface_open`. On success `*out` is a new surface; on failure it is left
+/// unchanged. Errors: `WAVG_STATUS_IO` (a missing or unreadable file; an embedding file
+/// that is corrupt or made for another mesh), `WAVG_STATUS_INVALID_MESH`.
+///
+/// # Safety
+/// `mesh_path` must be NULL or NUL-terminated, `embedding_path` NULL or NUL-terminated;
+/// `out` NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn wavg_surface_open_with_embedding(
+    mesh_path: *const c_char,
+    embedding_path: *const c_char,
+    out: *mut *mut wavg_surface,
+) -> wavg_status {
+    guard(|| {
+        // SAFETY: per this function's contract.
+        let (path, out) = unsafe { (path_arg(mesh_path)?, handle_mut(out, "out")?) };
+        let embedding = if embedding_path.is_null() {
+            None
+        } else {
+            // SAFETY: non-NULL, NUL-terminated by this function's contract.
+            Some(unsafe { path_arg(embedding_path)? })
+        };
+        give(
+            out,
+            wavg::Surface::open_with_embedding(path, embedding.as_deref())?,
+        );
         Ok(())
     })
 }

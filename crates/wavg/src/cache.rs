@@ -27,7 +27,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{SystemTime, UNIX_EPOCH};
 
-use wavg_embed::file::{FNV_OFFSET, fnv1a64, mesh_hash};
+use wavg_embed::file::{FNV_OFFSET, fnv1a64, mesh_fingerprint};
 use wavg_embed::{EmbedError, Embedding, PrecomputeOptions};
 use wavg_mesh::{TriMesh, ValidMesh};
 
@@ -114,7 +114,7 @@ impl Cache {
     /// The entry key of `mesh` under `options` (landmarks as given: resolve a 0 first).
     pub fn key(mesh: &TriMesh, options: &PrecomputeOptions) -> String {
         let o = fnv1a64(FNV_OFFSET, format!("{options:?}").as_bytes());
-        format!("{:016x}-{o:016x}", mesh_hash(mesh))
+        format!("{:016x}-{o:016x}", mesh_fingerprint(mesh))
     }
 
     /// The `.wavg` file of `key`, whether or not it exists.

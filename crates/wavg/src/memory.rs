@@ -7,17 +7,18 @@
 use crate::error::{Error, Result};
 
 /// Bytes of the precomputation's peak per mesh vertex (faces included, about two per
-/// vertex): the slope of the peak resident sizes measured with `/usr/bin/time -v` from
-/// 0.8M to 3.1M vertices (1,450), and of 2.1M to 8.6M (1,520), rounded up
-/// (`BENCHMARKS.md`).
-pub const PEAK_BYTES_PER_VERTEX: u64 = 1500;
+/// vertex), above about 0.5M vertices: the peaks measured with the stage trace
+/// (`WAVG_MEMORY_TRACE`) after the memory changes of issue 44 are 1.88 GB at 2.15M
+/// vertices, 2.50 GB at 3.1M (806 B a vertex) and 7.43 GB at 10.3M (722 B a vertex), a
+/// slope of 687 B a vertex from 3.1M to 10.3M, rounded up (`BENCHMARKS.md`).
+pub const PEAK_BYTES_PER_VERTEX: u64 = 700;
 /// Bytes of the peak whatever the mesh (the landmark stages' dense matrices, the
-/// program): with [`PEAK_BYTES_PER_VERTEX`], the smallest that covers every measured
-/// peak (0.2M to 8.6M vertices).
-pub const PEAK_BYTES_BASE: u64 = 700 << 20;
-/// Below about 0.9M vertices the peak follows a steeper, lower line (the least-squares
+/// program): with [`PEAK_BYTES_PER_VERTEX`], it covers the measured peaks with a margin
+/// (3.17 GB estimated against 2.50 GB at 3.1M vertices, 8.20 GB against 7.43 GB at 10.3M).
+pub const PEAK_BYTES_BASE: u64 = 1_000_000_000;
+/// Below about 0.5M vertices the peak follows a steeper, lower line (the least-squares
 /// mesh is factored directly): 300 MB + 2,000 B a vertex covers the peaks measured at 0.2M
-/// and 0.8M, so that small meshes are not refused on small machines.
+/// and 0.5M, so that small meshes are not refused on small machines.
 const SMALL_BASE: u64 = 300_000_000;
 const SMALL_PER_VERTEX: u64 = 2000;
 
@@ -160,18 +161,23 @@ mod tests {
         assert!(!e.kind().is_callers_fault());
         let m = e.message();
         assert!(
-            m.contains("3000000 vertices") && m.contains("5.23 GB"),
+            m.contains("3000000 vertices") && m.contains("3.10 GB"),
             "{m}"
         );
         assert!(m.contains("2.00 GB are available (a test)"), "{m}");
-        assert!(check_fits(3_000_000, Some((6_000_000_000, "a test"))).is_ok());
+        assert!(check_fits(3_000_000, Some((3_200_000_000, "a test"))).is_ok());
         assert!(check_fits(3_000_000, None).is_ok());
         // Small meshes follow the lower line: 320 MB for 10,000 vertices.
         assert_eq!(precompute_peak_bytes(10_000), 320_000_000);
         assert_eq!(
             precompute_peak_bytes(3_000_000),
-            (700 << 20) + 4_500_000_000
+            1_000_000_000 + 2_100_000_000
         );
+        // The estimate covers the peaks measured at 3.1M and 10.3M vertices (722 B a
+        // vertex at 10.3M), and a 10.3M-vertex mesh fits a machine with 8.5 GB free.
+        assert!(precompute_peak_bytes(3_102_914) > 2_502_500_000);
+        assert!(precompute_peak_bytes(10_285_056) > 7_431_000_000);
+        assert!(check_fits(10_285_056, Some((8_500_000_000, "a test"))).is_ok());
     }
 
     #[test]

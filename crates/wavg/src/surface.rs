@@ -52,6 +52,15 @@ impl Surface {
         Self::from_mesh(mesh)
     }
 
+    /// Reads the mesh file `path`, validates it and builds a surface on it with the
+    /// embedding of the `.wavg` file `embedding` when one is given, the projector built
+    /// once, on that embedding ([`Surface::from_valid_and_file`]): the one-call open of a
+    /// large surface whose embedding was computed before.
+    pub fn open_with_embedding(path: impl AsRef<Path>, embedding: Option<&Path>) -> Result<Self> {
+        let mesh = ValidMesh::new(wavg_mesh::io::load(path.as_ref())?)?;
+        Self::from_valid_and_file(mesh, embedding)
+    }
+
     /// Validates `mesh` (an oriented manifold without degenerate faces or unreferenced
     /// vertices; see [`ValidMesh::new`]) and builds a surface on it.
     pub fn from_mesh(mesh: TriMesh) -> Result<Self> {

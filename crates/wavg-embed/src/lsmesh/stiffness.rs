@@ -11,7 +11,11 @@
 
 use wavg_mesh::{ValidMesh, geometry};
 
-use crate::error::EmbedError;
+use crate::error::{EmbedError, Progress, check_cancel};
+
+/// Faces (or vertices) assembled between two looks at `progress`'s cancellation (a few
+/// milliseconds of work).
+const CANCEL_EVERY: usize = 1 << 16;
 
 /// A symmetric sparse matrix in compressed columns (column `j`'s rows, ascending, and
 /// values lie at `col_ptr[j]..col_ptr[j + 1]`).
@@ -23,8 +27,9 @@ pub(crate) struct Stiffness {
 
 impl Stiffness {
     /// The cotangent stiffness `L` of `mesh` (the sign convention of
-    /// [`geometry::cotan_stiffness`]).
-    pub(crate) fn cotan(mesh: &ValidMesh) -> Result<Self, EmbedError> {
+    /// [`geometry::cotan_stiffness`]); stops with [`EmbedError::Cancelled`] when
+    /// `progress` asks (looked at every [`CANCEL_EVERY`] vertices and faces).
+    pub(crate) fn cotan(mesh: &ValidMesh, progress: &dyn Progress) -> Result<Self, EmbedError> {
         let n = mesh.n_vertices();
         let topo = mesh.topology();
         let too_large =
@@ -35,6 +40,9 @@ impl Stiffness {
         let mut rows = Vec::with_capacity(nnz);
         col_ptr.push(0u32);
         for v in 0..n as u32 {
+            if v as usize % CANCEL_EVERY == 0 {
+                check_cancel(progress)?;
+            }
             let start = rows.len();
             rows.push(v);
             rows.extend_from_slice(topo.ring(v));
@@ -47,6 +55,9 @@ impl Stiffness {
             vals: vec![-0.0; nnz],
         };
         for (f, t) in mesh.triangles.iter().enumerate() {
+            if f % CANCEL_EVERY == 0 {
+                check_cancel(progress)?;
+            }
             let cot = geometry::cotangents(mesh, f);
             for i in 0..3 {
                 let (a, b) = (t[(i + 1) % 3], t[(i + 2) % 3]);
@@ -104,6 +115,23 @@ mod tests {
     use super::*;
     use wavg_mesh::procedural;
 
+    /// A cancelled assembly stops (at its first look) with `Cancelled`.
+    #[test]
+    fn a_cancelled_assembly_stops() {
+        struct Cancelled;
+        impl Progress for Cancelled {
+            fn report(&self, _: crate::Stage, _: f64) {}
+            fn cancelled(&self) -> bool {
+                true
+            }
+        }
+        let mesh = ValidMesh::new(procedural::torus(30, 14, 1.0, 0.4)).unwrap();
+        assert!(matches!(
+            Stiffness::cotan(&mesh, &Cancelled),
+            Err(EmbedError::Cancelled)
+        ));
+    }
+
     /// The same pattern and, up to rounding of the diagonal sums, the same values as the
     /// triplet assembly, on a closed and an open mesh.
     #[test]
@@ -113,7 +141,7 @@ mod tests {
             procedural::with_noise(procedural::grid(12, 9, 2.0, 1.0), 0.2, 5),
         ] {
             let mesh = ValidMesh::new(m).unwrap();
-            let s = Stiffness::cotan(&mesh).unwrap();
+            let s = Stiffness::cotan(&mesh, &crate::NoProgress).unwrap();
             let reference = geometry::cotan_stiffness(&mesh).unwrap();
             let (sym, vals) = reference.parts();
             assert_eq!(s.rows.len(), vals.len());

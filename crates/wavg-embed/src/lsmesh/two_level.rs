@@ -105,7 +105,7 @@ impl TwoLevelLsMesh {
         let (coarse_mesh, coarse_solver) = coarse_system(n, coarse, landmarks, progress)?;
         check_cancel(progress)?;
 
-        let stiffness = Stiffness::cotan(mesh)?;
+        let stiffness = Stiffness::cotan(mesh, progress)?;
         let mass = geometry::lumped_mass(mesh);
         if let Some(v) = mass.iter().position(|&m| !(m > 0.0 && m.is_finite())) {
             return Err(EmbedError::InvalidArgument(format!(

@@ -3,6 +3,10 @@
 //! leaves a partial file under the final name. A destination that exists and is not a
 //! regular file (`/dev/null`, a named pipe, a terminal) is written in place instead:
 //! renaming over it would replace the device or pipe with a file.
+//!
+//! The temporary file is named `.wavg-tmp-PID-XXXXXX` after the writing process, so a
+//! later write into the same folder can remove what a killed writer left (see
+//! [`remove_stale_temporaries`]).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -16,7 +20,8 @@ pub fn is_special_destination(path: &Path) -> bool {
 
 /// Writes `path` atomically with `body`. On any error the destination is untouched and
 /// the temporary file is removed (a killed process can leave a `.wavg-tmp-*` file beside
-/// the destination, never a partial destination). The result gets the permissions a new
+/// the destination, never a partial destination; the next write into that folder removes
+/// it: [`remove_stale_temporaries`]). The result gets the permissions a new
 /// file would (0666 minus the umask). A destination that exists and is not a regular file
 /// (a device such as `/dev/null`, a named pipe) is opened and written directly.
 pub fn write_atomic(
@@ -37,8 +42,10 @@ pub fn write_atomic(
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    remove_stale_temporaries(&dir);
     let mut builder = tempfile::Builder::new();
-    builder.prefix(".wavg-tmp-");
+    let prefix = format!("{TEMP_PREFIX}{}-", std::process::id());
+    builder.prefix(&prefix);
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
@@ -57,6 +64,52 @@ pub fn write_atomic(
         let _ = d.sync_all();
     }
     Ok(())
+}
+
+/// How every temporary file of [`write_atomic`] starts, before the writer's process id.
+pub const TEMP_PREFIX: &str = ".wavg-tmp-";
+
+/// A temporary file untouched for this long, whose writer is gone, is stale.
+const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(60);
+
+/// Removes from `dir` the temporary files of [`write_atomic`] left by writers that were
+/// killed: named `.wavg-tmp-PID-...` for a process that no longer runs (Linux: no
+/// `/proc/PID`) and not modified for a minute (a live writer in another PID namespace
+/// sharing the folder keeps its file fresh). Elsewhere than Linux nothing is removed.
+/// Best effort: failures are ignored. Returns how many files were removed.
+pub fn remove_stale_temporaries(dir: &Path) -> usize {
+    if !cfg!(target_os = "linux") {
+        return 0;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix(TEMP_PREFIX))
+            .and_then(|rest| rest.split_once('-'))
+            .and_then(|(pid, _)| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid == std::process::id() || Path::new("/proc").join(pid.to_string()).exists() {
+            continue;
+        }
+        let old = entry
+            .metadata()
+            .ok()
+            .filter(|m| m.is_file())
+            .and_then(|m| m.modified().ok())
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age >= STALE_AFTER);
+        if old && std::fs::remove_file(entry.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
 }
 
 /// What the symbolic link `path` points to, resolved through every link (for a dangling
@@ -121,6 +174,62 @@ mod tests {
         assert_eq!(std::fs::read(&path).unwrap(), b"hello");
         let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(names.len(), 1);
+    }
+
+    /// A process that ended and was never waited for by a writer: its id, now unused.
+    #[cfg(target_os = "linux")]
+    fn dead_pid() -> u32 {
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let pid = child.id();
+        child.wait().unwrap();
+        pid
+    }
+
+    /// A temporary file left by a killed writer is removed by the next write into the
+    /// folder; one of a live process, a fresh one, and names of other forms are kept.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_killed_writers_temporary_file_is_removed_by_the_next_write() {
+        let dir = tempfile::tempdir().unwrap();
+        let old = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+        let make = |name: &str, modified: std::time::SystemTime| {
+            let path = dir.path().join(name);
+            let f = std::fs::File::create(&path).unwrap();
+            f.set_modified(modified).unwrap();
+            path
+        };
+        let dead = dead_pid();
+        let stale = make(&format!("{TEMP_PREFIX}{dead}-a1b2c3"), old);
+        let fresh = make(
+            &format!("{TEMP_PREFIX}{dead}-d4e5f6"),
+            std::time::SystemTime::now(),
+        );
+        let live = make(&format!("{TEMP_PREFIX}1-g7h8i9"), old); // init is alive
+        let mine = make(&format!("{TEMP_PREFIX}{}-j0k1l2", std::process::id()), old);
+        let other = make(".wavg-tmp-x9y8z7", old);
+        write_atomic(&dir.path().join("out.wavg"), |w| w.write_all(b"data")).unwrap();
+        assert!(!stale.exists(), "the dead writer's old file is removed");
+        for kept in [&fresh, &live, &mine, &other] {
+            assert!(kept.exists(), "{} kept", kept.display());
+        }
+        assert_eq!(std::fs::read(dir.path().join("out.wavg")).unwrap(), b"data");
+    }
+
+    /// The temporary file carries the writer's process id.
+    #[test]
+    fn the_temporary_file_is_named_after_the_writer() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut seen = Vec::new();
+        write_atomic(&dir.path().join("o"), |w| {
+            seen = std::fs::read_dir(dir.path())
+                .unwrap()
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect();
+            w.write_all(b"x")
+        })
+        .unwrap();
+        let prefix = format!("{TEMP_PREFIX}{}-", std::process::id());
+        assert!(seen.iter().any(|n| n.starts_with(&prefix)), "{seen:?}");
     }
 
     /// Writing to a named pipe writes through it and leaves the pipe in place (a rename

@@ -30,7 +30,7 @@ mod text;
 use std::io::{Read, Write};
 use std::path::Path;
 
-pub use atomic::{is_special_destination, write_atomic};
+pub use atomic::{TEMP_PREFIX, is_special_destination, remove_stale_temporaries, write_atomic};
 use format::{Format, LoadNotes};
 
 use crate::error::MeshError;

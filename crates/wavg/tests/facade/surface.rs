@@ -84,6 +84,17 @@ fn precompute_save_load_round_trip() {
             .embedding()
             .is_none()
     );
+    // In one call from the mesh file (binary PLY keeps every coordinate's bits).
+    let mesh_path = dir.path().join("t.ply");
+    wavg::mesh::io::save(&mesh_path, &procedural::torus(32, 12, 1.0, 0.35)).unwrap();
+    let opened = Surface::open_with_embedding(&mesh_path, Some(&path)).unwrap();
+    assert_eq!(opened.embedding(), s.embedding());
+    assert_eq!(opened.embedded_coords(), s.embedded_coords());
+    let plain = Surface::open_with_embedding(&mesh_path, None).unwrap();
+    assert!(plain.embedding().is_none());
+    let e =
+        Surface::open_with_embedding(&mesh_path, Some(&dir.path().join("none.wavg"))).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::Io, "{e}");
 
     // Loading onto another mesh fails and leaves the surface as it was.
     let mut other = Surface::from_mesh(procedural::icosphere(2)).unwrap();
