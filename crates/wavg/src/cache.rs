@@ -4,10 +4,11 @@
 //! An entry is `KEY.wavg` (the `.wavg` file, whose own fingerprint and checksum are checked
 //! on every read) and `KEY.json` (its description: [`EntryMeta`]). `KEY` is 16 hex digits
 //! of the mesh fingerprint (positions and faces, as in the `.wavg` header), a dash, and 16
-//! of a hash of the precomputation options, so an edited mesh or other options never hit
-//! an old entry. Both files are written to a temporary file and renamed into place, so
-//! processes that compute the same entry at once each leave a whole file, and a reader
-//! never sees half of one.
+//! of a hash of the precomputation options and the algorithm's revision
+//! ([`wavg_embed::PRECOMPUTE_REVISION`]), so an edited mesh, other options or another
+//! algorithm never hit an old entry. Both files are written to a temporary file and renamed
+//! into place, so processes that compute the same entry at once each leave a whole file,
+//! and a reader never sees half of one.
 //!
 //! ```
 //! use wavg::cache::{Cache, EntryInfo};
@@ -113,7 +114,8 @@ impl Cache {
 
     /// The entry key of `mesh` under `options` (landmarks as given: resolve a 0 first).
     pub fn key(mesh: &TriMesh, options: &PrecomputeOptions) -> String {
-        let o = fnv1a64(FNV_OFFSET, format!("{options:?}").as_bytes());
+        let described = format!("{options:?} r{}", wavg_embed::PRECOMPUTE_REVISION);
+        let o = fnv1a64(FNV_OFFSET, described.as_bytes());
         format!("{:016x}-{o:016x}", mesh_fingerprint(mesh))
     }
 
