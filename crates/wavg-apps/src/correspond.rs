@@ -393,11 +393,17 @@ pub fn correspond_vertices(
     })
 }
 
-/// The local test (see the module docs): per vertex, whether most of its edges map
-/// stretched beyond `max_stretch` times the map's median edge stretch (image length over
-/// source length), or two thirds of its faces land flipped against `normals` (per face;
-/// `None`: not judged), with `answered[v]` the image of vertex `v` (edges to unanswered
-/// neighbours do not count).
+/// The local test (see the module docs): per vertex, whether most of the segments from it
+/// to the edge of its neighbourhood map stretched beyond `max_stretch` times the map's
+/// median edge stretch (image length over source length), or two thirds of the faces of
+/// its neighbourhood land flipped against `normals` (per face; `None`: not judged), with
+/// `answered[v]` the image of vertex `v` (unanswered vertices do not count).
+///
+/// A vertex's neighbourhood is its one-ring, grown to the vertices within
+/// [`NEIGHBOURHOOD`] of the source's diagonal: an image a fraction of an edge off flips
+/// and stretches the edges of a fine mesh although it lands close to the truth, so the
+/// test judges a map at one scale whatever the resolution (a mesh and its subdivision keep
+/// about the same vertices).
 pub fn inconsistent_vertices(
     mesh: &ValidMesh,
     answered: &[Option<Vector3<f64>>],
@@ -430,21 +436,84 @@ pub fn inconsistent_vertices(
     let mid = ratios.len() / 2;
     let median = *ratios.select_nth_unstable_by(mid, f64::total_cmp).1;
     let limit = max_stretch * median;
+    let radius = neighbourhood_radius() * mesh.bounding_box_diagonal();
     (0..mesh.n_vertices() as u32)
         .into_par_iter()
-        .map(|v| {
+        .map_init(Neighbourhood::default, |nb, v| {
+            nb.grow(mesh, v, radius);
             let (mut measured, mut bad) = (0usize, 0usize);
-            for &u in topo.ring(v) {
+            for &u in &nb.edge {
                 if let Some(r) = ratio(v, u) {
                     measured += 1;
                     bad += usize::from(r > limit);
                 }
             }
-            let faces = topo.ring_faces(v);
-            let folded = faces.iter().filter(|&&f| flipped[f as usize]).count();
-            2 * bad > measured || FOLDED.1 * folded >= FOLDED.0 * faces.len()
+            let folded = nb.faces.iter().filter(|&&f| flipped[f as usize]).count();
+            2 * bad > measured || FOLDED.1 * folded >= FOLDED.0 * nb.faces.len()
         })
         .collect()
+}
+
+/// The radius of a vertex's neighbourhood in the local test, as a fraction of the source's
+/// bounding-box diagonal (half the 1% error that counts as a correct image).
+const NEIGHBOURHOOD: f64 = 0.005;
+
+fn neighbourhood_radius() -> f64 {
+    std::env::var("WAVG_NB")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(NEIGHBOURHOOD)
+}
+
+/// Vertices a neighbourhood holds at most (the growth stops there on meshes much finer
+/// than [`NEIGHBOURHOOD`]).
+const NEIGHBOURHOOD_VERTICES: usize = 64;
+
+/// A vertex's neighbourhood in the local test: the vertices inside (the vertex, and those
+/// within the radius reached through them), the vertices at its edge (outside, adjacent
+/// to one inside) and the faces around the inside vertices.
+#[derive(Default)]
+struct Neighbourhood {
+    inside: Vec<u32>,
+    edge: Vec<u32>,
+    faces: Vec<u32>,
+}
+
+impl Neighbourhood {
+    fn grow(&mut self, mesh: &ValidMesh, v: u32, radius: f64) {
+        let topo = mesh.topology();
+        let centre = mesh.positions[v as usize];
+        let r2 = radius * radius;
+        self.inside.clear();
+        self.edge.clear();
+        self.faces.clear();
+        self.inside.push(v);
+        let mut next = 0;
+        while next < self.inside.len() {
+            let x = self.inside[next];
+            next += 1;
+            for &u in topo.ring(x) {
+                if self.inside.contains(&u) || self.edge.contains(&u) {
+                    continue;
+                }
+                let within = (mesh.positions[u as usize] - centre).norm_squared() <= r2;
+                if within && self.inside.len() < NEIGHBOURHOOD_VERTICES {
+                    self.inside.push(u);
+                } else {
+                    self.edge.push(u);
+                }
+            }
+        }
+        // A vertex first met as outside and later reached within the radius stays at the
+        // edge: the neighbourhood is what the growth reached, in order.
+        for &x in &self.inside {
+            for &f in topo.ring_faces(x) {
+                if !self.faces.contains(&f) {
+                    self.faces.push(f);
+                }
+            }
+        }
+    }
 }
 
 /// The local test rejects a vertex when at least this fraction (numerator, denominator)

@@ -73,7 +73,7 @@ fn main() {
         }
         let tm = c.timings;
         println!(
-            "{n} vertices, {threads} threads: {secs:.4} s ({:.0} v/s); weights {:.4} forward {:.4} validity {:.4}; valid {:.4} mean error {:.5}; paths {paths:?}; trips failed {}",
+            "{n} vertices, {threads} threads: {secs:.4} s ({:.0} v/s); weights {:.4} forward {:.4} validity {:.4}; valid {:.4} mean error {:.5}; paths {paths:?}; trips failed {}; reasons {:?}",
             n as f64 / secs,
             tm.weights_seconds,
             tm.forward_seconds,
@@ -81,7 +81,11 @@ fn main() {
             c.valid_fraction(),
             err / k.max(1) as f64,
             c.mapped.iter().filter(|m| !m.round_trip).count(),
+            c.reason_counts(),
         );
+        if std::env::var_os("REASONS").is_some() {
+            reasons(&s, &t, &c);
+        }
     }
 }
 
@@ -219,5 +223,39 @@ fn compare(s: &Solver, t: &Solver) {
         "target forward: cold {cold_s:.4} s, warm chain {:.4} s, same image {same} of {}, image on the previous image's face {warm_face}",
         t0.elapsed().as_secs_f64(),
         rows.len()
+    );
+}
+
+/// Per reason: vertices, mean error and the fraction within 1% of the diagonal; then how
+/// many the stretch test alone rejects.
+fn reasons(s: &Solver, t: &Solver, c: &wavg_apps::Correspondence) {
+    let diag = t.mesh().bounding_box_diagonal();
+    let mut by = std::collections::BTreeMap::new();
+    for (v, (m, val)) in c.mapped.iter().zip(&c.validity).enumerate() {
+        if let Ok(r) = &m.target {
+            let e = (r.position - t.mesh().positions[v]).norm() / diag;
+            let entry = by.entry(val.reason()).or_insert((0usize, 0.0, 0usize));
+            entry.0 += 1;
+            entry.1 += e;
+            entry.2 += usize::from(e <= 0.01);
+        }
+    }
+    for (k, (n, sum, ok)) in by {
+        println!(
+            "  {k}: {n} vertices, mean error {:.5}, within 1%: {:.4}",
+            sum / n as f64,
+            ok as f64 / n as f64
+        );
+    }
+    let answered: Vec<_> = c
+        .mapped
+        .iter()
+        .map(|m| m.target.as_ref().ok().map(|r| r.position))
+        .collect();
+    let none = vec![None; s.mesh().n_faces()];
+    let stretch = wavg_apps::internal::inconsistent_vertices(s.mesh(), &answered, &none, 4.0);
+    println!(
+        "  stretch alone rejects {}",
+        stretch.iter().filter(|&&b| b).count()
     );
 }
