@@ -7,7 +7,12 @@
 //! instructions per vertex.
 //!
 //! `cargo xtask lab correspond_profile SRC SRC.wavg TGT TGT.wavg ANCHORS [THREADS] [REPEAT]`
-//! (ANCHORS: a file of `v VERTEX` lines, the same ids on both meshes).
+//! (ANCHORS: a file of `v VERTEX` lines, the same ids on both meshes). Environment:
+//! `TARGET_ANCHORS=FILE` the target's own anchors (other shapes: the error printed is then
+//! meaningless), `REASONS=1` error per rejection reason, `DUMP=FILE` a line per vertex
+//! (reason, error, source position) for locating the rejected vertices, `COMPARE=1`
+//! compares validity tests. With shared connectivity it prints `rejected_correct` and
+//! `accepted_wrong` against the ground truth.
 
 use std::sync::Arc;
 
@@ -38,7 +43,15 @@ fn main() {
     let threads: usize = a.get(5).map_or(1, |s| s.parse().unwrap());
     let repeat: usize = a.get(6).map_or(1, |s| s.parse().unwrap());
     let s = solver(&a[0], &a[1], &anchors);
-    let t = solver(&a[2], &a[3], &anchors);
+    // TARGET_ANCHORS: the target's own anchor file (shapes that do not share connectivity).
+    let target_anchors: Vec<u32> = std::env::var("TARGET_ANCHORS").map_or(anchors.clone(), |f| {
+        std::fs::read_to_string(f)
+            .unwrap()
+            .lines()
+            .filter_map(|l| l.strip_prefix("v ")?.trim().parse().ok())
+            .collect()
+    });
+    let t = solver(&a[2], &a[3], &target_anchors);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -83,8 +96,17 @@ fn main() {
             c.mapped.iter().filter(|m| !m.round_trip).count(),
             c.reason_counts(),
         );
+        if let Ok(g) = c.ground_truth_errors(s.mesh(), t.mesh()) {
+            println!(
+                "  ground truth: rejected_correct {}, accepted_wrong {}",
+                g.rejected_correct, g.accepted_wrong
+            );
+        }
         if std::env::var_os("REASONS").is_some() {
             reasons(&s, &t, &c);
+        }
+        if let Some(path) = std::env::var_os("DUMP") {
+            dump(&path, &s, &t, &c);
         }
     }
 }
@@ -258,4 +280,21 @@ fn reasons(s: &Solver, t: &Solver, c: &wavg_apps::Correspondence) {
         "  stretch alone rejects {}",
         stretch.iter().filter(|&&b| b).count()
     );
+}
+
+/// Per source vertex, a line `REASON ERROR X Y Z` (error in target diagonals, -1 without
+/// an image; the source position) for finding where the rejected vertices are.
+fn dump(path: &std::ffi::OsStr, s: &Solver, t: &Solver, c: &wavg_apps::Correspondence) {
+    use std::fmt::Write;
+    let diag = t.mesh().bounding_box_diagonal();
+    let mut out = String::new();
+    for (v, (m, val)) in c.mapped.iter().zip(&c.validity).enumerate() {
+        let e = m
+            .target
+            .as_ref()
+            .map_or(-1.0, |r| (r.position - t.mesh().positions[v]).norm() / diag);
+        let p = s.mesh().positions[v];
+        writeln!(out, "{} {e:.6} {} {} {}", val.reason(), p.x, p.y, p.z).unwrap();
+    }
+    std::fs::write(path, out).unwrap();
 }
