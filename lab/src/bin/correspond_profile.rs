@@ -96,6 +96,10 @@ fn main() {
             c.mapped.iter().filter(|m| !m.round_trip).count(),
             c.reason_counts(),
         );
+        println!(
+            "  distortion: stretch_best95 {:.4}, flipped_area_fraction {:.4}",
+            c.distortion.stretch_best95, c.distortion.flipped_area_fraction
+        );
         if let Ok(g) = c.ground_truth_errors(s.mesh(), t.mesh()) {
             println!(
                 "  ground truth: rejected_correct {}, accepted_wrong {}",
