@@ -26,6 +26,7 @@ pub use spline::{
 
 mod correspond;
 mod ground_truth;
+mod local_test;
 mod metrics;
 
 pub use correspond::{
@@ -41,7 +42,7 @@ pub use metrics::{Distortion, distortion};
 /// release.
 #[doc(hidden)]
 pub mod internal {
-    pub use crate::correspond::inconsistent_vertices;
+    pub use crate::local_test::{NEIGHBOURHOOD, NEIGHBOURHOOD_VERTICES, inconsistent_vertices};
 }
 
 mod decal;

@@ -21,8 +21,8 @@ use crate::textio;
 /// The validity test, on the command line.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum Test {
-    /// Local consistency: rejects vertices whose edges mostly land over-stretched on the
-    /// target, or whose weights do not round-trip.
+    /// Local consistency: rejects vertices whose neighbourhoods mostly land over-stretched
+    /// or folded on the target, or whose weights do not round-trip.
     Local,
     /// The paper's: the weights round-trip and none is below --max-negative.
     Paper,
@@ -43,8 +43,8 @@ pub struct MapArgs {
     /// Validity test.
     #[arg(long, value_enum, default_value_t = Test::Local)]
     pub validity: Test,
-    /// Local test: an edge is over-stretched above this many times the map's median edge
-    /// stretch.
+    /// Local test: a segment from a vertex to the edge of its neighbourhood is
+    /// over-stretched above this many times the map's median edge stretch.
     #[arg(long, default_value_t = CorrespondOptions::default().max_stretch)]
     pub max_stretch: f64,
 }
@@ -58,9 +58,11 @@ anchor i of --target-anchors. A vertex's weights come from the inverse problem o
 forward problem on the target with the same weights.
 
 Validity (--validity): `local` (default) keeps a vertex when its weights round-trip on the
-source and most of its edges land stretched by at most --max-stretch times the map's median
-edge stretch (image length over source length) and two thirds of its triangles do not land
-flipped where the target is smooth: it judges the image, so correct images with negative weights are kept and wrong images with harmless
+source and most of the segments from it to the edge of its neighbourhood (the vertices within
+half a percent of the source's diagonal; on coarse meshes its one-ring) land stretched by at
+most --max-stretch times the map's median edge stretch (image length over source length) and
+two thirds of the triangles around its neighbourhood do not land flipped where the target is
+smooth: it judges the image, so correct images with negative weights are kept and wrong images with harmless
 weights are not. `paper` is the paper's test: the weights round-trip and none is below
 --max-negative.
 

@@ -7,7 +7,12 @@
 //! instructions per vertex.
 //!
 //! `cargo xtask lab correspond_profile SRC SRC.wavg TGT TGT.wavg ANCHORS [THREADS] [REPEAT]`
-//! (ANCHORS: a file of `v VERTEX` lines, the same ids on both meshes).
+//! (ANCHORS: a file of `v VERTEX` lines, the same ids on both meshes). Environment:
+//! `TARGET_ANCHORS=FILE` the target's own anchors (other shapes: the error printed is then
+//! meaningless), `REASONS=1` error per rejection reason, `DUMP=FILE` a line per vertex
+//! (reason, error, source position) for locating the rejected vertices, `COMPARE=1`
+//! compares validity tests. With shared connectivity it prints `rejected_correct` and
+//! `accepted_wrong` against the ground truth.
 
 use std::sync::Arc;
 
@@ -38,7 +43,15 @@ fn main() {
     let threads: usize = a.get(5).map_or(1, |s| s.parse().unwrap());
     let repeat: usize = a.get(6).map_or(1, |s| s.parse().unwrap());
     let s = solver(&a[0], &a[1], &anchors);
-    let t = solver(&a[2], &a[3], &anchors);
+    // TARGET_ANCHORS: the target's own anchor file (shapes that do not share connectivity).
+    let target_anchors: Vec<u32> = std::env::var("TARGET_ANCHORS").map_or(anchors.clone(), |f| {
+        std::fs::read_to_string(f)
+            .unwrap()
+            .lines()
+            .filter_map(|l| l.strip_prefix("v ")?.trim().parse().ok())
+            .collect()
+    });
+    let t = solver(&a[2], &a[3], &target_anchors);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -73,7 +86,7 @@ fn main() {
         }
         let tm = c.timings;
         println!(
-            "{n} vertices, {threads} threads: {secs:.4} s ({:.0} v/s); weights {:.4} forward {:.4} validity {:.4}; valid {:.4} mean error {:.5}; paths {paths:?}; trips failed {}",
+            "{n} vertices, {threads} threads: {secs:.4} s ({:.0} v/s); weights {:.4} forward {:.4} validity {:.4}; valid {:.4} mean error {:.5}; paths {paths:?}; trips failed {}; reasons {:?}",
             n as f64 / secs,
             tm.weights_seconds,
             tm.forward_seconds,
@@ -81,7 +94,24 @@ fn main() {
             c.valid_fraction(),
             err / k.max(1) as f64,
             c.mapped.iter().filter(|m| !m.round_trip).count(),
+            c.reason_counts(),
         );
+        println!(
+            "  distortion: stretch_best95 {:.4}, flipped_area_fraction {:.4}",
+            c.distortion.stretch_best95, c.distortion.flipped_area_fraction
+        );
+        if let Ok(g) = c.ground_truth_errors(s.mesh(), t.mesh()) {
+            println!(
+                "  ground truth: rejected_correct {}, accepted_wrong {}",
+                g.rejected_correct, g.accepted_wrong
+            );
+        }
+        if std::env::var_os("REASONS").is_some() {
+            reasons(&s, &t, &c);
+        }
+        if let Some(path) = std::env::var_os("DUMP") {
+            dump(&path, &s, &t, &c);
+        }
     }
 }
 
@@ -220,4 +250,55 @@ fn compare(s: &Solver, t: &Solver) {
         t0.elapsed().as_secs_f64(),
         rows.len()
     );
+}
+
+/// Per reason: vertices, mean error and the fraction within 1% of the diagonal; then how
+/// many the stretch test alone rejects.
+fn reasons(s: &Solver, t: &Solver, c: &wavg_apps::Correspondence) {
+    let diag = t.mesh().bounding_box_diagonal();
+    let mut by = std::collections::BTreeMap::new();
+    for (v, (m, val)) in c.mapped.iter().zip(&c.validity).enumerate() {
+        if let Ok(r) = &m.target {
+            let e = (r.position - t.mesh().positions[v]).norm() / diag;
+            let entry = by.entry(val.reason()).or_insert((0usize, 0.0, 0usize));
+            entry.0 += 1;
+            entry.1 += e;
+            entry.2 += usize::from(e <= 0.01);
+        }
+    }
+    for (k, (n, sum, ok)) in by {
+        println!(
+            "  {k}: {n} vertices, mean error {:.5}, within 1%: {:.4}",
+            sum / n as f64,
+            ok as f64 / n as f64
+        );
+    }
+    let answered: Vec<_> = c
+        .mapped
+        .iter()
+        .map(|m| m.target.as_ref().ok().map(|r| r.position))
+        .collect();
+    let none = vec![None; s.mesh().n_faces()];
+    let stretch = wavg_apps::internal::inconsistent_vertices(s.mesh(), &answered, &none, 4.0);
+    println!(
+        "  stretch alone rejects {}",
+        stretch.iter().filter(|&&b| b).count()
+    );
+}
+
+/// Per source vertex, a line `REASON ERROR X Y Z` (error in target diagonals, -1 without
+/// an image; the source position) for finding where the rejected vertices are.
+fn dump(path: &std::ffi::OsStr, s: &Solver, t: &Solver, c: &wavg_apps::Correspondence) {
+    use std::fmt::Write;
+    let diag = t.mesh().bounding_box_diagonal();
+    let mut out = String::new();
+    for (v, (m, val)) in c.mapped.iter().zip(&c.validity).enumerate() {
+        let e = m
+            .target
+            .as_ref()
+            .map_or(-1.0, |r| (r.position - t.mesh().positions[v]).norm() / diag);
+        let p = s.mesh().positions[v];
+        writeln!(out, "{} {e:.6} {} {} {}", val.reason(), p.x, p.y, p.z).unwrap();
+    }
+    std::fs::write(path, out).unwrap();
 }

@@ -9,6 +9,7 @@ use wavg_apps::{CorrespondOptions, correspond_vertices};
 use wavg_embed::{NoProgress, PrecomputeOptions, precompute};
 use wavg_mesh::ValidMesh;
 use wavg_mesh::procedural::{FigureShape, body, figure};
+use wavg_mesh::subdivide::loop_subdivide;
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
 use wavg_solve::{Anchor, EmbeddedMesh, Projector, Solver, Vec8};
 
@@ -76,4 +77,84 @@ fn correspond_shapes(build: fn(&FigureShape) -> wavg_mesh::TriMesh, wrong_kept_p
         assert!(t.rejected_correct * 20 <= n, "{name}: {t:?}");
         assert!(t.accepted_wrong * wrong_kept_per <= n, "{name}: {t:?}");
     }
+}
+
+/// A mesh's embedding and a solver on it with vertex `anchors`.
+fn embedded(mesh: ValidMesh) -> (ValidMesh, Vec<Vec8>) {
+    let opts = PrecomputeOptions {
+        quality_pairs: 0,
+        ..Default::default()
+    };
+    let (emb, _) = precompute(&mesh, &opts, &NoProgress).unwrap();
+    let coords = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
+    (mesh, coords)
+}
+
+fn solver_on(mesh: ValidMesh, coords: Vec<Vec8>, anchors: &[u32]) -> Solver {
+    let e = Arc::new(EmbeddedMesh::new(Arc::new(mesh), coords).unwrap());
+    let proj = Arc::new(Projector::new(e).unwrap());
+    Solver::new(proj, anchors.iter().map(|&v| Anchor::Vertex(v))).unwrap()
+}
+
+/// A mesh and its embedding one Loop level finer: old vertices keep their coordinates
+/// and each new one (on an edge) takes the midpoint of its edge's, so the finer
+/// embedding is the same surface in 8-D and a map onto it the same map; only the 3-D
+/// mesh (smoothed by Loop) and its edges are finer.
+fn subdivided(coarse: &ValidMesh, coords: &[Vec8]) -> (ValidMesh, Vec<Vec8>) {
+    let fine = ValidMesh::new(loop_subdivide(coarse).unwrap()).unwrap();
+    let n0 = coarse.n_vertices();
+    let mut out = coords.to_vec();
+    out.resize(fine.n_vertices(), Vec8::zeros());
+    // Children of face f are faces 4f..4f+4, the three corner children first: each holds
+    // one old corner and the new vertices on its two edges.
+    let mut ends = vec![Vec::new(); fine.n_vertices()];
+    for t in fine.triangles.iter() {
+        if let Some(&old) = t.iter().find(|&&c| (c as usize) < n0) {
+            for &c in t.iter().filter(|&&c| c as usize >= n0) {
+                if !ends[c as usize].contains(&old) {
+                    ends[c as usize].push(old);
+                }
+            }
+        }
+    }
+    for (v, e) in ends.iter().enumerate().skip(n0) {
+        assert_eq!(e.len(), 2, "new vertex {v}");
+        out[v] = (coords[e[0] as usize] + coords[e[1] as usize]) / 2.0;
+    }
+    (fine, out)
+}
+
+/// The same map judged on a mesh and on its Loop subdivision keeps about the same
+/// fraction of the vertices: the local test judges each image at a scale of the
+/// diagonal, not of the edges (a one-ring test rejects more as the mesh gets finer,
+/// where an image a fraction of a coarse edge off flips and stretches fine edges).
+#[test]
+fn a_body_and_its_subdivision_keep_the_same_share() {
+    let slim = ValidMesh::new(body(&FigureShape::SLIM)).unwrap();
+    let heavy = ValidMesh::new(body(&FigureShape::HEAVY)).unwrap();
+    let anchors = farthest_point_vertices(&slim, 93, 1, FpsMetric::EdgeGraph).unwrap();
+    let (slim, slim_e) = embedded(slim);
+    let (heavy, heavy_e) = embedded(heavy);
+    let (fine_slim, fine_slim_e) = subdivided(&slim, &slim_e);
+    let (fine_heavy, fine_heavy_e) = subdivided(&heavy, &heavy_e);
+    let (a, b) = (
+        solver_on(slim, slim_e, &anchors),
+        solver_on(heavy, heavy_e, &anchors),
+    );
+    let (fa, fb) = (
+        solver_on(fine_slim, fine_slim_e, &anchors),
+        solver_on(fine_heavy, fine_heavy_e, &anchors),
+    );
+    let opts = CorrespondOptions::default();
+    let coarse = correspond_vertices(&a, &b, &opts).unwrap();
+    let fine = correspond_vertices(&fa, &fb, &opts).unwrap();
+    let (c, f) = (coarse.valid_fraction(), fine.valid_fraction());
+    eprintln!(
+        "valid {c:.4} ({:?}) -> {f:.4} ({:?})",
+        coarse.reason_counts(),
+        fine.reason_counts()
+    );
+    assert!((c - f).abs() <= 0.03, "coarse {c}, fine {f}");
+    let t = fine.ground_truth_errors(fa.mesh(), fb.mesh()).unwrap();
+    assert!(t.valid.mean <= 0.01, "mean error {}", t.valid.mean);
 }
