@@ -116,9 +116,13 @@ pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
 /// Installs the package as the README says, `pip install ./python` (PEP 517 through maturin, with
 /// build isolation), but in cargo's dev profile and target directory (`MATURIN_PEP517_ARGS`)
 /// so the workspace build's dependencies are reused; then runs `pytest python/tests` there,
-/// in a [`Sandbox`], with the `wavg` binary in `WAVG_CLI` and the C library in `WAVG_LIBWAVG`.
+/// in a [`Sandbox`], with the `wavg` binary in `WAVG_CLI` and the C library in `WAVG_LIBWAVG`
+/// (built first).
 /// pytest's "no tests ran" (exit 5) fails too.
 pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
+    // The C library the tests load is built from this source first: one left by an earlier
+    // run would make another embedding than the other doors.
+    steps::command(root, "cargo", &["build", "-p", "wavg-ffi"])?;
     let py = ensure_venv(root)?;
     let py_s = py.to_string_lossy();
     let target = steps::target_dir(root);
