@@ -22,6 +22,7 @@ import bpy
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import cases  # noqa: E402
+import cases_decal  # noqa: E402
 import cases_more  # noqa: E402
 import scene  # noqa: E402
 
@@ -76,7 +77,7 @@ def main():
     os.environ["WAVG_BLENDER_CACHE"] = os.path.join(tmp, "cache")
     install(args.zip, tmp, args.extension)
     ctx = cases.Context(tmp=tmp, cli=args.wavg_cli)
-    tests = [] if args.bench_only else cases.TESTS + cases_more.TESTS
+    tests = [] if args.bench_only else cases.TESTS + cases_more.TESTS + cases_decal.TESTS
     if args.bench or args.bench_only:
         import bench
 

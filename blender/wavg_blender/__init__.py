@@ -13,8 +13,8 @@ bl_info = {
 
 import bpy
 
-from . import (activation, background, common, errors, group_cache, live, memo, meshdata,
-               op_decal, op_point, op_precompute, op_spline, op_transfer, surfaces,
+from . import (activation, background, common, decal_memo, errors, group_cache, live, memo,
+               meshdata, op_decal, op_point, op_precompute, op_spline, op_transfer, surfaces,
                transfer_data, ui)
 
 OPERATORS = (
@@ -34,9 +34,11 @@ def register():
     live.register()
     memo.register()
     activation.register()
+    decal_memo.register()
 
 
 def unregister():
+    decal_memo.unregister()
     activation.unregister()
     memo.unregister()
     live.unregister()

@@ -8,11 +8,11 @@ whose index and name are; writers evaluate their own writes before storing (:fun
 import numpy as np
 
 from . import memo
-from .meshdata import group_members
+from .meshdata import groups_members
 
 # Object pointer -> (key, {group name: (group index, ids, weights)}).
 _ENTRIES = memo.store()
-# How many reads were answered from memory (for tests).
+# How many reads were answered wholly from memory (for tests).
 HITS = [0]
 
 
@@ -31,12 +31,43 @@ def known(obj, group):
 def members(context, obj, group):
     """``(ids, weights)`` of the members of ``group`` with a weight above zero (as
     :func:`~.meshdata.group_members`), from memory when the entry is still valid."""
+    return members_of(context, obj, [group])[group.name]
+
+
+def members_of(context, obj, groups):
+    """``{name: (ids, weights)}`` of each of ``groups``: from memory where the entry is
+    still valid, the others read in one visit of the vertices and remembered (Object mode
+    only; the read is of the settled mesh, so it stays valid until the next geometry
+    update)."""
     memo.settle(context)
-    got = known(obj, group)
-    if got is not None:
+    out, missing = {}, []
+    for g in groups:
+        got = known(obj, g)
+        if got is None:
+            missing.append(g)
+        else:
+            out[g.name] = got
+    if not missing:
         HITS[0] += 1
-        return got
-    return group_members(obj, group)
+    else:
+        read = groups_members(obj, missing)
+        out.update(read)
+        if obj.mode == 'OBJECT':
+            _remember(obj, read)
+    return out
+
+
+def _remember(obj, groups):
+    """Adds ``groups`` (``{name: (ids, weights)}``, read or written just now) to ``obj``'s
+    entry, starting a new entry when the old one no longer matches the object."""
+    key = memo.identity(obj)
+    entry = _ENTRIES.get(obj.as_pointer())
+    kept = entry[1] if entry is not None and entry[0] == key else {}
+    for name, (ids, weights) in groups.items():
+        group = obj.vertex_groups.get(name)
+        if group is not None:
+            kept[name] = (group.index, np.array(ids), np.array(weights))
+    _ENTRIES[obj.as_pointer()] = (key, kept)
 
 
 def keep(context, obj, groups):
@@ -46,9 +77,5 @@ def keep(context, obj, groups):
     memo.settle(context)
     if obj.mode != 'OBJECT':
         return
-    entry = {}
-    for name, (ids, weights) in groups.items():
-        group = obj.vertex_groups.get(name)
-        if group is not None:
-            entry[name] = (group.index, np.array(ids), np.array(weights))
-    _ENTRIES[obj.as_pointer()] = (memo.identity(obj), entry)
+    _ENTRIES.pop(obj.as_pointer(), None)
+    _remember(obj, groups)

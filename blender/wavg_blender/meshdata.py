@@ -131,17 +131,28 @@ def vertex_group(obj, name):
 
 def group_members(obj, group):
     """``(ids, weights)`` of the vertices in ``group`` with a weight above zero, by id."""
-    index = group.index
-    ids, weights = [], []
+    return groups_members(obj, [group])[group.name]
+
+
+def groups_members(obj, groups):
+    """``{name: (ids, weights)}`` of each of ``groups`` as :func:`group_members` gives it,
+    read in one visit of every vertex (the cost of reading one group, ~6 ms on 25k
+    vertices: Blender has no bulk read of vertex groups)."""
+    slots = {g.index: ([], []) for g in groups}
+    get = slots.get
     for v in obj.data.vertices:
         for g in v.groups:
-            if g.group == index:
+            slot = get(g.group)
+            if slot is not None:
                 w = g.weight
                 if w > 0.0:
-                    ids.append(v.index)
-                    weights.append(w)
-                break
-    return np.array(ids, dtype=np.int64), np.array(weights, dtype=np.float64)
+                    slot[0].append(v.index)
+                    slot[1].append(w)
+    return {
+        g.name: (np.array(slots[g.index][0], dtype=np.int64),
+                 np.array(slots[g.index][1], dtype=np.float64))
+        for g in groups
+    }
 
 
 def weights_of(group, ids):

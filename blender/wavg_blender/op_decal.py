@@ -5,7 +5,7 @@ vertex group ``wavg_invalid``."""
 import bpy
 import numpy as np
 
-from . import group_cache, surfaces
+from . import decal_memo, group_cache, surfaces
 from .common import ActiveMeshOperator, active_mesh, object_mode
 from .errors import AddonError, describe, wavg
 from .meshdata import point_attribute_2d, vertex_group
@@ -90,11 +90,10 @@ class WAVG_OT_decal_uv(ActiveMeshOperator, bpy.types.Operator):
         check_uv_layer_room(obj, self.uv_layer)
         w = wavg()
         try:
-            uv, valid = w.decal(surface, anchors, anchor_uv)
+            uv, valid = decal_memo.decal(obj, surface, anchors, anchor_uv)
         except (w.WavgError, ValueError, TypeError) as e:
             raise AddonError(f"wavg cannot make this decal: {describe(e)}") from e
-        uv = np.asarray(uv, dtype=np.float64)
-        valid = np.asarray(valid, dtype=bool)
+        decal_memo.remember_settings(obj, self.group, self.attribute)
         with object_mode(context):
             set_uv_layer(obj, self.uv_layer, np.where(np.isfinite(uv), uv, 0.0))
             invalid = np.flatnonzero(~valid)

@@ -1,0 +1,152 @@
+"""The decal kept and read ahead (``decal_memo``): a run whose inputs are those of the last
+decal takes it, any change of the anchors or their (u, v) computes it again, and after an
+edit the idle read-ahead leaves the click nothing to read or compute; every result is
+``wavg.decal``'s."""
+
+import time
+
+import bpy
+import numpy as np
+
+import scene
+from cases import decal_setup, precompute
+from cases_more import check_decal
+
+
+def uv_attribute(obj):
+    me = obj.data
+    flat = np.empty(len(me.vertices) * 2, dtype=np.float32)
+    me.attributes["wavg_uv"].data.foreach_get("vector", flat)
+    return flat.reshape(-1, 2)
+
+
+def set_uv_attribute(obj, uv):
+    obj.data.attributes["wavg_uv"].data.foreach_set("vector", uv.astype(np.float32).ravel())
+
+
+def test_decal_kept(ctx):
+    """Run again, or after an edit leaving the anchors as they were, the decal is taken
+    from memory; a changed (u, v), a moved anchor, another surface compute it again."""
+    from wavg_blender import decal_memo
+
+    ico = scene.icosphere("ico", subdivisions=3)
+    precompute(ico)
+    anchors, _uv = decal_setup(ico)
+    scene.activate(ico)
+    taken = decal_memo.TAKEN[0]
+    bpy.ops.wavg.decal_uv()
+    assert decal_memo.TAKEN[0] == taken, "a first decal was found in memory"
+    check_decal(ico, anchors)
+    bpy.ops.wavg.decal_uv()
+    assert decal_memo.TAKEN[0] == taken + 1, "the decal run again was computed again"
+    check_decal(ico, anchors)
+    group = ico.vertex_groups["wavg_anchors"]
+    group.add([anchors[0]], 1.0, 'REPLACE')  # an edit that keeps the anchors
+    bpy.ops.wavg.decal_uv()
+    assert decal_memo.TAKEN[0] == taken + 2, "same anchors after an edit: not taken"
+    check_decal(ico, anchors)
+    uv = uv_attribute(ico)
+    uv[anchors[1]] += (0.25, -0.125)  # written without an update: only the values tell
+    set_uv_attribute(ico, uv)
+    bpy.ops.wavg.decal_uv()
+    assert decal_memo.TAKEN[0] == taken + 2, "a decal of other (u, v) was taken"
+    check_decal(ico, anchors)
+    moved = scene.nearest_vertices(ico, [(0.2, 0.3, 1.0)])[0]
+    assert moved not in anchors
+    uv[moved] = uv[anchors[0]]
+    set_uv_attribute(ico, uv)
+    group.remove([anchors[0]])
+    group.add([moved], 1.0, 'REPLACE')
+    anchors = sorted(anchors[1:] + [moved])
+    bpy.ops.wavg.decal_uv()
+    assert decal_memo.TAKEN[0] == taken + 2, "a decal of other anchors was taken"
+    check_decal(ico, anchors)
+    # Another mesh of the same anchors and (u, v): its own decal.
+    other = scene.icosphere("other", subdivisions=3, scale=(1.0, 1.0, 0.8))
+    precompute(other)
+    other = bpy.data.objects["other"]
+    group = other.vertex_groups.new(name="wavg_anchors")
+    group.add(anchors, 1.0, 'REPLACE')
+    other.data.attributes.new("wavg_uv", 'FLOAT2', 'POINT')
+    set_uv_attribute(other, uv)
+    scene.activate(other)
+    bpy.ops.wavg.decal_uv()
+    assert decal_memo.TAKEN[0] == taken + 2, "another surface's decal was taken"
+    check_decal(other, anchors)
+
+
+def test_decal_read_ahead(ctx):
+    """After an edit of the anchors, the idle timer reads the anchor group, wavg_invalid
+    and the (u, v) and computes the decal in a worker thread: the click then reads no group
+    and computes nothing, with wavg.decal's result. Nothing is read ahead in Edit mode, for
+    an object the operator never ran on, or when the decal is already there."""
+    from wavg_blender import decal_memo, group_cache
+
+    decal_memo.forget_all()  # an object of an earlier test may have had this address
+    ico = scene.icosphere("ico", subdivisions=3)
+    precompute(ico)
+    anchors, _uv = decal_setup(ico)
+    scene.activate(ico)
+    assert not decal_memo.read_ahead(ico), "read ahead before the operator ever ran"
+    bpy.ops.wavg.decal_uv()
+    assert not decal_memo.read_ahead(ico), "read ahead though the decal is in memory"
+    decal_memo._CHANGED.clear()  # the operator's own writes count as an update too
+    uv = uv_attribute(ico)
+    moved = scene.nearest_vertices(ico, [(-0.2, 0.3, 1.0)])[0]
+    assert moved not in anchors
+    uv[moved] = uv[anchors[-1]]
+    set_uv_attribute(ico, uv)
+    group = ico.vertex_groups["wavg_anchors"]
+    group.remove([anchors[-1]])
+    group.add([moved], 1.0, 'REPLACE')
+    anchors = sorted(anchors[:-1] + [moved])
+    bpy.context.view_layer.update()
+    # The edit started the idle timer; it runs once the object has been left alone.
+    assert ico.as_pointer() in decal_memo._CHANGED, "the edit was not noticed"
+    assert bpy.app.timers.is_registered(decal_memo._idle), "no idle timer"
+    assert 0 < decal_memo._idle() <= decal_memo.IDLE, "read ahead during the edit"
+    decal_memo._CHANGED[ico.as_pointer()] -= decal_memo.IDLE
+    ahead = decal_memo.COMPUTED_AHEAD[0]
+    assert decal_memo._idle() is None
+    assert decal_memo.COMPUTED_AHEAD[0] == ahead + 1, "the idle timer read nothing ahead"
+    hits, taken = group_cache.HITS[0], decal_memo.TAKEN[0]
+    bpy.ops.wavg.decal_uv()
+    assert group_cache.HITS[0] == hits + 1, "the click read the anchor group"
+    assert decal_memo.TAKEN[0] == taken + 1, "the click computed the decal"
+    check_decal(ico, anchors)
+    # Read ahead, then edited again before the click: the click sees the edit.
+    group.add([moved], 0.0, 'REPLACE')
+    anchors.remove(moved)
+    uv[anchors[0]] += (0.5, 0.5)
+    set_uv_attribute(ico, uv)
+    bpy.context.view_layer.update()
+    assert decal_memo.read_ahead(ico)
+    uv[anchors[0]] -= (0.5, 0.5)
+    set_uv_attribute(ico, uv)
+    bpy.ops.wavg.decal_uv()
+    check_decal(ico, anchors)
+    # Not in Edit mode, nor for an object the operator never ran on.
+    bpy.ops.object.mode_set(mode='EDIT')
+    assert not decal_memo.read_ahead(ico), "read ahead in Edit mode"
+    bpy.ops.object.mode_set(mode='OBJECT')
+    other = scene.icosphere("other", subdivisions=2)
+    assert not decal_memo.read_ahead(other)
+    decal_memo._CHANGED.clear()
+    # The worker's decal is the operator's own (one made on Blender's thread).
+    group.add([moved], 1.0, 'REPLACE')
+    anchors = sorted(anchors + [moved])
+    bpy.context.view_layer.update()
+    start = time.perf_counter()
+    assert decal_memo.read_ahead(ico)
+    kept = decal_memo._DECALS[ico.as_pointer()]
+    ahead_uv, ahead_valid = kept.get()
+    decal_memo.forget_all()
+    bpy.ops.wavg.decal_uv()
+    assert decal_memo._DECALS[ico.as_pointer()] is not kept
+    now_uv, now_valid = decal_memo._DECALS[ico.as_pointer()].get()
+    assert np.array_equal(ahead_valid, now_valid)
+    assert np.array_equal(ahead_uv, now_uv, equal_nan=True)
+    print(f"    read ahead and its decal: {1e3 * (time.perf_counter() - start):.1f} ms")
+
+
+TESTS = [test_decal_kept, test_decal_read_ahead]
