@@ -75,7 +75,8 @@ class Table:
 
 def test_bench(ctx):
     w = wavg()
-    from wavg_blender import activation, background, op_point, op_spline, surfaces
+    from wavg_blender import (activation, background, decal_memo, op_point, op_spline,
+                              surfaces)
 
     table = Table()
     big = scene.uv_sphere("big", u=256, v=100)
@@ -135,14 +136,54 @@ def test_bench(ctx):
     anchors, uv = decal_inputs(big)
     scene.activate(big)
     anchor_group = big.vertex_groups["wavg_anchors"]
+    # A vertex next to the first anchor with its (u, v): moving the anchor there changes
+    # the decal's input and nothing else.
+    alt = int(anchors[0]) + 1
+    assert alt not in anchors
+    attr = big.data.attributes["wavg_uv"]
+    flat = np.empty(2 * len(big.data.vertices), dtype=np.float32)
+    attr.data.foreach_get("vector", flat)
+    flat[2 * alt:2 * alt + 2] = flat[2 * anchors[0]:2 * anchors[0] + 2]
+    attr.data.foreach_set("vector", flat)
 
-    def edit_anchors(i):
-        # An edit that leaves the anchors as they are, so the next run reads the group.
+    def move_anchor(i):
+        # The first anchor to its neighbour and back: every click has other anchors.
+        a, b = (int(anchors[0]), alt) if i % 2 == 0 else (alt, int(anchors[0]))
+        anchor_group.remove([a])
+        anchor_group.add([b], 1.0, 'REPLACE')
+        bpy.context.view_layer.update()
+
+    def keep_anchors(i):
+        # An edit that leaves the anchors as they are (a weight set again).
         anchor_group.add([int(anchors[0])], 1.0, 'REPLACE')
         bpy.context.view_layer.update()
 
-    table.add("`wavg.decal_uv` (8 anchors) after an edit of the object",
-              measure(lambda i: bpy.ops.wavg.decal_uv(*UNDO), CLICKS, edit_anchors), CLICK_MS)
+    def settled_move(i):
+        # The previous read-ahead's worker done first: runs are measured alone.
+        kept = decal_memo._DECALS.get(big.as_pointer())
+        if kept is not None and kept.thread is not None:
+            kept.thread.join()
+        move_anchor(i)
+
+    def idle_after_move(i):
+        # What the idle timer does between the edit and the click (0.25 s after it).
+        move_anchor(i)
+        decal_memo.read_ahead(big)
+        decal_memo._DECALS[big.as_pointer()].thread.join()
+
+    bpy.ops.wavg.decal_uv(*UNDO)  # the operator's settings, for the read ahead
+    table.add("`wavg.decal_uv` (8 anchors) after an anchor moved, clicked at once (the "
+              "group and mesh read, the decal computed by the click)",
+              measure(lambda i: bpy.ops.wavg.decal_uv(*UNDO), CLICKS, move_anchor), CLICK_MS)
+    table.add("`wavg.decal_uv` after an edit that keeps the anchors, clicked at once",
+              measure(lambda i: bpy.ops.wavg.decal_uv(*UNDO), CLICKS, keep_anchors), CLICK_MS)
+    table.add("`wavg.decal_uv` after an anchor moved, clicked after the idle read-ahead",
+              measure(lambda i: bpy.ops.wavg.decal_uv(*UNDO), CLICKS, idle_after_move),
+              CLICK_MS)
+    table.add("of which the idle read-ahead on Blender's thread (groups, mesh, (u, v); the "
+              "decal then runs in a worker)",
+              measure(lambda i: decal_memo.read_ahead(big), CLICKS, settled_move))
+    settled_move(0)
     table.add("`wavg.decal_uv` run again",
               measure(lambda i: bpy.ops.wavg.decal_uv(*UNDO), CLICKS), CLICK_MS)
     table.add("of which `wavg.decal` (the library)",

@@ -149,4 +149,43 @@ def test_decal_read_ahead(ctx):
     print(f"    read ahead and its decal: {1e3 * (time.perf_counter() - start):.1f} ms")
 
 
-TESTS = [test_decal_kept, test_decal_read_ahead]
+def test_mesh_checked_not_read(ctx):
+    """After a geometry update that left the positions and polygons (a vertex group
+    edited), the mesh read before is used again; a moved vertex or a flipped edge (same
+    positions, other triangles) is read anew, with its own fingerprint."""
+    import bmesh
+    from wavg_blender import surfaces
+
+    ico = scene.icosphere("ico", subdivisions=2)
+    scene.activate(ico)
+    first = surfaces.mesh_input(ico)
+    group = ico.vertex_groups.new(name="g")
+    group.add([3], 0.5, 'REPLACE')
+    bpy.context.view_layer.update()
+    assert surfaces.mesh_input(ico) is first, "a vertex group edit made the mesh be read"
+    me = ico.data
+    me.vertices[7].co.x += 0.05
+    me.update()
+    moved = surfaces.mesh_input(ico)
+    assert moved is not first and moved.key != first.key, "a moved vertex was not seen"
+    me.vertices[7].co.x -= 0.05
+    me.update()
+    back = surfaces.mesh_input(ico)
+    assert back.key == first.key and np.array_equal(back.F, first.F)
+    bm = bmesh.new()
+    bm.from_mesh(me)
+    bm.edges.ensure_lookup_table()
+    inner = next(e for e in bm.edges if len(e.link_faces) == 2)
+    bmesh.ops.rotate_edges(bm, edges=[inner], use_ccw=False)
+    bm.to_mesh(me)
+    bm.free()
+    me.update()
+    flipped = surfaces.mesh_input(ico)
+    assert flipped is not back and flipped.key != back.key, "a flipped edge was not seen"
+    assert np.array_equal(flipped.V, back.V), "the flip moved a vertex"
+    bpy.ops.ed.undo_push(message="flipped")
+    bpy.ops.ed.undo()
+    assert not surfaces._LAST, "meshes kept across an undo"
+
+
+TESTS = [test_decal_kept, test_decal_read_ahead, test_mesh_checked_not_read]

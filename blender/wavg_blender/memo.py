@@ -15,12 +15,23 @@ from bpy.app.handlers import persistent
 
 # The stores (dicts: object pointer -> (key, ...)) whose entries the handlers drop.
 _STORES = []
+# Stores emptied only on undo, redo, file load and `forget_all` (their users check an
+# entry's data before using it).
+_RELOAD_STORES = []
 
 
 def store():
     """A new store, emptied with the others."""
     entries = {}
     _STORES.append(entries)
+    return entries
+
+
+def reload_store():
+    """A new store that survives geometry updates (its user checks each entry) and is
+    emptied on undo, redo and file load, which replace the data its entries refer to."""
+    entries = {}
+    _RELOAD_STORES.append(entries)
     return entries
 
 
@@ -39,7 +50,7 @@ def settle(context):
 
 def forget_all():
     """Drops every entry of every store."""
-    for entries in _STORES:
+    for entries in _STORES + _RELOAD_STORES:
         entries.clear()
 
 

@@ -42,6 +42,27 @@ class MeshInput:
         self.V = co.reshape(n, 3).astype(np.float64)
         self.F = tris.reshape(m, 3).astype(np.int64)
         self._tri_loops = None
+        self._co = co
+        self._topology = topology(me)
+
+    def unchanged(self, obj):
+        """True when ``obj`` (in Object mode) still has this mesh: the same positions and
+        polygons (so the same triangulation and fingerprint). A check in bulk (~0.5 ms on
+        25k vertices) instead of a read and a hash (~2.5 ms): after an edit of anything
+        else (a vertex group, Weight Paint) the mesh need not be read again."""
+        if (obj is None or obj != self.obj or obj.name != self.name or obj.type != 'MESH'
+                or obj.mode != 'OBJECT'):
+            return False
+        me = obj.data
+        if len(me.vertices) * 3 != len(self._co):
+            return False
+        co = np.empty(len(self._co), dtype=np.float32)
+        me.vertices.foreach_get("co", co)
+        if not np.array_equal(co, self._co):
+            return False
+        now = topology(me)
+        return all(len(a) == len(b) and np.array_equal(a, b)
+                   for a, b in zip(now, self._topology))
 
     @property
     def tri_loops(self):
@@ -56,6 +77,18 @@ class MeshInput:
     def diagonal(self):
         """Length of the bounding-box diagonal (object space; computed once)."""
         return float(np.linalg.norm(self.V.max(axis=0) - self.V.min(axis=0)))
+
+
+def topology(me):
+    """The polygons of ``me`` as arrays (loop starts, loop counts, the loops' vertices):
+    with the positions, what Blender's triangulation depends on."""
+    out = []
+    for coll, prop in ((me.polygons, "loop_start"), (me.polygons, "loop_total"),
+                       (me.loops, "vertex_index")):
+        a = np.empty(len(coll), dtype=np.int32)
+        coll.foreach_get(prop, a)
+        out.append(a)
+    return out
 
 
 def fingerprint(co, tris):

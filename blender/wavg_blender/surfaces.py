@@ -28,6 +28,11 @@ _SURFACES = {}
 _TREES = {}
 # Object pointer -> (key, MeshInput): the mesh read last from each object.
 _MESHES = memo.store()
+# Object pointer -> the mesh read last from it, kept across geometry updates and used again
+# only when `MeshInput.unchanged` says it still is the object's mesh (oldest first).
+_LAST = memo.reload_store()
+#: Objects whose last mesh is kept that way.
+MAX_LAST = 8
 # Embeddings read on Blender's thread (for tests).
 LOADS = [0]
 
@@ -147,10 +152,18 @@ def mesh_input(obj):
     entry = _MESHES.get(obj.as_pointer())
     if entry is not None and entry[0] == memo.identity(obj):
         return entry[1]
-    mesh = MeshInput(obj)
+    last = _LAST.get(obj.as_pointer())
+    if last is not None and last.unchanged(obj):
+        mesh = last  # only something else than the positions and polygons changed
+    else:
+        mesh = MeshInput(obj)
     if obj.mode == 'EDIT':
         memo.settle(bpy.context)  # the sync out of Edit mode tagged the mesh: not an edit
     _MESHES[obj.as_pointer()] = (memo.identity(obj), mesh)
+    _LAST.pop(obj.as_pointer(), None)
+    while len(_LAST) >= MAX_LAST:
+        del _LAST[next(iter(_LAST))]
+    _LAST[obj.as_pointer()] = mesh
     return mesh
 
 
@@ -208,6 +221,7 @@ def forget_all():
     _SURFACES.clear()
     _TREES.clear()
     _MESHES.clear()
+    _LAST.clear()
     background.forget_all()
 
 
