@@ -8,7 +8,7 @@ import numpy as np
 from . import decal_memo, group_cache, surfaces
 from .common import ActiveMeshOperator, active_mesh, object_mode
 from .errors import AddonError, describe, wavg
-from .meshdata import point_attribute_2d, vertex_group
+from .meshdata import corner_vertices, point_attribute_2d, vertex_group
 
 INVALID_GROUP = "wavg_invalid"
 MAX_UV_LAYERS = 8
@@ -22,8 +22,7 @@ def set_uv_layer(obj, name, per_vertex_uv):
     layer = me.uv_layers.get(name) or me.uv_layers.new(name=name, do_init=False)
     if active >= 0:
         me.uv_layers.active_index = active
-    loop_vertex = np.empty(len(me.loops), dtype=np.uint32)
-    me.loops.foreach_get("vertex_index", loop_vertex)
+    loop_vertex = corner_vertices(me)
     uv = np.ascontiguousarray(per_vertex_uv[loop_vertex], dtype=np.float32).ravel()
     layer.data.foreach_set("uv", uv)
     me.update()
