@@ -36,19 +36,27 @@ def check_uv_layer_room(obj, name):
 
 
 def set_invalid_group(obj, ids, known=None):
-    """Vertex group ``wavg_invalid`` of ``obj`` holds exactly ``ids`` (weight 1); nothing
-    is written when ``known`` (its members as :func:`.group_cache.known` gives them) says it
-    does already."""
+    """Vertex group ``wavg_invalid`` of ``obj`` holds exactly ``ids`` (weight 1). When
+    ``known`` (its members as :func:`.group_cache.known` gives them) says what it holds,
+    only the difference is written (nothing when there is none; a decal after a small
+    edit changes a few hundred of its ~20k members; a member of weight 0 counts as absent,
+    as everywhere in the add-on); else it is made anew."""
+    ids = np.asarray(ids, dtype=np.int64)
     old = obj.vertex_groups.get(INVALID_GROUP)
-    if old is not None and known is not None and np.array_equal(known[0], ids) and np.all(
-        known[1] == 1.0
-    ):
+    if old is not None and known is not None:
+        held = known[0][known[1] == 1.0]
+        gone = np.setdiff1d(known[0], ids, assume_unique=True)
+        new = np.setdiff1d(ids, held, assume_unique=True)
+        if len(gone):
+            old.remove(gone.tolist())
+        if len(new):
+            old.add(new.tolist(), 1.0, 'REPLACE')
         return
     if old is not None:
         obj.vertex_groups.remove(old)
     group = obj.vertex_groups.new(name=INVALID_GROUP)
     if len(ids):
-        group.add(np.asarray(ids, dtype=np.int64).tolist(), 1.0, 'REPLACE')
+        group.add(ids.tolist(), 1.0, 'REPLACE')
 
 
 class WAVG_OT_decal_uv(ActiveMeshOperator, bpy.types.Operator):
