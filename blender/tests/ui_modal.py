@@ -1,7 +1,8 @@
 """The interactive precompute in a real Blender window (not background mode): its modal
 operator runs wavg in a worker thread, shows progress in the status bar, and Esc cancels;
 then making the mesh active reads its embedding ahead (a subscription to the active object,
-which only a window's event loop delivers).
+which only a window's event loop delivers), and after an edit of a decal's anchors the idle
+timer reads the decal ahead, which the next click takes.
 Needs a display (Xvfb is enough) and Blender's event simulation:
 
     xvfb-run -a blender --factory-startup --enable-event-simulate \\
@@ -10,6 +11,7 @@ Needs a display (Xvfb is enough) and Blender's event simulation:
 Prints `ok`/`FAILED` lines and exits 0 when every check passed, 1 otherwise.
 """
 
+import math
 import os
 import sys
 import tempfile
@@ -19,6 +21,7 @@ import traceback
 
 import bmesh
 import bpy
+import numpy as np
 
 ARGS = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 ZIP = os.path.abspath(ARGS[ARGS.index("--zip") + 1])
@@ -80,6 +83,26 @@ def setup():
     bpy.context.view_layer.objects.active = obj
     obj.select_set(True)
     return obj
+
+
+def decal_anchors(obj):
+    """A vertex group ``wavg_anchors`` of 8 vertices around the top, their (u, v) in the
+    point attribute ``wavg_uv`` (the first one's also on the vertex after it, where the
+    test moves it); returns the anchor ids."""
+    me = obj.data
+    V = np.empty(3 * len(me.vertices), dtype=np.float32)
+    me.vertices.foreach_get("co", V)
+    V = V.reshape(-1, 3)
+    ids = sorted({int(np.argmax(V @ np.array([math.cos(t), math.sin(t), 2.0])))
+                  for t in np.linspace(0, 2 * math.pi, 8, endpoint=False)})
+    obj.vertex_groups.new(name="wavg_anchors").add(ids, 1.0, 'REPLACE')
+    uv = np.zeros((len(V), 2), dtype=np.float32)
+    for k, i in enumerate(ids):
+        uv[i] = (0.5 + 0.5 * math.cos(k), 0.5 + 0.5 * math.sin(k))
+    assert ids[0] + 1 not in ids
+    uv[ids[0] + 1] = uv[ids[0]]
+    me.attributes.new("wavg_uv", 'FLOAT2', 'POINT').data.foreach_set("vector", uv.ravel())
+    return ids
 
 
 def start_precompute():
@@ -159,6 +182,28 @@ def step():
             check("making the mesh active reads its embedding ahead",
                   read is not None and read.result is not None,
                   f"(after {time.time() - STATE['t']:.1f} s)")
+            from wavg_blender import decal_memo
+
+            anchors = decal_anchors(obj)
+            bpy.ops.wavg.decal_uv()
+            # An anchor moved: once Blender is idle the decal is read ahead by the timer.
+            group = obj.vertex_groups["wavg_anchors"]
+            group.remove([anchors[0]])
+            group.add([anchors[0] + 1], 1.0, 'REPLACE')
+            bpy.context.view_layer.update()
+            STATE.update(phase="decal", t=time.time(), ahead=decal_memo.COMPUTED_AHEAD[0])
+            return 0.2
+        if phase == "decal":
+            from wavg_blender import decal_memo
+
+            if decal_memo.COMPUTED_AHEAD[0] == STATE["ahead"] and time.time() - STATE["t"] < 60:
+                return 0.2
+            check("after an edit, the idle timer reads the decal ahead",
+                  decal_memo.COMPUTED_AHEAD[0] == STATE["ahead"] + 1,
+                  f"(after {time.time() - STATE['t']:.1f} s)")
+            taken = decal_memo.TAKEN[0]
+            bpy.ops.wavg.decal_uv()
+            check("the click takes the decal read ahead", decal_memo.TAKEN[0] == taken + 1)
             finish()
     except Exception:
         traceback.print_exc()
