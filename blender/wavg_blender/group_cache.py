@@ -1,6 +1,6 @@
 """Members of vertex groups kept between operator runs (a :mod:`.memo` store). Blender 3.4
-has no bulk read of vertex groups, so reading one visits every vertex from Python (~9 ms on
-25k vertices): a decal run again on the same anchors reads them from here, and finds its
+has no bulk read of vertex groups (nor has 4.5), so reading one visits every vertex from
+Python (~6 ms on 25k vertices in 3.4, ~14 in 4.5): a decal run again on the same anchors reads them from here, and finds its
 ``wavg_invalid`` group already holding what it would write. An entry is used only for an
 object in Object mode whose mesh and vertex count are those it was read with, and a group
 whose index and name are; writers evaluate their own writes before storing (:func:`keep`)."""
