@@ -132,6 +132,19 @@ def test_decal_read_ahead(ctx):
     other = scene.icosphere("other", subdivisions=2)
     assert not decal_memo.read_ahead(other)
     decal_memo._CHANGED.clear()
+    # In Weight Paint mode (which writes the groups to the mesh itself) it is read ahead;
+    # the click back in Object mode takes that decal.
+    bpy.ops.object.mode_set(mode='WEIGHT_PAINT')
+    group.add([anchors[0]], 0.0, 'REPLACE')
+    painted = anchors[1:]
+    bpy.context.view_layer.update()
+    assert decal_memo.read_ahead(ico), "nothing read ahead in Weight Paint mode"
+    bpy.ops.object.mode_set(mode='OBJECT')
+    taken = decal_memo.TAKEN[0]
+    bpy.ops.wavg.decal_uv()
+    assert decal_memo.TAKEN[0] == taken + 1, "the decal read ahead in Weight Paint not taken"
+    check_decal(ico, painted)
+    group.add([anchors[0]], 1.0, 'REPLACE')
     # The worker's decal is the operator's own (one made on Blender's thread).
     group.add([moved], 1.0, 'REPLACE')
     anchors = sorted(anchors + [moved])

@@ -27,6 +27,9 @@ from .errors import wavg
 #: Seconds without a geometry update of the object before its decal is read ahead: a
 #: stroke of Weight Paint is not interrupted by reads.
 IDLE = 0.25
+#: Modes in which the mesh's own data is current, so its decal can be read ahead (Weight
+#: Paint writes vertex groups to the mesh itself; Edit mode keeps its edits apart).
+READ_MODES = ('OBJECT', 'WEIGHT_PAINT')
 #: Objects whose decal is kept (the most recent ones).
 MAX_KEPT = 4
 
@@ -115,14 +118,15 @@ def remember_settings(obj, group, attribute):
 
 def read_ahead(obj, context=None):
     """Reads what a ``wavg.decal_uv`` with ``obj``'s last settings needs and starts its
-    decal in a worker thread; True when one started. Only in Object mode, with the
+    decal in a worker thread; True when one started. Only in Object and Weight Paint mode
+    (:data:`READ_MODES`; the groups read are kept for Object mode only), with the
     embedding in memory and valid inputs (the operator reports the others)."""
     from .meshdata import point_attribute_2d
     from .op_decal import INVALID_GROUP
 
     context = context or bpy.context
     settings = _SETTINGS.get(obj.as_pointer()) if obj is not None else None
-    if settings is None or obj.type != 'MESH' or obj.mode != 'OBJECT':
+    if settings is None or obj.type != 'MESH' or obj.mode not in READ_MODES:
         return False
     group_name, attribute, mesh_ptr, name = settings
     if (mesh_ptr, name) != (obj.data.as_pointer(), obj.name):
