@@ -368,14 +368,14 @@ pub fn correspond_vertices(
             Ok(_) => Validity::Valid,
         })
         .collect();
-    let target_normals = vertex_normals(target.mesh());
-    let normals = mapped_normals(mesh, target.mesh(), &mapped, &target_normals);
+    let image_normals = image_normals(target.mesh(), &mapped);
+    let normals = mapped_normals(mesh, &image_normals);
     if opts.test == ValidityTest::Local {
         let answered: Vec<Option<Vector3<f64>>> = mapped
             .iter()
             .map(|m| m.target.as_ref().ok().map(|t| t.position))
             .collect();
-        let smooth = smooth_normals(mesh, target.mesh(), &mapped, &normals, &target_normals);
+        let smooth = smooth_normals(mesh, &normals, &image_normals);
         let inconsistent = inconsistent_vertices(mesh, &answered, &smooth, opts.max_stretch);
         for (v, bad) in validity.iter_mut().zip(inconsistent) {
             if bad && *v == Validity::Valid {
@@ -420,24 +420,34 @@ pub fn vertex_points(mesh: &ValidMesh) -> Vec<SurfacePoint> {
         .collect()
 }
 
+/// Per source vertex: the target's area-weighted vertex normals (see [`vertex_normals`])
+/// interpolated at its image, `None` without an image. Computed once per vertex, it is
+/// shared by the faces around the vertex in [`mapped_normals`] and [`smooth_normals`].
+fn image_normals(target: &ValidMesh, mapped: &[Mapped]) -> Vec<Option<Vector3<f64>>> {
+    let vn = vertex_normals(target);
+    mapped
+        .par_iter()
+        .with_min_len(VERTEX_CHUNK)
+        .map(|m| Some(m.target.as_ref().ok()?.point.interpolate(target, &vn)))
+        .collect()
+}
+
+/// Vertices one parallel task handles in the validity stage's per-vertex passes.
+const VERTEX_CHUNK: usize = 1024;
+
 /// Per source face: the target's normal where its corners land (the sum of the target's
-/// area-weighted vertex normals `normals` interpolated at the three images, which is smooth
-/// across the target's edges, unlike face normals at creases), `None` when a corner has no
-/// image.
-fn mapped_normals(
-    source: &ValidMesh,
-    target: &ValidMesh,
-    mapped: &[Mapped],
-    normals: &[Vector3<f64>],
-) -> Vec<Option<Vector3<f64>>> {
+/// area-weighted vertex normals interpolated at the three images, `image`, which is
+/// smooth across the target's edges, unlike face normals at creases), `None` when a
+/// corner has no image.
+fn mapped_normals(source: &ValidMesh, image: &[Option<Vector3<f64>>]) -> Vec<Option<Vector3<f64>>> {
     source
         .triangles
         .par_iter()
+        .with_min_len(VERTEX_CHUNK)
         .map(|t| {
             let mut n = Vector3::zeros();
             for &v in t {
-                let p = mapped.get(v as usize)?.target.as_ref().ok()?.point;
-                n += p.interpolate(target, normals);
+                n += (*image.get(v as usize)?)?;
             }
             Some(n)
         })
@@ -445,27 +455,25 @@ fn mapped_normals(
 }
 
 /// `normals` where the target is smooth at the scale of its edges around the three images
-/// (their interpolated vertex normals, from the target's `vn`, within [`SMOOTH_DEGREES`]
-/// of their sum), `None`
-/// elsewhere: on thin parts (fingers) an image a fraction of an edge off flips triangles
-/// while landing close to the truth, so flips there are no evidence of a wrong image.
+/// (their interpolated vertex normals `image` within [`SMOOTH_DEGREES`] of their sum),
+/// `None` elsewhere: on thin parts (fingers) an image a fraction of an edge off flips
+/// triangles while landing close to the truth, so flips there are no evidence of a wrong
+/// image.
 fn smooth_normals(
     source: &ValidMesh,
-    target: &ValidMesh,
-    mapped: &[Mapped],
     normals: &[Option<Vector3<f64>>],
-    vn: &[Vector3<f64>],
+    image: &[Option<Vector3<f64>>],
 ) -> Vec<Option<Vector3<f64>>> {
     let min_cos = SMOOTH_DEGREES.to_radians().cos();
     source
         .triangles
         .par_iter()
+        .with_min_len(VERTEX_CHUNK)
         .zip(normals)
         .map(|(t, n)| {
             let sum = (*n)?.normalize();
             for &v in t {
-                let p = mapped.get(v as usize)?.target.as_ref().ok()?.point;
-                let c = p.interpolate(target, vn).normalize();
+                let c = (*image.get(v as usize)?)?.normalize();
                 let cos = c.dot(&sum);
                 if cos.is_nan() || cos < min_cos {
                     return None;
@@ -609,7 +617,7 @@ mod tests {
             .iter()
             .map(|m| m.target.as_ref().ok().map(|t| t.position))
             .collect();
-        let normals = mapped_normals(mesh, mesh, &c.mapped, &vertex_normals(mesh));
+        let normals = mapped_normals(mesh, &image_normals(mesh, &c.mapped));
         let before = inconsistent_vertices(mesh, &answered, &normals, 4.0);
         assert!(before.iter().all(|b| !b));
         // Send vertex 1000's image to the far side of the sphere.

@@ -88,18 +88,24 @@ pub fn inconsistent_vertices(
         .into_par_iter()
         .map(|v| {
             SCRATCH.with_borrow_mut(|nb| {
-                nb.grow(mesh, v, radius);
-                let (mut measured, mut bad) = (0usize, 0usize);
-                for &u in &nb.edge {
-                    if let Some(r) = ratio(v, u) {
-                        measured += 1;
-                        bad += usize::from(r > limit);
-                    }
-                }
-                let (faces, folded) = nb.inside.iter().fold((0, 0), |(a, b), &x| {
-                    let (f, k) = ring_folds[x as usize];
-                    (a + f as usize, b + k as usize)
-                });
+                let (mut measured, mut bad, mut faces, mut folded) =
+                    (0usize, 0usize, 0usize, 0usize);
+                nb.grow(
+                    mesh,
+                    v,
+                    radius,
+                    |x| {
+                        let (f, k) = ring_folds[x as usize];
+                        faces += f as usize;
+                        folded += k as usize;
+                    },
+                    |u| {
+                        if let Some(r) = ratio(v, u) {
+                            measured += 1;
+                            bad += usize::from(r > limit);
+                        }
+                    },
+                );
                 2 * bad > measured || FOLDED.1 * folded >= FOLDED.0 * faces
             })
         })
@@ -112,7 +118,6 @@ thread_local! {
     static SCRATCH: RefCell<Neighbourhood> = const {
         RefCell::new(Neighbourhood {
             inside: Vec::new(),
-            edge: Vec::new(),
             stamp: Vec::new(),
             generation: 0,
         })
@@ -120,11 +125,10 @@ thread_local! {
 }
 
 /// A vertex's neighbourhood in the local test: the vertices inside (the vertex, and those
-/// within the radius reached through them) and at its edge (outside, adjacent to one
-/// inside), with one thread's marks of the vertices the growth met.
+/// within the radius reached through them), with one thread's marks of the vertices the
+/// growth met (inside or at the edge: outside, adjacent to one inside).
 struct Neighbourhood {
     inside: Vec<u32>,
-    edge: Vec<u32>,
     /// Per vertex: `2 g` inside, `2 g + 1` at the edge in generation `g` (one per
     /// growth); older values: not met.
     stamp: Vec<u32>,
@@ -132,10 +136,21 @@ struct Neighbourhood {
 }
 
 impl Neighbourhood {
-    /// Grows the neighbourhood of `v` on `mesh` (breadth first from `v`).
-    fn grow(&mut self, mesh: &ValidMesh, v: u32, radius: f64) {
-        if self.stamp.len() < mesh.n_vertices() {
-            self.stamp.resize(mesh.n_vertices(), 0);
+    /// Grows the neighbourhood of `v` on `mesh` (breadth first from `v`), calling
+    /// `on_inside` once for each vertex inside (`v` first) and `on_edge` once for each
+    /// vertex at the edge, as the growth meets them: the test's sums need no second pass
+    /// and the edge no list.
+    fn grow(
+        &mut self,
+        mesh: &ValidMesh,
+        v: u32,
+        radius: f64,
+        mut on_inside: impl FnMut(u32),
+        mut on_edge: impl FnMut(u32),
+    ) {
+        let n = mesh.n_vertices();
+        if self.stamp.len() < n {
+            self.stamp.resize(n, 0);
         }
         if self.generation >= u32::MAX / 2 - 1 {
             self.stamp.fill(0);
@@ -144,31 +159,36 @@ impl Neighbourhood {
         self.generation += 1;
         let (inside, edge) = (2 * self.generation, 2 * self.generation + 1);
         let topo = mesh.topology();
-        let centre = mesh.positions[v as usize];
+        let positions = &mesh.positions[..n];
+        let stamp = &mut self.stamp[..n];
+        let centre = positions[v as usize];
         let r2 = radius * radius;
         self.inside.clear();
-        self.edge.clear();
+        self.inside.reserve(NEIGHBOURHOOD_VERTICES);
         self.inside.push(v);
-        self.stamp[v as usize] = inside;
+        stamp[v as usize] = inside;
+        on_inside(v);
         let mut next = 0;
-        while next < self.inside.len() {
-            let x = self.inside[next];
+        while let Some(&x) = self.inside.get(next) {
             next += 1;
             for &u in topo.ring(x) {
-                let mark = &mut self.stamp[u as usize];
+                let Some(mark) = stamp.get_mut(u as usize) else {
+                    continue;
+                };
                 if *mark >= inside {
                     continue;
                 }
                 // A vertex first met outside the radius (or past the cap) stays at the
                 // edge even if a later path reaches it: the neighbourhood is what the
                 // growth reached, in order.
-                let within = (mesh.positions[u as usize] - centre).norm_squared() <= r2;
+                let within = (positions[u as usize] - centre).norm_squared() <= r2;
                 if within && self.inside.len() < NEIGHBOURHOOD_VERTICES {
                     *mark = inside;
                     self.inside.push(u);
+                    on_inside(u);
                 } else {
                     *mark = edge;
-                    self.edge.push(u);
+                    on_edge(u);
                 }
             }
         }
