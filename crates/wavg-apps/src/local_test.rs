@@ -87,6 +87,9 @@ pub fn inconsistent_vertices(
     (0..n as u32)
         .into_par_iter()
         .map(|v| {
+            // `ratio(v, u)` with `v`'s image and position read once.
+            let image = answered.get(v as usize).copied().flatten();
+            let centre = mesh.positions[v as usize];
             SCRATCH.with_borrow_mut(|nb| {
                 let (mut measured, mut bad, mut faces, mut folded) =
                     (0usize, 0usize, 0usize, 0usize);
@@ -100,7 +103,11 @@ pub fn inconsistent_vertices(
                         folded += k as usize;
                     },
                     |u| {
-                        if let Some(r) = ratio(v, u) {
+                        let (Some(pv), Some(Some(pu))) = (image, answered.get(u as usize)) else {
+                            return;
+                        };
+                        let r = (pv - pu).norm() / (centre - mesh.positions[u as usize]).norm();
+                        if r.is_finite() {
                             measured += 1;
                             bad += usize::from(r > limit);
                         }
@@ -181,8 +188,10 @@ impl Neighbourhood {
                 // A vertex first met outside the radius (or past the cap) stays at the
                 // edge even if a later path reaches it: the neighbourhood is what the
                 // growth reached, in order.
-                let within = (positions[u as usize] - centre).norm_squared() <= r2;
-                if within && self.inside.len() < NEIGHBOURHOOD_VERTICES {
+                // Past the cap the distance is not needed.
+                if self.inside.len() < NEIGHBOURHOOD_VERTICES
+                    && (positions[u as usize] - centre).norm_squared() <= r2
+                {
                     *mark = inside;
                     self.inside.push(u);
                     on_inside(u);
