@@ -223,6 +223,73 @@ mod tests {
             .collect()
     }
 
+    /// Below the cap, the disc is the part of the ball around the vertex reached through
+    /// the ball (each vertex reported once), its edge the other vertices next to it; with
+    /// a radius past the whole mesh, exactly the cap's count are inside, and the growth
+    /// still reports every vertex next to them at the edge.
+    #[test]
+    fn the_disc_is_the_ball_reached_from_the_vertex_and_its_edge_the_vertices_next_to_it() {
+        use std::collections::BTreeSet;
+        let mesh = ValidMesh::new(procedural::icosphere(6)).unwrap();
+        let topo = mesh.topology();
+        let edge_len = (mesh.positions[0] - mesh.positions[topo.ring(0)[0] as usize]).norm();
+        let mut nb = Neighbourhood {
+            inside: Vec::new(),
+            stamp: Vec::new(),
+            generation: 0,
+        };
+        let mut grown = |v: u32, radius: f64| {
+            let (mut inside, mut edge) = (Vec::new(), Vec::new());
+            nb.grow(&mesh, v, radius, |x| inside.push(x), |u| edge.push(u));
+            let (a, b) = (inside.len(), edge.len());
+            let (inside, edge): (BTreeSet<u32>, BTreeSet<u32>) =
+                (inside.into_iter().collect(), edge.into_iter().collect());
+            assert_eq!(
+                (inside.len(), edge.len()),
+                (a, b),
+                "a vertex reported twice"
+            );
+            (inside, edge)
+        };
+        for v in [0u32, 17, 4000, 40000] {
+            let radius = 3.5 * edge_len;
+            let (inside, edge) = grown(v, radius);
+            let centre = mesh.positions[v as usize];
+            let within = |u: u32| (mesh.positions[u as usize] - centre).norm() <= radius;
+            let mut want = BTreeSet::from([v]);
+            let mut todo = vec![v];
+            while let Some(x) = todo.pop() {
+                for &u in topo.ring(x) {
+                    if within(u) && want.insert(u) {
+                        todo.push(u);
+                    }
+                }
+            }
+            assert!(want.len() > 20 && want.len() < NEIGHBOURHOOD_VERTICES);
+            assert_eq!(inside, want);
+            let next: BTreeSet<u32> = want
+                .iter()
+                .flat_map(|&x| topo.ring(x).iter().copied())
+                .filter(|u| !want.contains(u))
+                .collect();
+            assert_eq!(edge, next);
+        }
+        let (inside, edge) = grown(5, 10.0);
+        assert_eq!(inside.len(), NEIGHBOURHOOD_VERTICES);
+        assert!(inside.contains(&5));
+        assert!(edge.is_disjoint(&inside));
+        for &u in &edge {
+            assert!(topo.ring(u).iter().any(|x| inside.contains(x)));
+        }
+        for &x in &inside {
+            assert!(
+                topo.ring(x)
+                    .iter()
+                    .all(|u| inside.contains(u) || edge.contains(u))
+            );
+        }
+    }
+
     /// A fine sphere (an edge shorter than the neighbourhood's radius) mapped onto itself,
     /// then a patch of seven vertices (a vertex and its one-ring) sent rigidly elsewhere:
     /// inside the patch no edge stretches and no face flips, so only a neighbourhood wider
