@@ -363,7 +363,7 @@ pub(crate) fn precompute_unscaled(
     //    which depends only on the mesh and the landmarks, is factored alongside
     //    (sequential): this fills the second core during the geodesics' tail. Then, where
     //    the landmarks leave a thin part uncovered (see `thin`), the landmarks so far are
-    //    locked, more are added (on the finest intermediate mesh, when there is one),
+    //    locked, more are added (on the finest intermediate mesh where it has vertices there),
     //    and steps 1 and 2 run again (at most `THIN_PART_ROUNDS` times, adding at most as
     //    many landmarks as asked for in all): the decimation restarts from that
     //    intermediate mesh, not from the full one.
@@ -437,15 +437,18 @@ pub(crate) fn precompute_unscaled(
         let base = ls_coarse.as_ref().or(coarse.as_ref());
         let more = if opts.cover_thin_parts && round < THIN_PART_ROUNDS {
             let t = Instant::now();
-            let mut collapsed =
+            let collapsed =
                 thin::collapsed_vertices(mesh, &landmarks, &solver, round > 0, progress)?;
-            if let Some(b) = base {
+            // Samples go on the intermediate mesh a later round restarts from, where
+            // it has vertices to offer.
+            let on_base = base.map(|b| {
                 let mut on_base = vec![false; n];
                 b.landmarks.iter().for_each(|&v| on_base[v as usize] = true);
-                collapsed.iter_mut().zip(on_base).for_each(|(c, b)| *c &= b);
-            }
+                on_base
+            });
             let limit = (opts.landmarks - added).min(n - landmarks.len());
-            let more = thin::landmarks_to_add(mesh, &landmarks, &collapsed, limit);
+            let more =
+                thin::landmarks_to_add(mesh, &landmarks, &collapsed, on_base.as_deref(), limit);
             stages.decimate += secs(t);
             more
         } else {

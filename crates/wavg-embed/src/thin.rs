@@ -280,45 +280,52 @@ impl PathDistances {
 }
 
 /// Landmarks to add where the extension collapses faces (`collapsed`, from
-/// [`collapsed_vertices`]): farthest-point sampling over the collapsed vertices, by
-/// edge-path distance to the landmarks, until every collapsed vertex is within half of
-/// the median collapsed vertex's distance, at most `limit` of them. Sorted.
+/// [`collapsed_vertices`]): farthest-point sampling, by edge-path distance to the
+/// landmarks, until every collapsed vertex is within `reach`, half of the median
+/// collapsed vertex's distance, at most `limit` of them. Sorted.
+///
+/// The samples are `allowed` vertices (those of the intermediate mesh a later round
+/// restarts from) first; collapsed vertices that these leave farther than `reach` get
+/// samples of their own (the next round then decimates the full mesh again). On a fine mesh the intermediate mesh may keep too few
+/// vertices on a small thin part (toes of a subdivided body) to cover it: quadric errors
+/// are small on small parts, so the decimation removes them first.
 pub(crate) fn landmarks_to_add(
     mesh: &ValidMesh,
     landmarks: &[u32],
     collapsed: &[bool],
+    allowed: Option<&[bool]>,
     limit: usize,
 ) -> Vec<u32> {
-    let candidates: Vec<u32> = (0..mesh.n_vertices() as u32)
+    let all: Vec<u32> = (0..mesh.n_vertices() as u32)
         .filter(|&v| collapsed[v as usize])
         .collect();
-    if candidates.is_empty() || limit == 0 {
+    if all.is_empty() || limit == 0 {
         return Vec::new();
     }
+    let preferred: Vec<u32> = match allowed {
+        Some(a) => all.iter().copied().filter(|&v| a[v as usize]).collect(),
+        None => all.clone(),
+    };
     let mut paths = PathDistances::new(mesh);
     paths.add_sources(landmarks);
-    let farthest = |paths: &PathDistances| {
-        candidates
-            .iter()
-            .copied()
-            .max_by(|&a, &b| {
-                paths.dist[a as usize]
-                    .total_cmp(&paths.dist[b as usize])
-                    .then(b.cmp(&a))
-            })
-            .map(|v| (v, paths.dist[v as usize]))
-    };
-    let mut reaches: Vec<f64> = candidates.iter().map(|&v| paths.dist[v as usize]).collect();
+    let mut reaches: Vec<f64> = all.iter().map(|&v| paths.dist[v as usize]).collect();
     let mid = reaches.len() / 2;
     let reach = *reaches.select_nth_unstable_by(mid, f64::total_cmp).1;
     let mut added = Vec::new();
-    while added.len() < limit {
-        match farthest(&paths) {
-            Some((v, d)) if d > reach && d > 0.0 => {
-                added.push(v);
-                paths.add_sources(&[v]);
+    for (candidates, beyond) in [(&preferred, reach), (&all, reach)] {
+        while added.len() < limit {
+            let farthest = (candidates.iter().copied())
+                .max_by(|&a, &b| {
+                    (paths.dist[a as usize].total_cmp(&paths.dist[b as usize])).then(b.cmp(&a))
+                })
+                .map(|v| (v, paths.dist[v as usize]));
+            match farthest {
+                Some((v, d)) if d > beyond && d > 0.0 => {
+                    added.push(v);
+                    paths.add_sources(&[v]);
+                }
+                _ => break,
             }
-            _ => break,
         }
     }
     added.sort_unstable();
