@@ -2,7 +2,7 @@
 //! `lambda * d_ref * |ybar - yhat|^2`, solved for a ladder of `lambda`s at one point.
 //!
 //! Everything that does not depend on `lambda` (the anchors' `D_ii` and constraint rows,
-//! the sums `V D^-2 V^T` and `V D^-2 C^T`) is computed once per point by
+//! the sums `V D^-2 V^T`, `C D^-2 C^T` and `V D^-2 1`) is computed once per point by
 //! [`PenaltySystem::new`]; each rung then costs an 8x8 Cholesky factor, a 3x3 solve and
 //! one pass over the anchors. The passes run [`LANES`] anchors at a time in vectors (see
 //! [`crate::simd::Quad`]), so the results are the same on every machine.
@@ -39,8 +39,9 @@ pub(crate) struct System<'a> {
     a1: Vec<f64>,
     /// `s_i`; zero in the padding.
     s: Vec<f64>,
-    /// `V S C^T = sum s_i v_i c_i^T`.
-    t: SMatrix<f64, DIM, 3>,
+    /// `m = V S 1 = sum s_i v_i`, the last column of `V S C^T` (its first two columns,
+    /// `V S V^T Psi^T`, are not needed: see [`System::weights_into`]).
+    m: Vec8,
     /// `V S V^T = sum s_i v_i v_i^T`.
     vsv: SMatrix<f64, DIM, DIM>,
     /// `C S C^T = sum s_i c_i c_i^T`.
@@ -93,7 +94,7 @@ impl<'a> PenaltySystem<'a> {
             a0,
             a1,
             s,
-            t: SMatrix::zeros(),
+            m: Vec8::zeros(),
             vsv: SMatrix::zeros(),
             csc: Matrix3::zeros(),
             psi: *psi,
@@ -202,8 +203,8 @@ impl pulp::WithSimd for Weigh<'_, '_> {
 }
 
 impl System<'_> {
-    /// Fills in `t`, `vsv` and `csc` (`s` and the rows already set): one pass over the
-    /// anchors per row `K` of `vsv` and `t`, then one for `csc`, so that each pass's sums
+    /// Fills in `m`, `vsv` and `csc` (`s` and the rows already set): one pass over the
+    /// anchors per row `K` of `vsv` and entry `K` of `m`, then one for `csc`, so that each pass's sums
     /// stay in vector registers (all 66 at once spill to memory at every anchor). Each sum
     /// adds the same products in the same order as one pass would.
     #[inline(always)]
@@ -234,33 +235,29 @@ impl System<'_> {
         self.csc = Matrix3::from_fn(|r, j| sum_lanes(q.lanes(csc[r.min(j)][r.max(j)])));
     }
 
-    /// Row `K` of `t` (`sum s_i v_ik c_i`) and of `vsv` (`sum s_i v_ik v_il`, `l >= K`,
-    /// mirrored).
+    /// Entry `K` of `m` (`sum s_i v_ik`) and row `K` of `vsv` (`sum s_i v_ik v_il`,
+    /// `l >= K`, mirrored).
     #[inline(always)]
     fn row_sums<const K: usize, Q: Quad>(&mut self, q: Q) {
         let zero = q.splat(0.0);
-        let mut t = [zero; 3];
+        let mut m = zero;
         let mut row = [zero; DIM];
         let nc = self.s.len() / LANES;
-        let (ss, a0, a1) = (quads(&self.s, nc), quads(&self.a0, nc), quads(&self.a1, nc));
+        let ss = quads(&self.s, nc);
         let ys: [&[[f64; LANES]]; DIM] = std::array::from_fn(|k| quads(self.anchors.dim(k), nc));
         let yhat: [Q::V; DIM] = std::array::from_fn(|k| q.splat(self.yhat[k]));
         for c in 0..nc {
             let s = q.load(&ss[c]);
-            let sc = [q.mul(s, q.load(&a0[c])), q.mul(s, q.load(&a1[c])), s];
             let vk = q.sub(q.load(&ys[K][c]), yhat[K]);
-            for j in 0..3 {
-                t[j] = q.add(t[j], q.mul(vk, sc[j]));
-            }
+            // `s v_ik` (the product is the same either way round).
             let sv = q.mul(s, vk);
+            m = q.add(m, sv);
             for l in K..DIM {
                 let vl = q.sub(q.load(&ys[l][c]), yhat[l]);
                 row[l] = q.add(row[l], q.mul(sv, vl));
             }
         }
-        for (j, x) in t.iter().enumerate() {
-            self.t[(K, j)] = sum_lanes(q.lanes(*x));
-        }
+        self.m[K] = sum_lanes(q.lanes(m));
         for (l, x) in row.iter().enumerate().skip(K) {
             let x = sum_lanes(q.lanes(*x));
             self.vsv[(K, l)] = x;
@@ -334,7 +331,7 @@ impl System<'_> {
                 let r = eps.sqrt();
                 let pt = self.psi.transpose();
                 let x = chol.solve(&pt);
-                let m: Vec8 = self.t.column(2).into_owned();
+                let m = self.m;
                 let y = chol.solve(&m);
                 let pp = self.psi * pt - (self.psi * x) * eps;
                 let py = self.psi * y * r;
@@ -578,7 +575,12 @@ mod tests {
             };
             let (t, vsv, csc) = one_pass_sums(&sys);
             let bits = |m: &[f64]| m.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(sys.t.as_slice()), bits(t.as_slice()), "case {case}");
+            // `m` is the last column of the one pass's `V S C^T`.
+            assert_eq!(
+                bits(sys.m.as_slice()),
+                bits(t.column(2).as_slice()),
+                "case {case}"
+            );
             assert_eq!(
                 bits(sys.vsv.as_slice()),
                 bits(vsv.as_slice()),
