@@ -82,11 +82,14 @@ pub fn run(root: &Path) -> Result<Artifacts, String> {
     })
 }
 
-/// Runs one artifact's build and prints its time (the step table shows only `dist`'s sum).
+/// Runs one artifact's build and prints its wall and CPU time (the step table shows only
+/// `dist`'s sum).
 fn timed<T>(name: &str, build: impl FnOnce() -> Result<T, String>) -> Result<T, String> {
-    let t = std::time::Instant::now();
+    let (t, cpu) = (std::time::Instant::now(), crate::cpu::now());
     let out = build()?;
-    eprintln!("    dist: {name} in {:.1} s", t.elapsed().as_secs_f64());
+    let cpu = crate::cpu::cell(crate::cpu::between(cpu, crate::cpu::now()));
+    let wall = t.elapsed().as_secs_f64();
+    eprintln!("    dist: {name} in {wall:.1} s ({cpu} CPU s)");
     Ok(out)
 }
 

@@ -6,6 +6,7 @@
 mod blender;
 mod cbuild;
 mod cli_docs;
+mod cpu;
 mod dist;
 mod examples;
 mod features;

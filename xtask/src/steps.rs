@@ -1,8 +1,11 @@
-//! The checks of `cargo xtask test`, each timed, with a table of step times at the end.
+//! The checks of `cargo xtask test`, each timed, with a table of step times (wall and CPU
+//! seconds) at the end.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
+
+use crate::cpu;
 
 /// The packages the everyday build leaves out: the experiments (`cargo xtask lab` builds
 /// them). Every step selects the same packages, so that cargo resolves one feature set and
@@ -17,46 +20,76 @@ pub fn target_dir(root: &Path) -> PathBuf {
         .map_or_else(|| root.join("target"), |d| root.join(d))
 }
 
+/// One step's row of the table.
+struct Row {
+    name: String,
+    wall: f64,
+    cpu: Option<f64>,
+    ok: bool,
+}
+
 /// Times and outcomes of the steps run so far.
 #[derive(Default)]
 pub struct Log {
-    rows: Vec<(String, f64, bool)>,
-    start: Option<Instant>,
+    rows: Vec<Row>,
+    start: Option<(Instant, Option<f64>)>,
 }
 
 impl Log {
-    /// Runs `step` under `name`, printing its start, its end and its time; false when it
-    /// failed (its message printed).
+    /// Runs `step` under `name`, printing its start, its end and its wall and CPU time;
+    /// false when it failed (its message printed).
     pub fn run(&mut self, name: &str, step: impl FnOnce() -> Result<(), String>) -> bool {
-        self.start.get_or_insert_with(Instant::now);
+        self.start
+            .get_or_insert_with(|| (Instant::now(), cpu::now()));
         eprintln!("==> {name}");
-        let t = Instant::now();
+        let (t, cpu_start) = (Instant::now(), cpu::now());
         let result = step();
-        let secs = t.elapsed().as_secs_f64();
+        let wall = t.elapsed().as_secs_f64();
+        let cpu = cpu::between(cpu_start, cpu::now());
+        let cpu_s = cpu::cell(cpu);
         match &result {
-            Ok(()) => eprintln!("==> {name} ok in {secs:.1} s"),
-            Err(msg) => eprintln!("==> {name} FAILED after {secs:.1} s: {msg}"),
+            Ok(()) => eprintln!("==> {name} ok in {wall:.1} s ({cpu_s} CPU s)"),
+            Err(msg) => eprintln!("==> {name} FAILED after {wall:.1} s ({cpu_s} CPU s): {msg}"),
         }
-        self.rows.push((name.to_string(), secs, result.is_ok()));
+        self.rows.push(Row {
+            name: name.to_string(),
+            wall,
+            cpu,
+            ok: result.is_ok(),
+        });
         result.is_ok()
     }
 
     /// Prints the table of step times and the total.
     pub fn print_table(&self) {
-        let total = self.start.map_or(0.0, |s| s.elapsed().as_secs_f64());
+        eprint!("\n{}", self.table());
+    }
+
+    /// The table: each step's wall seconds, CPU seconds (xtask's and its children's: user
+    /// plus system) and result, then the totals.
+    fn table(&self) -> String {
+        let (total, total_cpu) = self.start.map_or((0.0, None), |(t, c)| {
+            (t.elapsed().as_secs_f64(), cpu::between(c, cpu::now()))
+        });
         let width = self
             .rows
             .iter()
-            .map(|r| r.0.len())
+            .map(|r| r.name.len())
             .max()
             .unwrap_or(4)
             .max(5);
-        eprintln!("\n{:<width$}  {:>8}  result", "step", "seconds");
-        for (name, secs, ok) in &self.rows {
-            let result = if *ok { "ok" } else { "FAILED" };
-            eprintln!("{name:<width$}  {secs:>8.1}  {result}");
+        let mut out = format!(
+            "{:<width$}  {:>8}  {:>8}  result\n",
+            "step", "wall s", "CPU s"
+        );
+        for row in &self.rows {
+            let result = if row.ok { "ok" } else { "FAILED" };
+            let (name, wall, cpu) = (&row.name, row.wall, cpu::cell(row.cpu));
+            out += &format!("{name:<width$}  {wall:>8.1}  {cpu:>8}  {result}\n");
         }
-        eprintln!("{:<width$}  {total:>8.1}", "total");
+        let total_cpu = cpu::cell(total_cpu);
+        out += &format!("{:<width$}  {total:>8.1}  {total_cpu:>8}\n", "total");
+        out
     }
 }
 
@@ -107,4 +140,44 @@ pub fn cargo_workspace_env(
     all.extend(EXCLUDED);
     all.extend(tail);
     command_env(root, "cargo", &all, env)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_table_shows_wall_and_cpu_seconds_of_each_step() {
+        let mut log = Log::default();
+        assert!(log.run("burn", || {
+            command(
+                Path::new("."),
+                "sh",
+                &["-c", "i=0; while [ $i -lt 300000 ]; do i=$((i+1)); done"],
+            )
+        }));
+        assert!(!log.run("fail", || Err("no".into())));
+        let burn = &log.rows[0];
+        let cpu = burn.cpu.expect("CPU seconds on Linux");
+        assert!(cpu >= 0.1, "the loop took {cpu} CPU s");
+        assert!(
+            cpu <= burn.wall * 2.0 + 0.1,
+            "{cpu} CPU s in {} s",
+            burn.wall
+        );
+        let table = log.table();
+        let lines: Vec<&str> = table.lines().collect();
+        assert_eq!(lines.len(), 4, "{table}");
+        let header: Vec<&str> = lines[0].split_whitespace().collect();
+        assert_eq!(header, ["step", "wall", "s", "CPU", "s", "result"]);
+        let row: Vec<&str> = lines[1].split_whitespace().collect();
+        assert_eq!(row[0], "burn");
+        assert_eq!(row[2], format!("{cpu:.1}"));
+        assert_eq!(row[3], "ok");
+        assert!(lines[2].ends_with("FAILED"), "{table}");
+        let total: Vec<&str> = lines[3].split_whitespace().collect();
+        assert_eq!(total[0], "total");
+        let total_cpu: f64 = total[2].parse().unwrap();
+        assert!(total_cpu >= cpu - 0.05, "{table}");
+    }
 }
