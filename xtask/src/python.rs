@@ -121,8 +121,10 @@ pub fn build_wheel(root: &Path) -> Result<PathBuf, String> {
 /// pytest's "no tests ran" (exit 5) fails too.
 pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     // The C library the tests load is built from this source first: one left by an earlier
-    // run would make another embedding than the other doors.
-    steps::command(root, "cargo", &["build", "-p", "wavg-ffi"])?;
+    // run would make another embedding than the other doors. The whole workspace's build,
+    // as the CMake and fuzz steps run it, so the libraries keep the workspace's features
+    // (`-p wavg-ffi` alone compiled every crate of ours a second time with fewer).
+    steps::cargo_workspace(root, &["build", "--all-targets"], &[])?;
     let py = ensure_venv(root)?;
     let py_s = py.to_string_lossy();
     let target = steps::target_dir(root);
