@@ -631,6 +631,78 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// A two-crate workspace packaged twice by the real cargo (offline, a cargo home of
+    /// its own), `wavg-toyb` using an item `wavg-toya` gained in between: cargo verifies
+    /// against the stale registry copy unless [`forget_packaged`] ran.
+    #[test]
+    fn a_changed_crate_is_verified_against_its_new_source() {
+        let dir = std::env::temp_dir().join(format!("wavg-package-test-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let (ws, home, target) = (dir.join("ws"), dir.join("home"), dir.join("target"));
+        let write = |file: &str, text: &str| {
+            let path = ws.join(file);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, text).unwrap();
+        };
+        let manifest = "[workspace]\nmembers = [\"a\", \"b\"]\nresolver = \"3\"\n\n\
+                        [profile.dev]\nopt-level = 1\n";
+        write("Cargo.toml", manifest);
+        let package = |name: &str, deps: &str| {
+            format!(
+                "[package]\nname = \"{name}\"\nversion = \"0.1.0\"\nedition = \"2024\"\n\
+                 license = \"MIT\"\ndescription = \"test\"\n\n[dependencies]\n{deps}"
+            )
+        };
+        write("a/Cargo.toml", &package("wavg-toya", ""));
+        let dep = "wavg-toya = { path = \"../a\", version = \"0.1.0\" }\n";
+        write("b/Cargo.toml", &package("wavg-toyb", dep));
+        write("a/src/lib.rs", "pub fn one() -> u32 { 1 }\n");
+        write("b/src/lib.rs", "pub fn f() -> u32 { wavg_toya::one() }\n");
+        let names = ["wavg-toya".to_string(), "wavg-toyb".to_string()];
+        let config = dir.join("profiles.toml");
+        std::fs::write(&config, package_profiles(manifest, &names)).unwrap();
+        let package = || {
+            let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+            std::process::Command::new(cargo)
+                .args([
+                    "package",
+                    "--offline",
+                    "--workspace",
+                    "--allow-dirty",
+                    "--quiet",
+                ])
+                .arg("--config")
+                .arg(&config)
+                .arg("--target-dir")
+                .arg(&target)
+                .current_dir(&ws)
+                .env("CARGO_HOME", &home)
+                .env_remove("CARGO_TARGET_DIR")
+                .output()
+                .unwrap()
+        };
+        let first = package();
+        assert!(
+            first.status.success(),
+            "{}",
+            String::from_utf8_lossy(&first.stderr)
+        );
+        write(
+            "a/src/lib.rs",
+            "pub fn one() -> u32 { 1 }\npub fn two() -> u32 { 2 }\n",
+        );
+        write("b/src/lib.rs", "pub fn f() -> u32 { wavg_toya::two() }\n");
+        assert!(!package().status.success(), "the stale copy was not used");
+        forget_packaged(Some(&home), &target).unwrap();
+        let again = package();
+        assert!(
+            again.status.success(),
+            "{}",
+            String::from_utf8_lossy(&again.stderr)
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn packaging_verifies_with_the_dev_profiles_and_our_crates_unoptimised() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
