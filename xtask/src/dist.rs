@@ -338,48 +338,33 @@ fn check_glibc(lib: &Path) -> Result<(), String> {
 }
 
 /// `cargo package --workspace` (each package verified by building it alone), the `.crate`
-/// files copied to `dist/crates/`.
-///
-/// The verification builds in cargo's own target directory with the workspace's dev
-/// profiles (given as a `--config` file: a package's manifest carries no profile), so every
-/// dependency from crates.io is the one the tests built and is reused; only our crates
-/// compile, without optimisation or debug info (whether a package builds does not depend
-/// on them). With a profile or directory of its own it compiled every dependency again.
+/// files copied to `dist/crates/`. The verification builds without debug info: whether a
+/// package builds does not depend on it, and it costs compile and link time.
 ///
 /// Cargo verifies a package against its workspace dependencies unpacked from their own
 /// `.crate` files as if from a registry, and takes a registry crate of a name and version as
 /// immutable: it keeps the sources unpacked by an earlier run and the artifacts compiled
-/// from them. So both are removed first ([`forget_packaged`]); otherwise a crate using a new
-/// item of another would be verified against that crate's old source.
+/// from them. So the verification gets a target directory of its own, and both the
+/// unpacked workspace crates and their artifacts there are removed first; otherwise a
+/// crate using a new item of another would be verified against that crate's old source.
 fn crates(root: &Path, dist: &Path) -> Result<(), String> {
-    let target = steps::target_dir(root);
-    forget_packaged(cargo_home().as_deref(), &target)?;
-    // A target directory the verification had before it shared this one.
-    let old = target.join("package-verify");
-    if old.exists() {
-        std::fs::remove_dir_all(&old).map_err(|e| format!("{}: {e}", old.display()))?;
-    }
-    let config = target.join("package-profiles.toml");
-    let workspace =
-        std::fs::read_to_string(root.join("Cargo.toml")).map_err(|e| format!("Cargo.toml: {e}"))?;
-    let packaged = packaged_crates(root)?;
-    std::fs::write(&config, package_profiles(&workspace, &packaged))
-        .map_err(|e| format!("{}: {e}", config.display()))?;
-    let (config, target_s) = (config.to_string_lossy(), target.to_string_lossy());
+    let verify = steps::target_dir(root).join("package-verify");
+    forget_packaged(cargo_home().as_deref(), &verify)?;
+    let verify_arg = verify.to_string_lossy().into_owned();
     let mut args = vec![
         "package",
         "--workspace",
         "--allow-dirty",
         "--config",
-        &config,
+        "profile.dev.debug=0",
         "--target-dir",
-        &target_s,
+        &verify_arg,
     ];
     for name in NOT_PACKAGED {
         args.extend(["--exclude", name]);
     }
     steps::command(root, "cargo", &args)?;
-    let from = target.join("package");
+    let from = verify.join("package");
     let to = dist.join("crates");
     std::fs::create_dir_all(&to).map_err(|e| format!("{}: {e}", to.display()))?;
     let version = version::workspace(root)?;
@@ -400,43 +385,6 @@ fn crates(root: &Path, dist: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// The names of the workspace's packages that `cargo package` packs: those under `crates/`
-/// not in [`NOT_PACKAGED`].
-fn packaged_crates(root: &Path) -> Result<Vec<String>, String> {
-    let mut names = Vec::new();
-    for dir in entries(&root.join("crates")) {
-        let manifest = dir.join("Cargo.toml");
-        let Ok(text) = std::fs::read_to_string(&manifest) else {
-            continue;
-        };
-        let name = text
-            .lines()
-            .find_map(|l| l.trim().strip_prefix("name = "))
-            .map(|n| n.trim_matches('"').to_string())
-            .ok_or_else(|| format!("{}: no package name", manifest.display()))?;
-        if !NOT_PACKAGED.contains(&name.as_str()) {
-            names.push(name);
-        }
-    }
-    names.sort();
-    Ok(names)
-}
-
-/// The configuration `cargo package` verifies with: the workspace manifest's dev profiles
-/// verbatim (so dependencies build as for the tests), and each packaged crate of ours
-/// (`packaged`, compiled from its package anyway) without optimisation or debug info.
-fn package_profiles(workspace: &str, packaged: &[String]) -> String {
-    let mut out = String::from(
-        "# Written by `cargo xtask dist` (xtask/src/dist.rs): the dev profiles `cargo package`\n\
-         # verifies with.\n",
-    );
-    out += &crate::examples::dev_profiles(workspace);
-    for name in packaged {
-        out += &format!("\n[profile.dev.package.{name}]\nopt-level = 0\ndebug = 0\n");
-    }
-    out
-}
-
 /// Cargo's home: `$CARGO_HOME`, else `~/.cargo`.
 fn cargo_home() -> Option<PathBuf> {
     std::env::var_os("CARGO_HOME")
@@ -446,48 +394,26 @@ fn cargo_home() -> Option<PathBuf> {
 
 /// Removes what an earlier `cargo package` left of the workspace's own crates: their
 /// sources unpacked under cargo's home `home` (in the local registries, whose folder names
-/// start with `-`), their `.crate` files and unpacked folders in `target/package/`, and the
-/// artifacts compiled from those registry copies in the target directory `target` (known by
-/// their dep-info files, which name the unpacked sources; cargo compiles again a unit whose
-/// outputs are missing). The artifacts of the workspace's own build and of crates.io crates
-/// stay.
-fn forget_packaged(home: Option<&Path>, target: &Path) -> Result<(), String> {
+/// start with `-`) and everything compiled from them in the verification's target
+/// directory `verify`. Crates from crates.io and their artifacts stay.
+fn forget_packaged(home: Option<&Path>, verify: &Path) -> Result<(), String> {
     let mut doomed = Vec::new();
     if let Some(src) = home.map(|h| h.join("registry").join("src")) {
         for registry in entries(&src) {
             if file_name(&registry).starts_with('-') {
-                doomed.extend(entries(&registry).into_iter().filter(|p| is_ours(p)));
+                doomed.extend(entries(&registry));
             }
         }
     }
-    doomed.extend(
-        entries(&target.join("package"))
-            .into_iter()
-            .filter(|p| is_ours(p)),
-    );
-    let deps = target.join("debug").join("deps");
-    let from_registry: Vec<String> = entries(&deps)
-        .into_iter()
-        .filter(|p| is_ours(p) && file_name(p).ends_with(".d"))
-        .filter(|p| compiled_from_a_local_registry(p))
-        .filter_map(|p| {
-            Some(
-                file_name(&p)
-                    .strip_suffix(".d")?
-                    .rsplit_once('-')?
-                    .1
-                    .to_string(),
-            )
-        })
-        .collect();
-    doomed.extend(entries(&deps).into_iter().filter(|p| {
-        let name = file_name(p);
-        is_ours(p)
-            && from_registry
-                .iter()
-                .any(|hash| name.contains(&format!("-{hash}.")))
-    }));
+    for sub in [".fingerprint", "deps", "build", "incremental"] {
+        doomed.extend(entries(&verify.join("debug").join(sub)));
+    }
+    doomed.extend(entries(&verify.join("package")));
     for path in doomed {
+        let name = file_name(&path);
+        if !(name.starts_with("wavg") || name.starts_with("libwavg")) {
+            continue;
+        }
         let removed = if path.is_dir() {
             std::fs::remove_dir_all(&path)
         } else {
@@ -496,22 +422,6 @@ fn forget_packaged(home: Option<&Path>, target: &Path) -> Result<(), String> {
         removed.map_err(|e| format!("{}: {e}", path.display()))?;
     }
     Ok(())
-}
-
-/// Whether a file or folder name is one of the workspace's crates (`wavg...`, `libwavg...`).
-fn is_ours(path: &Path) -> bool {
-    let name = file_name(path);
-    name.starts_with("wavg") || name.starts_with("libwavg")
-}
-
-/// Whether the dep-info file `d` (`OUTPUT: SOURCES...`) names sources unpacked from one of
-/// cargo's local registries (`registry/src/-HASH/`), as `cargo package` makes them.
-fn compiled_from_a_local_registry(d: &Path) -> bool {
-    std::fs::read_to_string(d).is_ok_and(|text| {
-        text.lines()
-            .next()
-            .is_some_and(|first| first.contains("/registry/src/-"))
-    })
 }
 
 /// The entries of `dir`; none when it does not exist or cannot be read.
@@ -568,62 +478,33 @@ mod tests {
     fn only_the_workspace_crates_left_by_packaging_are_forgotten() {
         let dir = std::env::temp_dir().join(format!("wavg-forget-test-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let (home, target) = (dir.join("home"), dir.join("target"));
-        let registry = "/h/registry/src/-0123/wavg-mesh-0.1.0/src/lib.rs";
+        let (home, verify) = (dir.join("home"), dir.join("verify"));
         let made = [
-            ("home/registry/src/-0123/wavg-0.1.0/src/lib.rs", "x"),
-            ("home/registry/src/-0123/wavg-mesh-0.1.0/Cargo.toml", "x"),
-            (
-                "home/registry/src/index.crates.io-99/wavg-other-1.0.0/Cargo.toml",
-                "x",
-            ),
-            (
-                "home/registry/src/index.crates.io-99/faer-0.22.0/Cargo.toml",
-                "x",
-            ),
-            // The registry copy of wavg-mesh, by its dep-info.
-            ("target/debug/deps/libwavg_mesh-abc.rlib", "x"),
-            ("target/debug/deps/libwavg_mesh-abc.rmeta", "x"),
-            (
-                "target/debug/deps/wavg_mesh-abc.d",
-                &format!("/t/libwavg_mesh-abc.rlib: {registry}\n"),
-            ),
-            // The workspace's own wavg-mesh and a crates.io crate stay.
-            ("target/debug/deps/libwavg_mesh-def.rlib", "x"),
-            (
-                "target/debug/deps/wavg_mesh-def.d",
-                "/t/libwavg_mesh-def.rlib: /w/crates/wavg-mesh/src/lib.rs\n",
-            ),
-            ("target/debug/deps/libfaer-abc.rlib", "x"),
-            (
-                "target/debug/deps/faer-abc.d",
-                "/t/libfaer-abc.rlib: /h/registry/src/-0123/faer/src/lib.rs\n",
-            ),
-            ("target/debug/.fingerprint/wavg-mesh-def/lib-wavg_mesh", "x"),
-            ("target/package/wavg-0.1.0.crate", "x"),
-            ("target/package/wavg-0.1.0/Cargo.toml", "x"),
+            "home/registry/src/-0123/wavg-0.1.0/src/lib.rs",
+            "home/registry/src/-0123/wavg-mesh-0.1.0/Cargo.toml",
+            "home/registry/src/index.crates.io-99/wavg-other-1.0.0/Cargo.toml",
+            "home/registry/src/index.crates.io-99/faer-0.22.0/Cargo.toml",
+            "verify/debug/.fingerprint/wavg-mesh-abc/lib-wavg_mesh",
+            "verify/debug/.fingerprint/faer-abc/lib-faer",
+            "verify/debug/deps/libwavg_mesh-abc.rlib",
+            "verify/debug/deps/libfaer-abc.rlib",
+            "verify/debug/build/wavg-ffi-abc/output",
+            "verify/package/wavg-0.1.0.crate",
         ];
-        for (file, text) in made {
+        for file in made {
             let path = dir.join(file);
             std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-            std::fs::write(path, text).unwrap();
+            std::fs::write(path, "x").unwrap();
         }
-        forget_packaged(Some(&home), &target).unwrap();
-        let kept: Vec<_> = made
-            .iter()
-            .map(|(f, _)| *f)
-            .filter(|f| dir.join(f).exists())
-            .collect();
+        forget_packaged(Some(&home), &verify).unwrap();
+        let kept: Vec<_> = made.iter().filter(|f| dir.join(f).exists()).collect();
         assert_eq!(
             kept,
             [
-                "home/registry/src/index.crates.io-99/wavg-other-1.0.0/Cargo.toml",
-                "home/registry/src/index.crates.io-99/faer-0.22.0/Cargo.toml",
-                "target/debug/deps/libwavg_mesh-def.rlib",
-                "target/debug/deps/wavg_mesh-def.d",
-                "target/debug/deps/libfaer-abc.rlib",
-                "target/debug/deps/faer-abc.d",
-                "target/debug/.fingerprint/wavg-mesh-def/lib-wavg_mesh",
+                &"home/registry/src/index.crates.io-99/wavg-other-1.0.0/Cargo.toml",
+                &"home/registry/src/index.crates.io-99/faer-0.22.0/Cargo.toml",
+                &"verify/debug/.fingerprint/faer-abc/lib-faer",
+                &"verify/debug/deps/libfaer-abc.rlib",
             ]
         );
         // Nothing to forget, or no cargo home at all, is fine.
@@ -658,9 +539,6 @@ mod tests {
         write("b/Cargo.toml", &package("wavg-toyb", dep));
         write("a/src/lib.rs", "pub fn one() -> u32 { 1 }\n");
         write("b/src/lib.rs", "pub fn f() -> u32 { wavg_toya::one() }\n");
-        let names = ["wavg-toya".to_string(), "wavg-toyb".to_string()];
-        let config = dir.join("profiles.toml");
-        std::fs::write(&config, package_profiles(manifest, &names)).unwrap();
         let package = || {
             let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
             std::process::Command::new(cargo)
@@ -671,8 +549,7 @@ mod tests {
                     "--allow-dirty",
                     "--quiet",
                 ])
-                .arg("--config")
-                .arg(&config)
+                .args(["--config", "profile.dev.debug=0"])
                 .arg("--target-dir")
                 .arg(&target)
                 .current_dir(&ws)
@@ -701,26 +578,5 @@ mod tests {
             String::from_utf8_lossy(&again.stderr)
         );
         std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn packaging_verifies_with_the_dev_profiles_and_our_crates_unoptimised() {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let workspace = std::fs::read_to_string(root.join("Cargo.toml")).unwrap();
-        let packaged = packaged_crates(&root).unwrap();
-        for name in ["wavg", "wavg-mesh", "wavg-ffi", "wavg-cli"] {
-            assert!(packaged.iter().any(|p| p == name), "{packaged:?}");
-        }
-        for name in NOT_PACKAGED {
-            assert!(!packaged.iter().any(|p| p == name), "{packaged:?}");
-        }
-        let config = package_profiles(&workspace, &packaged);
-        assert!(config.contains(&crate::examples::dev_profiles(&workspace)));
-        assert!(config.contains("[profile.dev.package.\"*\"]\n"), "{config}");
-        assert!(
-            config.contains("[profile.dev.package.wavg-mesh]\nopt-level = 0\ndebug = 0\n"),
-            "{config}"
-        );
-        assert!(!config.contains("[profile.release"), "{config}");
     }
 }

@@ -80,7 +80,7 @@ fn outside_crate(root: &Path) -> Result<(), String> {
 }
 
 /// The `[profile.dev...]` sections of a workspace manifest, verbatim (comments included).
-pub fn dev_profiles(manifest: &str) -> String {
+fn dev_profiles(manifest: &str) -> String {
     let mut out = String::new();
     let mut inside = false;
     for line in manifest.lines() {
