@@ -324,8 +324,7 @@ pub(crate) fn precompute_unscaled(
         if opts.quality_pairs == 0 {
             return Ok((None, None, 0.0));
         }
-        check_cancel(progress)?;
-        let fm = FastMarching::new(mesh);
+        let fm = FastMarching::new_cancellable(mesh, progress)?;
         let sources = quality_sources(opts.quality_sources, n, opts.quality_pairs);
         let qo = QualityOptions {
             pairs: opts.quality_pairs,
@@ -352,7 +351,7 @@ pub(crate) fn precompute_unscaled(
     // (Matched as a tuple that owns it, so that the unused one is dropped here.)
     let fm = match (fm, needs_fine) {
         (Some(fm), true) => Some(fm),
-        (None, true) => Some(FastMarching::new(mesh)),
+        (None, true) => Some(FastMarching::new_cancellable(mesh, progress)?),
         (_, false) => None,
     };
     mark("decimation + quality geodesics");

@@ -132,7 +132,10 @@ impl QualityPairs {
                     for &t in ts {
                         is_target[t as usize] = true;
                     }
-                    let d = fm.run_until_targets(ws, &[s], is_target, ts.len());
+                    let d =
+                        fm.run_until_targets_cancellable(ws, &[s], is_target, ts.len(), progress);
+                    // (A cancelled run leaves `is_target` set: the whole check fails.)
+                    let d = d?;
                     let mut out = Vec::with_capacity(ts.len());
                     for &t in ts {
                         is_target[t as usize] = false;

@@ -393,11 +393,18 @@ impl<'a> Decimator<'a> {
         }
     }
 
-    pub(super) fn init_heap(&mut self) {
+    /// Fills the heap with every vertex's best collapse; [`EmbedError::Cancelled`] when
+    /// `progress` asks (looked at every [`CANCEL_EVERY`] vertices: a full mesh of 10M
+    /// vertices takes seconds).
+    pub(super) fn init_heap(&mut self, progress: &dyn Progress) -> Result<(), EmbedError> {
         self.heap.clear();
         for x in 0..self.alive.len() as u32 {
+            if x as usize % CANCEL_EVERY == 0 {
+                check_cancel(progress)?;
+            }
             self.heap_vertex(x);
         }
+        Ok(())
     }
 
     /// Pops one heap entry and performs its collapse if still legal; true if collapsed.

@@ -23,8 +23,8 @@
 //! The simplifier cannot stop partway (about 15 s at 3M vertices), so it runs on a thread
 //! of its own while the caller polls for cancellation every [`CANCEL_POLL`]: a cancelled
 //! precomputation returns within that, and the abandoned simplification finishes in the
-//! background and frees its memory (an exiting `wavg` ends it at once). Cancellation is
-//! also checked before and after the clean-up (about 4 s at 3M vertices).
+//! background and frees its memory (an exiting `wavg` ends it at once). The clean-up
+//! (about 4 s at 3M vertices) looks at the cancellation between its steps.
 
 use std::sync::mpsc;
 use std::time::Duration;
@@ -60,9 +60,11 @@ pub(super) fn first_pass(
     let raw = simplify(mesh, keep, locked, progress)?;
     check_cancel(progress)?;
     let raw = cancel_duplicate_faces(raw);
-    let reduced = clean(mesh, raw, locked).ok();
-    check_cancel(progress)?;
-    Ok(reduced)
+    match clean(mesh, raw, locked, progress) {
+        Ok(reduced) => Ok(Some(reduced)),
+        Err(Failed::Cancelled) => Err(EmbedError::Cancelled),
+        Err(Failed::Invalid(_)) => Ok(None),
+    }
 }
 
 /// meshoptimizer's simplifier towards `keep` vertices (`2 keep` faces), borders and
@@ -159,9 +161,38 @@ fn cancel_duplicate_faces(mut faces: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
     faces
 }
 
+/// Why the clean-up gave no mesh.
+#[derive(Debug)]
+enum Failed {
+    /// `progress` asked to stop.
+    Cancelled,
+    /// The simplifier's output could not be made a valid mesh of the input's topology
+    /// (why: the caller decimates the full mesh instead; the diagnosis test shows it).
+    Invalid(
+        #[cfg_attr(not(test), expect(dead_code, reason = "read by the diagnosis test"))] String,
+    ),
+}
+
+impl From<String> for Failed {
+    fn from(why: String) -> Self {
+        Self::Invalid(why)
+    }
+}
+
+/// [`check_cancel`] for the clean-up, between its steps (each under a second at 10M
+/// vertices, most of them on the reduced mesh).
+fn stop_if_cancelled(progress: &dyn Progress) -> Result<(), Failed> {
+    check_cancel(progress).map_err(|_| Failed::Cancelled)
+}
+
 /// Repairs the simplifier's faces into a valid mesh on distinct original vertices with the
 /// input's topology (module docs, steps 2 to 4); else what failed.
-fn clean(mesh: &ValidMesh, faces: Vec<[u32; 3]>, locked: &[u32]) -> Result<Reduced, String> {
+fn clean(
+    mesh: &ValidMesh,
+    faces: Vec<[u32; 3]>,
+    locked: &[u32],
+    progress: &dyn Progress,
+) -> Result<Reduced, Failed> {
     let n = mesh.n_vertices();
     // The used original vertices, ascending, as a compact mesh.
     let mut new_id = vec![u32::MAX; n];
@@ -188,8 +219,10 @@ fn clean(mesh: &ValidMesh, faces: Vec<[u32; 3]>, locked: &[u32]) -> Result<Reduc
         keep_largest_component: mesh.topology().n_components() == 1,
         ..RepairOptions::default()
     };
+    stop_if_cancelled(progress)?;
     let r = repair::repair_all(&compact, &opts);
     drop(compact);
+    stop_if_cancelled(progress)?;
     // Original id of each repaired vertex; a split copy repeats its vertex's id.
     let mut orig: Vec<u32> = r.vertex_map.iter().map(|&v| ids[v as usize]).collect();
     ids.clear();
@@ -209,6 +242,7 @@ fn clean(mesh: &ValidMesh, faces: Vec<[u32; 3]>, locked: &[u32]) -> Result<Reduc
             orig[c] = fresh;
         }
     }
+    stop_if_cancelled(progress)?;
     // Renumber by ascending original id.
     let mut order: Vec<u32> = (0..orig.len() as u32).collect();
     order.sort_unstable_by_key(|&i| orig[i as usize]);
@@ -226,18 +260,20 @@ fn clean(mesh: &ValidMesh, faces: Vec<[u32; 3]>, locked: &[u32]) -> Result<Reduc
             .map(|t| t.map(|v| rank[v as usize]))
             .collect(),
     );
+    stop_if_cancelled(progress)?;
     let reduced = ValidMesh::new(reduced).map_err(|e| e.to_string())?;
+    stop_if_cancelled(progress)?;
     let (a, b) = (mesh.topology(), reduced.topology());
     let shape = |t: &wavg_mesh::Topology| (t.genus(), t.boundary_loops().len(), t.n_components());
     if shape(a) != shape(b) {
-        return Err(format!(
+        return Err(Failed::Invalid(format!(
             "topology (genus, loops, components) {:?} became {:?}",
             shape(a),
             shape(b)
-        ));
+        )));
     }
     if !locked.iter().all(|l| original.binary_search(l).is_ok()) {
-        return Err("a locked vertex was lost".into());
+        return Err(Failed::Invalid("a locked vertex was lost".into()));
     }
     Ok(Reduced {
         mesh: reduced,
@@ -317,14 +353,15 @@ mod tests {
             raw.len()
         );
         let t = std::time::Instant::now();
-        match clean(&mesh, raw, &[]) {
+        match clean(&mesh, raw, &[], &NoProgress) {
             Ok(r) => eprintln!(
                 "clean: {} vertices, {} faces in {:.2} s",
                 r.mesh.n_vertices(),
                 r.mesh.n_faces(),
                 t.elapsed().as_secs_f64()
             ),
-            Err(e) => eprintln!("clean failed: {e}"),
+            Err(Failed::Invalid(why)) => eprintln!("clean failed: {why}"),
+            Err(Failed::Cancelled) => unreachable!("NoProgress never cancels"),
         }
     }
 
@@ -350,6 +387,32 @@ mod tests {
             first_pass(&mesh, 1000, &[], &Cancelled),
             Err(EmbedError::Cancelled)
         ));
+    }
+
+    /// The clean-up stops between its steps when cancelled: at its first look, and at
+    /// its last (after the reduced mesh is validated).
+    #[test]
+    fn the_clean_up_stops_when_cancelled() {
+        struct CancelAt(std::sync::atomic::AtomicUsize, usize);
+        impl Progress for CancelAt {
+            fn report(&self, _: crate::Stage, _: f64) {}
+            fn cancelled(&self) -> bool {
+                self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= self.1
+            }
+        }
+        let grid = valid(procedural::grid(80, 60, 2.0, 1.0));
+        let count = CancelAt(0.into(), usize::MAX);
+        assert!(clean(&grid, grid.triangles.clone(), &[], &count).is_ok());
+        let looks = count.0.into_inner();
+        assert!(looks >= 4, "{looks} looks");
+        for at in [0, looks - 1] {
+            let r = clean(&grid, grid.triangles.clone(), &[], &CancelAt(0.into(), at));
+            assert!(
+                matches!(r, Err(Failed::Cancelled)),
+                "at look {at}: {:?}",
+                r.err()
+            );
+        }
     }
 
     const FIRST_PASS_VERTICES_FOR_TEST: usize = super::super::FIRST_PASS_VERTICES;
@@ -429,7 +492,7 @@ mod tests {
             ValidMesh::new(broken).is_err(),
             "the pinch is not a valid mesh"
         );
-        let r = clean(&mesh, pinched, &[]).unwrap();
+        let r = clean(&mesh, pinched, &[], &NoProgress).unwrap();
         assert_eq!(
             r.original,
             (0..mesh.n_vertices() as u32).collect::<Vec<_>>()
@@ -438,7 +501,7 @@ mod tests {
         assert_eq!(r.mesh.topology().genus(), 0);
         // A face set the simplifier left intact comes back unchanged.
         let grid = valid(procedural::grid(20, 20, 1.0, 1.0));
-        let r = clean(&grid, grid.triangles.clone(), &[]).unwrap();
+        let r = clean(&grid, grid.triangles.clone(), &[], &NoProgress).unwrap();
         assert_eq!(
             r.original,
             (0..grid.n_vertices() as u32).collect::<Vec<_>>()

@@ -93,6 +93,9 @@ use quadric::*;
 
 const NONE: u32 = u32::MAX;
 
+/// Vertices evaluated between two looks at the cancellation while the heap is filled.
+const CANCEL_EVERY: usize = 1 << 16;
+
 /// Parameters of the landmark decimation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DecimateOptions {
@@ -316,7 +319,7 @@ fn decimate_exact(
         }
     };
     take(&d, &mut snaps);
-    d.init_heap();
+    d.init_heap(progress)?;
     let total = (n - opts.target).max(1) as f64;
     let mut since_report = 0usize;
     // Whether a collapse happened since the heap was last filled from scratch. Vertices
@@ -337,7 +340,7 @@ fn decimate_exact(
         } else if d.heap.is_empty() {
             if collapsed_since_fill {
                 collapsed_since_fill = false;
-                d.init_heap();
+                d.init_heap(progress)?;
                 continue;
             }
             if !opts.relax || !d.relax() {
@@ -348,8 +351,7 @@ fn decimate_exact(
                     opts.target, d.n_alive, d.flip_deg, d.cone_deg, d.aspect
                 )));
             }
-            check_cancel(progress)?;
-            d.init_heap();
+            d.init_heap(progress)?;
         }
     }
     progress.report(Stage::Decimate, 1.0);

@@ -2,6 +2,7 @@
 //! loop (stopping at a radius or once given targets are frozen).
 
 use super::*;
+use crate::error::NoProgress;
 
 /// Vertex count of the intermediate mesh for landmark geodesics on large meshes (see the
 /// module documentation), the pipeline's default: a balance between the time of one run
@@ -10,6 +11,10 @@ pub(crate) const DEFAULT_GEODESIC_VERTICES: usize = 10_000;
 
 /// How many triangles the obtuse-angle unfolding may cross before giving up.
 pub(crate) const MAX_UNFOLD_STEPS: usize = 40;
+
+/// Faces, stencils or vertices processed between two looks at the cancellation while a
+/// [`FastMarching`] is built (a few milliseconds of work).
+pub(super) const CANCEL_EVERY: usize = 1 << 16;
 
 /// One update that freezing a vertex `v` triggers on a neighbour `x`.
 ///
@@ -84,10 +89,27 @@ pub(super) struct Stencil {
 impl FastMarching {
     /// Precomputes the update stencils of `mesh` (unfolding obtuse corners).
     pub fn new(mesh: &ValidMesh) -> Self {
-        Self::build(mesh, true)
+        match Self::build(mesh, true, &NoProgress) {
+            Ok(fm) => fm,
+            Err(_) => unreachable!("NoProgress never cancels"),
+        }
     }
 
-    pub(super) fn build(mesh: &ValidMesh, unfold_obtuse: bool) -> Self {
+    /// [`FastMarching::new`], stopping with [`EmbedError::Cancelled`] when `progress` asks
+    /// (looked at every [`CANCEL_EVERY`] faces or vertices: about a second at 10M vertices
+    /// is the whole build's tenth).
+    pub(crate) fn new_cancellable(
+        mesh: &ValidMesh,
+        progress: &dyn Progress,
+    ) -> Result<Self, EmbedError> {
+        Self::build(mesh, true, progress)
+    }
+
+    pub(super) fn build(
+        mesh: &ValidMesh,
+        unfold_obtuse: bool,
+        progress: &dyn Progress,
+    ) -> Result<Self, EmbedError> {
         let n = mesh.n_vertices();
         let topo = mesh.topology();
         let pos = &mesh.positions;
@@ -95,6 +117,9 @@ impl FastMarching {
         let mut virtual_edges: Vec<(u32, u32, f64)> = Vec::new();
         let mut obtuse = (0usize, 0usize);
         for (f, t) in mesh.triangles.iter().enumerate() {
+            if f % CANCEL_EVERY == 0 {
+                check_cancel(progress)?;
+            }
             for k in 0..3 {
                 let x = t[k];
                 let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
@@ -159,7 +184,10 @@ impl FastMarching {
             entries[fill[v as usize] as usize] = e;
             fill[v as usize] += 1;
         };
-        for s in &stencils {
+        for (i, s) in stencils.iter().enumerate() {
+            if i % CANCEL_EVERY == 0 {
+                check_cancel(progress)?;
+            }
             let [gaa, gab, gbb] = s.g;
             let det = gaa * gbb - gab * gab;
             // Degenerate (sliver) stencils only contribute their edges.
@@ -204,19 +232,22 @@ impl FastMarching {
             );
         }
         for v in 0..n {
+            if v % CANCEL_EVERY == 0 {
+                check_cancel(progress)?;
+            }
             entries[offsets[v] as usize..offsets[v + 1] as usize].sort_by_key(|e| e.x);
         }
         // The stencils (40 bytes each, about six a vertex) go before the near field's
         // copy of the mesh is built.
         drop((stencils, virtual_edges, fill));
-        let near = NearField::new(mesh);
-        Self {
+        let near = NearField::new(mesh, progress)?;
+        Ok(Self {
             n,
             offsets,
             entries,
             near,
             obtuse,
-        }
+        })
     }
 
     /// Number of vertices of the mesh.
@@ -318,7 +349,38 @@ impl FastMarching {
         &ws.dist
     }
 
+    /// [`run_until_targets`](Self::run_until_targets), stopping with
+    /// [`EmbedError::Cancelled`] when `progress` asks (looked at every [`CANCEL_EVERY`]
+    /// frozen vertices: a run over a 10M-vertex mesh takes seconds).
+    pub(crate) fn run_until_targets_cancellable<'w>(
+        &self,
+        ws: &'w mut Workspace,
+        sources: &[u32],
+        targets: &[bool],
+        n_targets: usize,
+        progress: &dyn Progress,
+    ) -> Result<&'w [f64], EmbedError> {
+        if self.run_cancellable(ws, sources, Stop::Targets(targets, n_targets), progress) {
+            Ok(&ws.dist)
+        } else {
+            Err(EmbedError::Cancelled)
+        }
+    }
+
     pub(super) fn run_until(&self, ws: &mut Workspace, sources: &[u32], stop: Stop) {
+        // Without a sink that cancels, the run always completes.
+        self.run_cancellable(ws, sources, stop, &NoProgress);
+    }
+
+    /// The run loop; false when `progress` cancelled it (the workspace is then left for
+    /// the next run to reset).
+    fn run_cancellable(
+        &self,
+        ws: &mut Workspace,
+        sources: &[u32],
+        stop: Stop,
+        progress: &dyn Progress,
+    ) -> bool {
         if !ws.clean {
             ws.dist.fill(f64::INFINITY);
             ws.state.fill(FAR);
@@ -362,9 +424,15 @@ impl FastMarching {
             _ => usize::MAX,
         };
         if remaining == 0 {
-            return;
+            return true;
         }
+        let mut frozen = 0usize;
         while let Some(v) = ws.pop() {
+            frozen += 1;
+            if frozen % CANCEL_EVERY == 0 && progress.cancelled() {
+                ws.clean = false;
+                return false;
+            }
             let vi = v as usize;
             let uv = ws.dist[vi];
             match stop {
@@ -373,7 +441,7 @@ impl FastMarching {
                     if targets[vi] {
                         remaining -= 1;
                         if remaining == 0 {
-                            return;
+                            return true;
                         }
                     }
                 }
@@ -382,7 +450,7 @@ impl FastMarching {
                         // Not part of the result: back to the heap's bookkeeping for reset.
                         ws.state[vi] = FAR;
                         ws.heap.push(v);
-                        return;
+                        return true;
                     }
                     ws.local.push((v, uv));
                 }
@@ -424,6 +492,7 @@ impl FastMarching {
                 i = j;
             }
         }
+        true
     }
 }
 

@@ -147,15 +147,18 @@ pub fn landmark_distances(
         )));
     }
     let built = std::cell::OnceCell::new();
-    let fine = || {
-        opts.fine
-            .unwrap_or_else(|| built.get_or_init(|| FastMarching::new(mesh)))
+    let fine = || -> Result<&FastMarching, EmbedError> {
+        if let Some(fm) = opts.fine.or(built.get()) {
+            return Ok(fm);
+        }
+        let fm = FastMarching::new_cancellable(mesh, progress)?;
+        Ok(built.get_or_init(|| fm))
     };
     let decimated;
     let coarse = match opts.resolution {
-        Resolution::Full => return full_matrix(fine(), landmarks, progress),
+        Resolution::Full => return full_matrix(fine()?, landmarks, progress),
         Resolution::Decimate(target) if target >= mesh.n_vertices() => {
-            return full_matrix(fine(), landmarks, progress);
+            return full_matrix(fine()?, landmarks, progress);
         }
         Resolution::Decimate(target) => {
             let d = DecimateOptions {
@@ -173,14 +176,14 @@ pub fn landmark_distances(
         let radius = NEAR_PAIR_RADIUS_EDGES * wavg_mesh::geometry::mean_edge_length(&coarse.mesh);
         match opts.refine_on {
             None => {
-                refine_near_pairs(fine(), landmarks, radius, &mut q, progress)?;
+                refine_near_pairs(fine()?, landmarks, radius, &mut q, progress)?;
             }
             Some(mid) => {
                 let ids = decimated_ids(mid, landmarks)?;
                 let mid_mesh = ValidMesh::new(mid.mesh.clone()).map_err(|e| {
                     EmbedError::Numerical(format!("the decimated mesh is not valid: {e}"))
                 })?;
-                let fm = FastMarching::new(&mid_mesh);
+                let fm = FastMarching::new_cancellable(&mid_mesh, progress)?;
                 refine_near_pairs(&fm, &ids, radius, &mut q, progress)?;
             }
         }
@@ -343,7 +346,11 @@ fn landmark_distances_decimated(
     let ids = decimated_ids(coarse, landmarks)?;
     let mesh = ValidMesh::new(coarse.mesh.clone())
         .map_err(|e| EmbedError::Numerical(format!("the decimated mesh is not valid: {e}")))?;
-    full_matrix(&FastMarching::new(&mesh), &ids, progress)
+    full_matrix(
+        &FastMarching::new_cancellable(&mesh, progress)?,
+        &ids,
+        progress,
+    )
 }
 
 /// The indices in `coarse` of the original vertices `landmarks` (an error if one is not

@@ -220,7 +220,7 @@ mod tests {
         let (obtuse, split) = fm.obtuse_corners();
         assert!(obtuse == 9600 && split == obtuse, "{obtuse} {split}");
         let (mean, _) = plane_errors(&mesh, &fm, &sources, "grid sheared to 130 deg");
-        let plain = FastMarching::build(&mesh, false);
+        let plain = FastMarching::build(&mesh, false, &NoProgress).unwrap();
         let (mean_plain, _) = plane_errors(&mesh, &plain, &sources, "  same without unfolding");
         assert!(mean < 0.01, "{mean}");
         assert!(
@@ -232,7 +232,7 @@ mod tests {
         let mesh = sheared(1.5, 0.35);
         let fm = FastMarching::new(&mesh);
         let (_, far) = plane_errors(&mesh, &fm, &sources, "grid sheared to 167 deg");
-        let plain = FastMarching::build(&mesh, false);
+        let plain = FastMarching::build(&mesh, false, &NoProgress).unwrap();
         let (_, far_plain) = plane_errors(&mesh, &plain, &sources, "  same without unfolding");
         assert!(far < 0.01, "{far}");
         assert!(
@@ -268,7 +268,7 @@ mod tests {
         let fm = FastMarching::new(&mesh);
         let sources = [0, 20 * w as u32 + 80, 7 * w as u32 + 150];
         let (worst, _) = plane_errors(&mesh, &fm, &sources, "jittered 4:1 grid");
-        let plain = FastMarching::build(&mesh, false);
+        let plain = FastMarching::build(&mesh, false, &NoProgress).unwrap();
         let (worst_plain, _) = plane_errors(&mesh, &plain, &sources, "  same without unfolding");
         // Heavy jitter (40% of the short edges): first-order fast marching loses accuracy.
         assert!(
@@ -660,6 +660,96 @@ mod tests {
             ),
             Err(EmbedError::InvalidArgument(_))
         ));
+    }
+
+    /// Cancels from its `after`-th look on (counting every look).
+    struct CancelAfter {
+        looks: std::sync::atomic::AtomicUsize,
+        after: usize,
+    }
+
+    impl CancelAfter {
+        fn new(after: usize) -> Self {
+            Self {
+                looks: 0.into(),
+                after,
+            }
+        }
+        fn looks(&self) -> usize {
+            self.looks.load(std::sync::atomic::Ordering::Relaxed)
+        }
+    }
+
+    impl Progress for CancelAfter {
+        fn report(&self, _: Stage, _: f64) {}
+        fn cancelled(&self) -> bool {
+            self.looks
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+                .saturating_add(1)
+                > self.after
+        }
+    }
+
+    /// The build looks at the cancellation throughout (faces, stencils, entries, near
+    /// field), and a cancellation at its last look still stops it.
+    #[test]
+    fn a_fast_marching_build_stops_when_cancelled() {
+        let mesh = valid(procedural::torus(300, 120, 1.0, 0.35));
+        let (n, f) = (mesh.n_vertices(), mesh.n_faces());
+        let never = CancelAfter::new(usize::MAX);
+        let fm = FastMarching::new_cancellable(&mesh, &never).unwrap();
+        let looks = never.looks();
+        // Faces, stencils (three a face at least), sorted entries and near-field vertices.
+        let least = f.div_ceil(CANCEL_EVERY)
+            + (3 * f).div_ceil(CANCEL_EVERY)
+            + 2 * n.div_ceil(CANCEL_EVERY);
+        assert!(looks >= least, "{looks} looks, expected at least {least}");
+        let mut ws = fm.workspace();
+        assert_eq!(
+            fm.run(&mut ws, &[7]),
+            FastMarching::new(&mesh).run(&mut fm.workspace(), &[7])
+        );
+        for after in [0, looks / 2, looks - 1] {
+            assert!(
+                matches!(
+                    FastMarching::new_cancellable(&mesh, &CancelAfter::new(after)),
+                    Err(EmbedError::Cancelled)
+                ),
+                "cancelled at look {after} of {looks}"
+            );
+        }
+    }
+
+    /// A run to targets stops when cancelled, and the workspace it leaves gives the same
+    /// distances as a fresh one on the next run.
+    #[test]
+    fn a_run_to_targets_stops_when_cancelled() {
+        let mesh = valid(procedural::torus(400, 200, 1.0, 0.35));
+        let n = mesh.n_vertices();
+        assert!(n > CANCEL_EVERY);
+        let fm = FastMarching::new(&mesh);
+        let mut ws = fm.workspace();
+        // The farthest vertex from 0 freezes last.
+        let d = fm.run(&mut ws, &[0]);
+        let far = (0..n).max_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap();
+        let mut targets = vec![false; n];
+        targets[far] = true;
+        let cancel = CancelAfter::new(0);
+        let r = fm.run_until_targets_cancellable(&mut ws, &[0], &targets, 1, &cancel);
+        assert!(matches!(r, Err(EmbedError::Cancelled)));
+        assert_eq!(cancel.looks(), 1, "stopped at its first look");
+        let again = fm.run_until_targets_cancellable(&mut ws, &[0], &targets, 1, &NoProgress);
+        let again = again.unwrap()[far];
+        let fresh = fm.run_until_targets(&mut fm.workspace(), &[0], &targets, 1)[far];
+        assert_eq!(again, fresh);
+        // A run shorter than one look's worth of vertices never looks.
+        let near: Vec<bool> = (0..n).map(|v| v == 1).collect();
+        let quiet = CancelAfter::new(0);
+        assert!(
+            fm.run_until_targets_cancellable(&mut ws, &[0], &near, 1, &quiet)
+                .is_ok()
+        );
+        assert_eq!(quiet.looks(), 0);
     }
 
     proptest! {

@@ -33,6 +33,9 @@
 use nalgebra::{Vector2, Vector3};
 use wavg_mesh::{NONE, ValidMesh};
 
+use super::fast_marching::CANCEL_EVERY;
+use crate::error::{EmbedError, Progress, check_cancel};
+
 type V2 = Vector2<f64>;
 
 /// Radius of the exact near field, in mean edge lengths of the mesh.
@@ -166,7 +169,9 @@ fn segment_distance(a: &V2, b: &V2) -> f64 {
 }
 
 impl NearField {
-    pub(crate) fn new(mesh: &ValidMesh) -> Self {
+    /// The near field of `mesh`; [`EmbedError::Cancelled`] when `progress` asks (looked
+    /// at every [`CANCEL_EVERY`] vertices).
+    pub(crate) fn new(mesh: &ValidMesh, progress: &dyn Progress) -> Result<Self, EmbedError> {
         let topo = mesh.topology();
         let n = mesh.n_vertices();
         let edge = wavg_mesh::geometry::mean_edge_length(mesh);
@@ -176,6 +181,9 @@ impl NearField {
         let mut theta = Vec::with_capacity(mesh.n_faces() * 3 + n);
         vf_offsets.push(0);
         for v in 0..n as u32 {
+            if v as usize % CANCEL_EVERY == 0 {
+                check_cancel(progress)?;
+            }
             let (ring, faces) = (topo.ring(v), topo.ring_faces(v));
             vf.extend_from_slice(faces);
             vf_offsets.push(vf.len() as u32);
@@ -206,7 +214,7 @@ impl NearField {
                 total > full * (1.0 + 1e-9)
             })
             .collect();
-        Self {
+        Ok(Self {
             pos: mesh.positions.clone(),
             tris: mesh.triangles.clone(),
             adj: (0..mesh.n_faces() as u32)
@@ -221,7 +229,7 @@ impl NearField {
             shadows_only: true,
             edge,
             radius: NEAR_FIELD_EDGES * edge,
-        }
+        })
     }
 
     /// Sets the radius to `edges` mean edge lengths (0 turns the near field off).
@@ -588,6 +596,7 @@ pub(crate) fn place(p2: &V2, r2: &V2, lp: f64, lr: f64) -> Option<V2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::NoProgress;
     use wavg_mesh::procedural;
 
     /// Smallest candidate per vertex (`INFINITY` where none).
@@ -605,7 +614,7 @@ mod tests {
     /// it: the near field must reach every vertex within its radius (less one edge, for
     /// windows that narrow to nothing at a vertex) with exactly the flat distance.
     fn check_flat(mesh: &ValidMesh, flat: &[Vector2<f64>], sources: &[u32]) {
-        let nf = NearField::new(mesh);
+        let nf = NearField::new(mesh, &NoProgress).unwrap();
         let h = wavg_mesh::geometry::mean_edge_length(mesh);
         for &s in sources {
             let d = best(&nf, mesh.n_vertices(), s);
@@ -659,7 +668,7 @@ mod tests {
     fn every_candidate_is_at_least_the_straight_line_distance() {
         let mesh =
             ValidMesh::new(procedural::with_noise(procedural::icosphere(4), 0.3, 7)).unwrap();
-        let nf = NearField::new(&mesh);
+        let nf = NearField::new(&mesh, &NoProgress).unwrap();
         for s in [0u32, 100, 2000] {
             let (mut out, mut sc) = (Vec::new(), NearScratch::default());
             nf.candidates(s, &mut out, &mut sc);
@@ -692,7 +701,7 @@ mod tests {
     fn saddle_surface_distances_are_exact() {
         let mesh = saddle_surface();
         let n = mesh.n_vertices();
-        let mut nf = NearField::new(&mesh);
+        let mut nf = NearField::new(&mesh, &NoProgress).unwrap();
         let saddles = nf.bends.iter().filter(|&&b| b).count();
         assert!(saddles > n / 4, "{saddles} of {n}");
         // A 4 x 3 lattice of sources 5 to 6 cells apart in the middle of the 36 x 36 grid.
@@ -741,7 +750,7 @@ mod tests {
     #[test]
     fn vertex_budget_bounds_the_work_and_keeps_exactness() {
         let mesh = ValidMesh::new(procedural::grid(120, 120, 1.0, 1.0)).unwrap();
-        let mut nf = NearField::new(&mesh);
+        let mut nf = NearField::new(&mesh, &NoProgress).unwrap();
         nf.set_radius_edges(1000.0);
         let s = 60 * 121 + 60;
         let (mut out, mut sc) = (Vec::new(), NearScratch::default());
@@ -783,7 +792,7 @@ mod tests {
         }
         for mesh in &meshes {
             let n = mesh.n_vertices();
-            let mut nf = NearField::new(mesh);
+            let mut nf = NearField::new(mesh, &NoProgress).unwrap();
             let sources: Vec<u32> = (0..25).map(|i| (i * 7919 % n) as u32).collect();
             let shadow: Vec<Vec<f64>> = sources.iter().map(|&s| best(&nf, n, s)).collect();
             nf.shadows_only = false;
