@@ -352,11 +352,13 @@ impl Surface {
     /// The embedding, ``(n, 8)`` float64, or None before ``precompute``/``load_embedding``.
     #[getter]
     fn embedding<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        // From the projector's coordinates (the surface keeps one copy).
         self.inner
-            .embedding()
-            .map(|e| {
-                let v: Vec<f64> = e.coords.iter().flat_map(|c| c.iter().copied()).collect();
-                array(py, v, &[e.coords.len(), 8])
+            .has_embedding()
+            .then(|| {
+                let c = self.inner.embedded_coords();
+                let v: Vec<f64> = c.iter().flat_map(|c| c.iter().copied()).collect();
+                array(py, v, &[c.len(), 8])
             })
             .transpose()
     }
@@ -389,7 +391,7 @@ impl Surface {
     /// True once an embedding was computed or loaded.
     #[getter]
     fn has_embedding(&self) -> bool {
-        self.inner.embedding().is_some()
+        self.inner.has_embedding()
     }
 
     /// S.vertex_points(ids) -> (faces (q,) int64, bary (q, 3) float64)
@@ -474,7 +476,7 @@ impl Surface {
             "wavg.Surface({} vertices, {} faces, {})",
             self.inner.n_vertices(),
             self.inner.n_faces(),
-            if self.inner.embedding().is_some() {
+            if self.inner.has_embedding() {
                 "embedded"
             } else {
                 "no embedding"

@@ -253,7 +253,7 @@ pub unsafe extern "C" fn wavg_surface_save_embedding(
     guard(|| {
         // SAFETY: per this function's contract.
         let (s, path) = unsafe { (handle(surface, "surface")?, path_arg(path)?) };
-        if s.inner.embedding().is_none() {
+        if !s.inner.has_embedding() {
             return Err(Failure::arg(
                 "the surface has no embedding to save: precompute or load one first",
             ));

@@ -43,7 +43,7 @@ impl App {
     /// `.wavg` file or computed) it is ready at once; otherwise call
     /// [`App::precompute_in_background`].
     pub fn new(surface: Surface) -> Self {
-        let has = surface.embedding().is_some();
+        let has = surface.has_embedding();
         let mesh_bytes = crate::meshbin::encode_mesh(surface.mesh());
         Self {
             inner: Arc::new(Inner {

@@ -2,7 +2,7 @@
 //! question about weighted averages on that mesh starts from.
 
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
 use wavg_embed::{Embedding, PrecomputeOptions, Progress, Report};
@@ -38,9 +38,34 @@ pub struct Surface {
 
 struct Inner {
     mesh: Arc<ValidMesh>,
-    /// `None` while the 3-D positions are the embedding.
+    /// The embedding's landmarks and parameters, its coordinates left empty: they are kept
+    /// once, in the projector (64 bytes a vertex: 660 MB at 10M vertices). `None` while
+    /// the 3-D positions are the embedding.
     embedding: Option<Embedding>,
+    /// The whole embedding, its coordinates copied from the projector's when first asked
+    /// for ([`Surface::embedding`]).
+    whole: OnceLock<Embedding>,
     projector: Arc<Projector>,
+}
+
+impl Inner {
+    fn new(mesh: Arc<ValidMesh>, embedding: Option<Embedding>, projector: Projector) -> Self {
+        Self {
+            mesh,
+            embedding: embedding.map(|e| Embedding {
+                coords: Vec::new(),
+                ..e
+            }),
+            whole: OnceLock::new(),
+            projector: Arc::new(projector),
+        }
+    }
+}
+
+/// An embedding's coordinates as the projector keeps them (the same numbers; the
+/// allocation is reused, not copied).
+fn to_vec8(coords: Vec<[f64; 8]>) -> Vec<Vec8> {
+    coords.into_iter().map(Vec8::from).collect()
 }
 
 impl Surface {
@@ -72,34 +97,27 @@ impl Surface {
         let mesh = mesh.into();
         let projector = Projector::new(Arc::new(EmbeddedMesh::from_positions(mesh.clone())))?;
         Ok(Self {
-            inner: Arc::new(Inner {
-                mesh,
-                embedding: None,
-                projector: Arc::new(projector),
-            }),
+            inner: Arc::new(Inner::new(mesh, None, projector)),
         })
     }
 
     /// A surface on an already validated mesh with an embedding computed for it (one
     /// projector build, where [`Surface::from_valid`] then [`Surface::set_embedding`]
-    /// build two: the start-up time of a run that reads a cached embedding).
+    /// build two: the start-up time of a run that reads a cached embedding). The
+    /// embedding's coordinates move into the projector: one copy is kept, not two.
     pub fn from_valid_with_embedding(
         mesh: impl Into<Arc<ValidMesh>>,
-        embedding: Embedding,
+        mut embedding: Embedding,
     ) -> Result<Self> {
         let mesh = mesh.into();
         embedding
             .validate(mesh.n_vertices())
             .map_err(wavg_embed::EmbedError::InvalidArgument)?;
-        let coords = embedding.coords.iter().map(|c| Vec8::from(*c)).collect();
+        let coords = to_vec8(std::mem::take(&mut embedding.coords));
         let emb = EmbeddedMesh::new(mesh.clone(), coords)?;
         let projector = Projector::new(Arc::new(emb))?;
         Ok(Self {
-            inner: Arc::new(Inner {
-                mesh,
-                embedding: Some(embedding),
-                projector: Arc::new(projector),
-            }),
+            inner: Arc::new(Inner::new(mesh, Some(embedding), projector)),
         })
     }
 
@@ -169,7 +187,7 @@ impl Surface {
     /// Writes the embedding to a `.wavg` file (atomically: a temporary file renamed into
     /// place). Fails when the surface has no computed or loaded embedding.
     pub fn save_embedding(&self, path: impl AsRef<Path>) -> Result<()> {
-        let embedding = self.inner.embedding.as_ref().ok_or_else(|| {
+        let embedding = self.embedding().ok_or_else(|| {
             wavg_embed::EmbedError::InvalidArgument(
                 "the surface has no embedding to save: precompute or load one first".into(),
             )
@@ -180,18 +198,18 @@ impl Surface {
 
     /// Uses `embedding` (one point per vertex) from now on; on any error the surface is
     /// unchanged.
-    pub fn set_embedding(&mut self, embedding: Embedding) -> Result<()> {
+    pub fn set_embedding(&mut self, mut embedding: Embedding) -> Result<()> {
         embedding
             .validate(self.inner.mesh.n_vertices())
             .map_err(wavg_embed::EmbedError::InvalidArgument)?;
-        let coords = embedding.coords.iter().map(|c| Vec8::from(*c)).collect();
+        let coords = to_vec8(std::mem::take(&mut embedding.coords));
         let emb = EmbeddedMesh::new(self.inner.mesh.clone(), coords)?;
         let projector = Projector::new(Arc::new(emb))?;
-        self.inner = Arc::new(Inner {
-            mesh: self.inner.mesh.clone(),
-            embedding: Some(embedding),
-            projector: Arc::new(projector),
-        });
+        self.inner = Arc::new(Inner::new(
+            self.inner.mesh.clone(),
+            Some(embedding),
+            projector,
+        ));
         Ok(())
     }
 
@@ -201,8 +219,21 @@ impl Surface {
     }
 
     /// The computed or loaded embedding; `None` while the 3-D positions serve as one.
+    /// Its coordinates are kept once, by the projector ([`Surface::embedded_coords`]):
+    /// the first call copies them into the [`Embedding`] returned (64 bytes a vertex),
+    /// later calls return the same one. [`Surface::has_embedding`] asks without copying.
     pub fn embedding(&self) -> Option<&Embedding> {
-        self.inner.embedding.as_ref()
+        let meta = self.inner.embedding.as_ref()?;
+        Some(self.inner.whole.get_or_init(|| Embedding {
+            coords: self.embedded_coords().iter().map(|&c| c.into()).collect(),
+            ..meta.clone()
+        }))
+    }
+
+    /// Whether the surface has a computed or loaded embedding (without
+    /// [`Surface::embedding`]'s copy of its coordinates).
+    pub fn has_embedding(&self) -> bool {
+        self.inner.embedding.is_some()
     }
 
     /// Every vertex's point in R^8 (3-D positions padded with zeros when there is no
@@ -274,7 +305,53 @@ impl std::fmt::Debug for Surface {
         f.debug_struct("Surface")
             .field("vertices", &self.n_vertices())
             .field("faces", &self.n_faces())
-            .field("embedded", &self.inner.embedding.is_some())
+            .field("embedded", &self.has_embedding())
             .finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wavg_embed::NoProgress;
+
+    /// An embedding given to a surface moves into the projector (same allocation, no
+    /// second copy); the whole [`Embedding`] is assembled only when asked for, with the
+    /// same numbers.
+    #[test]
+    fn an_embedding_is_kept_once_until_asked_for() {
+        let mesh = ValidMesh::new(wavg_mesh::procedural::torus(32, 12, 1.0, 0.35)).unwrap();
+        let opts = PrecomputeOptions {
+            landmarks: 40,
+            ..Default::default()
+        };
+        let (e, _) = crate::precompute(&mesh, &opts, &NoProgress).unwrap();
+        let given = e.clone();
+        let at = given.coords.as_ptr() as usize;
+        let s = Surface::from_valid_with_embedding(mesh, given).unwrap();
+        assert_eq!(
+            s.embedded_coords().as_ptr() as usize,
+            at,
+            "moved, not copied"
+        );
+        assert!(s.has_embedding());
+        assert!(s.inner.whole.get().is_none(), "nothing copied yet");
+        assert!(s.inner.embedding.as_ref().unwrap().coords.is_empty());
+        assert_eq!(s.landmarks(), e.landmarks.as_slice());
+        assert_eq!(s.embedding(), Some(&e));
+        assert!(s.inner.whole.get().is_some());
+        assert!(std::ptr::eq(s.embedding().unwrap(), s.embedding().unwrap()));
+        let plain = Surface::from_valid(s.mesh().clone()).unwrap();
+        assert!(!plain.has_embedding() && plain.embedding().is_none());
+    }
+
+    /// The coordinates' allocation is reused when they move into the projector.
+    #[test]
+    fn coordinates_move_without_a_copy() {
+        let coords = vec![[1.0; 8]; 1000];
+        let at = coords.as_ptr() as usize;
+        let v = to_vec8(coords);
+        assert_eq!(v.as_ptr() as usize, at);
+        assert_eq!(v[999], Vec8::from([1.0; 8]));
     }
 }

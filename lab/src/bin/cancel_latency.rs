@@ -53,18 +53,19 @@ impl Progress for GapTimer {
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
-    let mut flag = |name: &str| {
+    let mut take = |name: &str, with_value: bool| {
         let i = args.iter().position(|a| a == name)?;
         args.remove(i);
-        Some(if i < args.len() && !args[i].starts_with("--") {
+        Some(if with_value {
             args.remove(i)
         } else {
             String::new()
         })
     };
-    let cancel_at = flag("--cancel-at").map(|t| Duration::from_secs_f64(t.parse().expect("T")));
-    let no_first_pass = flag("--no-first-pass").is_some();
-    let out = flag("-o");
+    let cancel_at =
+        take("--cancel-at", true).map(|t| Duration::from_secs_f64(t.parse().expect("T")));
+    let no_first_pass = take("--no-first-pass", false).is_some();
+    let out = take("-o", true);
     let path = args.first().expect("MESH");
     let mesh = ValidMesh::new(wavg_mesh::io::load(path.as_ref()).expect("load")).expect("valid");
     let mut opts = PrecomputeOptions::default();

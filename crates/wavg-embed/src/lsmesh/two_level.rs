@@ -206,7 +206,7 @@ impl TwoLevelLsMesh {
     ) -> Result<Vec<Row>, EmbedError> {
         let coarse = self.coarse.solve(values, dim)?;
         check_cancel(progress)?;
-        let mut x = self.prolongate(&coarse);
+        let mut x = self.prolongate(&coarse, progress)?;
         for (&s, v) in self.landmarks.iter().zip(values) {
             x[s as usize] = *v;
             x[s as usize][dim..].fill(0.0);
@@ -229,7 +229,8 @@ impl TwoLevelLsMesh {
     /// Coarse values at the coarse vertices; every other vertex gets the mean of its
     /// neighbours one breadth-first layer closer to the coarse vertices, then a few
     /// Gauss-Seidel sweeps of neighbour averaging smooth the result.
-    fn prolongate(&self, coarse: &[Row]) -> Vec<Row> {
+    /// Looks at `progress`'s cancellation after each layer and sweep (seconds at 10M).
+    fn prolongate(&self, coarse: &[Row], progress: &dyn Progress) -> Result<Vec<Row>, EmbedError> {
         const SWEEPS: usize = 4;
         let n = self.fixed.len();
         let neighbours = |v: usize| {
@@ -271,8 +272,10 @@ impl TwoLevelLsMesh {
                 known[u] = true;
             }
             frontier = next;
+            check_cancel(progress)?;
         }
         for _ in 0..SWEEPS {
+            check_cancel(progress)?;
             for v in (0..n).filter(|&v| !is_coarse[v]) {
                 let (mut sum, mut count) = ([0.0; MAX_DIM], 0.0);
                 for w in neighbours(v) {
@@ -286,7 +289,7 @@ impl TwoLevelLsMesh {
                 }
             }
         }
-        x
+        Ok(x)
     }
 }
 
