@@ -129,8 +129,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     crate::common::check_outputs(&[std::path::Path::new(&*args.mesh)], &outputs, args.json)?;
     let interrupted = Arc::new(AtomicBool::new(false));
-    let flag = interrupted.clone();
-    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed));
+    let loading = Arc::new(AtomicBool::new(true));
+    let (flag, while_loading) = (interrupted.clone(), loading.clone());
+    let output = args.output.display().to_string();
+    let _ = ctrlc::set_handler(move || {
+        // Reading and validating cannot stop partway (seconds at 10M vertices) and leave no
+        // file (a repaired mesh goes through a temporary one): the command ends at once.
+        if while_loading.load(Ordering::Relaxed) {
+            eprintln!("wavg: interrupted; {output} was not written");
+            std::process::exit(130);
+        }
+        flag.store(true, Ordering::Relaxed)
+    });
     let t_load = Instant::now();
     let mut mesh = load_mesh(&args.mesh)?;
     let mut removed = None;
@@ -144,6 +154,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         wavg::mesh::io::save(path, &mesh)?;
     }
     let load_seconds = t_load.elapsed().as_secs_f64();
+    loading.store(false, Ordering::Relaxed);
 
     let defaults = wavg::default_precompute_options(&mesh);
     let opts = PrecomputeOptions {
