@@ -48,7 +48,7 @@ impl VertexOrder {
                     c.min((1 << BITS) - 1)
                 });
                 (
-                    spread(cell[0]) | spread(cell[1]) << 1 | spread(cell[2]) << 2,
+                    spread(cell[0]) | (spread(cell[1]) << 1) | (spread(cell[2]) << 2),
                     v as u32,
                 )
             })
@@ -83,11 +83,11 @@ impl VertexOrder {
 /// The low 21 bits of `x` spread to every third bit.
 fn spread(x: u64) -> u64 {
     let mut x = x & 0x1f_ffff;
-    x = (x | x << 32) & 0x1f_0000_0000_ffff;
-    x = (x | x << 16) & 0x1f_0000_ff00_00ff;
-    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
-    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
-    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x = (x | (x << 32)) & 0x1f_0000_0000_ffff;
+    x = (x | (x << 16)) & 0x1f_0000_ff00_00ff;
+    x = (x | (x << 8)) & 0x100f_00f0_0f00_f00f;
+    x = (x | (x << 4)) & 0x10c3_0c30_c30c_30c3;
+    x = (x | (x << 2)) & 0x1249_2492_4924_9249;
     x
 }
 

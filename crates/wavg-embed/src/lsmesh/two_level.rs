@@ -440,6 +440,49 @@ mod tests {
         assert!(fresh.with_landmarks(&snap, &[off], &NoProgress).is_err());
     }
 
+    /// The same bits with 1, 2 and 3 threads: the vertex order, the stiffness's parallel
+    /// assembly, the prolongation's layers and the chunked dot products do not depend on
+    /// the schedule (the mesh spans several assembly blocks).
+    #[test]
+    fn the_same_bits_whatever_the_thread_count() {
+        let mesh = noisy_torus(200, 100, 9);
+        assert!(mesh.n_vertices() > 16_384);
+        let opts = DecimateOptions {
+            target: 100,
+            ..Default::default()
+        };
+        let (fin, mut snaps) = decimate_with_snapshots(&mesh, &opts, &[2000], &NoProgress).unwrap();
+        let snap = snaps.pop().unwrap();
+        let values: Vec<Row> = (fin.landmarks.iter())
+            .map(|&l| std::array::from_fn(|k| ((l as usize * 5 + k) % 11) as f64))
+            .collect();
+        let run = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                TwoLevelLsMesh::new(
+                    &mesh,
+                    &snap,
+                    &fin.landmarks,
+                    CgOptions::default(),
+                    &NoProgress,
+                )
+                .unwrap()
+                .solve(&values, MAX_DIM, &NoProgress)
+                .unwrap()
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            assert!(run(threads) == one, "{threads} threads");
+        }
+        for (&s, v) in fin.landmarks.iter().zip(&values) {
+            assert_eq!(one[s as usize], *v);
+        }
+    }
+
     #[test]
     fn converges_to_the_direct_solve() {
         let mesh = noisy_torus(160, 80, 3);
