@@ -605,7 +605,7 @@ mod tests {
     /// once, consecutive ring vertices spanning each face.
     #[test]
     fn rings_are_fans_whatever_the_thread_count() {
-        let mesh = procedural::grid(230, 120, 2.0, 1.0);
+        let mesh = procedural::grid(300, 130, 2.0, 1.0);
         let build = |threads| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
