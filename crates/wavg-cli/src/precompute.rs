@@ -270,11 +270,8 @@ struct Removed {
 
 /// Validates with a message naming the problems and the repair options.
 fn validate(name: &str, mesh: wavg::TriMesh) -> Result<ValidMesh, CliError> {
-    let analysis = wavg::mesh::analyze(&mesh);
-    let components = analysis.stats.components;
-    // What the default repairs would do, for the hint (only for an invalid mesh).
-    let preview = (!analysis.report.is_valid()).then(|| wavg::mesh::RepairPreview::of(&mesh));
-    match ValidMesh::new(mesh) {
+    // One analysis: a mesh that fails comes back with it, for the message.
+    let rejected = match ValidMesh::try_new(mesh) {
         Ok(m) => {
             if m.topology().n_components() != 1 {
                 return Err(CliError::input(format!(
@@ -286,34 +283,37 @@ fn validate(name: &str, mesh: wavg::TriMesh) -> Result<ValidMesh, CliError> {
                     m.topology().n_components()
                 )));
             }
-            Ok(m)
+            return Ok(m);
         }
-        Err(MeshError::Invalid(report)) => {
-            let mut hint = String::from("run `wavg info` for details");
-            if let Some(preview) = preview.filter(|p| p.fixes_all) {
-                let one = if preview.components > 1 {
-                    " --largest-component"
-                } else {
-                    ""
-                };
-                hint.push_str(&format!(
-                    "; `wavg repair {name} -o FIXED.obj{one}` fixes it (then use FIXED.obj)"
-                ));
-            }
-            if components > 1 {
-                hint.push_str(&format!(
-                    "; the mesh has {components} components: --largest-component keeps the \
-                     largest"
-                ));
-            }
-            let message = format!(
-                "{name}: not a valid oriented manifold mesh: {} ({hint})",
-                report.lines().join("; ")
-            );
-            Err(CliError::from(MeshError::Invalid(report)).with_message(message))
-        }
-        Err(e) => Err(e.into()),
+        Err(rejected) => rejected,
+    };
+    let wavg::mesh::Rejected { mesh, analysis } = *rejected;
+    let components = analysis.stats.components;
+    let report = analysis.report;
+    // What the default repairs would do, for the hint.
+    let preview = wavg::mesh::RepairPreview::of(&mesh);
+    let mut hint = String::from("run `wavg info` for details");
+    if preview.fixes_all {
+        let one = if preview.components > 1 {
+            " --largest-component"
+        } else {
+            ""
+        };
+        hint.push_str(&format!(
+            "; `wavg repair {name} -o FIXED.obj{one}` fixes it (then use FIXED.obj)"
+        ));
     }
+    if components > 1 {
+        hint.push_str(&format!(
+            "; the mesh has {components} components: --largest-component keeps the \
+             largest"
+        ));
+    }
+    let message = format!(
+        "{name}: not a valid oriented manifold mesh: {} ({hint})",
+        report.lines().join("; ")
+    );
+    Err(CliError::from(MeshError::Invalid(Box::new(report))).with_message(message))
 }
 
 /// One progress bar per stage on stderr (hidden when stderr is not a terminal); also

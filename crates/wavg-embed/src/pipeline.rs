@@ -2,6 +2,7 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use wavg_mesh::ValidMesh;
 
 use crate::decimate::{DecimateOptions, Decimated, decimate_beside, decimate_with_snapshots};
@@ -87,9 +88,7 @@ pub const LANDMARK_ASPECT_RATIO: f64 = 10.0;
 /// then loses every landmark of some regions).
 fn landmark_aspect_bound(mesh: &ValidMesh, asked: Option<f64>) -> Option<f64> {
     let asked = asked?;
-    let mut ratios: Vec<f64> = mesh
-        .triangles
-        .iter()
+    let mut ratios: Vec<f64> = (mesh.triangles.par_iter())
         .map(|t| {
             let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
             crate::decimate::aspect_ratio(a, b, c)
@@ -248,9 +247,11 @@ pub(crate) fn precompute_unscaled(
             two_level.then_some(opts.lsmesh_coarse_vertices),
         ]
     };
+    // One pass over the faces, whatever the rounds.
+    let aspect_bound = landmark_aspect_bound(mesh, opts.decimate.max_aspect_ratio);
     let decimate_options = |target: usize, locked: Vec<u32>| DecimateOptions {
         target,
-        max_aspect_ratio: landmark_aspect_bound(mesh, opts.decimate.max_aspect_ratio),
+        max_aspect_ratio: aspect_bound,
         locked,
         ..opts.decimate.clone()
     };

@@ -67,100 +67,64 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
             faces: nf,
         });
     }
-    for (v, p) in mesh.positions.iter().enumerate() {
-        if !p.iter().all(|c| c.is_finite()) {
-            defects.push(Defect::NonFiniteCoordinate { vertex: v as u32 });
-        }
-    }
-    // Faces usable for combinatorics: indices in range and distinct.
-    let mut usable = vec![true; nf];
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        if let Some(&bad) = t.iter().find(|&&i| i as usize >= nv) {
-            defects.push(Defect::IndexOutOfRange {
-                face: f as u32,
-                index: bad,
-                vertex_count: nv,
-            });
-            usable[f] = false;
-        }
-    }
-    for (f, t) in mesh.triangles.iter().enumerate() {
-        if usable[f] && (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
-            defects.push(Defect::RepeatedIndex { face: f as u32 });
-            usable[f] = false;
-        }
-    }
-    for (f, &ok) in usable.iter().enumerate() {
-        if ok {
-            let [a, b, c] = mesh.corners(f);
-            if [a, b, c].iter().all(|p| p.iter().all(|x| x.is_finite())) && is_degenerate(a, b, c) {
-                defects.push(Defect::ZeroAreaFace { face: f as u32 });
+    defects.extend(
+        (mesh.positions.par_iter().enumerate())
+            .filter(|(_, p)| !p.iter().all(|c| c.is_finite()))
+            .map(|(v, _)| Defect::NonFiniteCoordinate { vertex: v as u32 })
+            .collect::<Vec<_>>(),
+    );
+    // Faces usable for combinatorics: indices in range and distinct. Each face is judged
+    // once, in parallel; the defects are listed kind by kind, each in face order.
+    let verdicts: Vec<FaceVerdict> = (mesh.triangles.par_iter().enumerate())
+        .map(|(f, t)| face_verdict(mesh, f, t))
+        .collect();
+    let usable: Vec<bool> = (verdicts.par_iter())
+        .map(|v| matches!(v, FaceVerdict::Usable | FaceVerdict::ZeroArea))
+        .collect();
+    for kind in 0..3 {
+        defects.extend(verdicts.iter().enumerate().filter_map(|(f, v)| {
+            let face = f as u32;
+            match (kind, *v) {
+                (0, FaceVerdict::OutOfRange(index)) => Some(Defect::IndexOutOfRange {
+                    face,
+                    index,
+                    vertex_count: nv,
+                }),
+                (1, FaceVerdict::RepeatedIndex) => Some(Defect::RepeatedIndex { face }),
+                (2, FaceVerdict::ZeroArea) => Some(Defect::ZeroAreaFace { face }),
+                _ => None,
             }
-        }
+        }));
     }
-    // Duplicate faces: same vertex set.
-    // Sorted by (smallest vertex, middle, largest, face): equal vertex sets are adjacent.
-    let by_vertices = topology::bucket_sorted((0..nf).filter(|&f| usable[f]).map(|f| {
-        let mut t = mesh.triangles[f];
-        t.sort_unstable();
-        ((t[0] as u64) << 32 | t[1] as u64, f as u32)
-    }));
-    let mut i = 0;
-    while i < by_vertices.len() {
-        // Within a run of equal (smallest, middle), group by the largest vertex.
-        let mut j = i + 1;
-        while j < by_vertices.len() && by_vertices[j].0 == by_vertices[i].0 {
-            j += 1;
-        }
-        if j - i > 1 {
-            let mut run: Vec<(u32, u32)> = by_vertices[i..j]
-                .iter()
-                .map(|&(_, f)| (mesh.triangles[f as usize].into_iter().max().unwrap_or(0), f))
-                .collect();
-            run.sort_unstable();
-            for w in run.windows(2) {
-                if w[0].0 == w[1].0 {
-                    defects.push(Defect::DuplicateFace {
-                        face: w[1].1,
-                        first: w[0].1,
-                    });
-                }
-            }
-        }
-        i = j;
-    }
-    drop(by_vertices);
-
-    let edges = topology::EdgeTable::build(&mesh.triangles, &usable);
-    let mut oriented = true;
-    let mut edge_manifold = true;
-    for g in edges.groups() {
-        let hs = &edges.halfedges[g.clone()];
-        let (a, b) = edges.key_vertices(g.start);
-        if hs.len() > 2 {
-            edge_manifold = false;
-            defects.push(Defect::NonManifoldEdge {
-                a,
-                b,
-                faces: hs.len(),
-            });
-        } else if hs.len() == 2 {
-            let fa = hs[0] / 3;
-            let fb = hs[1] / 3;
-            let dir = |h: u32| mesh.triangles[(h / 3) as usize][(h % 3) as usize];
-            if dir(hs[0]) == dir(hs[1]) {
-                oriented = false;
-                defects.push(Defect::InconsistentOrientation {
-                    face_a: fa,
-                    face_b: fb,
-                    a,
-                    b,
-                });
-            }
-        }
-    }
-    let adj = edges.manifold_adjacency(nf);
-    let incidence = topology::VertexFaces::build(nv, &mesh.triangles, &usable);
+    drop(verdicts);
+    // The independent passes side by side: duplicate faces; the edge table with its
+    // orientation and manifold checks and the face adjacency; the vertex-to-face incidence;
+    // the components.
+    let ((duplicates, (edges, edge_problems, adj)), (incidence, comps)) = rayon::join(
+        || {
+            rayon::join(
+                || duplicate_faces(mesh, &usable),
+                || {
+                    let edges = topology::EdgeTable::build(&mesh.triangles, &usable);
+                    let defects = edge_defects(mesh, &edges);
+                    let adj = edges.manifold_adjacency(nf);
+                    (edges, defects, adj)
+                },
+            )
+        },
+        || {
+            rayon::join(
+                || topology::VertexFaces::build(nv, &mesh.triangles, &usable),
+                || topology::face_components(nv, &mesh.triangles, &usable),
+            )
+        },
+    );
+    defects.extend(duplicates);
+    let (oriented, edge_manifold) = (
+        !(edge_problems.iter()).any(|d| matches!(d, Defect::InconsistentOrientation { .. })),
+        !(edge_problems.iter()).any(|d| matches!(d, Defect::NonManifoldEdge { .. })),
+    );
+    defects.extend(edge_problems);
     let mut vertex_manifold = true;
     // Fans per vertex (0 for an unreferenced vertex), in parallel; the defects are then
     // listed in vertex order.
@@ -208,10 +172,9 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
                 Defect::IndexOutOfRange { .. } | Defect::RepeatedIndex { .. }
             )
         });
-    let comps = topology::face_components(nv, &mesh.triangles, &usable);
     let n_edges = edges.groups().count();
     let boundary = edges.boundary_loop_count(nv, &mesh.triangles);
-    let n_usable = usable.iter().filter(|&&u| u).count();
+    let n_usable = usable.par_iter().filter(|&&u| u).count();
     let chi = referenced as i64 - n_edges as i64 + n_usable as i64;
     // Undefined for a mesh without any usable face (nothing to take the genus of).
     let genus = (manifold && oriented && n_usable > 0)
@@ -237,6 +200,100 @@ pub fn analyze(mesh: &TriMesh) -> Analysis {
         report,
         topology,
     }
+}
+
+/// What the face checks found about one face.
+#[derive(Clone, Copy)]
+enum FaceVerdict {
+    /// Usable, with a positive area.
+    Usable,
+    /// An index beyond the vertices (the first such).
+    OutOfRange(u32),
+    /// A vertex twice.
+    RepeatedIndex,
+    /// Usable for combinatorics, but of zero area.
+    ZeroArea,
+}
+
+/// The checks of face `f` (`t`) on its own.
+fn face_verdict(mesh: &TriMesh, f: usize, t: &[u32; 3]) -> FaceVerdict {
+    if let Some(&bad) = t.iter().find(|&&i| i as usize >= mesh.n_vertices()) {
+        return FaceVerdict::OutOfRange(bad);
+    }
+    if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
+        return FaceVerdict::RepeatedIndex;
+    }
+    let [a, b, c] = mesh.corners(f);
+    if [a, b, c].iter().all(|p| p.iter().all(|x| x.is_finite())) && is_degenerate(a, b, c) {
+        FaceVerdict::ZeroArea
+    } else {
+        FaceVerdict::Usable
+    }
+}
+
+/// Faces with the vertex set of an earlier one, in the order of their vertex sets.
+fn duplicate_faces(mesh: &TriMesh, usable: &[bool]) -> Vec<Defect> {
+    let mut defects = Vec::new();
+    // Sorted by (smallest vertex, middle, largest, face): equal vertex sets are adjacent.
+    let by_vertices =
+        topology::bucket_sorted((0..mesh.n_faces()).filter(|&f| usable[f]).map(|f| {
+            let mut t = mesh.triangles[f];
+            t.sort_unstable();
+            ((t[0] as u64) << 32 | t[1] as u64, f as u32)
+        }));
+    let mut i = 0;
+    while i < by_vertices.len() {
+        // Within a run of equal (smallest, middle), group by the largest vertex.
+        let mut j = i + 1;
+        while j < by_vertices.len() && by_vertices[j].0 == by_vertices[i].0 {
+            j += 1;
+        }
+        if j - i > 1 {
+            let mut run: Vec<(u32, u32)> = by_vertices[i..j]
+                .iter()
+                .map(|&(_, f)| (mesh.triangles[f as usize].into_iter().max().unwrap_or(0), f))
+                .collect();
+            run.sort_unstable();
+            for w in run.windows(2) {
+                if w[0].0 == w[1].0 {
+                    defects.push(Defect::DuplicateFace {
+                        face: w[1].1,
+                        first: w[0].1,
+                    });
+                }
+            }
+        }
+        i = j;
+    }
+    defects
+}
+
+/// Edges with more than two faces, and pairs of faces that run along their shared edge in
+/// the same direction, in edge order.
+fn edge_defects(mesh: &TriMesh, edges: &topology::EdgeTable) -> Vec<Defect> {
+    let mut defects = Vec::new();
+    for g in edges.groups() {
+        let hs = &edges.halfedges[g.clone()];
+        let (a, b) = edges.key_vertices(g.start);
+        if hs.len() > 2 {
+            defects.push(Defect::NonManifoldEdge {
+                a,
+                b,
+                faces: hs.len(),
+            });
+        } else if hs.len() == 2 {
+            let dir = |h: u32| mesh.triangles[(h / 3) as usize][(h % 3) as usize];
+            if dir(hs[0]) == dir(hs[1]) {
+                defects.push(Defect::InconsistentOrientation {
+                    face_a: hs[0] / 3,
+                    face_b: hs[1] / 3,
+                    a,
+                    b,
+                });
+            }
+        }
+    }
+    defects
 }
 
 /// Doubled area small against the longest squared edge (collinear or coincident corners),

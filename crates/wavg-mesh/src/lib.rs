@@ -51,7 +51,7 @@ mod valid;
 pub use mesh::{FaceId, NONE, TexCoords, TriMesh, VertexId};
 pub use rings::RingSearch;
 pub use topology::Topology;
-pub use valid::ValidMesh;
+pub use valid::{Rejected, ValidMesh};
 
 // Diagnostics.
 pub use analyze::{Analysis, MeshStats, ZERO_AREA_RELATIVE_TOLERANCE, analyze};

@@ -3,6 +3,8 @@
 
 use std::ops::Range;
 
+use rayon::prelude::*;
+
 use crate::mesh::{FaceId, NONE, TriMesh, VertexId};
 
 /// Undirected edges as sorted groups of halfedges (`face * 3 + corner`, the edge from
@@ -294,8 +296,8 @@ pub(crate) fn genus_per_component(
         }
     }
     // Boundary loops per component: each boundary edge belongs to its face's component.
-    let mut uf = UnionFind::new(tris.len() * 3);
-    // Oriented manifold: at most one boundary halfedge leaves each vertex.
+    // Oriented manifold: at most one boundary halfedge leaves each vertex (`bnd_start`
+    // holds its index in `bnd`).
     let mut bnd_start = vec![usize::MAX; nv];
     let mut bnd: Vec<usize> = Vec::new();
     for g in edges.groups() {
@@ -303,28 +305,101 @@ pub(crate) fn genus_per_component(
         let c = comps.of_face[(h / 3) as usize] as usize;
         chi[c] -= 1;
         if g.len() == 1 {
-            bnd.push(h as usize);
             let t = tris[(h / 3) as usize];
             let a = t[(h % 3) as usize];
-            bnd_start[a as usize] = h as usize;
+            bnd_start[a as usize] = bnd.len();
+            bnd.push(h as usize);
         }
     }
     // Join each boundary halfedge to the one leaving its end vertex.
-    for &h in &bnd {
+    let mut uf = UnionFind::new(bnd.len());
+    for (i, &h) in bnd.iter().enumerate() {
         let t = tris[h / 3];
         let end = t[(h % 3 + 1) % 3];
         let next = bnd_start[end as usize];
         if next != usize::MAX {
-            uf.union(h, next);
+            uf.union(i, next);
         }
     }
     let mut loops = vec![0i64; k];
-    for &h in &bnd {
-        if uf.find(h) == h {
+    for (i, &h) in bnd.iter().enumerate() {
+        if uf.find(i) == i {
             loops[comps.of_face[h / 3] as usize] += 1;
         }
     }
     (0..k).map(|c| (2 - chi[c] - loops[c]) / 2).sum()
+}
+
+/// A vertex's fan of faces: its first face (clockwise), its face count and whether it is
+/// open (a boundary vertex).
+struct Fan {
+    start: u32,
+    faces: u32,
+    boundary: bool,
+}
+
+impl Fan {
+    /// The fan of `v`, whose faces (`faces[0]` among them) form one fan.
+    fn of(v: u32, faces: &[u32], tris: &[[u32; 3]], adjacency: &[[u32; 3]]) -> Fan {
+        // Walk clockwise to the fan's first face (or all the way round).
+        let mut start = faces[0];
+        let mut boundary = false;
+        loop {
+            let c = corner_of(&tris[start as usize], v);
+            let prev = adjacency[start as usize][c];
+            if prev == NONE {
+                boundary = true;
+                break;
+            }
+            start = prev;
+            if start == faces[0] {
+                break;
+            }
+        }
+        let faces = Self::fill(v, start, tris, adjacency, &mut [], &mut []);
+        Fan {
+            start,
+            faces,
+            boundary,
+        }
+    }
+
+    /// Walks the fan of `v` counter-clockwise from its first face `start`, writing its
+    /// ring vertices into `ring` and its faces into `ring_faces` as far as they reach;
+    /// returns the face count.
+    fn fill(
+        v: u32,
+        start: u32,
+        tris: &[[u32; 3]],
+        adjacency: &[[u32; 3]],
+        ring: &mut [u32],
+        ring_faces: &mut [u32],
+    ) -> u32 {
+        let put = |slots: &mut [u32], i: usize, x: u32| {
+            if let Some(s) = slots.get_mut(i) {
+                *s = x;
+            }
+        };
+        let mut f = start;
+        let c0 = corner_of(&tris[f as usize], v);
+        put(ring, 0, tris[f as usize][(c0 + 1) % 3]);
+        let mut count = 0usize;
+        loop {
+            put(ring_faces, count, f);
+            count += 1;
+            let c = corner_of(&tris[f as usize], v);
+            let next = adjacency[f as usize][(c + 2) % 3];
+            // An interior fan's last face closes on ring vertex 0.
+            if next != start {
+                put(ring, count, tris[f as usize][(c + 2) % 3]);
+            }
+            if next == NONE || next == start {
+                break;
+            }
+            f = next;
+        }
+        count as u32
+    }
 }
 
 /// Connectivity of a valid (oriented, manifold, non-degenerate) mesh.
@@ -369,53 +444,55 @@ impl Topology {
         let nv = mesh.n_vertices();
         let tris = &mesh.triangles;
         let adjacency: Vec<[u32; 3]> = adj
-            .chunks_exact(3)
+            .par_chunks_exact(3)
             .map(|c| [c[0], c[1], c[2]].map(|h| if h == NONE { NONE } else { h / 3 }))
             .collect();
+        drop(adj);
+        // Each vertex's fan walked twice, in parallel: once for its sizes, once to fill
+        // its slices of the rings.
+        let fans: Vec<Fan> = (0..nv)
+            .into_par_iter()
+            .map(|v| Fan::of(v as u32, incidence.faces(v), tris, &adjacency))
+            .collect();
+        drop(incidence);
         let mut ring_offsets = Vec::with_capacity(nv + 1);
         let mut face_offsets = Vec::with_capacity(nv + 1);
-        let mut ring = Vec::with_capacity(tris.len() * 3 + nv);
-        let mut ring_faces = Vec::with_capacity(tris.len() * 3);
-        let mut boundary = vec![false; nv];
-        ring_offsets.push(0);
-        face_offsets.push(0);
-        #[allow(clippy::needless_range_loop)] // v indexes incidence, boundary and rings alike
-        for v in 0..nv {
-            let faces = incidence.faces(v);
-            let vid = v as u32;
-            // Walk clockwise to the fan's first face (or all the way round).
-            let mut start = faces[0];
-            loop {
-                let c = corner_of(&tris[start as usize], vid);
-                let prev = adjacency[start as usize][c];
-                if prev == NONE {
-                    boundary[v] = true;
-                    break;
-                }
-                start = prev;
-                if start == faces[0] {
-                    break;
-                }
-            }
-            let mut f = start;
-            let c0 = corner_of(&tris[f as usize], vid);
-            ring.push(tris[f as usize][(c0 + 1) % 3]);
-            loop {
-                ring_faces.push(f);
-                let c = corner_of(&tris[f as usize], vid);
-                let next = adjacency[f as usize][(c + 2) % 3];
-                if next == NONE || next == start {
-                    if next == NONE {
-                        ring.push(tris[f as usize][(c + 2) % 3]);
-                    }
-                    break;
-                }
-                ring.push(tris[f as usize][(c + 2) % 3]);
-                f = next;
-            }
-            ring_offsets.push(ring.len() as u32);
-            face_offsets.push(ring_faces.len() as u32);
+        ring_offsets.push(0u32);
+        face_offsets.push(0u32);
+        let (mut r_end, mut f_end) = (0u32, 0u32);
+        for fan in &fans {
+            r_end += fan.faces + fan.boundary as u32;
+            f_end += fan.faces;
+            ring_offsets.push(r_end);
+            face_offsets.push(f_end);
         }
+        let mut ring = vec![0; r_end as usize];
+        let mut ring_faces = vec![0; f_end as usize];
+        let boundary: Vec<bool> = fans.par_iter().map(|f| f.boundary).collect();
+        // Blocks of vertices with their slices of the rings, filled in parallel.
+        const BLOCK: usize = 1 << 14;
+        let mut blocks = Vec::with_capacity(nv.div_ceil(BLOCK));
+        let (mut rest_ring, mut rest_faces) = (&mut ring[..], &mut ring_faces[..]);
+        for first in (0..nv).step_by(BLOCK) {
+            let last = (first + BLOCK).min(nv);
+            let r = (ring_offsets[last] - ring_offsets[first]) as usize;
+            let f = (face_offsets[last] - face_offsets[first]) as usize;
+            let (r, rr) = std::mem::take(&mut rest_ring).split_at_mut(r);
+            let (f, rf) = std::mem::take(&mut rest_faces).split_at_mut(f);
+            (rest_ring, rest_faces) = (rr, rf);
+            blocks.push((first..last, r, f));
+        }
+        blocks.into_par_iter().for_each(|(vs, mut r, mut f)| {
+            for v in vs {
+                let fan = &fans[v];
+                let (rv, rr) =
+                    std::mem::take(&mut r).split_at_mut((fan.faces + fan.boundary as u32) as usize);
+                let (fv, rf) = std::mem::take(&mut f).split_at_mut(fan.faces as usize);
+                (r, f) = (rr, rf);
+                Fan::fill(v as u32, fan.start, tris, &adjacency, rv, fv);
+            }
+        });
+        drop(fans);
         // Boundary loops: follow boundary halfedges a -> b.
         let mut next_on_boundary = vec![NONE; nv];
         for (f, a) in adjacency.iter().enumerate() {
@@ -516,5 +593,60 @@ impl Topology {
     /// Total genus (sum over components).
     pub fn genus(&self) -> i64 {
         self.genus
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{ValidMesh, procedural};
+
+    /// Rings built in parallel blocks (a mesh of several blocks, with a boundary) are the
+    /// same whatever the thread count, and each is its vertex's fan: every incident face
+    /// once, consecutive ring vertices spanning each face.
+    #[test]
+    fn rings_are_fans_whatever_the_thread_count() {
+        let mesh = procedural::grid(300, 130, 2.0, 1.0);
+        let build = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| ValidMesh::new(mesh.clone()).unwrap())
+        };
+        let (one, two) = (build(1), build(2));
+        assert!(mesh.n_vertices() > 2 * (1 << 14));
+        let mut incident = vec![Vec::new(); mesh.n_vertices()];
+        for (f, t) in mesh.triangles.iter().enumerate() {
+            for &v in t {
+                incident[v as usize].push(f as u32);
+            }
+        }
+        for v in 0..mesh.n_vertices() as u32 {
+            let (t1, t2) = (one.topology(), two.topology());
+            assert_eq!(t1.ring(v), t2.ring(v));
+            assert_eq!(t1.ring_faces(v), t2.ring_faces(v));
+            assert_eq!(t1.is_boundary_vertex(v), t2.is_boundary_vertex(v));
+            let (ring, faces) = (t1.ring(v), t1.ring_faces(v));
+            let mut sorted = faces.to_vec();
+            sorted.sort_unstable();
+            assert_eq!(sorted, incident[v as usize], "vertex {v}");
+            let open = t1.is_boundary_vertex(v);
+            assert_eq!(ring.len(), faces.len() + open as usize);
+            for (j, &f) in faces.iter().enumerate() {
+                let t = mesh.triangles[f as usize];
+                let (a, b) = (ring[j], ring[(j + 1) % ring.len()]);
+                let c = t.iter().position(|&x| x == v).unwrap();
+                assert_eq!(
+                    (t[(c + 1) % 3], t[(c + 2) % 3]),
+                    (a, b),
+                    "vertex {v} face {f}"
+                );
+            }
+        }
+        assert_eq!(
+            one.topology().boundary_loops(),
+            two.topology().boundary_loops()
+        );
+        assert_eq!(one.topology().genus(), 0);
     }
 }

@@ -1,6 +1,6 @@
 //! The validated mesh that every later stage takes.
 
-use crate::analyze::{MeshStats, analyze};
+use crate::analyze::{Analysis, MeshStats, analyze};
 use crate::error::MeshError;
 use crate::mesh::TriMesh;
 use crate::topology::Topology;
@@ -27,6 +27,22 @@ pub struct ValidMesh {
 impl ValidMesh {
     /// Validates `mesh`; the error lists every defect found.
     pub fn new(mesh: TriMesh) -> Result<Self, MeshError> {
+        Self::try_new(mesh).map_err(|r| MeshError::Invalid(Box::new(r.analysis.report)))
+    }
+
+    /// Validates `mesh` in one pass of [`analyze`]; a mesh that fails comes back with the
+    /// whole analysis (statistics and defects), so that a caller explaining the failure
+    /// need not analyse it again.
+    ///
+    /// ```
+    /// use wavg_mesh::{ValidMesh, TriMesh, procedural};
+    /// let mut raw = procedural::icosphere(1);
+    /// raw.triangles.push(raw.triangles[0]);
+    /// let rejected = ValidMesh::try_new(raw).unwrap_err();
+    /// assert!(!rejected.analysis.report.is_valid());
+    /// assert_eq!(rejected.mesh.n_faces(), rejected.analysis.stats.faces);
+    /// ```
+    pub fn try_new(mesh: TriMesh) -> Result<Self, Box<Rejected>> {
         let a = analyze(&mesh);
         match a.topology {
             Some(topology) => Ok(Self {
@@ -34,7 +50,7 @@ impl ValidMesh {
                 topology,
                 stats: a.stats,
             }),
-            None => Err(MeshError::Invalid(Box::new(a.report))),
+            None => Err(Box::new(Rejected { mesh, analysis: a })),
         }
     }
 
@@ -67,6 +83,15 @@ impl ValidMesh {
     pub fn n_faces(&self) -> usize {
         self.mesh.n_faces()
     }
+}
+
+/// A mesh that failed validation ([`ValidMesh::try_new`]), with its analysis.
+#[derive(Clone, Debug)]
+pub struct Rejected {
+    /// The mesh as given.
+    pub mesh: TriMesh,
+    /// Its statistics and every defect found (no topology).
+    pub analysis: Analysis,
 }
 
 impl std::ops::Deref for ValidMesh {

@@ -21,6 +21,7 @@ use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
 
 mod cg;
+mod locality;
 mod ordering;
 mod stiffness;
 pub(crate) mod two_level;

@@ -1,21 +1,25 @@
 //! The cotangent stiffness of a large mesh in compressed columns with 32-bit indices,
-//! assembled in place from the mesh's one-rings: the pattern first (each column is its
-//! vertex and its ring, sorted), then the faces' contributions added into their slots.
-//! [`wavg_mesh::geometry::cotan_stiffness`] builds the same matrix from a list of
-//! triplets, which at its peak holds about 770 bytes a vertex beside the result; this
-//! holds the result alone (about 90 bytes a vertex).
+//! assembled in place from the mesh's one-rings, one column per vertex, in parallel: each
+//! column is its vertex and its ring (sorted), and each entry sums the contributions of
+//! the vertex's faces in ascending face order. [`wavg_mesh::geometry::cotan_stiffness`]
+//! builds the same matrix from a list of triplets, which at its peak holds about 770 bytes
+//! a vertex beside the result; this holds the result alone (about 90 bytes a vertex).
 //!
-//! Each entry sums its contributions in face order, starting from `-0.0` (the identity of
-//! floating-point addition). The triplet assembly sums a diagonal entry's contributions
-//! in the order of its unstable sort, so diagonals can differ from it in the last bits.
+//! The columns can be laid out in another vertex order ([`VertexOrder`]): column and row
+//! `j` are then vertex `old_of_new[j]`, and every value is bit for bit the one of the
+//! file's order. Each entry starts from `-0.0` (the identity of floating-point
+//! addition); the triplet assembly sums a diagonal entry's contributions in the order of
+//! its unstable sort, so diagonals can differ from it in the last bits.
 
+use rayon::prelude::*;
 use wavg_mesh::{ValidMesh, geometry};
 
+use super::locality::VertexOrder;
 use crate::error::{EmbedError, Progress, check_cancel};
 
-/// Faces (or vertices) assembled between two looks at `progress`'s cancellation (a few
-/// milliseconds of work).
-const CANCEL_EVERY: usize = 1 << 16;
+/// Columns assembled between two looks at `progress`'s cancellation (a few milliseconds
+/// of work), and the unit of parallel work.
+const CANCEL_EVERY: usize = 1 << 14;
 
 /// A symmetric sparse matrix in compressed columns (column `j`'s rows, ascending, and
 /// values lie at `col_ptr[j]..col_ptr[j + 1]`).
@@ -27,63 +31,74 @@ pub(crate) struct Stiffness {
 
 impl Stiffness {
     /// The cotangent stiffness `L` of `mesh` (the sign convention of
-    /// [`geometry::cotan_stiffness`]); stops with [`EmbedError::Cancelled`] when
-    /// `progress` asks (looked at every [`CANCEL_EVERY`] vertices and faces).
-    pub(crate) fn cotan(mesh: &ValidMesh, progress: &dyn Progress) -> Result<Self, EmbedError> {
+    /// [`geometry::cotan_stiffness`]) with its rows and columns in `order` (the file's
+    /// order when `None`), and the lumped masses ([`geometry::lumped_mass`], bit for bit)
+    /// in the same order. Stops with [`EmbedError::Cancelled`] when `progress` asks
+    /// (looked at every [`CANCEL_EVERY`] columns).
+    pub(crate) fn cotan(
+        mesh: &ValidMesh,
+        order: Option<&VertexOrder>,
+        progress: &dyn Progress,
+    ) -> Result<(Self, Vec<f64>), EmbedError> {
         let n = mesh.n_vertices();
         let topo = mesh.topology();
-        let too_large =
-            || EmbedError::InvalidArgument("the mesh is too large for 32-bit indices".into());
-        let nnz: usize = n + (0..n as u32).map(|v| topo.ring(v).len()).sum::<usize>();
-        u32::try_from(nnz).map_err(|_| too_large())?;
+        let old = |j: usize| order.map_or(j, |o| o.old_of_new[j] as usize) as u32;
+        let new = |v: u32| order.map_or(v, |o| o.new_of_old[v as usize]);
+        let lens: Vec<u32> = (0..n)
+            .into_par_iter()
+            .map(|j| 1 + topo.ring(old(j)).len() as u32)
+            .collect();
+        let nnz: usize = lens.iter().map(|&l| l as usize).sum();
+        u32::try_from(nnz).map_err(|_| {
+            EmbedError::InvalidArgument("the mesh is too large for 32-bit indices".into())
+        })?;
         let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut rows = Vec::with_capacity(nnz);
         col_ptr.push(0u32);
-        for v in 0..n as u32 {
-            if v as usize % CANCEL_EVERY == 0 {
-                check_cancel(progress)?;
-            }
-            let start = rows.len();
-            rows.push(v);
-            rows.extend_from_slice(topo.ring(v));
-            rows[start..].sort_unstable();
-            col_ptr.push(rows.len() as u32);
+        let mut end = 0u32;
+        for l in lens {
+            end += l;
+            col_ptr.push(end);
         }
-        let mut s = Self {
-            col_ptr,
-            rows,
-            vals: vec![-0.0; nnz],
-        };
-        for (f, t) in mesh.triangles.iter().enumerate() {
-            if f % CANCEL_EVERY == 0 {
-                check_cancel(progress)?;
-            }
-            let cot = geometry::cotangents(mesh, f);
-            for i in 0..3 {
-                let (a, b) = (t[(i + 1) % 3], t[(i + 2) % 3]);
-                let w = 0.5 * cot[i];
-                s.add(a, b, -w)?;
-                s.add(b, a, -w)?;
-                s.add(a, a, w)?;
-                s.add(b, b, w)?;
-            }
+        let mut rows = vec![0u32; nnz];
+        let mut vals = vec![-0.0; nnz];
+        let mut mass = vec![0.0; n];
+        // Blocks of columns with their slices of the arrays, filled in parallel.
+        let mut blocks = Vec::with_capacity(n.div_ceil(CANCEL_EVERY));
+        let (mut rest_rows, mut rest_vals) = (&mut rows[..], &mut vals[..]);
+        for (b, m) in mass.chunks_mut(CANCEL_EVERY).enumerate() {
+            let first = b * CANCEL_EVERY;
+            let len = (col_ptr[first + m.len()] - col_ptr[first]) as usize;
+            let (r, rr) = std::mem::take(&mut rest_rows).split_at_mut(len);
+            let (v, rv) = std::mem::take(&mut rest_vals).split_at_mut(len);
+            (rest_rows, rest_vals) = (rr, rv);
+            blocks.push((first, m, r, v));
         }
-        Ok(s)
-    }
-
-    /// Adds `w` to entry `(row, col)` of the pattern.
-    fn add(&mut self, row: u32, col: u32, w: f64) -> Result<(), EmbedError> {
-        let range = self.col_range(col as usize);
-        let k = self.rows[range.clone()]
-            .iter()
-            .position(|&r| r == row)
-            .ok_or_else(|| {
-                EmbedError::InvalidArgument(format!(
-                    "stiffness: vertices {row} and {col} share a face but not a ring"
-                ))
+        blocks
+            .into_par_iter()
+            .try_for_each(|(first, mass, rows, vals)| {
+                check_cancel(progress)?;
+                let (mut entries, mut faces) = (Vec::new(), Vec::new());
+                let mut at = 0;
+                for (i, m) in mass.iter_mut().enumerate() {
+                    *m = column(mesh, old(first + i), &mut entries, &mut faces)?;
+                    entries.iter_mut().for_each(|e| e.0 = new(e.0));
+                    entries.sort_unstable_by_key(|e| e.0);
+                    for (k, &(r, x)) in entries.iter().enumerate() {
+                        rows[at + k] = r;
+                        vals[at + k] = x;
+                    }
+                    at += entries.len();
+                }
+                Ok::<_, EmbedError>(())
             })?;
-        self.vals[range.start + k] += w;
-        Ok(())
+        Ok((
+            Self {
+                col_ptr,
+                rows,
+                vals,
+            },
+            mass,
+        ))
     }
 
     /// The slots of column `j`.
@@ -110,6 +125,51 @@ impl Stiffness {
     }
 }
 
+/// Column `v` of the stiffness into `entries` (`(row, value)` for `v` and its ring, in
+/// ring order), each entry summed over `v`'s faces in ascending face order, as the serial
+/// assembly over all faces would; returns `v`'s lumped mass, summed the same way.
+/// `faces` is scratch.
+fn column(
+    mesh: &ValidMesh,
+    v: u32,
+    entries: &mut Vec<(u32, f64)>,
+    faces: &mut Vec<u32>,
+) -> Result<f64, EmbedError> {
+    let topo = mesh.topology();
+    entries.clear();
+    entries.push((v, -0.0));
+    entries.extend(topo.ring(v).iter().map(|&u| (u, -0.0)));
+    faces.clear();
+    faces.extend_from_slice(topo.ring_faces(v));
+    faces.sort_unstable();
+    let mut mass = 0.0;
+    for &f in faces.iter() {
+        let f = f as usize;
+        let t = mesh.triangles[f];
+        let cot = geometry::cotangents(mesh, f);
+        for i in 0..3 {
+            let (a, b) = (t[(i + 1) % 3], t[(i + 2) % 3]);
+            let other = match (a == v, b == v) {
+                (true, _) => b,
+                (_, true) => a,
+                _ => continue,
+            };
+            let w = 0.5 * cot[i];
+            let slot = (entries[1..].iter_mut())
+                .find(|e| e.0 == other)
+                .ok_or_else(|| {
+                    EmbedError::InvalidArgument(format!(
+                        "stiffness: vertices {other} and {v} share a face but not a ring"
+                    ))
+                })?;
+            slot.1 += -w;
+            entries[0].1 += w;
+        }
+        mass += geometry::face_area(mesh, f) / 3.0;
+    }
+    Ok(mass)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -127,7 +187,7 @@ mod tests {
         }
         let mesh = ValidMesh::new(procedural::torus(30, 14, 1.0, 0.4)).unwrap();
         assert!(matches!(
-            Stiffness::cotan(&mesh, &Cancelled),
+            Stiffness::cotan(&mesh, None, &Cancelled),
             Err(EmbedError::Cancelled)
         ));
     }
@@ -141,7 +201,13 @@ mod tests {
             procedural::with_noise(procedural::grid(12, 9, 2.0, 1.0), 0.2, 5),
         ] {
             let mesh = ValidMesh::new(m).unwrap();
-            let s = Stiffness::cotan(&mesh, &crate::NoProgress).unwrap();
+            let (s, mass) = Stiffness::cotan(&mesh, None, &crate::NoProgress).unwrap();
+            let lumped = geometry::lumped_mass(&mesh);
+            assert!(
+                mass.iter()
+                    .zip(&lumped)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            );
             let reference = geometry::cotan_stiffness(&mesh).unwrap();
             let (sym, vals) = reference.parts();
             assert_eq!(s.rows.len(), vals.len());
@@ -158,6 +224,39 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// In the Morton order, the same matrix and masses bit for bit, permuted.
+    #[test]
+    fn another_order_permutes_the_same_values() {
+        let mesh = ValidMesh::new(procedural::with_noise(
+            procedural::torus(40, 18, 1.0, 0.4),
+            0.3,
+            4,
+        ))
+        .unwrap();
+        let order = VertexOrder::morton(&mesh);
+        let (a, ma) = Stiffness::cotan(&mesh, None, &crate::NoProgress).unwrap();
+        let (b, mb) = Stiffness::cotan(&mesh, Some(&order), &crate::NoProgress).unwrap();
+        assert!(
+            order
+                .old_of_new
+                .iter()
+                .enumerate()
+                .any(|(j, &v)| j != v as usize)
+        );
+        for (j, &v) in order.old_of_new.iter().enumerate() {
+            let v = v as usize;
+            assert_eq!(ma[v].to_bits(), mb[j].to_bits());
+            let mut want: Vec<(u32, u64)> = (a.col_range(v))
+                .map(|k| (order.new_of_old[a.row(k)], a.val(k).to_bits()))
+                .collect();
+            want.sort_unstable();
+            let got: Vec<(u32, u64)> = (b.col_range(j))
+                .map(|k| (b.row(k) as u32, b.val(k).to_bits()))
+                .collect();
+            assert_eq!(got, want, "column {j}");
         }
     }
 }

@@ -13,13 +13,17 @@
 //! ([`CgOptions::default`]) rather than converge.
 //!
 //! `A = L M⁻¹ L` is applied as two products with the cotangent stiffness `L` and never
-//! assembled, so the memory is a few vectors per vertex on top of the coarse factor.
+//! assembled, so the memory is a few vectors per vertex on top of the coarse factor. The
+//! full system's unknowns are laid out in a vertex order with memory locality
+//! ([`VertexOrder::morton`]): its products gather neighbours' values, and in the file's
+//! order most of those gathers miss the caches.
 
 use rayon::prelude::*;
-use wavg_mesh::{ValidMesh, geometry};
+use wavg_mesh::ValidMesh;
 
 use super::LsMeshSolver;
 use super::cg::FreeOperator;
+use super::locality::VertexOrder;
 use super::stiffness::Stiffness;
 use crate::decimate::Decimated;
 use crate::error::{EmbedError, Progress, check_cancel};
@@ -75,13 +79,18 @@ impl LsMeshExtension {
 /// The least-squares mesh of a large mesh: a factored coarse system plus the operator of
 /// the full one.
 pub(crate) struct TwoLevelLsMesh {
-    landmarks: Vec<u32>,
+    /// The landmarks' positions in `order`.
+    landmarks_ordered: Vec<u32>,
+    /// Whether each vertex, in `order`, is a landmark.
     fixed: Vec<bool>,
     /// Original ids of the coarse vertices, in coarse order.
     coarse_ids: Vec<u32>,
     coarse: LsMeshSolver,
     /// The coarse mesh (vertex `i` is original vertex `coarse_ids[i]`).
     coarse_mesh: ValidMesh,
+    /// The order of the full system's unknowns (and of `fixed`, `stiffness`, `inv_mass`
+    /// and `inv_diag`).
+    order: VertexOrder,
     /// Cotangent stiffness of the full mesh (symmetric, both triangles stored).
     stiffness: Stiffness,
     inv_mass: Vec<f64>,
@@ -105,16 +114,18 @@ impl TwoLevelLsMesh {
         let (coarse_mesh, coarse_solver) = coarse_system(n, coarse, landmarks, progress)?;
         check_cancel(progress)?;
 
-        let stiffness = Stiffness::cotan(mesh, progress)?;
-        let mass = geometry::lumped_mass(mesh);
-        if let Some(v) = mass.iter().position(|&m| !(m > 0.0 && m.is_finite())) {
+        let order = VertexOrder::morton(mesh);
+        let (stiffness, mass) = Stiffness::cotan(mesh, Some(&order), progress)?;
+        if let Some(j) = mass.iter().position(|&m| !(m > 0.0 && m.is_finite())) {
             return Err(EmbedError::InvalidArgument(format!(
-                "vertex {v} has zero or invalid area; the least-squares mesh needs a mesh \
-                 without isolated vertices or degenerate faces"
+                "vertex {} has zero or invalid area; the least-squares mesh needs a mesh \
+                 without isolated vertices or degenerate faces",
+                order.old_of_new[j]
             )));
         }
-        let inv_mass: Vec<f64> = mass.iter().map(|m| 1.0 / m).collect();
+        let inv_mass: Vec<f64> = mass.par_iter().map(|m| 1.0 / m).collect();
         let full = FullOperator {
+            order,
             stiffness,
             inv_mass,
         };
@@ -142,6 +153,7 @@ impl TwoLevelLsMesh {
         let (cg, full) = (
             self.cg,
             FullOperator {
+                order: self.order,
                 stiffness: self.stiffness,
                 inv_mass: self.inv_mass,
             },
@@ -157,11 +169,16 @@ impl TwoLevelLsMesh {
         coarse: &Decimated,
         (coarse_mesh, coarse_solver): (ValidMesh, LsMeshSolver),
         FullOperator {
+            order,
             stiffness,
             inv_mass,
         }: FullOperator,
         cg: CgOptions,
     ) -> Self {
+        let fixed = order.to_new(&fixed);
+        let landmarks_ordered = (landmarks.iter())
+            .map(|&s| order.new_of_old[s as usize])
+            .collect();
         // diag(L M⁻¹ L)_j = sum_k L_kj² / m_k.
         let inv_diag: Vec<f64> = (0..fixed.len())
             .into_par_iter()
@@ -176,11 +193,12 @@ impl TwoLevelLsMesh {
             })
             .collect();
         Self {
-            landmarks: landmarks.to_vec(),
+            landmarks_ordered,
             fixed,
             coarse_ids: coarse.landmarks.clone(),
             coarse: coarse_solver,
             coarse_mesh,
+            order,
             stiffness,
             inv_mass,
             inv_diag,
@@ -207,7 +225,7 @@ impl TwoLevelLsMesh {
         let coarse = self.coarse.solve(values, dim)?;
         check_cancel(progress)?;
         let mut x = self.prolongate(&coarse, progress)?;
-        for (&s, v) in self.landmarks.iter().zip(values) {
+        for (&s, v) in self.landmarks_ordered.iter().zip(values) {
             x[s as usize] = *v;
             x[s as usize][dim..].fill(0.0);
         }
@@ -217,19 +235,20 @@ impl TwoLevelLsMesh {
             inv_diag: &self.inv_diag,
             fixed: &self.fixed,
         };
-        op.solve(&self.landmarks, &mut x, dim, self.cg, progress)?;
-        if x.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
+        op.solve(&self.landmarks_ordered, &mut x, dim, self.cg, progress)?;
+        if x.par_iter().any(|p| p.iter().any(|c| !c.is_finite())) {
             return Err(EmbedError::Numerical(
                 "least-squares mesh produced non-finite coordinates".into(),
             ));
         }
-        Ok(x)
+        Ok(self.order.to_old(&x))
     }
 
     /// Coarse values at the coarse vertices; every other vertex gets the mean of its
-    /// neighbours one breadth-first layer closer to the coarse vertices, then a few
-    /// Gauss-Seidel sweeps of neighbour averaging smooth the result.
-    /// Looks at `progress`'s cancellation after each layer and sweep (seconds at 10M).
+    /// neighbours one breadth-first layer closer to the coarse vertices (a layer in
+    /// parallel), then a few Gauss-Seidel sweeps of neighbour averaging smooth the result.
+    /// In the system's order. Looks at `progress`'s cancellation after each layer and
+    /// sweep (seconds at 10M).
     fn prolongate(&self, coarse: &[Row], progress: &dyn Progress) -> Result<Vec<Row>, EmbedError> {
         const SWEEPS: usize = 4;
         let n = self.fixed.len();
@@ -241,12 +260,15 @@ impl TwoLevelLsMesh {
         let mut x = vec![[0.0; MAX_DIM]; n];
         let mut known = vec![false; n];
         let mut is_coarse = vec![false; n];
-        for (&v, c) in self.coarse_ids.iter().zip(coarse) {
-            x[v as usize] = *c;
-            known[v as usize] = true;
-            is_coarse[v as usize] = true;
+        let coarse_ids: Vec<usize> = (self.coarse_ids.iter())
+            .map(|&v| self.order.new_of_old[v as usize] as usize)
+            .collect();
+        for (&v, c) in coarse_ids.iter().zip(coarse) {
+            x[v] = *c;
+            known[v] = true;
+            is_coarse[v] = true;
         }
-        let mut frontier: Vec<usize> = self.coarse_ids.iter().map(|&v| v as usize).collect();
+        let mut frontier = coarse_ids;
         let mut queued = known.clone();
         while !frontier.is_empty() {
             let mut next = Vec::new();
@@ -258,17 +280,21 @@ impl TwoLevelLsMesh {
                     }
                 }
             }
-            for &u in &next {
-                let (mut sum, mut count) = ([0.0; MAX_DIM], 0.0);
-                for w in neighbours(u).filter(|&w| known[w]) {
-                    for c in 0..MAX_DIM {
-                        sum[c] += x[w][c];
+            let layer: Vec<Row> = (next.par_iter())
+                .with_min_len(1024)
+                .map(|&u| {
+                    let (mut sum, mut count) = ([0.0; MAX_DIM], 0.0);
+                    for w in neighbours(u).filter(|&w| known[w]) {
+                        for c in 0..MAX_DIM {
+                            sum[c] += x[w][c];
+                        }
+                        count += 1.0;
                     }
-                    count += 1.0;
-                }
-                x[u] = sum.map(|s| s / count);
-            }
-            for &u in &next {
+                    sum.map(|s| s / count)
+                })
+                .collect();
+            for (&u, value) in next.iter().zip(layer) {
+                x[u] = value;
                 known[u] = true;
             }
             frontier = next;
@@ -295,6 +321,7 @@ impl TwoLevelLsMesh {
 
 /// The full mesh's part of the system that does not depend on the landmarks.
 struct FullOperator {
+    order: VertexOrder,
     stiffness: Stiffness,
     inv_mass: Vec<f64>,
 }
@@ -414,6 +441,49 @@ mod tests {
             .find(|&v| snap.coarse_index(v).is_none())
             .unwrap();
         assert!(fresh.with_landmarks(&snap, &[off], &NoProgress).is_err());
+    }
+
+    /// The same bits with 1, 2 and 3 threads: the vertex order, the stiffness's parallel
+    /// assembly, the prolongation's layers and the chunked dot products do not depend on
+    /// the schedule (the mesh spans several assembly blocks).
+    #[test]
+    fn the_same_bits_whatever_the_thread_count() {
+        let mesh = noisy_torus(200, 100, 9);
+        assert!(mesh.n_vertices() > 16_384);
+        let opts = DecimateOptions {
+            target: 100,
+            ..Default::default()
+        };
+        let (fin, mut snaps) = decimate_with_snapshots(&mesh, &opts, &[2000], &NoProgress).unwrap();
+        let snap = snaps.pop().unwrap();
+        let values: Vec<Row> = (fin.landmarks.iter())
+            .map(|&l| std::array::from_fn(|k| ((l as usize * 5 + k) % 11) as f64))
+            .collect();
+        let run = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                TwoLevelLsMesh::new(
+                    &mesh,
+                    &snap,
+                    &fin.landmarks,
+                    CgOptions::default(),
+                    &NoProgress,
+                )
+                .unwrap()
+                .solve(&values, MAX_DIM, &NoProgress)
+                .unwrap()
+            })
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            assert!(run(threads) == one, "{threads} threads");
+        }
+        for (&s, v) in fin.landmarks.iter().zip(&values) {
+            assert_eq!(one[s as usize], *v);
+        }
     }
 
     #[test]
