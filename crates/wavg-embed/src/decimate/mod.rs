@@ -81,12 +81,13 @@ use wavg_mesh::{TriMesh, ValidMesh};
 
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 
+mod aspect;
 mod collapse;
 mod first_pass;
 mod heap;
 mod quadric;
 
-pub(crate) use collapse::aspect_ratio;
+pub(crate) use aspect::aspect_ratio;
 use collapse::*;
 use heap::*;
 use quadric::*;
