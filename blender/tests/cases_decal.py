@@ -201,4 +201,63 @@ def test_mesh_checked_not_read(ctx):
     assert not surfaces._LAST, "meshes kept across an undo"
 
 
-TESTS = [test_decal_kept, test_decal_read_ahead, test_mesh_checked_not_read]
+def test_group_read(ctx):
+    """Vertex groups read through Geometry Nodes (Blender 4+) give what the visit of every
+    vertex gives, weight for weight, leave nothing behind and keep the mesh read; the read
+    declines (``None``) where it does not apply."""
+    from wavg_blender import group_cache, group_read, surfaces
+    from wavg_blender.meshdata import groups_members
+
+    ico = scene.icosphere("ico", subdivisions=3)
+    scene.activate(ico)
+    n = len(ico.data.vertices)
+    a = ico.vertex_groups.new(name="a")
+    b = ico.vertex_groups.new(name="b weights")
+    empty = ico.vertex_groups.new(name="empty")
+    for v in range(0, n, 3):
+        a.add([v], (v % 7) / 6.0, 'REPLACE')  # weight 0 every 7th: absent, as in the visit
+    b.add(list(range(n // 2)), 0.375, 'REPLACE')
+    b.add([1, 5], 1.0, 'REPLACE')
+    groups = [a, b, empty]
+    want = groups_members(ico, groups)
+    assert len(want["a"][0]) > 30 and 0.0 in [(v % 7) / 6.0 for v in range(0, n, 3)]
+    bpy.context.view_layer.update()
+    kept = surfaces.mesh_input(ico)
+    counts = [len(c) for c in (bpy.data.objects, bpy.data.meshes, bpy.data.node_groups)]
+    before = group_read.READS[0]
+    got = group_read.members(bpy.context, ico, groups)
+    if bpy.app.version < group_read.MIN_VERSION:
+        assert got is None, "read through Geometry Nodes before Blender 4"
+    else:
+        assert group_read.READS[0] == before + 1
+        assert set(got) == set(want)
+        for name, (ids, weights) in want.items():
+            assert got[name][0].dtype == ids.dtype and got[name][1].dtype == weights.dtype
+            assert np.array_equal(got[name][0], ids), name
+            assert np.array_equal(got[name][1], weights), name
+        # What the operators read goes this way.
+        assert group_cache.members_of(bpy.context, ico, [a])["a"][0].tolist() == \
+            want["a"][0].tolist()
+        assert group_read.READS[0] == before + 2, "the group cache did not read in bulk"
+    assert [len(c) for c in (bpy.data.objects, bpy.data.meshes, bpy.data.node_groups)] \
+        == counts, "the read left data behind"
+    bpy.context.view_layer.update()
+    assert surfaces.mesh_input(ico) is kept, "the read made the mesh be read again"
+    # Where it declines: a group named like an attribute, shape keys, Edit mode.
+    # (Blender 4 refuses an attribute named like a group; a group named like an
+    # attribute it may make.)
+    ico.data.attributes.new("clash", 'FLOAT', 'POINT')
+    clash = ico.vertex_groups.new(name="clash")
+    clash.add([0, 1, 2], 1.0, 'REPLACE')
+    if clash.name == "clash" and ico.data.attributes.get("clash") is not None:
+        assert group_read.members(bpy.context, ico, [clash]) is None, "an ambiguous name read"
+        assert group_cache.members_of(bpy.context, ico, [clash])["clash"][0].tolist() == \
+            [0, 1, 2]
+    bpy.ops.object.mode_set(mode='EDIT')
+    assert group_read.members(bpy.context, ico, [a]) is None, "read in Edit mode"
+    bpy.ops.object.mode_set(mode='OBJECT')
+    ico.shape_key_add(name="Basis")
+    assert group_read.members(bpy.context, ico, [a]) is None, "read with shape keys"
+
+
+TESTS = [test_decal_kept, test_decal_read_ahead, test_mesh_checked_not_read, test_group_read]

@@ -1,13 +1,14 @@
-"""Members of vertex groups kept between operator runs (a :mod:`.memo` store). Blender 3.4
-has no bulk read of vertex groups (nor has 4.5), so reading one visits every vertex from
-Python (~6 ms on 25k vertices in 3.4, ~14 in 4.5): a decal run again on the same anchors reads them from here, and finds its
-``wavg_invalid`` group already holding what it would write. An entry is used only for an
+"""Members of vertex groups kept between operator runs (a :mod:`.memo` store). Blender has
+no bulk read of vertex groups: a read goes through Geometry Nodes where that pays
+(:mod:`.group_read`, ~1 ms on 25k vertices in 4.x) and visits every vertex from Python
+elsewhere (~6 ms in 3.4); a decal run again on the same anchors reads them from here, and
+finds its ``wavg_invalid`` group already holding what it would write. An entry is used only for an
 object in Object mode whose mesh and vertex count are those it was read with, and a group
 whose index and name are; writers evaluate their own writes before storing (:func:`keep`)."""
 
 import numpy as np
 
-from . import memo
+from . import group_read, memo
 from .meshdata import groups_members
 
 # Object pointer -> (key, {group name: (group index, ids, weights)}).
@@ -36,8 +37,8 @@ def members(context, obj, group):
 
 def members_of(context, obj, groups):
     """``{name: (ids, weights)}`` of each of ``groups``: from memory where the entry is
-    still valid, the others read in one visit of the vertices and remembered (Object mode
-    only; the read is of the settled mesh, so it stays valid until the next geometry
+    still valid, the others read together (:mod:`.group_read`, else one visit of the
+    vertices) and remembered (Object mode only; the read is of the settled mesh, so it stays valid until the next geometry
     update)."""
     memo.settle(context)
     out, missing = {}, []
@@ -50,7 +51,9 @@ def members_of(context, obj, groups):
     if not missing:
         HITS[0] += 1
     else:
-        read = groups_members(obj, missing)
+        read = group_read.members(context, obj, missing)
+        if read is None:
+            read = groups_members(obj, missing)
         out.update(read)
         if obj.mode == 'OBJECT':
             _remember(obj, read)
