@@ -225,19 +225,34 @@ def test_group_read(ctx):
     kept = surfaces.mesh_input(ico)
     counts = [len(c) for c in (bpy.data.objects, bpy.data.meshes, bpy.data.node_groups)]
     before = group_read.READS[0]
-    got = group_read.members(bpy.context, ico, groups)
+    # The cost model: a small mesh is visited, a large one read in bulk, unless the scene
+    # has too many objects.
+    learned = group_read._OBJECT_COST[0]
+    group_read._OBJECT_COST[0] = group_read.OBJECT_US  # as at the start of a session
+    assert not group_read.worth_it(bpy.context, n)
+    assert group_read.members(bpy.context, ico, groups) is None, "a small mesh read in bulk"
+    objects = len(bpy.context.view_layer.objects)
+    assert group_read.worth_it(bpy.context, 25_000) is (objects < 100)
+    assert not group_read.worth_it(bpy.context, 1000 * objects)  # 1000 vertices per object
+    visit_us = group_read.VISIT_US
+    group_read.VISIT_US = 1e6  # every mesh read in bulk, for this test
+    try:
+        got = group_read.members(bpy.context, ico, groups)
+        got_cache = group_cache.members_of(bpy.context, ico, [a])["a"][0].tolist()
+    finally:
+        group_read.VISIT_US = visit_us
+        group_read._OBJECT_COST[0] = learned
     if bpy.app.version < group_read.MIN_VERSION:
         assert got is None, "read through Geometry Nodes before Blender 4"
+        assert group_read.READS[0] == before
     else:
-        assert group_read.READS[0] == before + 1
         assert set(got) == set(want)
         for name, (ids, weights) in want.items():
             assert got[name][0].dtype == ids.dtype and got[name][1].dtype == weights.dtype
             assert np.array_equal(got[name][0], ids), name
             assert np.array_equal(got[name][1], weights), name
         # What the operators read goes this way.
-        assert group_cache.members_of(bpy.context, ico, [a])["a"][0].tolist() == \
-            want["a"][0].tolist()
+        assert got_cache == want["a"][0].tolist()
         assert group_read.READS[0] == before + 2, "the group cache did not read in bulk"
     assert [len(c) for c in (bpy.data.objects, bpy.data.meshes, bpy.data.node_groups)] \
         == counts, "the read left data behind"
