@@ -227,13 +227,13 @@ def test_group_read(ctx):
     before = group_read.READS[0]
     # The cost model: a small mesh is visited, a large one read in bulk, unless the scene
     # has too many objects.
-    learned = group_read._OBJECT_COST[0]
-    group_read._OBJECT_COST[0] = group_read.OBJECT_US  # as at the start of a session
+    learned = group_read._SCALE[0]
+    group_read._SCALE[0] = 1.0  # as at the start of a session
     assert not group_read.worth_it(bpy.context, n)
     assert group_read.members(bpy.context, ico, groups) is None, "a small mesh read in bulk"
     objects = len(bpy.context.view_layer.objects)
-    assert group_read.worth_it(bpy.context, 25_000) is (objects < 100)
-    assert not group_read.worth_it(bpy.context, 1000 * objects)  # 1000 vertices per object
+    assert group_read.worth_it(bpy.context, 25_000) is (objects < 250)
+    assert not group_read.worth_it(bpy.context, 100 * max(objects, 2))  # per object: 100
     visit_us = group_read.VISIT_US
     group_read.VISIT_US = 1e6  # every mesh read in bulk, for this test
     try:
@@ -241,7 +241,7 @@ def test_group_read(ctx):
         got_cache = group_cache.members_of(bpy.context, ico, [a])["a"][0].tolist()
     finally:
         group_read.VISIT_US = visit_us
-        group_read._OBJECT_COST[0] = learned
+        group_read._SCALE[0] = learned
     if bpy.app.version < group_read.MIN_VERSION:
         assert got is None, "read through Geometry Nodes before Blender 4"
         assert group_read.READS[0] == before

@@ -14,9 +14,9 @@ for it is dropped), and the object, the copy and the node group are removed befo
 the whole depsgraph twice, a cost that grows with the scene (4.5, 25k vertices, read and
 rebuilds: 1.8 ms with 4 objects, 4.7 with 104, 15 with 304, 84 with 1004). So the read is
 used only where it is expected to cost less than the visit (:func:`worth_it`:
-:data:`VISIT_US` per vertex against :data:`BASE_US` and :data:`OBJECT_US` per object of
-the view layer), and each read measures what an object cost it, so a scene whose objects
-cost more to relate (modifiers, drivers, constraints) raises the estimate for the next."""
+:data:`VISIT_US` per vertex against :func:`expected_us` of the view layer's objects), and
+each read measures its cost against that estimate, so a scene whose objects cost more to
+relate (modifiers, drivers, constraints) raises the estimate for the next."""
 
 import time
 
@@ -29,24 +29,30 @@ MIN_VERSION = (4, 0, 0)
 READ_MODES = ('OBJECT', 'WEIGHT_PAINT')
 #: Microseconds of CPU the visit of one vertex costs (4.5: 14-15 ms on 25k vertices).
 VISIT_US = 0.55
-#: Microseconds of CPU one object of the view layer adds to this read (the two relation
-#: rebuilds; 50-80 at 300-1000 objects in 4.5), with :data:`BASE_US` for the rest.
-OBJECT_US = 80.0
+#: Microseconds of CPU of this read in an empty scene, and what ``k`` objects of the view
+#: layer add: ``OBJECT_US * k + PAIR_US * k**2`` (the two relation rebuilds; fitted to 4.5
+#: with 4-1004 objects).
 BASE_US = 1500.0
-#: The fewest objects a measured cost per object is spread over (a read in a small scene
-#: says little about one object).
+OBJECT_US = 30.0
+PAIR_US = 0.05
+#: The fewest objects with which a read's cost rescales the estimate (in a smaller scene
+#: the rebuilds are lost in the rest).
 MIN_OBJECTS = 50
 # Reads made through Geometry Nodes (for tests).
 READS = [0]
-# Microseconds per object of the view layer the last read measured (at least OBJECT_US).
-_OBJECT_COST = [OBJECT_US]
+# What the last read cost over what the estimate said of the objects (at least 1).
+_SCALE = [1.0]
+
+
+def expected_us(objects):
+    """The expected CPU microseconds of a read with ``objects`` objects in the view layer."""
+    return BASE_US + _SCALE[0] * (OBJECT_US * objects + PAIR_US * objects * objects)
 
 
 def worth_it(context, n_vertices):
     """True when a read of a mesh of ``n_vertices`` through Geometry Nodes is expected to
     cost less than the visit in the current scene."""
-    objects = len(context.view_layer.objects)
-    return BASE_US + _OBJECT_COST[0] * objects < VISIT_US * n_vertices
+    return expected_us(len(context.view_layer.objects)) < VISIT_US * n_vertices
 
 
 def members(context, obj, groups):
@@ -102,8 +108,10 @@ def members(context, obj, groups):
             context.view_layer.update()  # the second rebuild, counted here
         except Exception:  # noqa: BLE001 (the next update does it)
             pass
-        spent = 1e6 * (time.process_time() - start)
-        _OBJECT_COST[0] = max(OBJECT_US, (spent - BASE_US) / max(objects, MIN_OBJECTS))
+        if objects >= MIN_OBJECTS:
+            spent = 1e6 * (time.process_time() - start)
+            model = OBJECT_US * objects + PAIR_US * objects * objects
+            _SCALE[0] = max(1.0, (spent - BASE_US) / model)
 
 
 def _stored(k):
