@@ -13,6 +13,7 @@ on the first failed check.
 
 import argparse
 import os
+import shutil
 import sys
 import tempfile
 import traceback
@@ -74,6 +75,18 @@ def install(zip_path, tmp, extension):
 def main():
     args = parse_args()
     tmp = tempfile.mkdtemp(prefix="wavg-blender-tests-")
+    try:
+        run(args, tmp)
+    finally:
+        # The installed add-on, its cache and the tests' files go with the run, unless kept
+        # for a look after a failure.
+        if os.environ.get("WAVG_KEEP_TEST_FILES"):
+            print(f"test files kept in {tmp}")
+        else:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+def run(args, tmp):
     os.environ["WAVG_BLENDER_CACHE"] = os.path.join(tmp, "cache")
     install(args.zip, tmp, args.extension)
     ctx = cases.Context(tmp=tmp, cli=args.wavg_cli)
@@ -96,6 +109,5 @@ def main():
     print(f"{len(tests) - len(failed)} passed, {len(failed)} failed")
     if failed:
         raise SystemExit(f"failed: {', '.join(failed)}")
-
 
 main()

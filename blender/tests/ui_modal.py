@@ -13,6 +13,7 @@ Prints `ok`/`FAILED` lines and exits 0 when every check passed, 1 otherwise.
 
 import math
 import os
+import shutil
 import sys
 import tempfile
 import threading
@@ -39,6 +40,10 @@ def check(name, ok, detail=""):
 
 def finish():
     print(f"{'all passed' if not FAILURES else 'failed: ' + ', '.join(FAILURES)}", flush=True)
+    if os.environ.get("WAVG_KEEP_TEST_FILES"):
+        print(f"test files kept in {TMP}", flush=True)
+    else:
+        shutil.rmtree(TMP, ignore_errors=True)
     os._exit(1 if FAILURES else 0)
 
 
