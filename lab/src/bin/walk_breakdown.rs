@@ -36,6 +36,12 @@ fn main() {
             .collect();
         setups.push((pair[0].clone(), p, s, ws, ys));
     }
+    if std::env::var("STEPS").is_ok() {
+        for (name, p, _, _, ys) in &setups {
+            steps(name, p, ys);
+        }
+        return;
+    }
     if let Ok(n) = std::env::var("BATCH_ONLY") {
         eprintln!("setup done");
         for (name, _, s, ws, _) in &setups {
@@ -109,4 +115,133 @@ fn main() {
             println!("ratio {i}/first: {}", r.join(" "));
         }
     }
+}
+
+/// `STEPS=1`: per query, the vertex walk's steps from the start grid's vertex (replayed in
+/// f64, so within rounding of the projector's 16-bit walk), the distance the walk covers
+/// and the query's distance from the surface, in mean embedded edges, and the hops from
+/// the walk's end to the answer's face (breadth-first, at most 64).
+fn steps(name: &str, p: &Projector, ys: &[(Vec8, u32)]) {
+    let m = p.embedded().mesh();
+    let topo = m.topology();
+    let x = p.embedded().coords();
+    let mut edge = 0.0;
+    let mut ne = 0usize;
+    for t in m.triangles.iter().step_by(97) {
+        for k in 0..3 {
+            edge += (x[t[k] as usize] - x[t[(k + 1) % 3] as usize]).norm();
+            ne += 1;
+        }
+    }
+    edge /= ne as f64;
+    let mut walk = Vec::new();
+    let mut cover = Vec::new();
+    let mut off = Vec::new();
+    let mut hops = Vec::new();
+    let mut same = 0usize;
+    for (y, a) in ys {
+        let s = p.start_near(y, *a);
+        let mut v = s;
+        let mut d = (x[v as usize] - y).norm_squared();
+        let mut n = 0usize;
+        loop {
+            let mut next = v;
+            for &u in topo.ring(v) {
+                let du = (x[u as usize] - y).norm_squared();
+                if du < d {
+                    (d, next) = (du, u);
+                }
+            }
+            if next == v {
+                break;
+            }
+            v = next;
+            n += 1;
+        }
+        let e = p.walk(y, s);
+        same += usize::from(e == v);
+        walk.push(n as f64);
+        cover.push((x[s as usize] - x[e as usize]).norm() / edge);
+        let r = p.project_with(y, s, None, SearchGoal::FirstHit).unwrap();
+        off.push(r.distance / edge);
+        let target = m.triangles[r.point.face as usize];
+        let mut seen = std::collections::HashMap::new();
+        let mut q = std::collections::VecDeque::from([(e, 0usize)]);
+        seen.insert(e, 0usize);
+        let mut h = 65;
+        while let Some((u, k)) = q.pop_front() {
+            if target.contains(&u) {
+                h = k;
+                break;
+            }
+            if k < 64 {
+                for &w in topo.ring(u) {
+                    if seen.insert(w, k + 1).is_none() {
+                        q.push_back((w, k + 1));
+                    }
+                }
+            }
+        }
+        hops.push(h as f64);
+    }
+    let q = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let at = |f: f64| v[((v.len() - 1) as f64 * f) as usize];
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        format!(
+            "mean {mean:.1} p50 {:.1} p90 {:.1} p99 {:.1} max {:.1}",
+            at(0.5),
+            at(0.9),
+            at(0.99),
+            at(1.0)
+        )
+    };
+    // Per-query times (after the pass above built whatever is built on first use).
+    let mut nv = ys
+        .iter()
+        .map(|(y, _)| {
+            let t = std::time::Instant::now();
+            let u = p.nearest_vertex(y);
+            (t.elapsed().as_secs_f64() * 1e6, u)
+        })
+        .collect::<Vec<_>>();
+    let nv_mean = nv.iter().map(|t| t.0).sum::<f64>() / nv.len() as f64;
+    nv.sort_by(|a, b| b.0.total_cmp(&a.0));
+    println!(
+        "{name}: nearest_vertex mean {nv_mean:.1} us, p90 {:.1}, p50 {:.1}",
+        nv[nv.len() / 10].0,
+        nv[nv.len() / 2].0
+    );
+    let mut times: Vec<(f64, bool)> = ys
+        .iter()
+        .map(|(y, a)| {
+            let t = std::time::Instant::now();
+            let r = p.project_with(y, p.start_near(y, *a), None, SearchGoal::FirstHit);
+            let dt = t.elapsed().as_secs_f64() * 1e6;
+            (
+                dt,
+                r.unwrap().path == wavg_project::ProjectionPath::Fallback,
+            )
+        })
+        .collect();
+    let total: f64 = times.iter().map(|t| t.0).sum();
+    let fb: f64 = times.iter().filter(|t| t.1).map(|t| t.0).sum();
+    let nfb = times.iter().filter(|t| t.1).count();
+    times.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let top = |k: usize| times[..k.min(times.len())].iter().map(|t| t.0).sum::<f64>() / total;
+    println!(
+        "{name}: project mean {:.2} us; fallback {nfb} queries {:.1}% of the time; slowest 0.1% / 1% / 10%: {:.1}% / {:.1}% / {:.1}% of the time; slowest {:.0} us",
+        total / ys.len() as f64,
+        100.0 * fb / total,
+        100.0 * top(ys.len() / 1000),
+        100.0 * top(ys.len() / 100),
+        100.0 * top(ys.len() / 10),
+        times[0].0
+    );
+    println!("{name}: {} vertices, mean edge {edge:.3e}", m.n_vertices());
+    println!("  walk steps (f64 replay): {}", q(&mut walk));
+    println!("  walk end = replay's end: {same} of {}", ys.len());
+    println!("  start to walk end, edges: {}", q(&mut cover));
+    println!("  query off the surface, edges: {}", q(&mut off));
+    println!("  hops walk end to answer face: {}", q(&mut hops));
 }
