@@ -115,6 +115,67 @@ impl FreeOperator<'_> {
         self.free_stiffness_dot(t, y, x)
     }
 
+    /// Per-column squared norms of `A x_S` on the free rows, where `x_S` is `x` at the
+    /// landmarks and 0 elsewhere: the right-hand side's norms, which the stopping test
+    /// compares against. `x_S` reaches only the landmarks' two-rings, so only those rows
+    /// are computed, each as [`Self::apply`] computes it (the same terms in the same
+    /// order, 0 for the vertices left out), and summed per chunk in the same order: the
+    /// same bits as the full product, without its pass over every vertex.
+    fn rhs_norms<const C: usize>(&self, landmarks: &[u32], x: &[[f64; C]]) -> [f64; C] {
+        use std::collections::HashMap;
+        let sym = self.stiffness;
+        let ring_of = |vs: &mut dyn Iterator<Item = usize>| -> Vec<usize> {
+            let mut ring: Vec<usize> = vs
+                .flat_map(|v| sym.col_rows(v).iter().map(|&u| u as usize))
+                .collect();
+            ring.sort_unstable();
+            ring.dedup();
+            ring
+        };
+        // One pass of `M⁻¹ L` or `L` over the rows `at`, reading `v` (0 where absent).
+        let product = |at: &[usize], v: &HashMap<usize, [f64; C]>| -> Vec<[f64; C]> {
+            at.iter()
+                .map(|&j| {
+                    let mut acc = [0.0; C];
+                    for k in sym.col_range(j) {
+                        let (a, vi) = (sym.val(k), v.get(&sym.row(k)).unwrap_or(&[0.0; C]));
+                        for c in 0..C {
+                            acc[c] += a * vi[c];
+                        }
+                    }
+                    acc
+                })
+                .collect()
+        };
+        let xs: HashMap<usize, [f64; C]> = (landmarks.iter())
+            .map(|&s| (s as usize, x[s as usize]))
+            .collect();
+        let ring1 = ring_of(&mut landmarks.iter().map(|&s| s as usize));
+        let t: HashMap<usize, [f64; C]> = (ring1.iter().zip(product(&ring1, &xs)))
+            .map(|(&j, acc)| (j, acc.map(|v| v * self.inv_mass[j])))
+            .collect();
+        let ring2: Vec<usize> = ring_of(&mut ring1.iter().copied())
+            .into_iter()
+            .filter(|&j| !self.fixed[j])
+            .collect();
+        let y = product(&ring2, &t);
+        // Chunks in order, rows in order within each: the full sum's order (its other
+        // rows add +0).
+        let mut parts: Vec<[f64; C]> = Vec::new();
+        let mut chunk = usize::MAX;
+        for (&j, yj) in ring2.iter().zip(&y) {
+            if j / CHUNK != chunk {
+                chunk = j / CHUNK;
+                parts.push([0.0; C]);
+            }
+            let s = parts.last_mut().expect("a chunk was pushed");
+            for c in 0..C {
+                s[c] += yj[c] * yj[c];
+            }
+        }
+        sum_chunks(parts)
+    }
+
     /// Conjugate gradients from the iterate `x` (whose fixed rows hold the landmark values
     /// and stay unchanged) on the first `dim` columns, until every column's residual norm
     /// is at most `cg.tolerance` times its right-hand side's or `cg.max_iterations` pass.
@@ -150,26 +211,7 @@ impl FreeOperator<'_> {
         let mut t = vec![[0.0; C]; n];
         let mut r = vec![[0.0; C]; n];
         // Right-hand side norms: b = -(A x_S) on the free rows.
-        let b2 = {
-            let mut xs = vec![[0.0; C]; n];
-            for &s in landmarks {
-                xs[s as usize] = x[s as usize];
-            }
-            self.apply(&xs, &mut t, &mut r);
-            let parts = r
-                .par_chunks(CHUNK)
-                .map(|rs| {
-                    let mut s = [0.0; C];
-                    for ri in rs {
-                        for c in 0..C {
-                            s[c] += ri[c] * ri[c];
-                        }
-                    }
-                    s
-                })
-                .collect();
-            sum_chunks(parts)
-        };
+        let b2 = self.rhs_norms(landmarks, &x);
         // r = b - A_FF x_F = -(A x) on the free rows; p = z = D r.
         self.apply(&x, &mut t, &mut r);
         let mut p = vec![[0.0; C]; n];
@@ -268,5 +310,67 @@ impl FreeOperator<'_> {
             .zip(&x)
             .for_each(|(o, v)| o[..C].copy_from_slice(v));
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::NoProgress;
+    use rand::{Rng, SeedableRng};
+    use wavg_mesh::{ValidMesh, procedural};
+
+    /// The right-hand side's norms from the landmarks' two-rings have the bits of the full
+    /// product's, on a mesh of several chunks with landmarks spread over them.
+    #[test]
+    fn right_hand_side_norms_from_the_two_rings_equal_the_full_product_bitwise() {
+        let torus = procedural::torus(160, 80, 1.0, 0.35);
+        let mesh = ValidMesh::new(procedural::with_noise(torus, 0.002, 3)).unwrap();
+        let n = mesh.n_vertices();
+        assert!(n > 3 * CHUNK);
+        let (stiffness, mass) = Stiffness::cotan(&mesh, None, &NoProgress).unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut landmarks: Vec<u32> = (0..40).map(|_| rng.random_range(0..n as u32)).collect();
+        landmarks.push(0);
+        landmarks.push(n as u32 - 1);
+        landmarks.sort_unstable();
+        landmarks.dedup();
+        let mut fixed = vec![false; n];
+        for &s in &landmarks {
+            fixed[s as usize] = true;
+        }
+        let inv_mass: Vec<f64> = mass.iter().map(|m| 1.0 / m).collect();
+        let inv_diag = vec![1.0; n];
+        let op = FreeOperator {
+            stiffness: &stiffness,
+            inv_mass: &inv_mass,
+            inv_diag: &inv_diag,
+            fixed: &fixed,
+        };
+        let x: Vec<[f64; 4]> = (0..n)
+            .map(|_| std::array::from_fn(|_| rng.random_range(-1.0..1.0)))
+            .collect();
+        let mut xs = vec![[0.0; 4]; n];
+        for &s in &landmarks {
+            xs[s as usize] = x[s as usize];
+        }
+        let (mut t, mut r) = (vec![[0.0; 4]; n], vec![[0.0; 4]; n]);
+        op.apply(&xs, &mut t, &mut r);
+        let full = sum_chunks(
+            r.chunks(CHUNK)
+                .map(|rs| {
+                    let mut s = [0.0; 4];
+                    for ri in rs {
+                        for c in 0..4 {
+                            s[c] += ri[c] * ri[c];
+                        }
+                    }
+                    s
+                })
+                .collect(),
+        );
+        let sparse = op.rhs_norms(&landmarks, &x);
+        assert!(full.iter().all(|&v| v > 0.0));
+        assert_eq!(full.map(f64::to_bits), sparse.map(f64::to_bits));
     }
 }
