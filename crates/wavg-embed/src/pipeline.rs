@@ -367,10 +367,13 @@ pub(crate) fn precompute_unscaled(
     //    and steps 1 and 2 run again (at most `THIN_PART_ROUNDS` times, adding at most as
     //    many landmarks as asked for in all): the decimation restarts from that
     //    intermediate mesh, not from the full one.
-    let geodesics = |landmarks: &[u32], coarse: Option<&Decimated>, mid: Option<&Decimated>| {
+    let geodesics = |fine: Option<&FastMarching>,
+                     landmarks: &[u32],
+                     coarse: Option<&Decimated>,
+                     mid: Option<&Decimated>| {
         let t = Instant::now();
         let mut geo = GeodesicOptions::new();
-        if let Some(fine) = &fm {
+        if let Some(fine) = fine {
             geo = geo.fast_marching(fine);
         }
         if let Some(c) = coarse {
@@ -404,6 +407,26 @@ pub(crate) fn precompute_unscaled(
         };
         Ok::<_, EmbedError>((solver, secs(t)))
     };
+    // The selection of `locked` landmarks after a round (from `base`, the finest
+    // intermediate mesh, where there is one). Locking every landmark may leave a vertex
+    // that no legal collapse removes; a few more landmarks then get around it, and
+    // failing that (None), the landmarks so far stay.
+    let relock = |base: Option<&Decimated>, locked: &[u32]| {
+        [0, 1, 8]
+            .into_iter()
+            .filter(|extra| locked.len() + extra <= n)
+            .find_map(|extra| {
+                let target = locked.len() + extra;
+                let next = match base {
+                    Some(b) => reselect(b, target, locked),
+                    None => select(target, locked, None).0,
+                };
+                match next {
+                    Err(EmbedError::InvalidArgument(_)) => None,
+                    other => Some(other),
+                }
+            })
+    };
     let mut added = 0;
     let mut round = 0;
     let mut previous: Option<LsMeshExtension> = None;
@@ -413,7 +436,7 @@ pub(crate) fn precompute_unscaled(
         // Later rounds only need the factorisation; the geodesics wait for the last.
         let (q, solver) = if round == 0 {
             let (q, solver) = rayon::join(
-                || geodesics(&landmarks, coarse.as_ref(), ls_coarse.as_ref()),
+                || geodesics(fm.as_ref(), &landmarks, coarse.as_ref(), ls_coarse.as_ref()),
                 || factor(&landmarks, ls_coarse.as_ref(), None),
             );
             let (q, t_geodesics) = q?;
@@ -441,12 +464,11 @@ pub(crate) fn precompute_unscaled(
                 thin::collapsed_vertices(mesh, &landmarks, &solver, round > 0, progress)?;
             // Samples go on the intermediate mesh a later round restarts from, where
             // it has vertices to offer.
-            let on_base = base.map(|b| {
-                let mut on_base = vec![false; n];
-                b.landmarks.iter().for_each(|&v| on_base[v as usize] = true);
-                on_base
-            });
-            let limit = (opts.landmarks - added).min(n - landmarks.len());
+            let on_base = base.map(|b| thin::kept_by(b, n));
+            let limit = opts
+                .landmarks
+                .saturating_sub(added)
+                .min(n - landmarks.len());
             let more =
                 thin::landmarks_to_add(mesh, &landmarks, &collapsed, on_base.as_deref(), limit);
             stages.decimate += secs(t);
@@ -472,24 +494,7 @@ pub(crate) fn precompute_unscaled(
                 None
             }
         };
-        // Locking every landmark may leave a vertex that no legal collapse removes; a
-        // few more landmarks then get around it, and failing that, the landmarks so far
-        // stay.
-        let next = [0, 1, 8]
-            .into_iter()
-            .filter(|extra| locked.len() + extra <= n)
-            .find_map(|extra| {
-                let target = locked.len() + extra;
-                let next = match base {
-                    Some(b) => reselect(b, target, &locked),
-                    None => select(target, &locked, None).0,
-                };
-                match next {
-                    Err(EmbedError::InvalidArgument(_)) => None,
-                    other => Some(other),
-                }
-            });
-        match next {
+        match relock(base, &locked) {
             Some(next) => {
                 drop((coarse, ls_coarse));
                 selected = next?;
@@ -508,13 +513,12 @@ pub(crate) fn precompute_unscaled(
     let q = match q {
         Some(q) => q,
         None => {
-            let (q, t_geodesics) = geodesics(&landmarks, coarse.as_ref(), ls_coarse.as_ref())?;
+            let (q, t_geodesics) =
+                geodesics(fm.as_ref(), &landmarks, coarse.as_ref(), ls_coarse.as_ref())?;
             stages.geodesics += t_geodesics;
             q
         }
     };
-    let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
-    drop((coarse, ls_coarse));
     drop(fm);
     mark("landmark geodesics (if redone)");
 
@@ -528,12 +532,62 @@ pub(crate) fn precompute_unscaled(
 
     // 4. Least-squares mesh: the landmarks' MDS positions extended to every vertex.
     let t = Instant::now();
-    let coords = solver.solve(&mds.points, dim, progress)?;
+    let mut coords = solver.solve(&mds.points, dim, progress)?;
     drop(solver);
     mark("lsmesh solve");
     progress.report(Stage::LsMesh, 1.0);
     stages.lsmesh += secs(t);
     check_cancel(progress)?;
+
+    // 4b. On meshes with thin parts (landmarks were added), where the solved embedding
+    //     still squashes vertices (`thin::squashed_vertices`), landmarks go there and the
+    //     selection, geodesics, MDS and solve run again.
+    let (mut landmarks, mut mds, mut coarse, mut ls_coarse) = (landmarks, mds, coarse, ls_coarse);
+    for _ in 0..thin::SQUASHED_ROUNDS {
+        if !(opts.cover_thin_parts && added > 0) {
+            break;
+        }
+        let t = Instant::now();
+        let squashed = thin::squashed_vertices(mesh, &landmarks, &coords);
+        let base = ls_coarse.as_ref().or(coarse.as_ref());
+        let limit = opts
+            .landmarks
+            .saturating_sub(added)
+            .min(n - landmarks.len());
+        let on_base = base.map(|b| thin::kept_by(b, n));
+        let more = thin::landmarks_to_add(mesh, &landmarks, &squashed, on_base.as_deref(), limit);
+        stages.decimate += secs(t);
+        if more.is_empty() {
+            break;
+        }
+        let mut locked = landmarks.clone();
+        locked.extend(&more);
+        locked.sort_unstable();
+        let Some(next) = relock(base, &locked) else {
+            break;
+        };
+        let (next, c, ls, t_decimate) = next?;
+        stages.decimate += t_decimate;
+        let (q, solver) = rayon::join(
+            || geodesics(None, &next, c.as_ref(), ls.as_ref()),
+            || factor(&next, ls.as_ref(), None),
+        );
+        let ((q, t_geodesics), (solver, t_factor)) = (q?, solver?);
+        (stages.geodesics, stages.lsmesh) =
+            (stages.geodesics + t_geodesics, stages.lsmesh + t_factor);
+        let t = Instant::now();
+        mds = metric_mds(&q, next.len(), &opts.mds, progress)?;
+        stages.mds += secs(t);
+        let t = Instant::now();
+        coords = solver.solve(&mds.points, dim, progress)?;
+        stages.lsmesh += secs(t);
+        added += next.len() - landmarks.len();
+        (landmarks, coarse, ls_coarse) = (next, c, ls);
+        mark("squashed vertices: selection, geodesics, mds, solve");
+        check_cancel(progress)?;
+    }
+    let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
+    drop((coarse, ls_coarse));
 
     // 5. Quality.
     let t = Instant::now();
