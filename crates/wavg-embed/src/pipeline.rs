@@ -66,7 +66,9 @@ pub struct PrecomputeOptions {
     /// Add landmarks where parts thinner than the landmark spacing (fingers, toes, ears)
     /// would collapse in the embedding (default on): the least-squares extension of the
     /// landmarks' own positions shows where, and up to [`THIN_PART_ROUNDS`] rounds add at
-    /// most `landmarks` more in all. Meshes without such parts are unchanged.
+    /// most `landmarks` more in all. On meshes that got some, the solved embedding is
+    /// checked too: where it squashes vertices toward a landmark, up to two more rounds
+    /// add landmarks there and solve again. Meshes without such parts are unchanged.
     pub cover_thin_parts: bool,
 }
 
