@@ -2,7 +2,6 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use wavg_mesh::ValidMesh;
 
 use crate::decimate::{DecimateOptions, Decimated, decimate_beside, decimate_with_snapshots};
@@ -13,8 +12,8 @@ use crate::lsmesh::LsMeshSolver;
 use crate::lsmesh::two_level::{CgOptions, LsMeshExtension, TwoLevelLsMesh};
 use crate::mds::{MdsOptions, metric_mds};
 use crate::memtrace::mark;
-use crate::quality::{QualityOptions, QualityPairs};
-use crate::thin;
+use crate::quality::{QualityOptions, QualityPairs, quality_sources};
+use crate::thin::{self, landmark_aspect_bound};
 use crate::{Embedding, EmbeddingParams};
 
 /// Settings of [`precompute`](crate::precompute).
@@ -84,43 +83,9 @@ pub const THIN_PART_ROUNDS: usize = 8;
 /// triangles every cross-section keeps landmarks all around.
 pub const LANDMARK_ASPECT_RATIO: f64 = 10.0;
 
-/// The aspect-ratio bound of the landmark decimation: the one asked for, but at least
-/// twice the input's 90th-percentile ratio. Demanding rounder triangles than most of the
-/// mesh's own would let the bound, not the shape, steer the decimation (a mesh of slivers
-/// then loses every landmark of some regions).
-fn landmark_aspect_bound(mesh: &ValidMesh, asked: Option<f64>) -> Option<f64> {
-    let asked = asked?;
-    let mut ratios: Vec<f64> = (mesh.triangles.par_iter())
-        .map(|t| {
-            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-            crate::decimate::aspect_ratio(a, b, c)
-        })
-        .collect();
-    if ratios.is_empty() {
-        return Some(asked);
-    }
-    let k = ratios.len() * 9 / 10;
-    let (_, p90, _) = ratios.select_nth_unstable_by(k, f64::total_cmp);
-    Some(asked.max(2.0 * *p90))
-}
-
 /// What the quality check's first part yields: the full mesh's fast marching, the pairs
 /// with their geodesic distances, and its seconds.
 type QualityOut = Result<(Option<FastMarching>, Option<QualityPairs>, f64), EmbedError>;
-
-/// Vertex visits (sources x vertices) above which the quality check uses fewer sources.
-pub(crate) const QUALITY_SOURCE_VERTICES: usize = 16_000_000;
-
-/// Fewest quality-check sources on large meshes: two regions of the surface rather than one.
-const QUALITY_MIN_SOURCES: usize = 2;
-
-/// Fast-marching runs of the quality check on an `n`-vertex mesh for `asked` sources and
-/// `pairs` pairs ([`PrecomputeOptions::quality_sources`]).
-fn quality_sources(asked: usize, n: usize, pairs: usize) -> usize {
-    asked
-        .min((QUALITY_SOURCE_VERTICES / n.max(1)).max(QUALITY_MIN_SOURCES))
-        .clamp(1, pairs.max(1))
-}
 
 impl Default for PrecomputeOptions {
     fn default() -> Self {
@@ -410,9 +375,7 @@ pub(crate) fn precompute_unscaled(
         Ok::<_, EmbedError>((solver, secs(t)))
     };
     // The selection of `locked` landmarks after a round (from `base`, the finest
-    // intermediate mesh, where there is one). Locking every landmark may leave a vertex
-    // that no legal collapse removes; a few more landmarks then get around it, and
-    // failing that (None), the landmarks so far stay.
+    // intermediate mesh, if any), with 1 or 8 more should no collapse remove a vertex.
     let relock = |base: Option<&Decimated>, locked: &[u32]| {
         [0, 1, 8]
             .into_iter()
@@ -481,9 +444,7 @@ pub(crate) fn precompute_unscaled(
         if more.is_empty() {
             break (landmarks, q, solver, coarse, ls_coarse);
         }
-        let mut locked = landmarks.clone();
-        locked.extend(&more);
-        locked.sort_unstable();
+        let locked = thin::merged(&landmarks, &more);
         // The factorisation and the distances go before the next decimation allocates
         // (should no decimation be possible, they are computed again); a two-level
         // system's full-mesh operator stays for the next round when the decimation
@@ -545,27 +506,17 @@ pub(crate) fn precompute_unscaled(
     //     still squashes vertices (`thin::squashed_vertices`), landmarks go there and the
     //     selection, geodesics, MDS and solve run again.
     let (mut landmarks, mut mds, mut coarse, mut ls_coarse) = (landmarks, mds, coarse, ls_coarse);
-    for _ in 0..thin::SQUASHED_ROUNDS {
-        if !(opts.cover_thin_parts && added > 0) {
-            break;
-        }
+    let rounds = usize::from(opts.cover_thin_parts && added > 0) * thin::SQUASHED_ROUNDS;
+    for _ in 0..rounds {
         let t = Instant::now();
-        let squashed = thin::squashed_vertices(mesh, &landmarks, &coords);
         let base = ls_coarse.as_ref().or(coarse.as_ref());
-        let limit = opts
-            .landmarks
-            .saturating_sub(added)
-            .min(n - landmarks.len());
-        let on_base = base.map(|b| thin::kept_by(b, n));
-        let more = thin::landmarks_to_add(mesh, &landmarks, &squashed, on_base.as_deref(), limit);
+        let limit = opts.landmarks.saturating_sub(added);
+        let more = thin::landmarks_where_squashed(mesh, &landmarks, &coords, base, limit);
         stages.decimate += secs(t);
         if more.is_empty() {
             break;
         }
-        let mut locked = landmarks.clone();
-        locked.extend(&more);
-        locked.sort_unstable();
-        let Some(next) = relock(base, &locked) else {
+        let Some(next) = relock(base, &thin::merged(&landmarks, &more)) else {
             break;
         };
         let (next, c, ls, t_decimate) = next?;

@@ -10,6 +10,8 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
+use rayon::prelude::*;
+
 use wavg_mesh::ValidMesh;
 
 use crate::decimate::Decimated;
@@ -220,7 +222,6 @@ pub(crate) fn squashed_vertices(
     landmarks: &[u32],
     coords: &[[f64; MAX_DIM]],
 ) -> Vec<bool> {
-    use rayon::prelude::*;
     let pos = &mesh.positions;
     let n = mesh.n_vertices();
     let anchors: Vec<([f64; 3], [f64; MAX_DIM])> = (landmarks.iter())
@@ -257,6 +258,50 @@ pub(crate) fn squashed_vertices(
 pub(crate) fn kept_by(d: &Decimated, n: usize) -> Vec<bool> {
     let mut out = vec![false; n];
     d.landmarks.iter().for_each(|&v| out[v as usize] = true);
+    out
+}
+
+/// The aspect-ratio bound of the landmark decimation: the one asked for, but at least
+/// twice the input's 90th-percentile ratio. Demanding rounder triangles than most of the
+/// mesh's own would let the bound, not the shape, steer the decimation (a mesh of slivers
+/// then loses every landmark of some regions).
+pub(crate) fn landmark_aspect_bound(mesh: &ValidMesh, asked: Option<f64>) -> Option<f64> {
+    let asked = asked?;
+    let mut ratios: Vec<f64> = (mesh.triangles.par_iter())
+        .map(|t| {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            crate::decimate::aspect_ratio(a, b, c)
+        })
+        .collect();
+    if ratios.is_empty() {
+        return Some(asked);
+    }
+    let k = ratios.len() * 9 / 10;
+    let (_, p90, _) = ratios.select_nth_unstable_by(k, f64::total_cmp);
+    Some(asked.max(2.0 * *p90))
+}
+
+/// Landmarks to add where the solved embedding `coords` squashes vertices
+/// ([`squashed_vertices`]), at most `limit`, preferably on `base` (the finest
+/// intermediate mesh, which a later round restarts from): [`landmarks_to_add`].
+pub(crate) fn landmarks_where_squashed(
+    mesh: &ValidMesh,
+    landmarks: &[u32],
+    coords: &[[f64; MAX_DIM]],
+    base: Option<&Decimated>,
+    limit: usize,
+) -> Vec<u32> {
+    let n = mesh.n_vertices();
+    let squashed = squashed_vertices(mesh, landmarks, coords);
+    let on_base = base.map(|b| kept_by(b, n));
+    let limit = limit.min(n - landmarks.len());
+    landmarks_to_add(mesh, landmarks, &squashed, on_base.as_deref(), limit)
+}
+
+/// The landmarks with `more` added, sorted.
+pub(crate) fn merged(landmarks: &[u32], more: &[u32]) -> Vec<u32> {
+    let mut out = [landmarks, more].concat();
+    out.sort_unstable();
     out
 }
 
