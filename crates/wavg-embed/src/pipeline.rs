@@ -2,7 +2,6 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use wavg_mesh::ValidMesh;
 
 use crate::decimate::{DecimateOptions, Decimated, decimate_beside, decimate_with_snapshots};
@@ -13,8 +12,8 @@ use crate::lsmesh::LsMeshSolver;
 use crate::lsmesh::two_level::{CgOptions, LsMeshExtension, TwoLevelLsMesh};
 use crate::mds::{MdsOptions, metric_mds};
 use crate::memtrace::mark;
-use crate::quality::{QualityOptions, QualityPairs};
-use crate::thin;
+use crate::quality::{QualityOptions, QualityPairs, quality_sources};
+use crate::thin::{self, landmark_aspect_bound};
 use crate::{Embedding, EmbeddingParams};
 
 /// Settings of [`precompute`](crate::precompute).
@@ -66,7 +65,9 @@ pub struct PrecomputeOptions {
     /// Add landmarks where parts thinner than the landmark spacing (fingers, toes, ears)
     /// would collapse in the embedding (default on): the least-squares extension of the
     /// landmarks' own positions shows where, and up to [`THIN_PART_ROUNDS`] rounds add at
-    /// most `landmarks` more in all. Meshes without such parts are unchanged.
+    /// most `landmarks` more in all. On meshes that got some, the solved embedding is
+    /// checked too: where it squashes vertices toward a landmark, up to two more rounds
+    /// add landmarks there and solve again. Meshes without such parts are unchanged.
     pub cover_thin_parts: bool,
 }
 
@@ -82,43 +83,9 @@ pub const THIN_PART_ROUNDS: usize = 8;
 /// triangles every cross-section keeps landmarks all around.
 pub const LANDMARK_ASPECT_RATIO: f64 = 10.0;
 
-/// The aspect-ratio bound of the landmark decimation: the one asked for, but at least
-/// twice the input's 90th-percentile ratio. Demanding rounder triangles than most of the
-/// mesh's own would let the bound, not the shape, steer the decimation (a mesh of slivers
-/// then loses every landmark of some regions).
-fn landmark_aspect_bound(mesh: &ValidMesh, asked: Option<f64>) -> Option<f64> {
-    let asked = asked?;
-    let mut ratios: Vec<f64> = (mesh.triangles.par_iter())
-        .map(|t| {
-            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-            crate::decimate::aspect_ratio(a, b, c)
-        })
-        .collect();
-    if ratios.is_empty() {
-        return Some(asked);
-    }
-    let k = ratios.len() * 9 / 10;
-    let (_, p90, _) = ratios.select_nth_unstable_by(k, f64::total_cmp);
-    Some(asked.max(2.0 * *p90))
-}
-
 /// What the quality check's first part yields: the full mesh's fast marching, the pairs
 /// with their geodesic distances, and its seconds.
 type QualityOut = Result<(Option<FastMarching>, Option<QualityPairs>, f64), EmbedError>;
-
-/// Vertex visits (sources x vertices) above which the quality check uses fewer sources.
-pub(crate) const QUALITY_SOURCE_VERTICES: usize = 16_000_000;
-
-/// Fewest quality-check sources on large meshes: two regions of the surface rather than one.
-const QUALITY_MIN_SOURCES: usize = 2;
-
-/// Fast-marching runs of the quality check on an `n`-vertex mesh for `asked` sources and
-/// `pairs` pairs ([`PrecomputeOptions::quality_sources`]).
-fn quality_sources(asked: usize, n: usize, pairs: usize) -> usize {
-    asked
-        .min((QUALITY_SOURCE_VERTICES / n.max(1)).max(QUALITY_MIN_SOURCES))
-        .clamp(1, pairs.max(1))
-}
 
 impl Default for PrecomputeOptions {
     fn default() -> Self {
@@ -367,10 +334,13 @@ pub(crate) fn precompute_unscaled(
     //    and steps 1 and 2 run again (at most `THIN_PART_ROUNDS` times, adding at most as
     //    many landmarks as asked for in all): the decimation restarts from that
     //    intermediate mesh, not from the full one.
-    let geodesics = |landmarks: &[u32], coarse: Option<&Decimated>, mid: Option<&Decimated>| {
+    let geodesics = |fine: Option<&FastMarching>,
+                     landmarks: &[u32],
+                     coarse: Option<&Decimated>,
+                     mid: Option<&Decimated>| {
         let t = Instant::now();
         let mut geo = GeodesicOptions::new();
-        if let Some(fine) = &fm {
+        if let Some(fine) = fine {
             geo = geo.fast_marching(fine);
         }
         if let Some(c) = coarse {
@@ -404,6 +374,24 @@ pub(crate) fn precompute_unscaled(
         };
         Ok::<_, EmbedError>((solver, secs(t)))
     };
+    // The selection of `locked` landmarks after a round (from `base`, the finest
+    // intermediate mesh, if any), with 1 or 8 more should no collapse remove a vertex.
+    let relock = |base: Option<&Decimated>, locked: &[u32]| {
+        [0, 1, 8]
+            .into_iter()
+            .filter(|extra| locked.len() + extra <= n)
+            .find_map(|extra| {
+                let target = locked.len() + extra;
+                let next = match base {
+                    Some(b) => reselect(b, target, locked),
+                    None => select(target, locked, None).0,
+                };
+                match next {
+                    Err(EmbedError::InvalidArgument(_)) => None,
+                    other => Some(other),
+                }
+            })
+    };
     let mut added = 0;
     let mut round = 0;
     let mut previous: Option<LsMeshExtension> = None;
@@ -413,7 +401,7 @@ pub(crate) fn precompute_unscaled(
         // Later rounds only need the factorisation; the geodesics wait for the last.
         let (q, solver) = if round == 0 {
             let (q, solver) = rayon::join(
-                || geodesics(&landmarks, coarse.as_ref(), ls_coarse.as_ref()),
+                || geodesics(fm.as_ref(), &landmarks, coarse.as_ref(), ls_coarse.as_ref()),
                 || factor(&landmarks, ls_coarse.as_ref(), None),
             );
             let (q, t_geodesics) = q?;
@@ -441,12 +429,11 @@ pub(crate) fn precompute_unscaled(
                 thin::collapsed_vertices(mesh, &landmarks, &solver, round > 0, progress)?;
             // Samples go on the intermediate mesh a later round restarts from, where
             // it has vertices to offer.
-            let on_base = base.map(|b| {
-                let mut on_base = vec![false; n];
-                b.landmarks.iter().for_each(|&v| on_base[v as usize] = true);
-                on_base
-            });
-            let limit = (opts.landmarks - added).min(n - landmarks.len());
+            let on_base = base.map(|b| thin::kept_by(b, n));
+            let limit = opts
+                .landmarks
+                .saturating_sub(added)
+                .min(n - landmarks.len());
             let more =
                 thin::landmarks_to_add(mesh, &landmarks, &collapsed, on_base.as_deref(), limit);
             stages.decimate += secs(t);
@@ -457,9 +444,7 @@ pub(crate) fn precompute_unscaled(
         if more.is_empty() {
             break (landmarks, q, solver, coarse, ls_coarse);
         }
-        let mut locked = landmarks.clone();
-        locked.extend(&more);
-        locked.sort_unstable();
+        let locked = thin::merged(&landmarks, &more);
         // The factorisation and the distances go before the next decimation allocates
         // (should no decimation be possible, they are computed again); a two-level
         // system's full-mesh operator stays for the next round when the decimation
@@ -472,24 +457,7 @@ pub(crate) fn precompute_unscaled(
                 None
             }
         };
-        // Locking every landmark may leave a vertex that no legal collapse removes; a
-        // few more landmarks then get around it, and failing that, the landmarks so far
-        // stay.
-        let next = [0, 1, 8]
-            .into_iter()
-            .filter(|extra| locked.len() + extra <= n)
-            .find_map(|extra| {
-                let target = locked.len() + extra;
-                let next = match base {
-                    Some(b) => reselect(b, target, &locked),
-                    None => select(target, &locked, None).0,
-                };
-                match next {
-                    Err(EmbedError::InvalidArgument(_)) => None,
-                    other => Some(other),
-                }
-            });
-        match next {
+        match relock(base, &locked) {
             Some(next) => {
                 drop((coarse, ls_coarse));
                 selected = next?;
@@ -508,13 +476,12 @@ pub(crate) fn precompute_unscaled(
     let q = match q {
         Some(q) => q,
         None => {
-            let (q, t_geodesics) = geodesics(&landmarks, coarse.as_ref(), ls_coarse.as_ref())?;
+            let (q, t_geodesics) =
+                geodesics(fm.as_ref(), &landmarks, coarse.as_ref(), ls_coarse.as_ref())?;
             stages.geodesics += t_geodesics;
             q
         }
     };
-    let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
-    drop((coarse, ls_coarse));
     drop(fm);
     mark("landmark geodesics (if redone)");
 
@@ -528,12 +495,52 @@ pub(crate) fn precompute_unscaled(
 
     // 4. Least-squares mesh: the landmarks' MDS positions extended to every vertex.
     let t = Instant::now();
-    let coords = solver.solve(&mds.points, dim, progress)?;
+    let mut coords = solver.solve(&mds.points, dim, progress)?;
     drop(solver);
     mark("lsmesh solve");
     progress.report(Stage::LsMesh, 1.0);
     stages.lsmesh += secs(t);
     check_cancel(progress)?;
+
+    // 4b. On meshes with thin parts (landmarks were added), where the solved embedding
+    //     still squashes vertices (`thin::squashed_vertices`), landmarks go there and the
+    //     selection, geodesics, MDS and solve run again.
+    let (mut landmarks, mut mds, mut coarse, mut ls_coarse) = (landmarks, mds, coarse, ls_coarse);
+    let rounds = usize::from(opts.cover_thin_parts && added > 0) * thin::SQUASHED_ROUNDS;
+    for _ in 0..rounds {
+        let t = Instant::now();
+        let base = ls_coarse.as_ref().or(coarse.as_ref());
+        let limit = opts.landmarks.saturating_sub(added);
+        let more = thin::landmarks_where_squashed(mesh, &landmarks, &coords, base, limit);
+        stages.decimate += secs(t);
+        if more.is_empty() {
+            break;
+        }
+        let Some(next) = relock(base, &thin::merged(&landmarks, &more)) else {
+            break;
+        };
+        let (next, c, ls, t_decimate) = next?;
+        stages.decimate += t_decimate;
+        let (q, solver) = rayon::join(
+            || geodesics(None, &next, c.as_ref(), ls.as_ref()),
+            || factor(&next, ls.as_ref(), None),
+        );
+        let ((q, t_geodesics), (solver, t_factor)) = (q?, solver?);
+        (stages.geodesics, stages.lsmesh) =
+            (stages.geodesics + t_geodesics, stages.lsmesh + t_factor);
+        let t = Instant::now();
+        mds = metric_mds(&q, next.len(), &opts.mds, progress)?;
+        stages.mds += secs(t);
+        let t = Instant::now();
+        coords = solver.solve(&mds.points, dim, progress)?;
+        stages.lsmesh += secs(t);
+        added += next.len() - landmarks.len();
+        (landmarks, coarse, ls_coarse) = (next, c, ls);
+        mark("squashed vertices: selection, geodesics, mds, solve");
+        check_cancel(progress)?;
+    }
+    let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
+    drop((coarse, ls_coarse));
 
     // 5. Quality.
     let t = Instant::now();

@@ -247,6 +247,20 @@ pub fn geodesic_quality(
     Ok(q)
 }
 
+/// Vertex visits (sources x vertices) above which the quality check uses fewer sources.
+pub(crate) const QUALITY_SOURCE_VERTICES: usize = 16_000_000;
+
+/// Fewest quality-check sources on large meshes: two regions of the surface rather than one.
+const QUALITY_MIN_SOURCES: usize = 2;
+
+/// Fast-marching runs of the quality check on an `n`-vertex mesh for `asked` sources and
+/// `pairs` pairs ([`PrecomputeOptions::quality_sources`](crate::PrecomputeOptions::quality_sources)).
+pub(crate) fn quality_sources(asked: usize, n: usize, pairs: usize) -> usize {
+    asked
+        .min((QUALITY_SOURCE_VERTICES / n.max(1)).max(QUALITY_MIN_SOURCES))
+        .clamp(1, pairs.max(1))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -10,8 +10,11 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
+use rayon::prelude::*;
+
 use wavg_mesh::ValidMesh;
 
+use crate::decimate::Decimated;
 use crate::error::{EmbedError, Progress, check_cancel};
 use crate::file::MAX_DIM;
 use crate::lsmesh::two_level::LsMeshExtension;
@@ -190,6 +193,116 @@ fn collapsed_on(
         out[l as usize] = false;
     }
     Ok(out)
+}
+
+/// A vertex is squashed in the solved embedding when it lies closer to some landmark
+/// than this times their straight-line distance. Embedded distances stand for geodesic
+/// ones, which are never shorter than straight lines, so a well-embedded vertex stays
+/// near 1 or above; a margin above the 0.5 of a collapsed pair, since a pair of squashed
+/// vertices may come closer to each other than either comes to a landmark.
+pub(crate) const SQUASHED_SCALE: f64 = 0.6;
+
+/// Rounds at most in which landmarks go where the solved embedding squashes vertices
+/// ([`squashed_vertices`]), each followed by the geodesics, MDS and solve again.
+pub(crate) const SQUASHED_ROUNDS: usize = 2;
+
+/// Vertices checked at most by [`squashed_vertices`] (every `stride`-th one above):
+/// squashed regions span several vertices, and the check costs a distance per landmark.
+const SQUASHED_CHECKED_VERTICES: usize = 200_000;
+
+/// Vertices that the solved embedding `coords` brings closer to some landmark than
+/// [`SQUASHED_SCALE`] times their straight-line distance, landmarks excluded.
+///
+/// The check on the landmarks' 3D positions ([`collapsed_vertices`]) stands in for the
+/// embedding before it is computed; between landmarks whose own distances are kept, the
+/// 8D extension may still squash a fingertip or an ear tip that the 3D extension leaves
+/// whole. This check looks at the result itself.
+pub(crate) fn squashed_vertices(
+    mesh: &ValidMesh,
+    landmarks: &[u32],
+    coords: &[[f64; MAX_DIM]],
+) -> Vec<bool> {
+    let pos = &mesh.positions;
+    let n = mesh.n_vertices();
+    let anchors: Vec<([f64; 3], [f64; MAX_DIM])> = (landmarks.iter())
+        .map(|&l| {
+            let p = pos[l as usize];
+            ([p.x, p.y, p.z], coords[l as usize])
+        })
+        .collect();
+    let scale2 = SQUASHED_SCALE * SQUASHED_SCALE;
+    let squashed = |v: usize| {
+        let (p, e) = (pos[v], &coords[v]);
+        anchors.iter().any(|(q, f)| {
+            let d2 = (p.x - q[0]).powi(2) + (p.y - q[1]).powi(2) + (p.z - q[2]).powi(2);
+            let e2: f64 = e.iter().zip(f).map(|(a, b)| (a - b) * (a - b)).sum();
+            e2 < scale2 * d2
+        })
+    };
+    let stride = n.div_ceil(SQUASHED_CHECKED_VERTICES).max(1);
+    let found: Vec<usize> = (0..n)
+        .into_par_iter()
+        .step_by(stride)
+        .filter(|&v| squashed(v))
+        .collect();
+    let mut out = vec![false; n];
+    found.into_iter().for_each(|v| out[v] = true);
+    for &l in landmarks {
+        out[l as usize] = false;
+    }
+    out
+}
+
+/// Which of the `n` vertices of the full mesh the intermediate mesh `d` keeps: where a
+/// later round's landmarks preferably go ([`landmarks_to_add`]'s `allowed`).
+pub(crate) fn kept_by(d: &Decimated, n: usize) -> Vec<bool> {
+    let mut out = vec![false; n];
+    d.landmarks.iter().for_each(|&v| out[v as usize] = true);
+    out
+}
+
+/// The aspect-ratio bound of the landmark decimation: the one asked for, but at least
+/// twice the input's 90th-percentile ratio. Demanding rounder triangles than most of the
+/// mesh's own would let the bound, not the shape, steer the decimation (a mesh of slivers
+/// then loses every landmark of some regions).
+pub(crate) fn landmark_aspect_bound(mesh: &ValidMesh, asked: Option<f64>) -> Option<f64> {
+    let asked = asked?;
+    let mut ratios: Vec<f64> = (mesh.triangles.par_iter())
+        .map(|t| {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            crate::decimate::aspect_ratio(a, b, c)
+        })
+        .collect();
+    if ratios.is_empty() {
+        return Some(asked);
+    }
+    let k = ratios.len() * 9 / 10;
+    let (_, p90, _) = ratios.select_nth_unstable_by(k, f64::total_cmp);
+    Some(asked.max(2.0 * *p90))
+}
+
+/// Landmarks to add where the solved embedding `coords` squashes vertices
+/// ([`squashed_vertices`]), at most `limit`, preferably on `base` (the finest
+/// intermediate mesh, which a later round restarts from): [`landmarks_to_add`].
+pub(crate) fn landmarks_where_squashed(
+    mesh: &ValidMesh,
+    landmarks: &[u32],
+    coords: &[[f64; MAX_DIM]],
+    base: Option<&Decimated>,
+    limit: usize,
+) -> Vec<u32> {
+    let n = mesh.n_vertices();
+    let squashed = squashed_vertices(mesh, landmarks, coords);
+    let on_base = base.map(|b| kept_by(b, n));
+    let limit = limit.min(n - landmarks.len());
+    landmarks_to_add(mesh, landmarks, &squashed, on_base.as_deref(), limit)
+}
+
+/// The landmarks with `more` added, sorted.
+pub(crate) fn merged(landmarks: &[u32], more: &[u32]) -> Vec<u32> {
+    let mut out = [landmarks, more].concat();
+    out.sort_unstable();
+    out
 }
 
 /// A heap entry of Dijkstra's algorithm (smallest distance first).

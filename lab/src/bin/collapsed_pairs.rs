@@ -9,6 +9,8 @@
 //! (`--no-cover`: without the landmarks added around thin parts), or, with `MESH=EMB.wavg`,
 //! its embedding is read. Reported per mesh and level:
 //! * `seconds`: the precomputation's wall time, and the landmarks it used;
+//! * `p50 / p90`: the precomputation's own quality check (relative error of embedded
+//!   against geodesic distance over 1,024 pairs, the default);
 //! * `random`: collapsed pairs among 2,048 seeded random pairs of distinct vertices, per
 //!   seed (the exact-geodesic comparison's sample, `lab/tools/exact_geodesics.py`; the
 //!   collapse needs no geodesic), and the smallest ratio over them all;
@@ -45,16 +47,20 @@ fn main() {
         }
     }
     println!(
-        "| mesh | level | vertices | landmarks | seconds (decimate / geodesics / lsmesh) | collapsed of 2,048 random (per seed) | min ratio (random) | all pairs: collapsed fraction | expected of 2,048 | vertices in one | min ratio | worst pair at | min ratio between landmarks |"
+        "| mesh | level | vertices | landmarks | seconds (decimate / geodesics / lsmesh) | p50 / p90 | collapsed of 2,048 random (per seed) | min ratio (random) | all pairs: collapsed fraction | expected of 2,048 | vertices in one | min ratio | worst pair at | min ratio between landmarks |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for spec in &meshes {
         let (mesh_path, emb_path) = match spec.split_once('=') {
             Some((m, e)) => (m, Some(e)),
             None => (spec.as_str(), None),
         };
         let base = match mesh_path.strip_prefix("body:") {
-            Some(seed) => procedural::body(&shape(seed.parse().expect("body:SEED"))),
+            Some(seed) => {
+                let shape = shape(seed.parse().expect("body:SEED"));
+                eprintln!("{mesh_path}: {shape:?}");
+                procedural::body(&shape)
+            }
             None => wavg_mesh::io::load(Path::new(mesh_path)).expect("mesh"),
         };
         for &level in &levels {
@@ -63,14 +69,14 @@ fn main() {
                 mesh =
                     ValidMesh::new(wavg_mesh::subdivide::loop_subdivide(&mesh).unwrap()).unwrap();
             }
-            let (emb, seconds) = match emb_path {
+            let (emb, seconds, errors) = match emb_path {
                 Some(e) if level == 0 => (
                     wavg_embed::file::load(Path::new(e), &mesh).expect("embedding"),
+                    "-".to_string(),
                     "-".to_string(),
                 ),
                 _ => {
                     let opts = PrecomputeOptions {
-                        quality_pairs: 0,
                         cover_thin_parts: cover,
                         ..Default::default()
                     };
@@ -80,7 +86,11 @@ fn main() {
                         "{:.2} ({:.2} / {:.2} / {:.2})",
                         report.seconds, st.decimate, st.geodesics, st.lsmesh
                     );
-                    (emb, parts)
+                    let errors = format!(
+                        "{:.4} / {:.4}",
+                        report.geodesic_rel_err_p50, report.geodesic_rel_err_p90
+                    );
+                    (emb, parts, errors)
                 }
             };
             let name = Path::new(mesh_path)
@@ -112,7 +122,7 @@ fn main() {
                 format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z)
             });
             println!(
-                "| {name} | {level} | {} | {} | {seconds} | {} | {min_random:.3} | {:.2e} | {:.3} | {} | {:.3} | {x}-{y} | {landmark_min:.3} |",
+                "| {name} | {level} | {} | {} | {seconds} | {errors} | {} | {min_random:.3} | {:.2e} | {:.3} | {} | {:.3} | {x}-{y} | {landmark_min:.3} |",
                 mesh.n_vertices(),
                 emb.landmarks.len(),
                 counts.join(" "),
