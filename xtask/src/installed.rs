@@ -165,6 +165,8 @@ pub fn wheels(root: &Path, data_dir: &Path, a: &Artifacts) -> Result<(), String>
             envs.push((*minor, python.clone(), numpy, major));
         }
     }
+    // The two with the package's tests (the longest) first, so neither ends alone.
+    envs.sort_by_key(|(minor, _, _, major)| !FULL_TESTS_IN.contains(&(*minor, *major)));
     crate::parallel::run(&envs, ENVS_AT_ONCE, |(minor, python, numpy, major)| {
         wheel_env(root, data_dir, a, minor, python, numpy, *major)
     })?;
