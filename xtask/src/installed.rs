@@ -145,21 +145,10 @@ fn smoke(version: &str, numpy_major: u32) -> String {
 
 /// The wheel in a fresh environment of each CPython found, with each NumPy series it has,
 /// no Rust on `PATH`: the smoke check and `python/examples/smoke.py`, then in
-/// [`FULL_TESTS_IN`] the package's tests. A Python that is not installed here is reported
-/// `SKIPPED` with how to get it.
+/// [`FULL_TESTS_IN`] the package's tests; [`ENVS_AT_ONCE`] environments at a time. A Python
+/// that is not installed here is reported `SKIPPED` with how to get it.
 pub fn wheels(root: &Path, data_dir: &Path, a: &Artifacts) -> Result<(), String> {
-    let base = steps::target_dir(root).join("dist-venvs");
-    let no_rust = path_without_rust();
-    let wheel = a.wheel.to_string_lossy();
-    let data = data_dir.to_string_lossy();
-    let tests_dir = root.join("python").join("tests");
-    let tests: Vec<String> = WHEEL_TESTS
-        .iter()
-        .map(|t| tests_dir.join(t).display().to_string())
-        .collect();
-    let smoke_script = root.join("python/examples/smoke.py");
-    let smoke_script = smoke_script.to_string_lossy();
-    let mut ran = 0;
+    let mut envs = Vec::new();
     for minor in PYTHONS {
         let Some(python) = find_python(minor) else {
             eprintln!(
@@ -173,49 +162,80 @@ pub fn wheels(root: &Path, data_dir: &Path, a: &Artifacts) -> Result<(), String>
                 eprintln!("    (NumPy 1.x has no wheels for CPython 3.13: 2.x only there)");
                 continue;
             }
-            let dir = base.join(format!("py{minor}-numpy{major}"));
-            let py = fresh_venv(root, &python, &dir)?;
-            let env = [("PATH", no_rust.as_str())];
-            pip(
-                root,
-                &py,
-                &["--only-binary=:all:", &wheel, numpy, PYTEST],
-                &env,
-            )?;
-            let sandbox = Sandbox::new(root, "wheel")?;
-            let py_s = py.to_string_lossy();
-            let home = sandbox.home();
-            sandbox.run(&home, &py_s, &["-c", &smoke(&a.version, major)], &env)?;
-            sandbox.run(&home, &py_s, &[&smoke_script], &env)?;
-            if !FULL_TESTS_IN.contains(&(*minor, major)) {
-                let _ = std::fs::remove_dir_all(&dir);
-                ran += 1;
-                continue;
-            }
-            let mut args = vec![
-                "-m",
-                "pytest",
-                "-q",
-                "-p",
-                "no:cacheprovider",
-                "-k",
-                SKIPPED_TESTS,
-            ];
-            args.extend(tests.iter().map(String::as_str));
-            sandbox.run(
-                &home,
-                &py_s,
-                &args,
-                &[("PATH", &no_rust), ("WAVG_DATA_DIR", &data)],
-            )?;
-            let _ = std::fs::remove_dir_all(&dir);
-            ran += 1;
+            envs.push((*minor, python.clone(), numpy, major));
         }
     }
+    // The two with the package's tests (the longest) first, so neither ends alone.
+    envs.sort_by_key(|(minor, _, _, major)| !FULL_TESTS_IN.contains(&(*minor, *major)));
+    crate::parallel::run(&envs, ENVS_AT_ONCE, |(minor, python, numpy, major)| {
+        wheel_env(root, data_dir, a, minor, python, numpy, *major)
+    })?;
     eprintln!(
-        "    the wheel passed in {ran} environments (the package's tests in {})",
+        "    the wheel passed in {} environments (the package's tests in {})",
+        envs.len(),
         FULL_TESTS_IN.len()
     );
+    Ok(())
+}
+
+/// How many of [`wheels`]' environments are made and tested at once: each is one
+/// single-threaded pip or Python process at a time, so two keep both cores busy.
+const ENVS_AT_ONCE: usize = 2;
+
+/// One environment of [`wheels`]: CPython `minor` (`python`) with `numpy` (series
+/// `major`), removed after its checks passed.
+fn wheel_env(
+    root: &Path,
+    data_dir: &Path,
+    a: &Artifacts,
+    minor: &str,
+    python: &Path,
+    numpy: &str,
+    major: u32,
+) -> Result<(), String> {
+    let name = format!("py{minor}-numpy{major}");
+    let dir = steps::target_dir(root).join("dist-venvs").join(&name);
+    let no_rust = path_without_rust();
+    let wheel = a.wheel.to_string_lossy();
+    let py = fresh_venv(root, python, &dir)?;
+    let env = [("PATH", no_rust.as_str())];
+    pip(
+        root,
+        &py,
+        &["--only-binary=:all:", &wheel, numpy, PYTEST],
+        &env,
+    )?;
+    let sandbox = Sandbox::new(root, &format!("wheel-{name}"))?;
+    let py_s = py.to_string_lossy();
+    let home = sandbox.home();
+    sandbox.run(&home, &py_s, &["-c", &smoke(&a.version, major)], &env)?;
+    let smoke_script = root.join("python/examples/smoke.py");
+    sandbox.run(&home, &py_s, &[&smoke_script.to_string_lossy()], &env)?;
+    if FULL_TESTS_IN.contains(&(minor, major)) {
+        let tests_dir = root.join("python").join("tests");
+        let tests: Vec<String> = WHEEL_TESTS
+            .iter()
+            .map(|t| tests_dir.join(t).display().to_string())
+            .collect();
+        let mut args = vec![
+            "-m",
+            "pytest",
+            "-q",
+            "-p",
+            "no:cacheprovider",
+            "-k",
+            SKIPPED_TESTS,
+        ];
+        args.extend(tests.iter().map(String::as_str));
+        let data = data_dir.to_string_lossy();
+        sandbox.run(
+            &home,
+            &py_s,
+            &args,
+            &[("PATH", &no_rust), ("WAVG_DATA_DIR", &data)],
+        )?;
+    }
+    let _ = std::fs::remove_dir_all(&dir);
     Ok(())
 }
 
@@ -289,17 +309,18 @@ pub fn c_tarball(root: &Path, data_dir: &Path, a: &Artifacts) -> Result<(), Stri
     )
 }
 
-/// The Blender zip in each Blender of [`BPY`]: validated by Blender's own
-/// `blender_ext.py validate`, installed with `bpy.ops.extensions.package_install_files`
-/// and the add-on's headless tests run (`blender/tests/run.py --extension`), each in a
-/// [`Sandbox`]. The environments with `bpy` are kept in [`cache_root`] (`bpy-X.Y.Z/`).
+/// The Blender zip in each Blender of [`BPY`], all at once (their environments are made
+/// and their tests run side by side): validated by Blender's own `blender_ext.py
+/// validate`, installed with `bpy.ops.extensions.package_install_files` and the add-on's
+/// headless tests run (`blender/tests/run.py --extension`), each in a [`Sandbox`]. The
+/// environments with `bpy` are kept in [`cache_root`] (`bpy-X.Y.Z/`).
 pub fn blender(root: &Path, a: &Artifacts) -> Result<(), String> {
     let Some(python) = find_python(BPY_PYTHON) else {
         eprintln!("SKIPPED Blender as a module: the bpy wheels need CPython {BPY_PYTHON}");
         return Ok(());
     };
     let zip = a.blender_zip.to_string_lossy();
-    for (series, pin) in BPY {
+    crate::parallel::run(BPY, BPY.len(), |(series, pin)| {
         let py = bpy_venv(root, &python, pin)?;
         let validator = find_validator(&py)?;
         let py_s = py.to_string_lossy();
@@ -317,9 +338,8 @@ pub fn blender(root: &Path, a: &Artifacts) -> Result<(), String> {
                 &["blender/tests/run.py", "--", "--zip", &zip, "--extension"],
                 &[],
             )
-            .map_err(|e| format!("Blender {series} ({pin}): {e}"))?;
-    }
-    Ok(())
+            .map_err(|e| format!("Blender {series} ({pin}): {e}"))
+    })
 }
 
 /// The environment with `bpy==pin`, made once in [`cache_root`] and reused while its

@@ -17,6 +17,7 @@ mod lab;
 mod lines;
 mod man;
 mod map;
+mod parallel;
 mod policy;
 mod python;
 mod sancov;
