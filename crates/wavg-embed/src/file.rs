@@ -84,8 +84,10 @@ fn header(emb: &Embedding, mesh: &TriMesh) -> Vec<u8> {
 fn write_embedding(emb: &Embedding, mesh: &TriMesh, w: &mut dyn Write) -> std::io::Result<()> {
     let tail = landmark_bytes(emb);
     let (head_tx, head_rx) = std::sync::mpsc::sync_channel(1);
+    let tail = &tail;
     std::thread::scope(|s| {
-        let hashing = s.spawn(|| {
+        // The sender moves into the thread: should it fail, `recv` returns.
+        let hashing = s.spawn(move || {
             let head = header(emb, mesh);
             let mut sum = WordHash::new();
             sum.bytes(&head);
@@ -95,13 +97,17 @@ fn write_embedding(emb: &Embedding, mesh: &TriMesh, w: &mut dyn Write) -> std::i
                     sum.word(x.to_bits());
                 }
             }
-            sum.bytes(&tail);
+            sum.bytes(tail);
             sum.finish()
         });
         let lost = || std::io::Error::other("the .wavg checksum thread failed");
-        let head: Vec<u8> = head_rx.recv().map_err(|_| lost())?;
+        let Ok(head) = head_rx.recv() else {
+            // Joined here, its panic is this error (not the scope's panic).
+            let _ = hashing.join();
+            return Err(lost());
+        };
         w.write_all(&head)?;
-        let mut buf = Vec::with_capacity(BLOCK_ROWS * emb.dim * 8);
+        let mut buf: Vec<u8> = Vec::with_capacity(BLOCK_ROWS * emb.dim * 8);
         for block in emb.coords.chunks(BLOCK_ROWS) {
             buf.clear();
             for c in block {
@@ -111,7 +117,7 @@ fn write_embedding(emb: &Embedding, mesh: &TriMesh, w: &mut dyn Write) -> std::i
             }
             w.write_all(&buf)?;
         }
-        w.write_all(&tail)?;
+        w.write_all(tail)?;
         let sum = hashing.join().map_err(|_| lost())?;
         w.write_all(&sum.to_le_bytes())
     })
@@ -609,7 +615,7 @@ mod tests {
         let mut sum = WordHash::new();
         sum.bytes(&head);
         w.write_all(&head)?;
-        let mut buf = Vec::with_capacity(BLOCK_ROWS * emb.dim * 8);
+        let mut buf: Vec<u8> = Vec::with_capacity(BLOCK_ROWS * emb.dim * 8);
         for block in emb.coords.chunks(BLOCK_ROWS) {
             buf.clear();
             for c in block {
