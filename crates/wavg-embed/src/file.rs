@@ -77,59 +77,32 @@ fn header(emb: &Embedding, mesh: &TriMesh) -> Vec<u8> {
 }
 
 /// Writes the version-2 bytes of `emb` (already checked by [`checked_len`]) to `w`, a
-/// block at a time. The hashing (the mesh fingerprint the header holds, then the checksum
-/// of every byte before it) runs on a thread of its own beside the conversion and writing
-/// of the coordinates: the bytes one thread hashing as it writes would give, with one
-/// pass less on the writer's path.
+/// block at a time, with the running checksum.
 fn write_embedding(emb: &Embedding, mesh: &TriMesh, w: &mut dyn Write) -> std::io::Result<()> {
-    let tail = landmark_bytes(emb);
-    let (head_tx, head_rx) = std::sync::mpsc::sync_channel(1);
-    let tail = &tail;
-    std::thread::scope(|s| {
-        // The sender moves into the thread: should it fail, `recv` returns.
-        let hashing = s.spawn(move || {
-            let head = header(emb, mesh);
-            let mut sum = WordHash::new();
-            sum.bytes(&head);
-            let _ = head_tx.send(head);
-            for c in &emb.coords {
-                for x in &c[..emb.dim] {
-                    sum.word(x.to_bits());
-                }
+    let head = header(emb, mesh);
+    let mut sum = WordHash::new();
+    sum.bytes(&head);
+    w.write_all(&head)?;
+    let mut buf = Vec::with_capacity(BLOCK_ROWS * emb.dim * 8);
+    for block in emb.coords.chunks(BLOCK_ROWS) {
+        buf.clear();
+        for c in block {
+            for x in &c[..emb.dim] {
+                let bits = x.to_bits();
+                sum.word(bits);
+                buf.extend_from_slice(&bits.to_le_bytes());
             }
-            sum.bytes(tail);
-            sum.finish()
-        });
-        let lost = || std::io::Error::other("the .wavg checksum thread failed");
-        let Ok(head) = head_rx.recv() else {
-            // Joined here, its panic is this error (not the scope's panic).
-            let _ = hashing.join();
-            return Err(lost());
-        };
-        w.write_all(&head)?;
-        let mut buf: Vec<u8> = Vec::with_capacity(BLOCK_ROWS * emb.dim * 8);
-        for block in emb.coords.chunks(BLOCK_ROWS) {
-            buf.clear();
-            for c in block {
-                for x in &c[..emb.dim] {
-                    buf.extend_from_slice(&x.to_bits().to_le_bytes());
-                }
-            }
-            w.write_all(&buf)?;
         }
-        w.write_all(tail)?;
-        let sum = hashing.join().map_err(|_| lost())?;
-        w.write_all(&sum.to_le_bytes())
-    })
-}
-
-/// The landmark ids as written: little-endian `u32`s, padded to whole 64-bit words.
-fn landmark_bytes(emb: &Embedding) -> Vec<u8> {
-    let mut b: Vec<u8> = emb.landmarks.iter().flat_map(|l| l.to_le_bytes()).collect();
-    if emb.landmarks.len() % 2 == 1 {
-        b.extend_from_slice(&[0u8; 4]);
+        w.write_all(&buf)?;
     }
-    b
+    buf.clear();
+    buf.extend(emb.landmarks.iter().flat_map(|l| l.to_le_bytes()));
+    if emb.landmarks.len() % 2 == 1 {
+        buf.extend_from_slice(&[0u8; 4]);
+    }
+    sum.bytes(&buf);
+    w.write_all(&buf)?;
+    w.write_all(&sum.finish().to_le_bytes())
 }
 
 /// Serialises `emb` for `mesh` into the version-2 byte layout.
@@ -605,84 +578,6 @@ mod tests {
 
     fn p() -> &'static Path {
         Path::new("test.wavg")
-    }
-
-    /// The version-2 bytes written by one thread, hashing as it goes: the definition
-    /// [`write_embedding`] must reproduce byte for byte (and the writer it replaced, for
-    /// the timing below).
-    fn write_serially(emb: &Embedding, mesh: &TriMesh, w: &mut dyn Write) -> std::io::Result<()> {
-        let head = header(emb, mesh);
-        let mut sum = WordHash::new();
-        sum.bytes(&head);
-        w.write_all(&head)?;
-        let mut buf: Vec<u8> = Vec::with_capacity(BLOCK_ROWS * emb.dim * 8);
-        for block in emb.coords.chunks(BLOCK_ROWS) {
-            buf.clear();
-            for c in block {
-                for x in &c[..emb.dim] {
-                    let bits = x.to_bits();
-                    sum.word(bits);
-                    buf.extend_from_slice(&bits.to_le_bytes());
-                }
-            }
-            w.write_all(&buf)?;
-        }
-        let tail = landmark_bytes(emb);
-        sum.bytes(&tail);
-        w.write_all(&tail)?;
-        w.write_all(&sum.finish().to_le_bytes())
-    }
-
-    /// Save time of the serial writer against [`save`]'s, alternated in one run (best of
-    /// 5 each), on `WAVG_SAVE_TIMING_MESH` with `WAVG_SAVE_TIMING_EMBEDDING` (its `.wavg`):
-    /// `cargo test --release -p wavg-embed --lib save_timing -- --ignored --nocapture`.
-    #[test]
-    #[ignore = "a timing on a large mesh named by environment variables"]
-    fn save_timing() {
-        let var = |v| std::env::var(v).unwrap_or_else(|_| panic!("set {v}"));
-        let mesh = wavg_mesh::io::load(Path::new(&var("WAVG_SAVE_TIMING_MESH"))).unwrap();
-        let given = var("WAVG_SAVE_TIMING_EMBEDDING");
-        let emb = load(Path::new(&given), &mesh).unwrap();
-        let dir = std::path::PathBuf::from(format!("{given}.timing"));
-        std::fs::create_dir_all(&dir).unwrap();
-        let (old, new) = (dir.join("serial.wavg"), dir.join("parallel.wavg"));
-        let (mut t_old, mut t_new) = (f64::INFINITY, f64::INFINITY);
-        for _ in 0..5 {
-            let t = std::time::Instant::now();
-            wavg_mesh::io::write_atomic(&old, |w| write_serially(&emb, &mesh, w)).unwrap();
-            t_old = t_old.min(t.elapsed().as_secs_f64());
-            let t = std::time::Instant::now();
-            save(&new, &emb, &mesh).unwrap();
-            t_new = t_new.min(t.elapsed().as_secs_f64());
-        }
-        let same = std::fs::read(&old).unwrap() == std::fs::read(&new).unwrap();
-        let given_same = std::fs::read(&given).unwrap() == std::fs::read(&new).unwrap();
-        std::fs::remove_dir_all(&dir).unwrap();
-        println!(
-            "{} vertices: serial save {t_old:.3} s, parallel hashing {t_new:.3} s \
-             ({:.2}x); same bytes: {same}, same as the given file: {given_same}",
-            mesh.n_vertices(),
-            t_old / t_new
-        );
-        assert!(same);
-    }
-
-    /// The writer's hashing thread changes no byte: encoded and saved files equal the
-    /// serial definition, over several blocks, every dimension and both landmark parities.
-    #[test]
-    fn the_parallel_writer_writes_the_serial_bytes() {
-        let mesh = procedural::torus(256, 160, 1.0, 0.3);
-        assert!(mesh.n_vertices() > 2 * BLOCK_ROWS);
-        let dir = tempfile::tempdir().unwrap();
-        for (dim, k) in [(8, 7), (3, 8), (1, 0)] {
-            let emb = sample(&mesh, dim, k, 5 + k as u64);
-            let mut reference = Vec::new();
-            write_serially(&emb, &mesh, &mut reference).unwrap();
-            assert_eq!(encode(&emb, &mesh).unwrap(), reference, "dim {dim}");
-            let path = dir.path().join("t.wavg");
-            save(&path, &emb, &mesh).unwrap();
-            assert_eq!(std::fs::read(&path).unwrap(), reference, "dim {dim}");
-        }
     }
 
     /// A version-1 file as the version-1 writer made it: the same layout, version 1, the
