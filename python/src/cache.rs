@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use pyo3::prelude::*;
 use wavg::cache::Cache;
-use wavg::{CacheOutcome, Embedding, Provenance};
+use wavg::{CacheOutcome, EmbeddingSummary, Provenance};
 
 use crate::errors::{lib, value};
 
@@ -37,11 +37,12 @@ pub(crate) fn resolve(cache: Option<&Bound<'_, PyAny>>, auto: bool) -> PyResult<
 /// The report `Surface.precompute` returns: the precomputation's (the keys of `wavg
 /// precompute --json`) when it ran, else what the cached embedding says of itself; both
 /// with `cached` (bool) and `cache_path` (the entry, or None). Warns (`UserWarning`) when an
-/// entry could not be used or written.
+/// entry could not be used or written. `embedding` is the surface's summary, not its
+/// embedding: a cache hit is reported without copying the coordinates.
 pub(crate) fn report(
     py: Python<'_>,
     outcome: &CacheOutcome,
-    embedding: Option<&Embedding>,
+    embedding: Option<EmbeddingSummary>,
     n: (usize, usize),
 ) -> PyResult<Py<PyAny>> {
     let warn = |msg: String| -> PyResult<()> {
@@ -73,15 +74,9 @@ pub(crate) fn report(
         }
         Provenance::Cached(p) => {
             let e = embedding.ok_or_else(|| value("no embedding"))?;
-            let v = serde_json::json!({
-                "landmarks": e.landmarks.len(),
-                "dim": e.dim,
-                "stress": e.stress,
-                "geodesic_rel_err_p50": e.geodesic_rel_err_p50,
-                "geodesic_rel_err_p90": e.geodesic_rel_err_p90,
-                "vertices": n.0,
-                "faces": n.1,
-            });
+            let mut v = serde_json::to_value(e).map_err(|e| value(e.to_string()))?;
+            v["vertices"] = n.0.into();
+            v["faces"] = n.1.into();
             (v, true, Some(p.clone()))
         }
     };

@@ -228,7 +228,7 @@ impl Surface {
             .map_err(|e| value(format!("threads: {e}")))?
             .map_err(|e| to_py(py, e))?;
         let n = (s.n_vertices(), s.n_faces());
-        let report = crate::cache::report(py, &outcome, s.embedding(), n)?;
+        let report = crate::cache::report(py, &outcome, s.embedding_summary(), n)?;
         slf.borrow_mut().inner = s;
         Ok(report)
     }

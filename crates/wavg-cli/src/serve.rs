@@ -5,9 +5,10 @@
 use std::io::IsTerminal;
 use std::net::IpAddr;
 use std::path::PathBuf;
-use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
-use std::time::Instant;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
 use wavg::Surface;
 
@@ -32,7 +33,8 @@ progress, and the computing routes answer 503 until it is ready; then it is stor
 cache as the other commands do (not with --no-cache).
 
 Only this machine can connect unless --host names another interface (a warning is
-printed: anyone who can reach it can use the server). Ctrl-C stops the server.")]
+printed: anyone who can reach it can use the server). Ctrl-C (SIGINT) stops the server,
+also one started in the background of a script, with exit status 130.")]
 pub struct Args {
     #[command(flatten)]
     pub mesh: crate::mesh_arg::MeshArg,
@@ -53,8 +55,14 @@ pub struct Args {
     pub open: bool,
 }
 
-/// Runs the command (until the process is stopped).
+/// How long a stopping server waits for the requests it is answering, and then for the
+/// background precomputation to see the cancellation (and not leave a cache entry half
+/// written).
+const GRACE: Duration = Duration::from_secs(2);
+
+/// Runs the command until Ctrl-C (SIGINT: exit status 130) or another signal ends it.
 pub fn run(args: Args) -> Result<(), CliError> {
+    let interrupt = Interrupt::install();
     let mesh_name = args.mesh.to_string();
     let mesh = load_valid(&mesh_name)?;
     let embedding = args
@@ -67,6 +75,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let addr = std::net::SocketAddr::new(args.host, args.port);
     let server = wavg_serve::start(app.clone(), &addr.to_string())
         .map_err(|e| CliError::input(format!("cannot listen on {addr}: {e}")))?;
+    interrupt.serving(server.stopper());
     let addr = server.addr();
     if !args.host.is_loopback() {
         eprintln!(
@@ -77,11 +86,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     let url = format!("http://{addr}/");
     println!("{mesh_name}: {n} vertices, {m} faces; serving {url} (Ctrl-C to stop)");
+    let mut reporter = None;
     if embedding.is_none() {
         eprintln!("precomputing the embedding (the page shows the mesh meanwhile)...");
         let bars: Box<dyn wavg::Progress + Send> = Box::new(Bars::new(
             std::io::stderr().is_terminal(),
-            Arc::new(AtomicBool::new(false)),
+            interrupt.flag.clone(),
         ));
         let t = Instant::now();
         let info = wavg::cache::EntryInfo::new(mesh_name.clone(), "serve");
@@ -89,7 +99,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let handle = app.precompute_with_cache(Some(bars), cache, info);
         let app2 = app.clone();
         let name = mesh_name.clone();
-        std::thread::spawn(move || {
+        let interrupted = interrupt.flag.clone();
+        reporter = Some(std::thread::spawn(move || {
             let outcome = handle.join().ok().flatten();
             match app2.status() {
                 wavg_serve::Status::Ready => {
@@ -108,9 +119,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
                         );
                     }
                 }
+                _ if interrupted.load(Ordering::SeqCst) => {}
                 s => eprintln!("wavg: the embedding could not be computed: {s:?}"),
             }
-        });
+        }));
     }
     if args.open {
         let opener = if cfg!(target_os = "macos") {
@@ -122,6 +134,57 @@ pub fn run(args: Args) -> Result<(), CliError> {
             eprintln!("wavg: could not open a browser ({opener}: {e}); open {url} yourself");
         }
     }
-    server.join();
-    Ok(())
+    server.serve_until_stopped(GRACE);
+    if !interrupt.flag.load(Ordering::SeqCst) {
+        return Ok(());
+    }
+    wait_at_most(reporter, GRACE);
+    Err(CliError {
+        code: 130,
+        message: "interrupted; the server stopped".into(),
+    })
+}
+
+/// Ctrl-C while `wavg serve` runs. The handler is set whatever the process inherited, so
+/// a server started in the background of a script (where the shell ignores SIGINT for
+/// it) stops on SIGINT too. Before the server listens, the command ends at once (reading
+/// a large mesh cannot stop partway and leaves nothing behind); afterwards the server
+/// stops taking requests and the background precomputation is cancelled.
+struct Interrupt {
+    /// Set by the handler; the precomputation's cancellation token.
+    flag: Arc<AtomicBool>,
+    stopper: Arc<Mutex<Option<wavg_serve::Stopper>>>,
+}
+
+impl Interrupt {
+    fn install() -> Self {
+        let flag = Arc::new(AtomicBool::new(false));
+        let stopper: Arc<Mutex<Option<wavg_serve::Stopper>>> = Arc::default();
+        let (f, s) = (flag.clone(), stopper.clone());
+        let _ = ctrlc::set_handler(move || {
+            f.store(true, Ordering::SeqCst);
+            match s.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
+                Some(stopper) => stopper.stop(),
+                None => {
+                    eprintln!("wavg: interrupted");
+                    std::process::exit(130);
+                }
+            }
+        });
+        Self { flag, stopper }
+    }
+
+    /// From now on Ctrl-C stops `stopper`'s server.
+    fn serving(&self, stopper: wavg_serve::Stopper) {
+        *self.stopper.lock().unwrap_or_else(|e| e.into_inner()) = Some(stopper);
+    }
+}
+
+/// Waits for `thread` to finish, for at most `limit`.
+fn wait_at_most(thread: Option<JoinHandle<()>>, limit: Duration) {
+    let Some(thread) = thread else { return };
+    let t = Instant::now();
+    while !thread.is_finished() && t.elapsed() < limit {
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }

@@ -33,14 +33,41 @@ impl Running {
 
     /// Stops taking requests and waits (up to a minute) for the ones being answered.
     pub fn stop(self) {
-        self.server.unblock();
-        let _ = self.acceptor.join();
-        self.in_flight.wait_for_zero(Duration::from_secs(60));
+        self.stopper().stop();
+        self.serve_until_stopped(Duration::from_secs(60));
     }
 
     /// Serves until the process ends.
     pub fn join(self) {
         let _ = self.acceptor.join();
+    }
+
+    /// A handle that stops this server from another thread (a signal handler's).
+    pub fn stopper(&self) -> Stopper {
+        Stopper {
+            server: self.server.clone(),
+        }
+    }
+
+    /// Serves until a [`Stopper`] stops it (or the process ends), then waits up to `grace`
+    /// for the requests being answered.
+    pub fn serve_until_stopped(self, grace: Duration) {
+        let _ = self.acceptor.join();
+        self.in_flight.wait_for_zero(grace);
+    }
+}
+
+/// Stops a [`Running`] server from any thread: requests already received are still
+/// answered, then it takes no more and [`Running::serve_until_stopped`] returns.
+#[derive(Clone)]
+pub struct Stopper {
+    server: Arc<Server>,
+}
+
+impl Stopper {
+    /// Asks the server to stop (returns at once; a second call does nothing more).
+    pub fn stop(&self) {
+        self.server.unblock();
     }
 }
 

@@ -37,7 +37,7 @@ mod routes;
 mod state;
 
 pub use error::{ApiError, status_of};
-pub use http::{Running, start};
+pub use http::{Running, Stopper, start};
 pub use meshbin::encode_mesh;
 pub use state::{App, Status};
 

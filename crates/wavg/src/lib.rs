@@ -58,7 +58,7 @@ pub use precompute::{
     CacheOutcome, DEFAULT_LANDMARKS, Provenance, check_embeddable, default_precompute_options,
     embedding_cached, precompute, resolve_landmarks,
 };
-pub use surface::Surface;
+pub use surface::{EmbeddingSummary, Surface};
 pub use texture::mesh_texture;
 
 /// The crate's README (its page on the registry) compiles and runs as written.

@@ -36,6 +36,23 @@ pub struct Surface {
     inner: Arc<Inner>,
 }
 
+/// What an embedding says of itself, without its coordinates
+/// ([`Surface::embedding_summary`]): the figures a cached embedding is reported with
+/// (serialised with these names).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct EmbeddingSummary {
+    /// Number of landmark vertices.
+    pub landmarks: usize,
+    /// Dimension in use.
+    pub dim: usize,
+    /// Final MDS stress of the landmark embedding.
+    pub stress: f64,
+    /// Median relative error of embedding vs geodesic distance (NaN if not measured).
+    pub geodesic_rel_err_p50: f64,
+    /// 90th percentile of the same (NaN if not measured).
+    pub geodesic_rel_err_p90: f64,
+}
+
 struct Inner {
     mesh: Arc<ValidMesh>,
     /// The embedding's landmarks and parameters, its coordinates left empty: they are kept
@@ -236,6 +253,19 @@ impl Surface {
         self.inner.embedding.is_some()
     }
 
+    /// The computed or loaded embedding's landmark count, dimension and quality figures,
+    /// without [`Surface::embedding`]'s copy of its coordinates; `None` while the 3-D
+    /// positions serve as one.
+    pub fn embedding_summary(&self) -> Option<EmbeddingSummary> {
+        self.inner.embedding.as_ref().map(|e| EmbeddingSummary {
+            landmarks: e.landmarks.len(),
+            dim: e.dim,
+            stress: e.stress,
+            geodesic_rel_err_p50: e.geodesic_rel_err_p50,
+            geodesic_rel_err_p90: e.geodesic_rel_err_p90,
+        })
+    }
+
     /// Every vertex's point in R^8 (3-D positions padded with zeros when there is no
     /// embedding).
     pub fn embedded_coords(&self) -> &[Vec8] {
@@ -335,6 +365,15 @@ mod tests {
             "moved, not copied"
         );
         assert!(s.has_embedding());
+        let summary = s.embedding_summary().unwrap();
+        assert_eq!(
+            (summary.landmarks, summary.dim, summary.stress),
+            (e.landmarks.len(), e.dim, e.stress)
+        );
+        assert_eq!(
+            summary.geodesic_rel_err_p90.to_bits(),
+            e.geodesic_rel_err_p90.to_bits()
+        );
         assert!(s.inner.whole.get().is_none(), "nothing copied yet");
         assert!(s.inner.embedding.as_ref().unwrap().coords.is_empty());
         assert_eq!(s.landmarks(), e.landmarks.as_slice());
@@ -343,6 +382,7 @@ mod tests {
         assert!(std::ptr::eq(s.embedding().unwrap(), s.embedding().unwrap()));
         let plain = Surface::from_valid(s.mesh().clone()).unwrap();
         assert!(!plain.has_embedding() && plain.embedding().is_none());
+        assert!(plain.embedding_summary().is_none());
     }
 
     /// The coordinates' allocation is reused when they move into the projector.

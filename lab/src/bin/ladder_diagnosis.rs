@@ -5,32 +5,14 @@
 //!
 //! `cargo xtask lab ladder_diagnosis MESH EMB.wavg QUERIES`
 
-use std::sync::Arc;
-
-use wavg_mesh::ValidMesh;
 use wavg_solve::internal::penalized_weights;
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
-use wavg_solve::{
-    Anchor, EmbeddedMesh, ForwardOptions, PENALTY_LADDER, Projector, SearchMode, Solver, Vec8,
-};
+use wavg_solve::{Anchor, ForwardOptions, PENALTY_LADDER, SearchMode, Solver};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let mesh = if let Some(name) = args[1].strip_prefix("builtin:") {
-        Arc::new(ValidMesh::new(wavg_mesh::procedural::builtin(name).unwrap()).unwrap())
-    } else {
-        Arc::new(
-            ValidMesh::new(wavg_mesh::io::load(std::path::Path::new(&args[1])).unwrap()).unwrap(),
-        )
-    };
-    let e = wavg_embed::file::load(std::path::Path::new(&args[2]), &mesh).unwrap();
-    let emb = EmbeddedMesh::new(
-        mesh.clone(),
-        e.coords.iter().map(|c| Vec8::from(*c)).collect(),
-    )
-    .unwrap();
+    let (mesh, proj) = wavg_lab::mesh_and_projector(&args[1], &args[2]);
     let nq: usize = args[3].parse().unwrap();
-    let proj = Arc::new(Projector::new(Arc::new(emb)).unwrap());
     let anchors = farthest_point_vertices(&mesh, 93, 0, FpsMetric::EdgeGraph).unwrap();
     let solver = Solver::new(proj, anchors.iter().map(|&v| Anchor::Vertex(v))).unwrap();
     let points = uniform_surface_points(&mesh, nq, 1).unwrap();

@@ -12,14 +12,11 @@
 //!
 //! Prints the ladder's counts: points that climb it, rungs tried, points not reached.
 
-use std::sync::Arc;
-
 use wavg_mesh::SurfacePoint;
-use wavg_mesh::ValidMesh;
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
 use wavg_solve::{
-    Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, ForwardResult, ForwardScratch,
-    PENALTY_LADDER, Par, Projector, RoundTrip, SearchMode, SolveError, Solver, Vec8,
+    Anchor, BatchWeights, ForwardOptions, ForwardResult, ForwardScratch, PENALTY_LADDER, Par,
+    RoundTrip, SearchMode, SolveError, Solver,
 };
 
 #[inline(never)]
@@ -68,21 +65,8 @@ fn measured_verified(
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let mesh = if let Some(name) = args[1].strip_prefix("builtin:") {
-        Arc::new(ValidMesh::new(wavg_mesh::procedural::builtin(name).unwrap()).unwrap())
-    } else {
-        Arc::new(
-            ValidMesh::new(wavg_mesh::io::load(std::path::Path::new(&args[1])).unwrap()).unwrap(),
-        )
-    };
-    let e = wavg_embed::file::load(std::path::Path::new(&args[2]), &mesh).unwrap();
-    let emb = EmbeddedMesh::new(
-        mesh.clone(),
-        e.coords.iter().map(|c| Vec8::from(*c)).collect(),
-    )
-    .unwrap();
+    let (mesh, proj) = wavg_lab::mesh_and_projector(&args[1], &args[2]);
     let nq: usize = args.get(3).map_or(10_000, |q| q.parse().unwrap());
-    let proj = Arc::new(Projector::new(Arc::new(emb)).unwrap());
     let anchors = farthest_point_vertices(&mesh, 93, 0, FpsMetric::EdgeGraph).unwrap();
     let solver = Solver::new(proj, anchors.iter().map(|&v| Anchor::Vertex(v))).unwrap();
     let points = uniform_surface_points(&mesh, nq, 1).unwrap();

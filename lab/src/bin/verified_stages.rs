@@ -8,34 +8,23 @@
 //! `cargo xtask lab verified_stages MESH EMB.wavg ANCHORS QUERIES [THREADS]` (with
 //! `VERIFIED_ONLY` set: only the library's verified batch, five times, for a profiler)
 
-use std::sync::Arc;
 use std::time::Instant;
 
 use rayon::prelude::*;
 
-use wavg_mesh::ValidMesh;
 use wavg_solve::internal::penalized_weights;
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices, uniform_surface_points};
 use wavg_solve::{
-    Anchor, BatchWeights, EmbeddedMesh, ForwardOptions, ForwardScratch, PENALTY_LADDER, Par,
-    ProjectionPath, Projector, Solver, Vec8,
+    Anchor, BatchWeights, ForwardOptions, ForwardScratch, PENALTY_LADDER, Par, ProjectionPath,
+    Solver,
 };
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let mesh = Arc::new(
-        ValidMesh::new(wavg_mesh::io::load(std::path::Path::new(&args[1])).unwrap()).unwrap(),
-    );
-    let e = wavg_embed::file::load(std::path::Path::new(&args[2]), &mesh).unwrap();
-    let emb = EmbeddedMesh::new(
-        mesh.clone(),
-        e.coords.iter().map(|c| Vec8::from(*c)).collect(),
-    )
-    .unwrap();
+    let (mesh, proj) = wavg_lab::mesh_and_projector(&args[1], &args[2]);
     let k: usize = args[3].parse().unwrap();
     let nq: usize = args[4].parse().unwrap();
     let threads: usize = args.get(5).map_or(2, |t| t.parse().unwrap());
-    let proj = Arc::new(Projector::new(Arc::new(emb)).unwrap());
     let anchors = farthest_point_vertices(&mesh, k, 0, FpsMetric::EdgeGraph).unwrap();
     let solver = Solver::new(proj, anchors.iter().map(|&v| Anchor::Vertex(v))).unwrap();
     let points = uniform_surface_points(&mesh, nq, 0).unwrap();

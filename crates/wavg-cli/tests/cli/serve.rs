@@ -155,3 +155,83 @@ fn other_hosts_get_a_warning_and_bad_meshes_fail() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// Starts `wavg serve ARGS --port 0` the way a non-interactive script's `&` does, with
+/// SIGINT ignored (`trap "" INT` is inherited through `exec`); returns the child (its
+/// id is the server's) and the address.
+#[cfg(unix)]
+fn serve_with_sigint_ignored(args: &[&str], cache: &std::path::Path) -> (Child, String) {
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg("trap '' INT; exec \"$0\" serve \"$@\" --port 0")
+        .arg(env!("CARGO_BIN_EXE_wavg"))
+        .args(args)
+        .env("WAVG_CACHE_DIR", cache)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let addr = line
+        .split("serving http://")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no address in {line:?}"))
+        .split('/')
+        .next()
+        .unwrap()
+        .to_string();
+    (child, addr)
+}
+
+/// Sends SIGINT to `child` and returns its exit status (None: still running after 10 s,
+/// then killed) and standard error.
+#[cfg(unix)]
+fn interrupt(mut child: Child) -> (Option<i32>, String, Duration) {
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let t = Instant::now();
+    while t.elapsed() < Duration::from_secs(10) {
+        if let Some(status) = child.try_wait().unwrap() {
+            let waited = t.elapsed();
+            let mut err = String::new();
+            child
+                .stderr
+                .take()
+                .unwrap()
+                .read_to_string(&mut err)
+                .unwrap();
+            return (status.code(), err, waited);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    (None, kill_for_stderr(&mut child), t.elapsed())
+}
+
+/// Ctrl-C stops the server even when it was started with SIGINT ignored (in the
+/// background of a script): exit status 130 within seconds, while the embedding is
+/// still being precomputed and once it is ready.
+#[cfg(unix)]
+#[test]
+fn sigint_stops_a_server_started_with_sigint_ignored() {
+    let dir = cache_dir("sigint");
+    // Precomputing (no cache): SIGINT at once, the precomputation is cancelled.
+    let (child, addr) = serve_with_sigint_ignored(&["builtin:torus", "--no-cache"], &dir);
+    assert!(get(&addr, "/api/info").starts_with("HTTP/1.1 200"));
+    let (code, err, waited) = interrupt(child);
+    assert_eq!(code, Some(130), "{err}");
+    assert!(waited < Duration::from_secs(5), "{waited:?}: {err}");
+    assert!(err.contains("interrupted"), "{err}");
+    assert!(!err.contains("could not be computed"), "{err}");
+    // Ready, serving.
+    let (child, addr) = serve_with_sigint_ignored(&["builtin:sphere-small", "--no-cache"], &dir);
+    wait_ready(&addr);
+    let (code, err, waited) = interrupt(child);
+    assert_eq!(code, Some(130), "{err}");
+    assert!(waited < Duration::from_secs(5), "{waited:?}: {err}");
+}
