@@ -220,8 +220,13 @@ pub fn check_outputs(
         if let Some(dir) = parent
             && !dir.is_dir()
         {
+            let why = if dir.exists() {
+                "is not a folder"
+            } else {
+                "does not exist"
+            };
             return Err(CliError::input(format!(
-                "{opt} {}: the folder {} does not exist",
+                "{opt} {}: the folder {} {why}",
                 path.display(),
                 dir.display()
             )));
