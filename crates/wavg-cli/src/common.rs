@@ -221,15 +221,11 @@ pub fn check_outputs(
             && !dir.is_dir()
         {
             let why = if dir.exists() {
-                "is not a folder"
+                format!("{} is not a folder", dir.display())
             } else {
-                "does not exist"
+                format!("the folder {} does not exist", dir.display())
             };
-            return Err(CliError::input(format!(
-                "{opt} {}: the folder {} {why}",
-                path.display(),
-                dir.display()
-            )));
+            return Err(CliError::input(format!("{opt} {}: {why}", path.display())));
         }
         for &(other, q) in &outputs[..i] {
             if same_file(q, path) {
