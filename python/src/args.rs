@@ -68,7 +68,16 @@ fn coerce<'py, T: numpy::Element>(
         },
     )?;
     let c = np.call_method("ascontiguousarray", (arr,), Some(&kwargs))?;
-    let c = c.cast_into::<PyArrayDyn<T>>().map_err(PyErr::from)?;
+    let mut c = c.cast_into::<PyArrayDyn<T>>().map_err(PyErr::from)?;
+    // `ascontiguousarray` keeps an unaligned array (a view at an odd byte offset of a
+    // buffer, a field of a packed record) as it is, and no slice can be made of one: copy
+    // it into an aligned array.
+    if !c.is_aligned() {
+        c = c
+            .call_method0("copy")?
+            .cast_into::<PyArrayDyn<T>>()
+            .map_err(PyErr::from)?;
+    }
     Ok(c.readonly())
 }
 
@@ -122,7 +131,7 @@ fn check_shape<T: numpy::Element>(
 
 /// The contiguous data of a coerced array.
 pub(crate) fn data<'a, T: numpy::Element>(a: &'a PyReadonlyArrayDyn<'_, T>) -> &'a [T] {
-    // Coerced arrays are C-contiguous.
+    // Coerced arrays are C-contiguous and aligned.
     a.as_slice().unwrap_or(&[])
 }
 

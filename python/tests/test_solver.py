@@ -59,6 +59,12 @@ def test_weights_dtype_and_layout(solver):
         assert np.array_equal(solver.forward(W2).xyz, ref.xyz)
     W32 = W.astype(np.float32)
     assert np.array_equal(solver.forward(W32).xyz, solver.forward(W32.astype(np.float64)).xyz)
+    # An unaligned array (a view at an odd byte offset of a buffer) is read, not taken as empty.
+    buf = bytearray(W.nbytes + 1)
+    Wu = np.frombuffer(buf, dtype=W.dtype, count=W.size, offset=1).reshape(W.shape)
+    Wu[...] = W
+    assert not Wu.flags.aligned
+    assert np.array_equal(solver.forward(Wu).xyz, ref.xyz)
 
 
 def test_threads_equal_one_thread(solver):

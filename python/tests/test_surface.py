@@ -58,7 +58,18 @@ def test_embedding_of_another_mesh_is_refused(tmp_path, surface):
     assert other.embedding is None
 
 
-@pytest.mark.parametrize("variant", ["float32", "fortran", "slice", "list", "int32", "uint16"])
+def unaligned(a):
+    """A C-contiguous copy of `a` at an odd byte offset of a buffer (NumPy flags it unaligned)."""
+    buf = bytearray(a.nbytes + 1)
+    u = np.frombuffer(buf, dtype=a.dtype, count=a.size, offset=1).reshape(a.shape)
+    u[...] = a
+    assert not u.flags.aligned and u.flags.c_contiguous
+    return u
+
+
+@pytest.mark.parametrize(
+    "variant", ["float32", "fortran", "slice", "list", "int32", "uint16", "unaligned"]
+)
 def test_dtype_and_layout_variants(variant, torus_mesh):
     V, F = torus_mesh
     if variant == "float32":
@@ -73,8 +84,10 @@ def test_dtype_and_layout_variants(variant, torus_mesh):
         V2, F2, Vexp = V.tolist(), F.tolist(), V
     elif variant == "int32":
         V2, F2, Vexp = V, F.astype(np.int32), V
-    else:
+    elif variant == "uint16":
         V2, F2, Vexp = V, F.astype(np.uint16), V
+    else:
+        V2, F2, Vexp = unaligned(V), unaligned(F), V
     S = wavg.Surface(V2, F2)
     assert np.array_equal(S.vertices, Vexp) and np.array_equal(S.faces, F)
 

@@ -220,11 +220,12 @@ pub fn check_outputs(
         if let Some(dir) = parent
             && !dir.is_dir()
         {
-            return Err(CliError::input(format!(
-                "{opt} {}: the folder {} does not exist",
-                path.display(),
-                dir.display()
-            )));
+            let why = if dir.exists() {
+                format!("{} is not a folder", dir.display())
+            } else {
+                format!("the folder {} does not exist", dir.display())
+            };
+            return Err(CliError::input(format!("{opt} {}: {why}", path.display())));
         }
         for &(other, q) in &outputs[..i] {
             if same_file(q, path) {

@@ -32,6 +32,10 @@ fn bad_outputs_are_refused_before_any_work() {
         &["subdivide", &mesh, "-o", &d("nodir/x.obj")],
         "does not exist",
     );
+    refused(
+        &["subdivide", &mesh, "-o", &d("m.obj/x.obj")],
+        "is not a folder",
+    );
     let spline = |out: &str| {
         let args = [
             "spline",
