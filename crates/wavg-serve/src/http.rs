@@ -142,6 +142,10 @@ pub fn start(app: App, addr: &str) -> Result<Running, std::io::Error> {
     })
 }
 
+/// The largest declared body over [`MAX_BODY`] that is drained after its 413 answer (so
+/// that the connection closes); a larger declared length keeps its connection instead.
+const MAX_DRAINED: usize = 256 << 20;
+
 /// Reads, routes (once fewer than [`WORKERS`] requests are `computing`) and answers one
 /// request.
 fn answer(app: &App, mut request: Request, computing: &Counter) {
@@ -176,6 +180,13 @@ fn answer(app: &App, mut request: Request, computing: &Counter) {
         );
         if let Ok(h) = ty {
             response.add_header(h);
+        }
+        if request.body_length().is_some_and(|n| n > MAX_DRAINED) {
+            // tiny_http drains an unread body into one buffer of the length still declared;
+            // a length beyond memory would abort the server. The answer is written and the
+            // connection kept, unread, until the process ends.
+            std::mem::forget(request.upgrade("close", response));
+            return;
         }
         let _ = request.respond(response);
         return;
