@@ -120,6 +120,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
                     }
                 }
                 _ if interrupted.load(Ordering::SeqCst) => {}
+                wavg_serve::Status::Failed(m) => {
+                    eprintln!("wavg: the embedding could not be computed: {m}")
+                }
                 s => eprintln!("wavg: the embedding could not be computed: {s:?}"),
             }
         }));

@@ -87,9 +87,21 @@ pub fn available_memory() -> Option<(u64, &'static str)> {
     }
 }
 
-/// Refuses a precomputation of `vertices` vertices that needs more than `available`.
-pub(crate) fn check_fits(vertices: usize, available: Option<(u64, &'static str)>) -> Result<()> {
-    let needed = precompute_peak_bytes(vertices);
+/// Bytes of dense landmark-by-landmark matrices a precomputation holds per landmark pair.
+const LANDMARK_PAIR_BYTES: u64 = 40;
+
+/// Refuses a precomputation of `vertices` vertices that needs more than `available`;
+/// `landmarks` adds what their dense matrices take (the MDS's distances, Gram matrix and
+/// eigenvectors, the extension's landmark rows: about 40 bytes a landmark pair), which is
+/// small at the default 1,000 but dominates when nearly every vertex is one.
+pub(crate) fn check_fits(
+    vertices: usize,
+    landmarks: usize,
+    available: Option<(u64, &'static str)>,
+) -> Result<()> {
+    let landmarks = landmarks.min(vertices) as u64;
+    let needed = precompute_peak_bytes(vertices)
+        .saturating_add(LANDMARK_PAIR_BYTES.saturating_mul(landmarks.saturating_mul(landmarks)));
     match available {
         Some((available, source)) if needed > available => {
             Err(Error::OutOfMemory(Box::new(MemoryShortfall {
@@ -156,7 +168,7 @@ mod tests {
 
     #[test]
     fn a_mesh_beyond_the_available_memory_is_refused_with_both_figures() {
-        let e = check_fits(3_000_000, Some((2_000_000_000, "a test"))).unwrap_err();
+        let e = check_fits(3_000_000, 0, Some((2_000_000_000, "a test"))).unwrap_err();
         assert_eq!(e.kind(), ErrorKind::OutOfMemory);
         assert!(!e.kind().is_callers_fault());
         let m = e.message();
@@ -165,8 +177,8 @@ mod tests {
             "{m}"
         );
         assert!(m.contains("2.00 GB are available (a test)"), "{m}");
-        assert!(check_fits(3_000_000, Some((3_200_000_000, "a test"))).is_ok());
-        assert!(check_fits(3_000_000, None).is_ok());
+        assert!(check_fits(3_000_000, 1_000, Some((3_200_000_000, "a test"))).is_ok());
+        assert!(check_fits(3_000_000, 1_000, None).is_ok());
         // Small meshes follow the lower line: 320 MB for 10,000 vertices.
         assert_eq!(precompute_peak_bytes(10_000), 320_000_000);
         assert_eq!(
@@ -177,7 +189,19 @@ mod tests {
         // vertex at 10.3M), and a 10.3M-vertex mesh fits a machine with 8.5 GB free.
         assert!(precompute_peak_bytes(3_102_914) > 2_502_500_000);
         assert!(precompute_peak_bytes(10_285_056) > 7_431_000_000);
-        assert!(check_fits(10_285_056, Some((8_500_000_000, "a test"))).is_ok());
+        assert!(check_fits(10_285_056, 1_000, Some((8_500_000_000, "a test"))).is_ok());
+    }
+
+    #[test]
+    fn landmarks_count_in_the_estimate() {
+        // Every vertex of a 100k-vertex mesh as a landmark needs its dense matrices (400 GB);
+        // the default 1,000 add 40 MB.
+        let room = Some((16_000_000_000, "a test"));
+        assert!(check_fits(100_000, 1_000, room).is_ok());
+        let e = check_fits(100_000, usize::MAX, room).unwrap_err();
+        assert_eq!(e.kind(), ErrorKind::OutOfMemory);
+        // More landmarks than vertices count as one per vertex.
+        assert!(check_fits(5_000, usize::MAX, room).is_ok());
     }
 
     #[test]

@@ -79,8 +79,12 @@ pub fn precompute(
     progress: &dyn Progress,
 ) -> Result<(Embedding, Report)> {
     check_embeddable(mesh)?;
-    crate::memory::check_fits(mesh.n_vertices(), crate::memory::available_memory())?;
     let options = resolve_landmarks(options, mesh);
+    crate::memory::check_fits(
+        mesh.n_vertices(),
+        options.landmarks,
+        crate::memory::available_memory(),
+    )?;
     Ok(wavg_embed::precompute(mesh, &options, progress)?)
 }
 
