@@ -3,6 +3,7 @@
 //! and their tests run in parallel with one another.
 
 mod api;
+mod body_limits;
 mod common;
 mod malformed;
 mod stop;
