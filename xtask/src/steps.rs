@@ -159,12 +159,9 @@ mod tests {
         assert!(!log.run("fail", || Err("no".into())));
         let burn = &log.rows[0];
         let cpu = burn.cpu.expect("CPU seconds on Linux");
+        // Only a lower bound: the figure is the process's reaped children, and other tests
+        // of this binary reap theirs (cargo among them) while the loop runs.
         assert!(cpu >= 0.1, "the loop took {cpu} CPU s");
-        assert!(
-            cpu <= burn.wall * 2.0 + 0.1,
-            "{cpu} CPU s in {} s",
-            burn.wall
-        );
         let table = log.table();
         let lines: Vec<&str> = table.lines().collect();
         assert_eq!(lines.len(), 4, "{table}");
