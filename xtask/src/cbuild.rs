@@ -103,8 +103,9 @@ pub fn steps(root: &Path, data_dir: &Path) -> Vec<(&'static str, String, Vec<Str
                 // so cargo has only the C library itself left to link.
                 "-DWAVG_CARGO_PROFILE=dev".into(),
                 format!(
-                    "-DWAVG_CARGO_BUILD_ARGS=--workspace;{};--all-targets",
-                    crate::steps::EXCLUDED.join(";")
+                    "-DWAVG_CARGO_BUILD_ARGS=--workspace;{};{};--all-targets",
+                    crate::steps::EXCLUDED.join(";"),
+                    crate::steps::NOT_BUILT.join(";")
                 ),
             ],
         ),

@@ -8,7 +8,7 @@ use crate::steps;
 
 /// Builds the example (with the everyday build's feature set) and runs it.
 pub fn run(root: &Path) -> Result<(), String> {
-    steps::cargo_workspace(root, &["build", "--all-targets"], &[])?;
+    steps::cargo_build_all(root)?;
     let exe = steps::target_dir(root).join("debug/examples/cli_docs");
     let file = root.join("docs/cli.md");
     steps::command(root, &exe.to_string_lossy(), &[&file.to_string_lossy()])

@@ -1,9 +1,10 @@
 //! One build of each dependency: cargo compiles a dependency once per set of features (its
 //! own and those of everything below it), resolved over the packages one invocation builds.
-//! `cargo xtask test` builds the workspace, then maturin builds `wavg-py` alone, the fuzz
-//! step `wavg-fuzz` alone and the examples step the quickstart with `wavg` alone; each of
-//! these must see every dependency with the workspace's features, or it compiles faer and
-//! everything above it again (`crates/wavg-hack` names the features that would differ).
+//! `cargo xtask test` builds the workspace (`cargo build` without `wavg-py`), then maturin
+//! builds `wavg-py` alone, the fuzz step `wavg-fuzz` alone and the examples step the
+//! quickstart with `wavg` alone; each of these must see every dependency with the
+//! workspace's features, or it compiles faer and everything above it again
+//! (`crates/wavg-hack` names the features that would differ).
 //! `cargo package` verifies each published crate alone, in a target directory of its own:
 //! there faer and everything below it must have one feature set across the crates.
 
@@ -38,6 +39,18 @@ pub fn check(root: &Path) -> Result<(), String> {
         .concat(),
     )?;
     let mut errors = Vec::new();
+    // The everyday `cargo build` leaves the Python extension to maturin.
+    let built = tree(
+        root,
+        &[
+            &["--workspace"],
+            steps::EXCLUDED,
+            steps::NOT_BUILT,
+            &["-e", "normal,build,dev"],
+        ]
+        .concat(),
+    )?;
+    errors.extend(not_within(&built, &workspace, "cargo build (everyday)"));
     for selection in APART {
         let apart = tree(root, &[selection, &["-e", "normal,build"][..]].concat())?;
         errors.extend(not_within(&apart, &workspace, &selection.join(" ")));

@@ -203,8 +203,7 @@ fn seed_corpora(root: &Path, fuzz_dir: &Path) -> Result<(), String> {
         return Ok(());
     }
     // The everyday build's feature set, so that after the tests nothing is rebuilt.
-    steps::cargo_workspace(root, &["build", "--all-targets"], &[])
-        .map_err(|e| format!("building wavg for the seed corpora: {e}"))?;
+    steps::cargo_build_all(root).map_err(|e| format!("building wavg for the seed corpora: {e}"))?;
     let wavg = steps::target_dir(root).join("debug/wavg");
     let tmp = seeds.join("tmp");
     for d in [&mesh_dir, &file_dir, &tmp] {

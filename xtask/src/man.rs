@@ -12,7 +12,7 @@ const DEFAULT_DIR: &str = "target/man";
 
 /// Builds the example (with the everyday build's feature set) and runs it.
 pub fn run(root: &Path, dir: Option<&str>) -> Result<(), String> {
-    steps::cargo_workspace(root, &["build", "--all-targets"], &[])?;
+    steps::cargo_build_all(root)?;
     let dir = root.join(dir.unwrap_or(DEFAULT_DIR));
     let exe = steps::target_dir(root).join("debug/examples/man");
     steps::command(root, &exe.to_string_lossy(), &[&dir.to_string_lossy()])

@@ -124,7 +124,7 @@ pub fn test_package(root: &Path, data_dir: &Path) -> Result<(), String> {
     // run would make another embedding than the other doors. The whole workspace's build,
     // as the CMake and fuzz steps run it, so the libraries keep the workspace's features
     // (`-p wavg-ffi` alone compiled every crate of ours a second time with fewer).
-    steps::cargo_workspace(root, &["build", "--all-targets"], &[])?;
+    steps::cargo_build_all(root)?;
     let py = ensure_venv(root)?;
     let py_s = py.to_string_lossy();
     let target = steps::target_dir(root);

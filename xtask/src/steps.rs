@@ -12,6 +12,21 @@ use crate::cpu;
 /// builds each dependency once.
 pub const EXCLUDED: &[&str] = &["--exclude", "wavg-lab"];
 
+/// What the everyday `cargo build` leaves out besides [`EXCLUDED`]: the Python extension,
+/// which maturin builds (`wavg-py` alone, with the workspace's features). maturin gives
+/// PyO3's build script its interpreter (`PYO3_PYTHON`, `PYO3_CONFIG_FILE`, ...), which a
+/// plain build leaves unset, so a plain build of the extension after maturin's, or
+/// maturin's after a plain one, would run that script again and compile PyO3, NumPy's
+/// bindings and the extension once more (25-30 s each time, measured in a fresh run).
+pub const NOT_BUILT: &[&str] = &["--exclude", "wavg-py"];
+
+/// `cargo build --all-targets` of the everyday workspace without the Python extension
+/// ([`NOT_BUILT`]): the tests' dependency builds, reused by the C library, the examples
+/// and the fuzz seeds.
+pub fn cargo_build_all(root: &Path) -> Result<(), String> {
+    cargo_workspace(root, &["build", "--all-targets"], NOT_BUILT)
+}
+
 /// cargo's target directory: `$CARGO_TARGET_DIR` when set (CI keeps one across runs),
 /// else `target/` in the repository.
 pub fn target_dir(root: &Path) -> PathBuf {
