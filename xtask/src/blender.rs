@@ -22,7 +22,7 @@ const TESTS: &str = "blender/tests/run.py";
 const UI_TEST: &str = "blender/tests/ui_modal.py";
 /// The Debian packages the tests need: Blender, the NumPy of its (system) Python, and Xvfb
 /// for the one test that needs a window.
-const PACKAGES: &[&str] = &["blender", "python3-numpy", "xvfb"];
+pub const PACKAGES: &[&str] = &["blender", "python3-numpy", "xvfb"];
 
 /// Builds `target/wavg_blender.zip` (the wheel first) and returns its path.
 pub fn build_addon(root: &Path) -> Result<PathBuf, String> {

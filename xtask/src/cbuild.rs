@@ -43,13 +43,18 @@ fn present(r: &Requirement) -> bool {
     }
 }
 
-/// Installs the missing packages when possible; otherwise says exactly what to install.
-pub fn ensure_packages() -> Result<(), String> {
-    let missing: Vec<&str> = REQUIREMENTS
+/// The Debian packages of the C/C++ build that are missing.
+pub fn missing_packages() -> Vec<&'static str> {
+    REQUIREMENTS
         .iter()
         .filter(|r| !present(r))
         .map(|r| r.package)
-        .collect();
+        .collect()
+}
+
+/// Installs the missing packages when possible; otherwise says exactly what to install.
+pub fn ensure_packages() -> Result<(), String> {
+    let missing = missing_packages();
     if missing.is_empty() {
         return Ok(());
     }

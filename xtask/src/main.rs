@@ -19,6 +19,7 @@ mod man;
 mod map;
 mod parallel;
 mod policy;
+mod prefetch;
 mod python;
 mod sancov;
 mod sandbox;
@@ -117,7 +118,7 @@ fn usage() -> ExitCode {
 }
 
 /// Seconds each fuzz target runs within `cargo xtask test`.
-const SMOKE_SECONDS: u64 = 15;
+const SMOKE_SECONDS: u64 = 10;
 
 /// `[--seconds N] [--target NAME]` in any order: seconds (default 60) and target.
 fn fuzz_args(args: &[String]) -> Option<(u64, Option<String>)> {
@@ -173,6 +174,9 @@ fn run_all(root: &Path, quick: bool) -> ExitCode {
 /// The checks, stopping at the first failure. One optimised dev build serves the tests, the
 /// examples, the C library and the fuzz seeds.
 fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -> bool {
+    // Debian packages of later steps, installed while the first ones compile (joined when
+    // this returns).
+    let _packages = (!quick).then(|| prefetch::start(root));
     let cargo = |args: &[&str]| steps::command(root, "cargo", args);
     let ok = log.run("format", || cargo(&["fmt", "--all", "--check"]))
         && log.run("clippy", || {

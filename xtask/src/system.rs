@@ -2,6 +2,7 @@
 //! need system packages (the C/C++ build, Blender, the browser tests).
 
 use std::process::Command;
+use std::sync::Mutex;
 
 /// Whether `program args` starts and exits with success.
 pub fn runs(program: &str, args: &[&str]) -> bool {
@@ -30,11 +31,26 @@ pub fn is_root() -> bool {
         .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
 }
 
-/// Runs `apt-get args` non-interactively; whether it succeeded.
+/// One apt-get at a time in this process: the prefetch (`prefetch.rs`) runs beside the
+/// steps, and a second apt-get would fail on dpkg's lock.
+static APT: Mutex<()> = Mutex::new(());
+
+/// Runs `apt-get args` non-interactively, its output in this process's; whether it
+/// succeeded.
 pub fn apt(args: &[&str]) -> bool {
-    Command::new("apt-get")
-        .args(args)
-        .env("DEBIAN_FRONTEND", "noninteractive")
-        .status()
-        .is_ok_and(|s| s.success())
+    apt_to(args, None)
+}
+
+/// [`apt`] with its output appended to `log` when given.
+pub fn apt_to(args: &[&str], log: Option<&std::fs::File>) -> bool {
+    let _one = APT.lock().unwrap_or_else(|e| e.into_inner());
+    let mut cmd = Command::new("apt-get");
+    cmd.args(args).env("DEBIAN_FRONTEND", "noninteractive");
+    if let Some(f) = log {
+        let (Ok(out), Ok(err)) = (f.try_clone(), f.try_clone()) else {
+            return false;
+        };
+        cmd.stdout(out).stderr(err);
+    }
+    cmd.status().is_ok_and(|s| s.success())
 }

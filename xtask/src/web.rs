@@ -25,7 +25,7 @@ const VENDOR: &[(&str, &str)] = &[
 const VENDORED: &str = "web/vendor/three";
 
 /// The browser the tests drive (never Playwright's own downloads).
-const CHROMIUM: &str = "/usr/bin/chromium";
+pub const CHROMIUM: &str = "/usr/bin/chromium";
 
 fn npm_ci(dir: &Path) -> Result<(), String> {
     steps::command(dir, "npm", &["ci", "--no-audit", "--no-fund"])
