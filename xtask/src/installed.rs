@@ -8,6 +8,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::Mutex;
 
 use crate::dist::Artifacts;
 use crate::sandbox::Sandbox;
@@ -342,9 +343,23 @@ pub fn blender(root: &Path, a: &Artifacts) -> Result<(), String> {
     })
 }
 
+/// Makes the environments of [`BPY`] that are missing, one after the other (for
+/// `prefetch.rs`, beside the first builds); what fails is left for the step to report.
+pub fn prefetch_bpy(root: &Path) {
+    if let Some(python) = find_python(BPY_PYTHON) {
+        for (_, pin) in BPY {
+            let _ = bpy_venv(root, &python, pin);
+        }
+    }
+}
+
 /// The environment with `bpy==pin`, made once in [`cache_root`] and reused while its
-/// stamp names the same pin; returns its interpreter.
+/// stamp names the same pin; returns its interpreter. One thread at a time makes a given
+/// environment (the prefetch may still be at it).
 fn bpy_venv(root: &Path, python: &Path, pin: &str) -> Result<PathBuf, String> {
+    static MAKING: [Mutex<()>; BPY.len()] = [const { Mutex::new(()) }; BPY.len()];
+    let slot = BPY.iter().position(|(_, p)| *p == pin).unwrap_or(0);
+    let _one = MAKING[slot].lock().unwrap_or_else(|e| e.into_inner());
     let dir = cache_root().join(format!("bpy-{pin}"));
     let py = dir.join("bin").join("python");
     let stamp = dir.join("wavg-bpy.txt");

@@ -3,6 +3,7 @@
 //! (pinned), reinstalled only when that file changes.
 
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use crate::sandbox::Sandbox;
 use crate::steps;
@@ -30,6 +31,9 @@ pub fn python(root: &Path) -> PathBuf {
 /// Makes the environment when missing and installs the pinned requirements when the file
 /// differs from the copy recorded at the last install; returns the interpreter.
 pub fn ensure_venv(root: &Path) -> Result<PathBuf, String> {
+    // One thread at a time (the prefetch may still be at it).
+    static MAKING: Mutex<()> = Mutex::new(());
+    let _one = MAKING.lock().unwrap_or_else(|e| e.into_inner());
     let dir = venv_dir(root);
     let py = python(root);
     if !py.exists() {
