@@ -3,7 +3,7 @@
 //! test keeps at least 95% of the vertices with a mean error of at most 1% of the
 //! diagonal, and few of the images it keeps are wrong.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use wavg_apps::{CorrespondOptions, correspond_vertices};
 use wavg_embed::{NoProgress, PrecomputeOptions, precompute};
@@ -13,39 +13,44 @@ use wavg_mesh::subdivide::loop_subdivide;
 use wavg_solve::sampling::{FpsMetric, farthest_point_vertices};
 use wavg_solve::{Anchor, EmbeddedMesh, Projector, Solver, Vec8};
 
-fn solver(mesh: ValidMesh, anchors: &[u32]) -> Solver {
-    let opts = PrecomputeOptions {
-        quality_pairs: 0,
-        ..Default::default()
-    };
-    let (emb, _) = precompute(&mesh, &opts, &NoProgress).unwrap();
-    let coords: Vec<Vec8> = emb.coords.iter().map(|c| Vec8::from(*c)).collect();
-    let e = Arc::new(EmbeddedMesh::new(Arc::new(mesh), coords).unwrap());
-    let proj = Arc::new(Projector::new(e).unwrap());
-    Solver::new(proj, anchors.iter().map(|&v| Anchor::Vertex(v))).unwrap()
+/// The slim and heavy bodies (`procedural::body`) with their embeddings: precomputed once
+/// for the two tests that use them.
+fn bodies() -> &'static [(ValidMesh, Vec<Vec8>); 2] {
+    static BODIES: OnceLock<[(ValidMesh, Vec<Vec8>); 2]> = OnceLock::new();
+    BODIES.get_or_init(|| {
+        [FigureShape::SLIM, FigureShape::HEAVY].map(|s| embedded(ValidMesh::new(body(&s)).unwrap()))
+    })
 }
 
 #[test]
 fn body_shapes_correspond_with_a_mask_that_keeps_what_is_right() {
-    correspond_shapes(figure, 40);
+    let [slim, heavy] = [FigureShape::SLIM, FigureShape::HEAVY]
+        .map(|s| embedded(ValidMesh::new(figure(&s)).unwrap()));
+    correspond_shapes(slim, heavy, 40);
 }
 
 /// The same with ears and toes (`procedural::body`): more thin parts, close to others,
 /// where more of the kept images are wrong (at most 1 in 20 vertices).
 #[test]
 fn bodies_with_ears_and_toes_correspond() {
-    correspond_shapes(body, 20);
+    let [slim, heavy] = bodies().clone();
+    correspond_shapes(slim, heavy, 20);
 }
 
-/// Corresponds the slim and heavy shapes of `build` both ways and checks the default
-/// mask keeps at least 95% of the vertices, with a mean error of at most 1% of the
-/// diagonal, rejects at most 1 right image in 20 vertices and keeps at most 1 wrong one
-/// in `wrong_kept_per` vertices.
-fn correspond_shapes(build: fn(&FigureShape) -> wavg_mesh::TriMesh, wrong_kept_per: usize) {
-    let slim = ValidMesh::new(build(&FigureShape::SLIM)).unwrap();
-    let heavy = ValidMesh::new(build(&FigureShape::HEAVY)).unwrap();
+/// Corresponds a slim and a heavy shape (meshes of the same connectivity, with their
+/// embeddings) both ways and checks the default mask keeps at least 95% of the vertices,
+/// with a mean error of at most 1% of the diagonal, rejects at most 1 right image in 20
+/// vertices and keeps at most 1 wrong one in `wrong_kept_per` vertices.
+fn correspond_shapes(
+    (slim, slim_e): (ValidMesh, Vec<Vec8>),
+    (heavy, heavy_e): (ValidMesh, Vec<Vec8>),
+    wrong_kept_per: usize,
+) {
     let anchors = farthest_point_vertices(&slim, 93, 1, FpsMetric::EdgeGraph).unwrap();
-    let (a, b) = (solver(slim, &anchors), solver(heavy, &anchors));
+    let (a, b) = (
+        solver_on(slim, slim_e, &anchors),
+        solver_on(heavy, heavy_e, &anchors),
+    );
     for (src, tgt, name) in [(&a, &b, "slim -> heavy"), (&b, &a, "heavy -> slim")] {
         let t0 = std::time::Instant::now();
         let c = correspond_vertices(src, tgt, &CorrespondOptions::default()).unwrap();
@@ -79,7 +84,7 @@ fn correspond_shapes(build: fn(&FigureShape) -> wavg_mesh::TriMesh, wrong_kept_p
     }
 }
 
-/// A mesh's embedding and a solver on it with vertex `anchors`.
+/// A mesh and its embedding.
 fn embedded(mesh: ValidMesh) -> (ValidMesh, Vec<Vec8>) {
     let opts = PrecomputeOptions {
         quality_pairs: 0,
@@ -130,11 +135,8 @@ fn subdivided(coarse: &ValidMesh, coords: &[Vec8]) -> (ValidMesh, Vec<Vec8>) {
 /// where an image a fraction of a coarse edge off flips and stretches fine edges).
 #[test]
 fn a_body_and_its_subdivision_keep_the_same_share() {
-    let slim = ValidMesh::new(body(&FigureShape::SLIM)).unwrap();
-    let heavy = ValidMesh::new(body(&FigureShape::HEAVY)).unwrap();
+    let [(slim, slim_e), (heavy, heavy_e)] = bodies().clone();
     let anchors = farthest_point_vertices(&slim, 93, 1, FpsMetric::EdgeGraph).unwrap();
-    let (slim, slim_e) = embedded(slim);
-    let (heavy, heavy_e) = embedded(heavy);
     let (fine_slim, fine_slim_e) = subdivided(&slim, &slim_e);
     let (fine_heavy, fine_heavy_e) = subdivided(&heavy, &heavy_e);
     let (a, b) = (

@@ -2,6 +2,8 @@
 //! keeps landmarks all around a thin tube, and the embedding does not fold one side of
 //! it onto the other.
 
+use std::sync::OnceLock;
+
 use wavg_embed::{DecimateOptions, Embedding, NoProgress, PrecomputeOptions, decimate, precompute};
 use wavg_mesh::{ValidMesh, procedural};
 
@@ -82,17 +84,24 @@ fn no_cross_section_of_a_thin_tube_collapses() {
     );
 }
 
-/// The worst ratio of embedded to straight-line distance over `pairs` of body `shape`'s
-/// vertices (`procedural::body`: fingers, toes, ears), with its pair, after the default
-/// precomputation.
-fn worst_pair(
-    shape: &procedural::FigureShape,
-    pairs: impl Fn(&ValidMesh) -> Vec<(usize, usize)>,
-) -> (f64, usize, usize) {
-    worst_pair_with(shape, pairs, true)
+/// The slim and heavy bodies (`procedural::body`: fingers, toes, ears) with their default
+/// embeddings, precomputed once for the tests that share them.
+fn bodies() -> &'static [(procedural::FigureShape, Embedded); 2] {
+    static BODIES: OnceLock<[(procedural::FigureShape, Embedded); 2]> = OnceLock::new();
+    BODIES.get_or_init(|| {
+        [
+            procedural::FigureShape::SLIM,
+            procedural::FigureShape::HEAVY,
+        ]
+        .map(|s| {
+            let mesh = ValidMesh::new(procedural::body(&s)).unwrap();
+            (s, Embedded::new(mesh, true))
+        })
+    })
 }
 
-/// [`worst_pair`], with or without the landmarks added around thin parts.
+/// The worst ratio of embedded to straight-line distance over `pairs` of body `shape`'s
+/// vertices, with its pair, with or without the landmarks added around thin parts.
 fn worst_pair_with(
     shape: &procedural::FigureShape,
     pairs: impl Fn(&ValidMesh) -> Vec<(usize, usize)>,
@@ -161,11 +170,8 @@ fn random_pairs(mesh: &ValidMesh) -> Vec<(usize, usize)> {
 /// half their straight-line distance (a collapsed pair: one part folded onto another).
 #[test]
 fn no_random_pair_of_a_body_collapses() {
-    for shape in [
-        procedural::FigureShape::SLIM,
-        procedural::FigureShape::HEAVY,
-    ] {
-        let (worst, a, b) = worst_pair(&shape, random_pairs);
+    for (shape, body) in bodies() {
+        let (worst, a, b) = body.worst(random_pairs(&body.mesh));
         assert!(
             worst >= 0.5,
             "{shape:?}: vertices {a} and {b} embedded {worst:.3} x their distance apart"
@@ -180,11 +186,8 @@ fn no_random_pair_of_a_body_collapses() {
 /// their width.
 #[test]
 fn no_close_pair_of_a_body_collapses() {
-    for shape in [
-        procedural::FigureShape::SLIM,
-        procedural::FigureShape::HEAVY,
-    ] {
-        let (worst, a, b) = worst_pair(&shape, close_pairs);
+    for (shape, body) in bodies() {
+        let (worst, a, b) = body.worst(close_pairs(&body.mesh));
         assert!(
             worst >= 0.5,
             "{shape:?}: vertices {a} and {b} embedded {worst:.3} x their distance apart"
