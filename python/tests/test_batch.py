@@ -136,6 +136,10 @@ def test_pair_arguments_are_checked(tmp_path: Path, assets: dict) -> None:
         wb.correspond_all(assets["template"], assets["template_anchors"], ["just-a-path.obj"], tmp_path)
     with pytest.raises(TypeError, match="executor"):
         wb.precompute_all(assets["meshes"][:1], tmp_path, executor=object())
+    for one in (assets["meshes"][0], Path(assets["meshes"][0])):
+        with pytest.raises(TypeError, match=r"meshes: expected a list of mesh paths, got one path"):
+            wb.precompute_all(one, tmp_path / "one")
+    assert not (tmp_path / "one").exists()
 
 
 def test_template_failure_fails_every_job(tmp_path: Path, assets: dict) -> None:
