@@ -74,16 +74,14 @@ impl Shared {
     }
 }
 
-/// Calls `callback` with each of `calls`; `Ok(false)` when one answered `False` (the later
-/// calls are not made), the callable's exception as the error.
-fn tell(
-    py: Python<'_>,
-    callback: &Bound<'_, PyAny>,
-    calls: Vec<(&'static str, u64, u64)>,
-) -> PyResult<bool> {
-    let no = pyo3::types::PyBool::new(py, false);
+/// Calls `callback` with each of `calls`; `Ok(false)` when one answered a false value
+/// other than `None` (`False`, NumPy's `False_` from a comparison, 0; the later calls are
+/// not made), the callable's exception (or its answer's, judged as a bool) as the error. A
+/// callable that returns nothing goes on.
+fn tell(callback: &Bound<'_, PyAny>, calls: Vec<(&'static str, u64, u64)>) -> PyResult<bool> {
     for args in calls {
-        if callback.call1(args)?.is(&*no) {
+        let answer = callback.call1(args)?;
+        if !answer.is_none() && !answer.is_truthy()? {
             return Ok(false);
         }
     }
@@ -125,7 +123,7 @@ pub(crate) fn watch<T: Send + 'static>(
             break;
         }
         let stop = py.check_signals().err().or_else(|| {
-            match tell(py, callback?, shared.calls(&mut shown, false)) {
+            match tell(callback?, shared.calls(&mut shown, false)) {
                 Ok(true) => None,
                 Ok(false) => Some(crate::errors::cancelled(py)),
                 Err(e) => Some(e),
@@ -140,9 +138,9 @@ pub(crate) fn watch<T: Send + 'static>(
         .join()
         .map_err(|_| PyRuntimeError::new_err("wavg: internal error (a worker thread panicked)"))?;
     if let Some(cb) = callback {
-        // The work has ended (every stage has when it succeeded): a `False` now cancels
+        // The work has ended (every stage has when it succeeded): a false answer now cancels
         // nothing.
-        tell(py, cb, shared.calls(&mut shown, succeeded(&result)))?;
+        tell(cb, shared.calls(&mut shown, succeeded(&result)))?;
     }
     Ok(result)
 }

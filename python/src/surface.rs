@@ -150,7 +150,8 @@ impl Surface {
     /// True draws a text bar on a terminal, False nothing, a callable ``(stage: str, done:
     /// int, total: int)`` is called at the start, at every new stage and about ten times a
     /// second in between (also while the progress stands still) and cancels
-    /// (``CancelledError``) by returning ``False``. Ctrl-C stops it within a second
+    /// (``CancelledError``) by returning ``False`` (any false value but None, such as
+    /// NumPy's ``False_``; None goes on). Ctrl-C stops it within a second
     /// (``KeyboardInterrupt``). A cancelled call returns at once; the abandoned work stops
     /// at its next checkpoint in the background. On any error the surface is unchanged.
     /// While it runs, another thread's ``precompute`` or ``load_embedding`` of this surface

@@ -73,6 +73,11 @@ def test_write_rejects_bad_anchors(tmp_path):
         wavg.write_anchors(path, ([0], [[np.nan, 0.5, 0.5]]))
     with pytest.raises(TypeError, match="anchors"):
         wavg.write_anchors(path, [0.5, 1.5])
+    # Only what `read_anchors` takes back is written.
+    with pytest.raises(wavg.InvalidArgumentError, match="do not sum to 1"):
+        wavg.write_anchors(path, ([0], [[5.0, 0.0, 1.0]]))
+    with pytest.raises(wavg.InvalidArgumentError, match="anchor"):
+        wavg.write_anchors(path, np.zeros(0, np.int64))
     assert not path.exists()
 
 

@@ -7,6 +7,7 @@ import concurrent.futures as cf
 import dataclasses
 import json
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -135,6 +136,10 @@ def test_pair_arguments_are_checked(tmp_path: Path, assets: dict) -> None:
         wb.correspond_all(assets["template"], assets["template_anchors"], ["just-a-path.obj"], tmp_path)
     with pytest.raises(TypeError, match="executor"):
         wb.precompute_all(assets["meshes"][:1], tmp_path, executor=object())
+    for one in (assets["meshes"][0], Path(assets["meshes"][0])):
+        with pytest.raises(TypeError, match=r"meshes: expected a list of mesh paths, got one path"):
+            wb.precompute_all(one, tmp_path / "one")
+    assert not (tmp_path / "one").exists()
 
 
 def test_template_failure_fails_every_job(tmp_path: Path, assets: dict) -> None:
@@ -169,6 +174,17 @@ def test_command_line(tmp_path: Path, assets: dict, capsys: pytest.CaptureFixtur
     with pytest.raises(SystemExit):
         cli.main(["transfer", "--template", "t.obj", "--template-anchors", "a.txt", "--texture", "t.png", "-o", str(tmp_path), "--size", "0x3"])
     capsys.readouterr()
+
+
+def test_command_line_without_dask(tmp_path: Path, assets: dict, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setitem(sys.modules, "distributed", None)  # `import distributed` fails
+    for where in (["--local", "2"], ["--scheduler", "tcp://127.0.0.1:1"]):
+        with pytest.raises(SystemExit) as e:
+            cli.main(["precompute", assets["meshes"][0], "-o", str(tmp_path / "out"), *where])
+        assert e.value.code == 2
+        err = capsys.readouterr().err
+        assert f"{where[0]} runs on Dask, which is not installed" in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
 
 
 class BreaksOnce(cf.Executor):

@@ -130,6 +130,17 @@ def test_precompute_cancel_leaves_surface_unchanged(torus_mesh):
     assert S.embedding is None
 
 
+def test_precompute_cancels_on_any_false_answer_but_none(torus_mesh):
+    # A deadline test written with NumPy answers `np.False_`, which is not `False`.
+    S = wavg.Surface(*torus(60, 30))
+    for answer in (np.False_, 0):
+        with pytest.raises(wavg.CancelledError):
+            S.precompute(landmarks=200, progress=lambda *a: answer)
+        assert S.embedding is None
+    S.precompute(landmarks=30, progress=lambda *a: None)  # returning nothing goes on
+    assert S.embedding is not None
+
+
 def test_progress_exception_propagates(torus_mesh):
     S = wavg.Surface(*torus(60, 30))
 

@@ -27,7 +27,7 @@ use std::path::Path;
 
 use wavg_io::text::PointSpec;
 use wavg_mesh::{MeshError, SurfacePoint, ValidMesh, VertexId};
-use wavg_solve::{Anchor, Vec8};
+use wavg_solve::{Anchor, BARY_TOLERANCE, SolveError, Vec8};
 
 use crate::error::{Error, Result};
 use crate::surface::Surface;
@@ -101,9 +101,20 @@ pub fn format(anchors: &[Anchor]) -> String {
 }
 
 /// Writes an anchors file ([`format()`]) atomically: a temporary file beside it, renamed
-/// into place, so a failure leaves nothing at `path`.
+/// into place, so a failure leaves nothing at `path`. Only what [`read`] takes back is
+/// written: no anchors, or barycentric coordinates that are not finite, clearly negative
+/// or do not sum to 1, are an error ([`ErrorKind::InvalidArgument`](crate::ErrorKind))
+/// and nothing is written.
 pub fn write(path: impl AsRef<Path>, anchors: &[Anchor]) -> Result<()> {
     let path = path.as_ref();
+    if anchors.is_empty() {
+        return Err(SolveError::NoAnchors.into());
+    }
+    for a in anchors {
+        if let Anchor::Point(p) = a {
+            check_bary(p)?;
+        }
+    }
     let text = format(anchors);
     wavg_mesh::io::write_atomic(path, |w| w.write_all(text.as_bytes())).map_err(|source| {
         MeshError::Io {
@@ -111,6 +122,25 @@ pub fn write(path: impl AsRef<Path>, anchors: &[Anchor]) -> Result<()> {
             source,
         }
     })?;
+    Ok(())
+}
+
+/// The barycentric rule of [`wavg_solve::check_point`], which needs no mesh.
+fn check_bary(p: &SurfacePoint) -> std::result::Result<(), SolveError> {
+    let bad = |reason| SolveError::BadBarycentrics {
+        face: p.face,
+        bary: p.bary,
+        reason,
+    };
+    if !p.bary.iter().all(|b| b.is_finite()) {
+        return Err(bad("not finite"));
+    }
+    if p.bary.iter().any(|&b| b < -BARY_TOLERANCE) {
+        return Err(bad("negative (the point is outside the face)"));
+    }
+    if (p.bary.iter().sum::<f64>() - 1.0).abs() > BARY_TOLERANCE {
+        return Err(bad("they do not sum to 1"));
+    }
     Ok(())
 }
 

@@ -119,6 +119,9 @@ def precompute_all(
     total, failed)`` is called after each job. A mesh that cannot be embedded (invalid,
     missing) ends ``failed`` with its message; the others go on.
     """
+    if isinstance(meshes, (str, bytes, os.PathLike)):
+        # A lone path would otherwise be iterated: a job per character, each one failing.
+        raise TypeError(f"meshes: expected a list of mesh paths, got one path {os.fsdecode(meshes)!r} (pass [path])")
     meshes = list(meshes)
     threads = _threads(threads, executor)
     out = Path(out_dir)

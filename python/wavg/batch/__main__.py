@@ -129,10 +129,26 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _check_dask(p: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Exits with a usage error (status 2) when ``--scheduler``/``--local`` is given and
+    Dask's distributed scheduler cannot be imported, before any work starts."""
+    if args.scheduler is None and args.local is None:
+        return
+    try:
+        import dask  # noqa: F401
+        import distributed  # noqa: F401
+    except ImportError as e:
+        option = "--scheduler" if args.scheduler is not None else "--local"
+        p.error(f"{option} runs on Dask, which is not installed ({e}): pip install 'dask[distributed]', or leave {option} out to run in this process")
+    if args.local is not None and args.local < 1:
+        p.error(f"--local needs at least 1 worker process, got {args.local}")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Runs the command line; returns the exit status."""
     p = _parser()
     args = p.parse_args(argv)
+    _check_dask(p, args)
     bar = Bar(args.command)
     if args.command == "precompute":
         meshes = list(args.meshes) + ([r[0] for r in _lines(args.list)] if args.list else [])

@@ -32,6 +32,30 @@ fn files_round_trip_and_comments_are_skipped() {
 }
 
 #[test]
+fn only_what_reads_back_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("a.txt");
+    let point = |bary| Anchor::Point(SurfacePoint::new(0, bary));
+    for (anchors, says) in [
+        (vec![], "the anchor set is empty"),
+        (
+            vec![Anchor::Vertex(1), point([5.0, 0.0, 1.0])],
+            "do not sum to 1",
+        ),
+        (vec![point([-0.5, 0.5, 1.0])], "negative"),
+        (vec![point([f64::NAN, 0.5, 0.5])], "not finite"),
+    ] {
+        let e = wavg::anchors::write(&path, &anchors).unwrap_err();
+        assert_eq!(e.kind(), ErrorKind::InvalidArgument, "{anchors:?}");
+        assert!(e.to_string().contains(says), "{e}");
+        assert!(!path.exists(), "{anchors:?}");
+    }
+    let ok = [point([0.2, 0.3, 0.5]), Anchor::Vertex(7)];
+    wavg::anchors::write(&path, &ok).unwrap();
+    assert_eq!(wavg::anchors::read(&path, torus().mesh()).unwrap(), ok);
+}
+
+#[test]
 fn bad_files_name_the_file_and_line() {
     let s = torus();
     let dir = tempfile::tempdir().unwrap();
