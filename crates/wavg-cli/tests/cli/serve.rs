@@ -21,11 +21,18 @@ fn cache_dir(name: &str) -> std::path::PathBuf {
 }
 
 fn serve_cached(args: &[&str], cache: &std::path::Path) -> (Child, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_wavg"))
-        .env("WAVG_CACHE_DIR", cache)
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_wavg"));
+    cmd.env("WAVG_CACHE_DIR", cache)
         .arg("serve")
         .args(args)
-        .args(["--port", "0"])
+        .args(["--port", "0"]);
+    spawn_server(cmd)
+}
+
+/// Spawns `cmd` (a `wavg serve`) with its output piped; returns the child and the address
+/// its first line says it serves on.
+fn spawn_server(mut cmd: Command) -> (Child, String) {
+    let mut child = cmd
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -161,29 +168,13 @@ fn other_hosts_get_a_warning_and_bad_meshes_fail() {
 /// id is the server's) and the address.
 #[cfg(unix)]
 fn serve_with_sigint_ignored(args: &[&str], cache: &std::path::Path) -> (Child, String) {
-    let mut child = Command::new("sh")
-        .arg("-c")
+    let mut cmd = Command::new("sh");
+    cmd.arg("-c")
         .arg("trap '' INT; exec \"$0\" serve \"$@\" --port 0")
         .arg(env!("CARGO_BIN_EXE_wavg"))
         .args(args)
-        .env("WAVG_CACHE_DIR", cache)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let addr = line
-        .split("serving http://")
-        .nth(1)
-        .unwrap_or_else(|| panic!("no address in {line:?}"))
-        .split('/')
-        .next()
-        .unwrap()
-        .to_string();
-    (child, addr)
+        .env("WAVG_CACHE_DIR", cache);
+    spawn_server(cmd)
 }
 
 /// Sends SIGINT to `child` and returns its exit status (None: still running after 10 s,
