@@ -66,20 +66,17 @@ pub fn write_atomic(
     Ok(())
 }
 
-/// `e` without the temporary file's path that tempfile adds to its message: callers
-/// name the destination the user asked for, which is all the user knows of.
+/// `e` without the temporary file's path that tempfile appends to its message (`... at
+/// path ".wavg-tmp-..."`): callers name the destination the user asked for, which is all
+/// the user knows of.
 fn without_temporary(e: std::io::Error) -> std::io::Error {
-    use std::error::Error as _;
-    if let Some(code) = e.raw_os_error() {
-        return std::io::Error::from_raw_os_error(code);
+    if e.raw_os_error().is_some() {
+        return e;
     }
-    let kind = e.kind();
-    match e.into_inner() {
-        Some(inner) => match inner.source() {
-            Some(cause) => std::io::Error::new(kind, cause.to_string()),
-            None => std::io::Error::new(kind, inner),
-        },
-        None => std::io::Error::from(kind),
+    let text = e.to_string();
+    match text.find(" at path ") {
+        Some(i) if text.contains(TEMP_PREFIX) => std::io::Error::new(e.kind(), &text[..i]),
+        _ => e,
     }
 }
 
