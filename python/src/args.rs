@@ -157,7 +157,9 @@ pub(crate) fn finite(values: &[f64], what: &str) -> PyResult<()> {
     match values.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
         Some(i) => Err(value(format!(
-            "{what} must be finite; element {i} (flat) is {}",
+            "{what} must be finite; element {} (flat, counting from 1, as every message \
+             does) is {}",
+            i + 1,
             values[i]
         ))),
     }

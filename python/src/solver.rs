@@ -238,6 +238,15 @@ impl Solver {
         let par = par(threads)?;
         let flat = data(&a);
         let rows: Vec<&[f64]> = flat.chunks_exact(k.max(1)).collect();
+        // Malformed weights refuse the call, as in every door; rows without an answer are
+        // `ok` False.
+        if let Err((i, e)) = wavg::check_weight_rows(&rows, k, wavg::Normalization::Reject) {
+            return Err(value(if squeeze {
+                format!("{name}: {}", e.message())
+            } else {
+                format!("{name} row {}: {}", i + 1, e.message())
+            }));
+        }
         let mut out = Vec::new();
         let mut scratch = wavg::ForwardScratch::default();
         py.detach_run(|| {
@@ -289,8 +298,10 @@ impl Solver {
     /// The weighted averages of the anchors: ``W`` is ``(q, k)`` float weights (one row per
     /// query, one column per anchor; any float dtype and layout), or ``(k,)`` for one
     /// query. Returns ``wavg.Points``: ``face (q,) int64``, ``bary (q, 3) float64``,
-    /// ``xyz (q, 3) float64``, ``ok (q,) bool``; a row without an answer has ``face == -1``
-    /// and NaN. For ``(k,)`` weights, ``face`` and ``ok`` are scalars and ``bary``, ``xyz``
+    /// ``xyz (q, 3) float64``, ``ok (q,) bool``; a row without an answer (no weighted
+    /// average) has ``face == -1`` and NaN. Weights that are not finite or do not sum to 1
+    /// raise ``ValueError`` naming the first such row (counting from 1), as every door
+    /// refuses them. For ``(k,)`` weights, ``face`` and ``ok`` are scalars and ``bary``, ``xyz``
     /// ``(3,)``. Runs in parallel without the GIL (``threads``: None = all cores).
     #[pyo3(signature = (W, threads=None))]
     #[allow(non_snake_case)]

@@ -152,7 +152,8 @@ impl Surface {
     /// second in between (also while the progress stands still) and cancels
     /// (``CancelledError``) by returning ``False`` (any false value but None, such as
     /// NumPy's ``False_``; None goes on). Ctrl-C stops it within a second
-    /// (``KeyboardInterrupt``). A cancelled call returns at once; the abandoned work stops
+    /// (``KeyboardInterrupt``). Any other value of ``progress`` (a number, a string) is a
+    /// ``TypeError``. A cancelled call returns at once; the abandoned work stops
     /// at its next checkpoint in the background. On any error the surface is unchanged.
     /// While it runs, another thread's ``precompute`` or ``load_embedding`` of this surface
     /// raises ``RuntimeError`` (the other methods go on with the current embedding).
@@ -186,7 +187,15 @@ impl Surface {
         };
         let bar = match &progress {
             None => true,
-            Some(p) => !p.is_callable() && p.is_truthy()?,
+            Some(p) if p.is_callable() => false,
+            Some(p) => p.extract::<bool>().map_err(|_| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "progress must be True, False, None or a callable (stage, done, total), \
+                     got {}",
+                    p.repr()
+                        .map_or_else(|_| "another value".into(), |r| r.to_string())
+                ))
+            })?,
         };
         let callback: Option<Bound<'_, PyAny>> =
             if let Some(p) = progress.filter(|p| p.is_callable()) {

@@ -78,13 +78,21 @@ def test_threads_equal_one_thread(solver):
     assert np.array_equal(wa, wb) and np.array_equal(oa, ob)
 
 
-def test_unanswerable_rows_are_masked(solver):
+def test_malformed_weights_refuse_the_call_in_a_batch_as_alone(solver):
+    # The rule of every door (`wavg::check_weight_rows`): weights that do not sum to 1
+    # refuse the request, naming the first bad row counting from 1; only rows without an
+    # answer are `ok` False.
     k = solver.anchor_count
     W = np.full((3, k), 1 / k)
-    W[1] = 0.0  # weights that do not sum to 1: no answer, not an exception
-    P = solver.forward(W)
-    assert list(P.ok) == [True, False, True]
-    assert P.face[1] == -1 and np.isnan(P.xyz[1]).all()
+    W[1] *= 0.6
+    with pytest.raises(ValueError, match=r"W row 2: weights sum to 0\.6"):
+        solver.forward(W)
+    with pytest.raises(ValueError, match=r"W: weights sum to 0\.6"):
+        solver.forward(W[1])
+    W[1, 1] = np.nan
+    with pytest.raises(ValueError, match="W row 2: weight 2 is not finite"):
+        solver.forward(W)
+    assert list(solver.forward(np.full((2, k), 1 / k)).ok) == [True, True]
 
 
 def test_inverse_paper_weights(solver, surface):

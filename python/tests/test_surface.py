@@ -123,6 +123,16 @@ def test_precompute_report_and_progress(torus_mesh):
     assert all(isinstance(s, str) and 0 <= d <= t for s, d, t in calls)
 
 
+def test_progress_is_a_flag_or_a_callable(torus_mesh):
+    S = wavg.Surface(*torus_mesh)
+    for bad in (5, 0, 0.5, "yes"):
+        with pytest.raises(TypeError, match="progress must be True, False, None or a callable"):
+            S.precompute(landmarks=40, progress=bad)
+    assert S.embedding is None
+    S.precompute(landmarks=40, progress=False)
+    assert S.embedding is not None
+
+
 def test_precompute_cancel_leaves_surface_unchanged(torus_mesh):
     S = wavg.Surface(*torus(60, 30))
     with pytest.raises(wavg.CancelledError):

@@ -14,7 +14,9 @@ vertices, faces, landmarks, seconds, created; all but key and bytes null for an 
 whose description is missing or damaged).")]
     List(ListArgs),
     /// Remove every cached embedding.
-    #[command(after_long_help = "Removes every cached embedding and says how much space it freed.")]
+    #[command(after_long_help = "\
+Removes every cached embedding (the files the cache named: KEY.wavg and KEY.json) and says
+how much space it freed; other .wavg files in the folder are kept, and counted.")]
     Clear,
 }
 
@@ -90,6 +92,10 @@ pub fn run(cmd: Command) -> Result<(), CliError> {
                 freed as f64 / 1e6,
                 dir.display()
             );
+            let kept = cache.others()?.len();
+            if kept > 0 {
+                println!("kept {kept} other .wavg files there (not named by the cache)");
+            }
         }
     }
     Ok(())

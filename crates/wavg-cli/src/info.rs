@@ -18,7 +18,7 @@ Counts, topology and every validation problem (counts and the first offending in
 whether `wavg repair` would fix them. Succeeds for any file it can parse, valid or not.
 
 --json prints one object with at least vertices, faces, components, boundary_loops, genus
-(null when undefined), manifold (bool), problems (list of strings), plus edges,
+(null for an invalid mesh), manifold (bool), problems (list of strings), plus edges,
 euler_characteristic, oriented, watertight, valid, uv, bounding_box, problem_summary,
 welded_vertices (glTF: vertex copies merged by position), skipped_primitives,
 repair and out_of_range: null, or why the embedding and the solvers would refuse this
@@ -131,7 +131,7 @@ pub fn to_text(name: &str, mesh: &TriMesh, notes: Option<&LoadNotes>, s: &MeshIn
     let _ = writeln!(o, "euler characteristic: {}", s.euler_characteristic);
     let genus = s
         .genus
-        .map_or("undefined (not an oriented manifold)".to_string(), |g| {
+        .map_or("undefined (not a valid mesh)".to_string(), |g| {
             g.to_string()
         });
     let _ = writeln!(o, "genus:                {genus}");

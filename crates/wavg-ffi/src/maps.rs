@@ -28,7 +28,7 @@ fn finish(
                 if first.is_none() {
                     first = Some(Failure {
                         status,
-                        message: format!("query {i}: {message}"),
+                        message: format!("query {}: {message}", i + 1),
                     });
                 }
                 status

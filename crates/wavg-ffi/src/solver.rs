@@ -142,7 +142,7 @@ impl Statuses<'_> {
                 if self.first.is_none() {
                     self.first = Some(Failure {
                         status,
-                        message: format!("query {i}: {}", e.message()),
+                        message: format!("query {}: {}", i + 1, e.message()),
                     });
                 }
                 status
@@ -155,8 +155,9 @@ impl Statuses<'_> {
 
     fn no_solution(&mut self, i: usize) {
         let message = format!(
-            "query {i}: the point is not reached as a weighted average of these anchors \
-             (add anchors near it)"
+            "query {}: the point is not reached as a weighted average of these anchors \
+             (add anchors near it)",
+            i + 1
         );
         let status = status_of(ErrorKind::NoSolution);
         if self.first.is_none() {

@@ -45,7 +45,8 @@ pub struct MeshInfo {
     pub boundary_loops: usize,
     /// Euler characteristic.
     pub euler_characteristic: i64,
-    /// Genus (`None` unless the mesh is an oriented manifold).
+    /// Genus (`None` unless the mesh is valid: an invalid mesh's genus, even when its
+    /// faces form an oriented manifold, says nothing about the surface its repair gives).
     pub genus: Option<i64>,
     /// Whether every edge and vertex is manifold.
     pub manifold: bool,
@@ -92,7 +93,7 @@ impl MeshInfo {
             components: s.components,
             boundary_loops: s.boundary_loops,
             euler_characteristic: s.euler_characteristic,
-            genus: s.genus,
+            genus: s.genus.filter(|_| valid),
             manifold: s.manifold,
             oriented: s.oriented,
             watertight: s.watertight,

@@ -56,17 +56,11 @@ pub(crate) fn forward(app: &App, body: body::Forward) -> Result<Reply, ApiError>
         Normalization::Reject
     };
     let k = solver.n_anchors();
-    let weights = body
-        .weights
-        .0
-        .into_iter()
-        .enumerate()
-        .map(|(i, w)| {
-            wavg::validate_weights(&w.0, k, norm)
-                .map_err(|e| ApiError::lib(e).within(&format!("weights[{i}]")))?;
-            Ok(w.0)
-        })
-        .collect::<Result<Vec<_>, ApiError>>()?;
+    let weights: Vec<Vec<f64>> = body.weights.0.into_iter().map(|w| w.0).collect();
+    // Malformed rows refuse the request, as in every door.
+    let rows: Vec<&[f64]> = weights.iter().map(Vec::as_slice).collect();
+    wavg::check_weight_rows(&rows, k, norm)
+        .map_err(|(i, e)| ApiError::lib(e).within(&format!("weights[{i}]")))?;
     let opts = ForwardOptions {
         normalization: norm,
         ..Default::default()

@@ -11,10 +11,11 @@ pub enum SolveError {
         /// Number of weights given.
         got: usize,
     },
-    /// A weight is NaN or infinite.
-    #[error("weight {index} is not finite ({value})")]
+    /// A weight is NaN or infinite. The message counts weights from 1 (the first is
+    /// weight 1), as every message that names a position in a list does, in every door.
+    #[error("weight {} is not finite ({value})", index + 1)]
     NonFiniteWeight {
-        /// Index of the weight.
+        /// Index of the weight (0-based).
         index: usize,
         /// Its value.
         value: f64,

@@ -107,6 +107,9 @@ mod tests {
             validate_weights(&[0.5, f64::INFINITY], 2, Normalize),
             Err(SolveError::NonFiniteWeight { index: 1, .. })
         ));
+        // Messages count from 1, as the text formats do: index 1 is the second weight.
+        let e = validate_weights(&[0.5, f64::INFINITY], 2, Normalize).unwrap_err();
+        assert_eq!(e.to_string(), "weight 2 is not finite (inf)");
         assert!(matches!(
             validate_weights(&[0.5, 0.5 + 2e-6], 2, Reject),
             Err(SolveError::WeightSum { .. })

@@ -198,10 +198,7 @@ impl Cache {
         };
         for entry in list {
             let path = entry.map_err(io)?.path();
-            if path.extension().is_none_or(|x| x != "wavg") {
-                continue;
-            }
-            let Some(key) = path.file_stem().and_then(|s| s.to_str()) else {
+            let Some(key) = entry_key(&path) else {
                 continue;
             };
             let bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
@@ -219,7 +216,33 @@ impl Cache {
         Ok(out)
     }
 
-    /// Removes every entry; returns how many and their `.wavg` bytes.
+    /// The `.wavg` files in the folder that are not entries (not named `KEY.wavg`): a
+    /// user's own files put there, which [`Cache::clear`] keeps. Sorted; an absent folder
+    /// has none.
+    pub fn others(&self) -> Result<Vec<PathBuf>> {
+        let list = match std::fs::read_dir(&self.dir) {
+            Ok(l) => l,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+            Err(e) => {
+                return Err(EmbedError::Io {
+                    path: self.dir.clone(),
+                    source: e,
+                }
+                .into());
+            }
+        };
+        let mut out: Vec<PathBuf> = list
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == "wavg") && entry_key(p).is_none())
+            .collect();
+        out.sort();
+        Ok(out)
+    }
+
+    /// Removes every entry (the files the cache named, `KEY.wavg` and `KEY.json`; other
+    /// files in the folder are kept: [`Cache::others`]); returns how many and their
+    /// `.wavg` bytes.
     pub fn clear(&self) -> Result<(usize, u64)> {
         let entries = self.entries()?;
         let mut freed = 0;
@@ -242,6 +265,17 @@ impl Cache {
         }
         Ok((entries.len(), freed))
     }
+}
+
+/// The key of an entry's `.wavg` file: its name is `KEY.wavg` with `KEY` as
+/// [`Cache::key`] makes it (16 lowercase hex digits, a dash, 16 more); `None` for any
+/// other file.
+fn entry_key(path: &Path) -> Option<&str> {
+    let name = path.file_name()?.to_str()?;
+    let key = name.strip_suffix(".wavg")?;
+    let hex = |s: &str| s.len() == 16 && s.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'));
+    let (mesh, options) = key.split_once('-')?;
+    (hex(mesh) && hex(options)).then_some(key)
 }
 
 /// The cache folder: `$WAVG_CACHE_DIR` when set, else the platform's user cache folder

@@ -53,7 +53,7 @@ pub use memory::{
     available_memory, precompute_peak_bytes,
 };
 pub use nalgebra::Vector3;
-pub use oneoff::{barycentric_weights, weighted_average};
+pub use oneoff::{barycentric_weights, check_weight_rows, weighted_average};
 pub use precompute::{
     CacheOutcome, DEFAULT_LANDMARKS, Provenance, check_embeddable, default_precompute_options,
     embedding_cached, precompute, resolve_landmarks,

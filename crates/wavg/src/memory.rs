@@ -71,20 +71,32 @@ pub fn precompute_peak_bytes(vertices: usize) -> u64 {
 
 /// The memory this process may still use, and where the figure came from: the
 /// environment override, else the smaller of `MemAvailable` and the cgroup's room;
-/// `None` when neither can be read (then nothing is refused).
-pub fn available_memory() -> Option<(u64, &'static str)> {
-    if let Ok(v) = std::env::var(MEMORY_AVAILABLE_VAR) {
-        return parse_bytes(&v).map(|b| (b, MEMORY_AVAILABLE_VAR));
+/// `None` when neither can be read (then nothing is refused). An override that is not a
+/// byte count is an [`crate::ErrorKind::InvalidArgument`] naming the variable and its
+/// value, rather than a check silently skipped.
+pub fn available_memory() -> Result<Option<(u64, &'static str)>> {
+    if let Some(v) = std::env::var_os(MEMORY_AVAILABLE_VAR) {
+        return override_bytes(&v.to_string_lossy()).map(|b| Some((b, MEMORY_AVAILABLE_VAR)));
     }
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok();
     let mem = meminfo.as_deref().and_then(mem_available);
     let cgroup = cgroup_room();
-    match (mem, cgroup) {
+    Ok(match (mem, cgroup) {
         (Some(m), Some(c)) if c < m => Some((c, "the cgroup's memory limit less its usage")),
         (Some(m), _) => Some((m, "MemAvailable in /proc/meminfo")),
         (None, Some(c)) => Some((c, "the cgroup's memory limit less its usage")),
         (None, None) => None,
-    }
+    })
+}
+
+/// The value of [`MEMORY_AVAILABLE_VAR`] in bytes, or the error naming it.
+fn override_bytes(value: &str) -> Result<u64> {
+    parse_bytes(value).ok_or_else(|| {
+        Error::Embed(wavg_embed::EmbedError::InvalidArgument(format!(
+            "{MEMORY_AVAILABLE_VAR}={value:?} is not a byte count: write a whole number of \
+             bytes, or one with a K, M or G suffix (powers of 1024), such as 8G"
+        )))
+    })
 }
 
 /// Bytes of dense landmark-by-landmark matrices a precomputation holds per landmark pair.
@@ -215,7 +227,18 @@ mod tests {
         assert_eq!(parse_bytes("lots"), None);
         // This machine has a /proc/meminfo.
         if std::env::var_os(MEMORY_AVAILABLE_VAR).is_none() {
-            assert!(available_memory().is_some_and(|(b, _)| b > 0));
+            assert!(available_memory().unwrap().is_some_and(|(b, _)| b > 0));
+        }
+    }
+
+    #[test]
+    fn an_override_that_is_not_a_byte_count_is_refused_by_name() {
+        assert_eq!(override_bytes("8G").unwrap(), 8 << 30);
+        for bad in ["lots", "", "-1", "1.5G", "8GB"] {
+            let e = override_bytes(bad).unwrap_err();
+            assert_eq!(e.kind(), ErrorKind::InvalidArgument);
+            let m = e.message();
+            assert!(m.contains(&format!("WAVG_MEMORY_AVAILABLE={bad:?}")), "{m}");
         }
     }
 }

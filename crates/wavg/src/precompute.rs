@@ -70,7 +70,8 @@ pub fn check_embeddable(mesh: &ValidMesh) -> Result<()> {
 /// Computes the 8-D embedding of `mesh` (landmarks, geodesics, MDS, least-squares mesh)
 /// after [`check_embeddable`] and a check that the machine has the memory it needs
 /// ([`crate::precompute_peak_bytes`] against [`crate::available_memory`]: else
-/// [`crate::ErrorKind::OutOfMemory`], before any work); `progress` receives per-stage fractions and can cancel
+/// [`crate::ErrorKind::OutOfMemory`], before any work; a malformed
+/// `WAVG_MEMORY_AVAILABLE` is [`crate::ErrorKind::InvalidArgument`]); `progress` receives per-stage fractions and can cancel
 /// ([`crate::ErrorKind::Cancelled`]). A landmark count of 0 means "choose"
 /// ([`resolve_landmarks`]).
 pub fn precompute(
@@ -83,7 +84,7 @@ pub fn precompute(
     crate::memory::check_fits(
         mesh.n_vertices(),
         options.landmarks,
-        crate::memory::available_memory(),
+        crate::memory::available_memory()?,
     )?;
     Ok(wavg_embed::precompute(mesh, &options, progress)?)
 }

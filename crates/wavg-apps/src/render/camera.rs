@@ -105,7 +105,9 @@ impl Camera {
     pub fn project(&self, p: &Vector3<f64>) -> [f64; 3] {
         let q = p - self.eye;
         let z = q.dot(&self.forward);
-        let zs = z.max(1e-12);
+        // Points at or behind the eye are held just in front of it, at a depth relative
+        // to their distance, so no scale of the model falls under the floor.
+        let zs = z.max(q.norm() * 1e-12).max(f64::MIN_POSITIVE);
         [
             0.5 * self.size.0 as f64 + self.focal * q.dot(&self.right) / zs,
             0.5 * self.size.1 as f64 - self.focal * q.dot(&self.up) / zs,

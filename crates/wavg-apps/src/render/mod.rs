@@ -230,7 +230,13 @@ fn bounds(points: &[Vector3<f64>]) -> (Vector3<f64>, f64) {
     }
     let c = (lo + hi) / 2.0;
     let r = points.iter().map(|p| (p - c).norm()).fold(0.0, f64::max);
-    (c, r.max(1e-12))
+    // A single point still gets a ball to look at, of a size relative to where it is.
+    let r = if r > 0.0 {
+        r
+    } else {
+        (c.norm() * 1e-12).max(f64::MIN_POSITIVE)
+    };
+    (c, r)
 }
 
 /// Renders the mesh with the given colouring and overlays; errors (before drawing) on

@@ -4,4 +4,5 @@
 
 mod figure_correspond;
 mod remesh;
+mod render_scale;
 mod transfer;

@@ -131,9 +131,15 @@ fn second_run_reuses_the_embedding_and_gives_the_same_curve() {
     }
     assert_eq!(listed[0]["bytes"], bytes.len());
 
+    // A user's own `.wavg` file in the folder is not the cache's: kept, and counted.
+    let mine = cache.join("mine.wavg");
+    std::fs::write(&mine, b"mine").unwrap();
     let cleared = run(&cache, &["cache", "clear"]);
-    assert!(String::from_utf8_lossy(&cleared.stdout).contains("removed 1 cached"));
+    let said = String::from_utf8_lossy(&cleared.stdout);
+    assert!(said.contains("removed 1 cached"), "{said}");
+    assert!(said.contains("kept 1 other .wavg files"), "{said}");
     assert!(entries(&cache).is_empty());
+    assert!(mine.exists());
 }
 
 #[test]

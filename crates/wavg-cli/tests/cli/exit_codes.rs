@@ -58,6 +58,19 @@ fn a_failed_write_exits_1() {
     );
 }
 
+/// A write that fails before its temporary file exists (`/proc` takes no new files, even
+/// from root) names the file asked for, never the temporary file beside it.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_failed_write_names_the_file_asked_for() {
+    let (code, err) = failed(&["repair", "builtin:torus", "-o", "/proc/fixed.obj"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("/proc/fixed.obj") && !err.contains(".wavg-tmp"),
+        "{err}"
+    );
+}
+
 /// A precomputation the machine's memory cannot hold is refused before it starts (exit
 /// 1, not the input's fault), with the estimate and the available memory, and nothing is
 /// written; the environment override stands in for a small machine.
@@ -85,6 +98,13 @@ fn a_precomputation_beyond_the_available_memory_is_refused_up_front() {
     assert!(!out.exists());
     assert!(t.elapsed().as_secs() < 30, "refused up front");
     // The same with room: computed.
+    // An override that is not a byte count is the caller's error, named, not a check
+    // skipped.
+    let bad = run("lots");
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(bad.status.code(), Some(2), "{err}");
+    assert!(err.contains("WAVG_MEMORY_AVAILABLE=\"lots\""), "{err}");
+    assert!(!out.exists());
     let ok = run("64G");
     assert!(
         ok.status.success(),

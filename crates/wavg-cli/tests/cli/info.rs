@@ -80,6 +80,24 @@ fn builtin_json_and_unknown_builtin() {
     );
 }
 
+/// An invalid mesh whose faces form an oriented manifold (a triangle and an unused
+/// vertex) has no genus to report: null, and "undefined" in the text.
+#[test]
+fn an_invalid_mesh_has_no_genus() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stray.off");
+    std::fs::write(&path, "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n9 9 9\n3 0 1 2\n").unwrap();
+    let j = info_json(&path);
+    assert_eq!(
+        (j["manifold"].clone(), j["valid"].clone()),
+        (true.into(), false.into())
+    );
+    assert!(j["genus"].is_null(), "{j}");
+    let out = wavg(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("genus:                undefined"), "{text}");
+}
+
 #[test]
 fn invalid_but_parseable_file_exits_zero_and_lists_problems() {
     let dir = tempfile::tempdir().unwrap();

@@ -51,19 +51,33 @@ pub fn write_atomic(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let tmp = builder.tempfile_in(&dir)?;
+    let tmp = builder.tempfile_in(&dir).map_err(without_temporary)?;
     {
         let mut w = std::io::BufWriter::new(tmp.as_file());
         body(&mut w)?;
         w.flush()?;
     }
     tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
+    tmp.persist(path).map_err(|e| without_temporary(e.error))?;
     // Make the rename itself durable where the platform allows it (best effort).
     if let Ok(d) = std::fs::File::open(&dir) {
         let _ = d.sync_all();
     }
     Ok(())
+}
+
+/// `e` without the temporary file's path that tempfile appends to its message (`... at
+/// path ".wavg-tmp-..."`): callers name the destination the user asked for, which is all
+/// the user knows of.
+fn without_temporary(e: std::io::Error) -> std::io::Error {
+    if e.raw_os_error().is_some() {
+        return e;
+    }
+    let text = e.to_string();
+    match text.find(" at path ") {
+        Some(i) if text.contains(TEMP_PREFIX) => std::io::Error::new(e.kind(), &text[..i]),
+        _ => e,
+    }
 }
 
 /// How every temporary file of [`write_atomic`] starts, before the writer's process id.
@@ -174,6 +188,16 @@ mod tests {
         assert_eq!(std::fs::read(&path).unwrap(), b"hello");
         let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(names.len(), 1);
+    }
+
+    #[test]
+    fn a_failed_write_names_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("missing").join("out.txt");
+        let e = write_atomic(&path, |w| w.write_all(b"hello")).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::NotFound);
+        let m = e.to_string();
+        assert!(!m.contains(TEMP_PREFIX) && !m.contains("missing"), "{m}");
     }
 
     /// A process that ended and was never waited for by a writer: its id, now unused.

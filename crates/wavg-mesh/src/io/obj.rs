@@ -1,4 +1,5 @@
-//! Wavefront OBJ: `v`, `vt` and `f` statements; everything else is skipped.
+//! Wavefront OBJ: `v`, `vt` and `f` statements (continued over lines that end in `\`);
+//! everything else, and `#` comments whatever their bytes, is skipped.
 //!
 //! Why not tobj: tobj re-indexes vertices per object (`o`/`g`) and drops unreferenced
 //! ones, so a file whose objects share vertices (trimesh's `joined_tetrahedra.obj`) would
@@ -71,8 +72,26 @@ pub(crate) fn parse<R: Read>(lines: &mut TextLines<'_, R>) -> Result<(TriMesh, L
     let mut notes = LoadNotes::default();
     let mut poly: Vec<Corner> = Vec::new();
 
+    // A statement continued over lines ending in `\`, joined (numbered by its first line).
+    let mut joined: Option<(usize, String)> = None;
     while let Some((line, raw)) = lines.next_line()? {
-        let mut it = strip_comment(raw).split_ascii_whitespace();
+        let text = strip_comment(raw).trim_end();
+        if let Some(head) = text.strip_suffix('\\') {
+            let (_, j) = joined.get_or_insert_with(|| (line, String::new()));
+            j.push_str(head);
+            j.push(' ');
+            continue;
+        }
+        let whole: String;
+        let (line, text) = match joined.take() {
+            None => (line, text),
+            Some((first, mut j)) => {
+                j.push_str(text);
+                whole = j;
+                (first, whole.as_str())
+            }
+        };
+        let mut it = text.split_ascii_whitespace();
         let Some(tag) = it.next() else { continue };
         match tag {
             "v" => {

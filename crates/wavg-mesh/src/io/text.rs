@@ -35,8 +35,9 @@ impl ParseError {
 
 pub(crate) type Result<T> = std::result::Result<T, ParseError>;
 
-/// The lines of a text file, numbered from 1, checked to be UTF-8 (a byte-order mark at
-/// the start is dropped, as it would otherwise hide the first statement).
+/// The lines of a text file, numbered from 1, checked to be UTF-8 outside `#` comments (a
+/// byte-order mark at the start is dropped, as it would otherwise hide the first
+/// statement).
 pub(crate) struct TextLines<'a, R> {
     src: &'a mut Source<R>,
     /// The number of the line last returned.
@@ -58,8 +59,8 @@ impl<'a, R: Read> TextLines<'a, R> {
         if n == 1 {
             bytes = bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes);
         }
-        let text = std::str::from_utf8(bytes)
-            .map_err(|_| ParseError::new(n, "invalid UTF-8 (binary data in a text format?)"))?;
+        let text = decode(bytes)
+            .ok_or_else(|| ParseError::new(n, "invalid UTF-8 (binary data in a text format?)"))?;
         Ok(Some((n, text)))
     }
 
@@ -70,8 +71,18 @@ impl<'a, R: Read> TextLines<'a, R> {
             1 => bytes.strip_prefix("\u{feff}".as_bytes()).unwrap_or(bytes),
             _ => bytes,
         };
-        std::str::from_utf8(bytes).unwrap_or_default()
+        decode(bytes).unwrap_or_default()
     }
+}
+
+/// A line as text: UTF-8, or, when only a `#` comment holds other bytes (a Latin-1 name
+/// in an exporter's comment), the line up to and including its `#` (comments are skipped
+/// whatever their bytes).
+fn decode(bytes: &[u8]) -> Option<&str> {
+    std::str::from_utf8(bytes).ok().or_else(|| {
+        let hash = bytes.iter().position(|&b| b == b'#')?;
+        std::str::from_utf8(&bytes[..=hash]).ok()
+    })
 }
 
 /// A float token; `nan`/`inf` are accepted (validation reports them, they are data).

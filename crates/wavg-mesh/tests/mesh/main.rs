@@ -11,6 +11,7 @@ mod gltf_read;
 mod gltf_write;
 mod hostile;
 mod io_formats;
+mod odd_inputs;
 mod ply_layouts;
 mod properties;
 mod repair;

@@ -105,11 +105,28 @@ fn clear_removes_every_entry_and_an_absent_folder_is_empty() {
         let o = PrecomputeOptions { seed, ..small() };
         wavg::embedding_cached(&mesh, &o, Some(&cache), &info, &NoProgress).unwrap();
     }
+    // A user's own `.wavg` files in the folder are neither listed nor removed.
+    let mine = [
+        dir.path().join("never-made").join("mine.wavg"),
+        dir.path()
+            .join("never-made")
+            .join(format!("{}.wavg", "0".repeat(33))),
+    ];
+    for m in &mine {
+        std::fs::write(m, b"mine").unwrap();
+    }
     assert_eq!(cache.entries().unwrap().len(), 2);
+    assert_eq!(cache.others().unwrap().len(), 2);
     let (n, bytes) = cache.clear().unwrap();
     assert_eq!(n, 2);
     assert!(bytes > 0);
     assert!(cache.entries().unwrap().is_empty());
+    assert!(mine.iter().all(|m| m.exists()));
+    assert_eq!(cache.others().unwrap(), {
+        let mut m = mine.to_vec();
+        m.sort();
+        m
+    });
 }
 
 #[test]

@@ -33,6 +33,20 @@ impl Scalar {
         })
     }
 
+    /// The type's name in a PLY header, for messages.
+    pub(super) fn name(self) -> &'static str {
+        match self {
+            Self::I8 => "char",
+            Self::U8 => "uchar",
+            Self::I16 => "short",
+            Self::U16 => "ushort",
+            Self::I32 => "int",
+            Self::U32 => "uint",
+            Self::F32 => "float",
+            Self::F64 => "double",
+        }
+    }
+
     /// Bytes of one value in a binary file.
     pub(super) fn size(self) -> usize {
         match self {

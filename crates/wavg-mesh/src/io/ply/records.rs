@@ -14,6 +14,15 @@ pub(super) enum Num {
     Float(f64),
 }
 
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Num::Int(i) => write!(f, "{i}"),
+            Num::Float(x) => write!(f, "{x}"),
+        }
+    }
+}
+
 impl Num {
     pub(super) fn as_f64(self) -> f64 {
         match self {
@@ -148,7 +157,7 @@ impl<'a, R: Read> Records<'a, R> {
                 el.name
             )));
         }
-        let bad = || self.err(format!("{tok:?} is not a {ty:?} value"));
+        let bad = || self.err(format!("{tok:?} is not a value of type {}", ty.name()));
         Ok(match ty {
             Scalar::F32 => Num::Float(tok.parse::<f32>().map_err(|_| bad())? as f64),
             Scalar::F64 => Num::Float(tok.parse::<f64>().map_err(|_| bad())?),
@@ -174,7 +183,10 @@ impl<'a, R: Read> Records<'a, R> {
     pub(super) fn length(&mut self, ty: Scalar, el: &Element, record: usize) -> Result<usize> {
         match self.value(ty, el, record)? {
             Num::Int(n) if n >= 0 => Ok(n as usize),
-            v => Err(self.err(format!("list length {v:?} in element '{}'", el.name))),
+            v => Err(self.err(format!(
+                "list length {v} in element '{}' is not a count (a whole number, 0 or more)",
+                el.name
+            ))),
         }
     }
 
