@@ -896,7 +896,8 @@ mod tests {
         assert_eq!(bits(&public), bits(&kept));
         let seen = rec.0.into_inner().unwrap();
         assert!(!rounds_seen(&seen).2, "a fraction went down");
-        for stage in Stage::ALL {
+        // (No quality check here.)
+        for stage in [Stage::Decimate, Stage::Geodesics, Stage::Mds, Stage::LsMesh] {
             let last = seen.iter().rev().find(|(s, _)| *s == stage).map(|x| x.1);
             assert_eq!(last, Some(1.0), "{stage:?}");
         }
