@@ -292,7 +292,7 @@ impl FastMarching {
         keep_fields: bool,
         done_before: usize,
         progress: &dyn Progress,
-    ) -> Result<Vec<(Vec<f64>, Option<Vec<f64>>)>, EmbedError> {
+    ) -> Result<Vec<RowAndField>, EmbedError> {
         let fm = self;
         let n = landmarks.len();
         check_cancel(progress)?;
@@ -314,6 +314,9 @@ impl FastMarching {
             .collect()
     }
 }
+
+/// One run's row (its distances to the landmarks) and, if kept, its [`frozen_field`].
+type RowAndField = (Vec<f64>, Option<Vec<f64>>);
 
 /// Flags of `landmarks` among `n` vertices; an error for an id out of range or repeated.
 fn targets(n: usize, landmarks: &[u32]) -> Result<Vec<bool>, EmbedError> {
