@@ -118,6 +118,41 @@ impl Progress for NoProgress {
     fn report(&self, _stage: Stage, _fraction: f64) {}
 }
 
+/// Forwards to a sink only the reports that raise their stage's fraction, so that what
+/// the sink sees never decreases within a stage: the rounds that add landmarks run the
+/// geodesics, MDS and the least-squares mesh again, each from 0, and parallel runs report
+/// out of order.
+pub(crate) struct Monotone<'a> {
+    inner: &'a dyn Progress,
+    /// The highest fraction forwarded per stage (in [`Stage::ALL`]'s order), if any.
+    highest: std::sync::Mutex<[Option<f64>; 5]>,
+}
+
+impl<'a> Monotone<'a> {
+    pub(crate) fn new(inner: &'a dyn Progress) -> Self {
+        Monotone {
+            inner,
+            highest: std::sync::Mutex::new([None; 5]),
+        }
+    }
+}
+
+impl Progress for Monotone<'_> {
+    fn report(&self, stage: Stage, fraction: f64) {
+        let i = Stage::ALL.iter().position(|&s| s == stage).unwrap_or(0);
+        // A poisoned lock only means another report panicked: its values still hold.
+        let mut highest = self.highest.lock().unwrap_or_else(|e| e.into_inner());
+        if highest[i].is_none_or(|h| fraction > h) {
+            highest[i] = Some(fraction);
+            // Under the lock, so that two threads' reports reach the sink in order.
+            self.inner.report(stage, fraction);
+        }
+    }
+    fn cancelled(&self) -> bool {
+        self.inner.cancelled()
+    }
+}
+
 /// Returns `Err(Cancelled)` if the sink asks to stop.
 pub(crate) fn check_cancel(p: &dyn Progress) -> Result<(), EmbedError> {
     if p.cancelled() {

@@ -29,6 +29,7 @@ mod mds;
 pub mod memtrace;
 mod pipeline;
 mod quality;
+mod report;
 mod scaled;
 mod simd;
 mod thin;
@@ -38,9 +39,8 @@ pub use decimate::{
     Bounds, DecimateOptions, Decimated, FIRST_PASS_VERTICES, decimate, select_landmarks,
 };
 pub use mds::MdsOptions;
-pub use pipeline::{
-    LANDMARK_ASPECT_RATIO, PrecomputeOptions, Report, StageSeconds, THIN_PART_ROUNDS,
-};
+pub use pipeline::{LANDMARK_ASPECT_RATIO, PrecomputeOptions, THIN_PART_ROUNDS};
+pub use report::{Report, StageSeconds};
 pub use scaled::precompute;
 
 /// The revision of the precomputation's algorithm: raised whenever a change makes it give

@@ -7,12 +7,13 @@ use wavg_mesh::ValidMesh;
 use crate::decimate::{DecimateOptions, Decimated, decimate_beside, decimate_with_snapshots};
 use crate::error::{EmbedError, Progress, Stage, check_cancel};
 use crate::file::MAX_DIM;
-use crate::geodesic::{FastMarching, GeodesicOptions, landmark_distances};
+use crate::geodesic::{FastMarching, GeodesicOptions, KeptRows, landmark_distances_kept};
 use crate::lsmesh::LsMeshSolver;
 use crate::lsmesh::two_level::{CgOptions, LsMeshExtension, TwoLevelLsMesh};
 use crate::mds::{MdsOptions, metric_mds};
 use crate::memtrace::mark;
 use crate::quality::{QualityOptions, QualityPairs, quality_sources};
+use crate::report::{Report, StageSeconds};
 use crate::thin::{self, landmark_aspect_bound};
 use crate::{Embedding, EmbeddingParams};
 
@@ -83,6 +84,10 @@ pub const THIN_PART_ROUNDS: usize = 8;
 /// triangles every cross-section keeps landmarks all around.
 pub const LANDMARK_ASPECT_RATIO: f64 = 10.0;
 
+/// The most memory the geodesic runs kept between the rounds of step 4b may take
+/// (8 bytes a vertex of the geodesic mesh a landmark): beyond it they run again.
+const KEPT_ROWS_BYTES: usize = 256 << 20;
+
 /// What the quality check's first part yields: the full mesh's fast marching, the pairs
 /// with their geodesic distances, and its seconds.
 type QualityOut = Result<(Option<FastMarching>, Option<QualityPairs>, f64), EmbedError>;
@@ -108,66 +113,14 @@ impl Default for PrecomputeOptions {
     }
 }
 
-/// Wall-clock seconds per stage.
-#[derive(Clone, Debug, Default, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct StageSeconds {
-    /// Landmark selection.
-    pub decimate: f64,
-    /// Fast-marching setup and landmark-to-landmark distances.
-    pub geodesics: f64,
-    /// Classical MDS and SMACOF.
-    pub mds: f64,
-    /// Least-squares mesh.
-    pub lsmesh: f64,
-    /// Quality check (0 if skipped).
-    pub quality: f64,
-}
-
-/// What [`precompute`](crate::precompute) measured. With the `serde` feature it serialises to the keys of
-/// `wavg precompute --json` (a NaN error, when not measured, becomes `null` in JSON).
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct Report {
-    /// Total wall-clock seconds.
-    pub seconds: f64,
-    /// Per stage. Some stages overlap (the decimation with the quality check's fast
-    /// marching, the geodesics with the least-squares factorisation), so these can add up
-    /// to more than `seconds`.
-    pub stages: StageSeconds,
-    /// Landmarks used.
-    pub landmarks: usize,
-    /// Vertices of the mesh the landmark geodesics ran on (the input's own count when no
-    /// intermediate mesh was used).
-    pub geodesic_mesh_vertices: usize,
-    /// Embedding dimension.
-    pub dim: usize,
-    /// Final MDS stress (RMS relative landmark distance error).
-    pub stress: f64,
-    /// Stress of the classical-MDS start.
-    pub initial_stress: f64,
-    /// SMACOF iterations.
-    pub mds_iterations: usize,
-    /// Whether SMACOF met its tolerance.
-    pub mds_converged: bool,
-    /// Median relative error of embedding vs geodesic distance (NaN if not measured).
-    pub geodesic_rel_err_p50: f64,
-    /// 90th percentile of the same.
-    pub geodesic_rel_err_p90: f64,
-    /// Pairs in the quality check.
-    pub quality_pairs: usize,
-    /// Mesh vertices.
-    pub vertices: usize,
-    /// Mesh faces.
-    pub faces: usize,
-}
-
 /// [`crate::precompute`] on a mesh of moderate scale (see [`crate::scaled`]), its range
-/// already checked.
+/// already checked; `keep_rows` keeps the geodesic runs for step 4b's rounds (the same
+/// numbers either way: off only to test that).
 pub(crate) fn precompute_unscaled(
     mesh: &ValidMesh,
     opts: &PrecomputeOptions,
     progress: &dyn Progress,
+    keep_rows: bool,
 ) -> Result<(Embedding, Report), EmbedError> {
     let start = Instant::now();
     let n = mesh.n_vertices();
@@ -337,7 +290,8 @@ pub(crate) fn precompute_unscaled(
     let geodesics = |fine: Option<&FastMarching>,
                      landmarks: &[u32],
                      coarse: Option<&Decimated>,
-                     mid: Option<&Decimated>| {
+                     mid: Option<&Decimated>,
+                     kept: Option<&mut KeptRows>| {
         let t = Instant::now();
         let mut geo = GeodesicOptions::new();
         if let Some(fine) = fine {
@@ -350,7 +304,7 @@ pub(crate) fn precompute_unscaled(
                 geo = geo.refine_on(mid);
             }
         }
-        let q = landmark_distances(mesh, landmarks, &geo, progress)?;
+        let q = landmark_distances_kept(mesh, landmarks, &geo, kept, progress)?;
         Ok::<_, EmbedError>((q, secs(t)))
     };
     // The least-squares system; a later round's two-level system keeps the full mesh's
@@ -401,7 +355,15 @@ pub(crate) fn precompute_unscaled(
         // Later rounds only need the factorisation; the geodesics wait for the last.
         let (q, solver) = if round == 0 {
             let (q, solver) = rayon::join(
-                || geodesics(fm.as_ref(), &landmarks, coarse.as_ref(), ls_coarse.as_ref()),
+                || {
+                    geodesics(
+                        fm.as_ref(),
+                        &landmarks,
+                        coarse.as_ref(),
+                        ls_coarse.as_ref(),
+                        None,
+                    )
+                },
                 || factor(&landmarks, ls_coarse.as_ref(), None),
             );
             let (q, t_geodesics) = q?;
@@ -473,11 +435,14 @@ pub(crate) fn precompute_unscaled(
         round += 1;
         check_cancel(progress)?;
     };
+    // Where the rounds of step 4b may follow, they reuse these runs (`KeptRows`).
+    let rounds = usize::from(opts.cover_thin_parts && added > 0) * thin::SQUASHED_ROUNDS;
+    let mut kept = (rounds > 0 && keep_rows).then(|| KeptRows::new(KEPT_ROWS_BYTES));
     let q = match q {
         Some(q) => q,
         None => {
-            let (q, t_geodesics) =
-                geodesics(fm.as_ref(), &landmarks, coarse.as_ref(), ls_coarse.as_ref())?;
+            let (c, ls) = (coarse.as_ref(), ls_coarse.as_ref());
+            let (q, t_geodesics) = geodesics(fm.as_ref(), &landmarks, c, ls, kept.as_mut())?;
             stages.geodesics += t_geodesics;
             q
         }
@@ -505,9 +470,10 @@ pub(crate) fn precompute_unscaled(
     // 4b. On meshes with thin parts (landmarks were added), where the solved embedding
     //     still squashes vertices (`thin::squashed_vertices`), landmarks go there and the
     //     selection, geodesics, MDS and solve run again.
+    //     The landmarks kept from the round before keep their geodesic runs where the
+    //     geodesic mesh is the same (the full mesh, or the restart's intermediate mesh).
     let (mut landmarks, mut mds, mut coarse, mut ls_coarse) = (landmarks, mds, coarse, ls_coarse);
-    let rounds = usize::from(opts.cover_thin_parts && added > 0) * thin::SQUASHED_ROUNDS;
-    for _ in 0..rounds {
+    for r in 0..rounds {
         let t = Instant::now();
         let base = ls_coarse.as_ref().or(coarse.as_ref());
         let limit = opts.landmarks.saturating_sub(added);
@@ -521,8 +487,11 @@ pub(crate) fn precompute_unscaled(
         };
         let (next, c, ls, t_decimate) = next?;
         stages.decimate += t_decimate;
+        if let Some(k) = kept.as_mut() {
+            k.keep = r + 1 < rounds;
+        }
         let (q, solver) = rayon::join(
-            || geodesics(None, &next, c.as_ref(), ls.as_ref()),
+            || geodesics(None, &next, c.as_ref(), ls.as_ref(), kept.as_mut()),
             || factor(&next, ls.as_ref(), None),
         );
         let ((q, t_geodesics), (solver, t_factor)) = (q?, solver?);
@@ -540,7 +509,7 @@ pub(crate) fn precompute_unscaled(
         check_cancel(progress)?;
     }
     let geodesic_mesh_vertices = coarse.as_ref().map_or(0, |c| c.mesh.n_vertices());
-    drop((coarse, ls_coarse));
+    drop((coarse, ls_coarse, kept));
 
     // 5. Quality.
     let t = Instant::now();
@@ -598,6 +567,7 @@ pub(crate) fn precompute_unscaled(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geodesic::landmark_distances;
     use crate::{NoProgress, Stage, precompute};
     use std::sync::Mutex;
     use std::sync::atomic::{AtomicBool, Ordering};
@@ -851,6 +821,88 @@ mod tests {
         assert!(precompute(&mesh, &o, &NoProgress).is_err());
     }
 
+    /// Every report, in order.
+    struct Record(Mutex<Vec<(Stage, f64)>>);
+
+    impl Progress for Record {
+        fn report(&self, s: Stage, f: f64) {
+            assert!((0.0..=1.0).contains(&f));
+            self.0.lock().unwrap().push((s, f));
+        }
+    }
+
+    /// The landmark matrices computed (each one's geodesics reports end at 1), the
+    /// smallest fraction the last one reported, and whether some stage's fraction went
+    /// down.
+    fn rounds_seen(seen: &[(Stage, f64)]) -> (usize, f64, bool) {
+        let g: Vec<f64> = (seen.iter().filter(|x| x.0 == Stage::Geodesics))
+            .map(|x| x.1)
+            .collect();
+        let matrices: Vec<&[f64]> = g.split_inclusive(|&f| f == 1.0).collect();
+        let lowest = matrices.last().unwrap().iter().copied().fold(1.0, f64::min);
+        let down = Stage::ALL.iter().any(|&st| {
+            let f: Vec<f64> = seen.iter().filter(|x| x.0 == st).map(|x| x.1).collect();
+            f.windows(2).any(|w| w[1] < w[0])
+        });
+        (matrices.len(), lowest, down)
+    }
+
+    /// A body whose solved embedding squashes its hands (`thin_parts`'s
+    /// `no_pair_of_a_body_collapses_between_its_landmarks`), so that the rounds of step
+    /// 4b run: keeping the geodesic runs of the landmarks kept from one round to the next
+    /// changes no bit of the embedding, and most rows come from them. The progress the
+    /// caller sees never goes down within a stage, although the rounds start the
+    /// stages again.
+    #[test]
+    fn rounds_reuse_the_kept_rows_and_progress_never_goes_down() {
+        let shape = procedural::FigureShape {
+            height: 1.0315715517724773,
+            girth: 0.9488724982957178,
+            arm_spread: 0.7392461007790216,
+            elbow: 0.6853653952523319,
+            leg_spread: 0.0703057774264497,
+            finger_length: 0.09589633727489663,
+            finger_radius: 0.007367934190795696,
+        };
+        let mesh = ValidMesh::new(procedural::body(&shape)).unwrap();
+        let o = PrecomputeOptions {
+            quality_pairs: 0,
+            ..Default::default()
+        };
+        let run = |keep_rows: bool| {
+            let rec = Record(Mutex::new(Vec::new()));
+            let (emb, _) = precompute_unscaled(&mesh, &o, &rec, keep_rows).unwrap();
+            (emb, rec.0.into_inner().unwrap())
+        };
+        let (kept, kept_seen) = run(true);
+        let (fresh, fresh_seen) = run(false);
+        let bits = |e: &Embedding| -> Vec<u64> {
+            e.coords.iter().flatten().map(|x| x.to_bits()).collect()
+        };
+        assert_eq!(kept.landmarks, fresh.landmarks);
+        assert_eq!(bits(&kept), bits(&fresh));
+        // The rounds ran (a matrix for the first round, one after the thin-part rounds,
+        // then at least one for the squashed vertices), and the last one started far
+        // along with the kept rows.
+        let (matrices, lowest_kept, down) = rounds_seen(&kept_seen);
+        let (_, lowest_fresh, _) = rounds_seen(&fresh_seen);
+        assert!(matrices >= 3, "{matrices} landmark matrices");
+        assert!(lowest_fresh < 0.01, "{lowest_fresh}");
+        assert!(lowest_kept > 0.5, "{lowest_kept}");
+        assert!(down, "the pipeline's own reports go down");
+        // Through `precompute`, they do not.
+        let rec = Record(Mutex::new(Vec::new()));
+        let (public, _) = precompute(&mesh, &o, &rec).unwrap();
+        assert_eq!(bits(&public), bits(&kept));
+        let seen = rec.0.into_inner().unwrap();
+        assert!(!rounds_seen(&seen).2, "a fraction went down");
+        // (No quality check here.)
+        for stage in [Stage::Decimate, Stage::Geodesics, Stage::Mds, Stage::LsMesh] {
+            let last = seen.iter().rev().find(|(s, _)| *s == stage).map(|x| x.1);
+            assert_eq!(last, Some(1.0), "{stage:?}");
+        }
+    }
+
     /// Cancels once a report for `stage` arrives; records every report.
     struct CancelAt {
         stage: Stage,
@@ -903,13 +955,6 @@ mod tests {
             }
         }
         // Uncancelled: every stage reports, and each one finally reaches 1.
-        struct Record(Mutex<Vec<(Stage, f64)>>);
-        impl Progress for Record {
-            fn report(&self, s: Stage, f: f64) {
-                assert!((0.0..=1.0).contains(&f));
-                self.0.lock().unwrap().push((s, f));
-            }
-        }
         let rec = Record(Mutex::new(Vec::new()));
         precompute(&mesh, &opts(60), &rec).unwrap();
         let seen = rec.0.into_inner().unwrap();

@@ -8,9 +8,10 @@
 use wavg_mesh::{MAX_COORDINATE, MIN_EXTENT, TriMesh, ValidMesh};
 
 use crate::embedding::Embedding;
-use crate::error::{EmbedError, Progress};
+use crate::error::{EmbedError, Monotone, Progress};
 use crate::file::MAX_DIM;
-use crate::pipeline::{PrecomputeOptions, Report, precompute_unscaled};
+use crate::pipeline::{PrecomputeOptions, precompute_unscaled};
+use crate::report::Report;
 
 /// Meshes whose bounding box's longest side lies within `2^-SCALE_FREE ..= 2^SCALE_FREE`
 /// are computed as they are (the results of all everyday meshes are unchanged by the
@@ -45,9 +46,11 @@ pub fn precompute(
     if let Some(why) = wavg_mesh::coordinates_out_of_range(mesh) {
         return Err(EmbedError::InvalidArgument(why));
     }
+    // Later rounds run stages again: their bars hold where the first round left them.
+    let progress = &Monotone::new(progress);
     let k = scale_exponent(mesh);
     let (embedding, report) = if k == 0 {
-        precompute_unscaled(mesh, opts, progress)?
+        precompute_unscaled(mesh, opts, progress, true)?
     } else {
         let down = 2f64.powi(-k);
         let m = mesh.mesh();
@@ -55,7 +58,7 @@ pub fn precompute(
         // An exact rescaling of a valid mesh is valid (faces are judged by their shape).
         let scaled = ValidMesh::new(TriMesh::new(positions, m.triangles.clone()))
             .map_err(|e| EmbedError::Numerical(format!("the rescaled mesh: {e}")))?;
-        let (mut e, r) = precompute_unscaled(&scaled, opts, progress)?;
+        let (mut e, r) = precompute_unscaled(&scaled, opts, progress, true)?;
         let up = 2f64.powi(k);
         for c in &mut e.coords {
             for x in c.iter_mut() {

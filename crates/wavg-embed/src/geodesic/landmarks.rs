@@ -137,6 +137,18 @@ pub fn landmark_distances(
     opts: &GeodesicOptions<'_>,
     progress: &dyn Progress,
 ) -> Result<Vec<f64>, EmbedError> {
+    landmark_distances_kept(mesh, landmarks, opts, None, progress)
+}
+
+/// [`landmark_distances`], reusing the runs `kept` holds from an earlier call on the same
+/// mesh (the same runs give the same numbers) and keeping this call's runs in it.
+pub(crate) fn landmark_distances_kept(
+    mesh: &ValidMesh,
+    landmarks: &[u32],
+    opts: &GeodesicOptions<'_>,
+    kept: Option<&mut KeptRows>,
+    progress: &dyn Progress,
+) -> Result<Vec<f64>, EmbedError> {
     if let Some(fm) = opts.fine
         && fm.n != mesh.n_vertices()
     {
@@ -156,7 +168,10 @@ pub fn landmark_distances(
     };
     let decimated;
     let coarse = match opts.resolution {
-        Resolution::Full => return full_matrix(fine()?, landmarks, progress),
+        Resolution::Full => {
+            let key = MeshKey::new(mesh, None);
+            return full_matrix_kept(&fine, &key, landmarks, kept, progress);
+        }
         Resolution::Decimate(target) if target >= mesh.n_vertices() => {
             return full_matrix(fine()?, landmarks, progress);
         }
@@ -171,7 +186,7 @@ pub fn landmark_distances(
         }
         Resolution::Coarse(c) => c,
     };
-    let mut q = landmark_distances_decimated(coarse, landmarks, progress)?;
+    let mut q = landmark_distances_decimated(coarse, landmarks, kept, progress)?;
     if opts.refine_near_pairs {
         let radius = NEAR_PAIR_RADIUS_EDGES * wavg_mesh::geometry::mean_edge_length(&coarse.mesh);
         match opts.refine_on {
@@ -198,6 +213,28 @@ fn full_matrix(
     progress: &dyn Progress,
 ) -> Result<Vec<f64>, EmbedError> {
     let rows = fm.landmark_rows(landmarks, progress)?;
+    symmetrised(rows, landmarks)
+}
+
+/// [`full_matrix`] on the mesh `key` names, its runs from `kept` where it holds them (the
+/// fast marching, from `fm`, is built only when a run is missing).
+fn full_matrix_kept<'f>(
+    fm: &dyn Fn() -> Result<&'f FastMarching, EmbedError>,
+    key: &MeshKey,
+    landmarks: &[u32],
+    kept: Option<&mut KeptRows>,
+    progress: &dyn Progress,
+) -> Result<Vec<f64>, EmbedError> {
+    let rows = match kept {
+        Some(kept) => kept.rows(fm, key, landmarks, progress)?,
+        None => fm()?.landmark_rows(landmarks, progress)?,
+    };
+    symmetrised(rows, landmarks)
+}
+
+/// `Q = (D + D^T) / 2` from the rows of `D`, with a zero diagonal; an error where two
+/// landmarks do not reach each other.
+fn symmetrised(rows: Vec<Vec<f64>>, landmarks: &[u32]) -> Result<Vec<f64>, EmbedError> {
     let n = landmarks.len();
     let mut q = vec![0.0; n * n];
     for i in 0..n {
@@ -238,39 +275,176 @@ impl FastMarching {
         landmarks: &[u32],
         progress: &dyn Progress,
     ) -> Result<Vec<Vec<f64>>, EmbedError> {
+        let is_target = targets(self.n, landmarks)?;
+        let all: Vec<usize> = (0..landmarks.len()).collect();
+        let runs = self.runs(landmarks, &is_target, &all, false, 0, progress)?;
+        Ok(runs.into_iter().map(|(row, _)| row).collect())
+    }
+
+    /// The runs from `landmarks[i]` for each `i` in `which` (in parallel): each one's row
+    /// and, with `keep_fields`, its field ([`KeptRows`]); progress counts `done_before`
+    /// rows as done already.
+    fn runs(
+        &self,
+        landmarks: &[u32],
+        is_target: &[bool],
+        which: &[usize],
+        keep_fields: bool,
+        done_before: usize,
+        progress: &dyn Progress,
+    ) -> Result<Vec<RowAndField>, EmbedError> {
         let fm = self;
         let n = landmarks.len();
-        let mut is_target = vec![false; fm.n];
-        for &l in landmarks {
-            let slot = is_target.get_mut(l as usize).ok_or_else(|| {
-                EmbedError::InvalidArgument(format!(
-                    "landmark {l} out of range (mesh has {} vertices)",
-                    fm.n
-                ))
-            })?;
-            if std::mem::replace(slot, true) {
-                return Err(EmbedError::InvalidArgument(format!(
-                    "landmark {l} appears twice"
-                )));
-            }
-        }
         check_cancel(progress)?;
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let rows: Vec<Vec<f64>> = (0..n)
-            .into_par_iter()
+        let done = std::sync::atomic::AtomicUsize::new(done_before);
+        which
+            .par_iter()
             .map_init(
                 || fm.workspace(),
-                |ws, i| {
+                |ws, &i| {
                     check_cancel(progress)?;
-                    let d = fm.run_until_targets(ws, &landmarks[i..i + 1], &is_target, n);
-                    let row: Vec<f64> = landmarks.iter().map(|&l| d[l as usize]).collect();
+                    fm.run_until_targets(ws, &landmarks[i..i + 1], is_target, n);
+                    let row: Vec<f64> = landmarks.iter().map(|&l| ws.dist[l as usize]).collect();
+                    let field = keep_fields.then(|| frozen_field(ws));
                     let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                     progress.report(Stage::Geodesics, k as f64 / n as f64);
-                    Ok(row)
+                    Ok((row, field))
                 },
             )
-            .collect::<Result<_, EmbedError>>()?;
-        Ok(rows)
+            .collect()
+    }
+}
+
+/// One run's row (its distances to the landmarks) and, if kept, its [`frozen_field`].
+type RowAndField = (Vec<f64>, Option<Vec<f64>>);
+
+/// Flags of `landmarks` among `n` vertices; an error for an id out of range or repeated.
+fn targets(n: usize, landmarks: &[u32]) -> Result<Vec<bool>, EmbedError> {
+    let mut is_target = vec![false; n];
+    for &l in landmarks {
+        let slot = is_target.get_mut(l as usize).ok_or_else(|| {
+            EmbedError::InvalidArgument(format!(
+                "landmark {l} out of range (mesh has {n} vertices)"
+            ))
+        })?;
+        if std::mem::replace(slot, true) {
+            return Err(EmbedError::InvalidArgument(format!(
+                "landmark {l} appears twice"
+            )));
+        }
+    }
+    Ok(is_target)
+}
+
+/// A stopped run's distances, NaN where a vertex was not frozen yet (those are upper
+/// bounds that a longer run may lower; a frozen vertex's distance is final).
+fn frozen_field(ws: &Workspace) -> Vec<f64> {
+    (ws.dist.iter().zip(&ws.state))
+        .map(|(&d, &s)| if s == FROZEN { d } else { f64::NAN })
+        .collect()
+}
+
+/// Which mesh a landmark matrix ran on: its triangles and, for a decimation, the original
+/// ids of its vertices (a decimation's vertices keep their positions).
+#[derive(Clone, Debug, PartialEq)]
+struct MeshKey {
+    vertices: usize,
+    triangles: Vec<[u32; 3]>,
+    ids: Option<Vec<u32>>,
+}
+
+impl MeshKey {
+    fn new(mesh: &ValidMesh, ids: Option<&[u32]>) -> Self {
+        MeshKey {
+            vertices: mesh.n_vertices(),
+            triangles: mesh.triangles.clone(),
+            ids: ids.map(<[u32]>::to_vec),
+        }
+    }
+}
+
+/// The fast-marching runs of one landmark matrix, kept for the next matrix on the same
+/// mesh: a run stops once every landmark is frozen, and frozen distances do not depend on
+/// when it stops, so a landmark kept from one set to the next gets the same row, to the
+/// bit, wherever the new landmarks were frozen in its run (else it runs again). Each
+/// run's field costs 8 bytes a vertex of the geodesic mesh; fields are kept only while
+/// the whole set fits in `budget` bytes.
+#[derive(Debug)]
+pub(crate) struct KeptRows {
+    key: Option<MeshKey>,
+    /// Per source vertex (of the geodesic mesh), its run's [`frozen_field`].
+    fields: std::collections::HashMap<u32, Vec<f64>>,
+    budget: usize,
+    /// Whether this call's runs are kept for a next one (off for the last).
+    pub(crate) keep: bool,
+    /// Rows the last call took from kept runs.
+    pub(crate) reused: usize,
+}
+
+impl KeptRows {
+    /// Nothing kept yet; at most `budget` bytes of fields.
+    pub(crate) fn new(budget: usize) -> Self {
+        KeptRows {
+            key: None,
+            fields: Default::default(),
+            budget,
+            keep: true,
+            reused: 0,
+        }
+    }
+
+    /// Runs reused (kept fields that reach every landmark) and run again in the last call.
+    fn rows<'f>(
+        &mut self,
+        fm: &dyn Fn() -> Result<&'f FastMarching, EmbedError>,
+        key: &MeshKey,
+        landmarks: &[u32],
+        progress: &dyn Progress,
+    ) -> Result<Vec<Vec<f64>>, EmbedError> {
+        let n_vertices = key.vertices;
+        let is_target = targets(n_vertices, landmarks)?;
+        if self.key.as_ref() != Some(key) {
+            self.fields.clear();
+        }
+        let reached = |f: &Vec<f64>| landmarks.iter().all(|&l| !f[l as usize].is_nan());
+        let kept: Vec<Option<&Vec<f64>>> = (landmarks.iter())
+            .map(|l| self.fields.get(l).filter(|f| reached(f)))
+            .collect();
+        let missing: Vec<usize> = (0..landmarks.len())
+            .filter(|&i| kept[i].is_none())
+            .collect();
+        self.reused = landmarks.len() - missing.len();
+        let keep = self.keep && landmarks.len().saturating_mul(n_vertices) <= self.budget / 8;
+        let mut runs = if missing.is_empty() {
+            check_cancel(progress)?;
+            Vec::new()
+        } else {
+            let done = landmarks.len() - missing.len();
+            fm()?.runs(landmarks, &is_target, &missing, keep, done, progress)?
+        };
+        let mut rows: Vec<Option<Vec<f64>>> = (kept.iter())
+            .map(|f| f.map(|f| landmarks.iter().map(|&l| f[l as usize]).collect()))
+            .collect();
+        for (&i, (row, _)) in missing.iter().zip(&mut runs) {
+            rows[i] = Some(std::mem::take(row));
+        }
+        if keep {
+            let mut fields: std::collections::HashMap<u32, Vec<f64>> = Default::default();
+            for (&i, (_, field)) in missing.iter().zip(runs) {
+                fields.extend(field.map(|f| (landmarks[i], f)));
+            }
+            for l in landmarks {
+                if let Some(f) = self.fields.remove(l) {
+                    fields.entry(*l).or_insert(f);
+                }
+            }
+            self.fields = fields;
+            self.key = Some(key.clone());
+        } else {
+            self.fields.clear();
+            self.key = None;
+        }
+        Ok(rows.into_iter().map(|r| r.unwrap_or_default()).collect())
     }
 }
 
@@ -341,16 +515,22 @@ fn refine_near_pairs(
 fn landmark_distances_decimated(
     coarse: &Decimated,
     landmarks: &[u32],
+    kept: Option<&mut KeptRows>,
     progress: &dyn Progress,
 ) -> Result<Vec<f64>, EmbedError> {
     let ids = decimated_ids(coarse, landmarks)?;
     let mesh = ValidMesh::new(coarse.mesh.clone())
         .map_err(|e| EmbedError::Numerical(format!("the decimated mesh is not valid: {e}")))?;
-    full_matrix(
-        &FastMarching::new_cancellable(&mesh, progress)?,
-        &ids,
-        progress,
-    )
+    let built = std::cell::OnceCell::new();
+    let fm = || -> Result<&FastMarching, EmbedError> {
+        if let Some(fm) = built.get() {
+            return Ok(fm);
+        }
+        let fm = FastMarching::new_cancellable(&mesh, progress)?;
+        Ok(built.get_or_init(|| fm))
+    };
+    let key = MeshKey::new(&mesh, Some(&coarse.landmarks));
+    full_matrix_kept(&fm, &key, &ids, kept, progress)
 }
 
 /// The indices in `coarse` of the original vertices `landmarks` (an error if one is not

@@ -76,6 +76,7 @@ use unfold::*;
 pub(crate) use fast_marching::{DEFAULT_GEODESIC_VERTICES, MAX_UNFOLD_STEPS};
 pub use fast_marching::{FastMarching, Workspace};
 pub use landmarks::{GeodesicOptions, distances_from, landmark_distances};
+pub(crate) use landmarks::{KeptRows, landmark_distances_kept};
 
 #[cfg(test)]
 mod tests {
@@ -477,6 +478,63 @@ mod tests {
             );
             assert!(max < 0.02, "{file}: max asymmetry {max}");
         }
+    }
+
+    /// A matrix from kept runs (landmarks kept from the set before, in another order,
+    /// and new ones) is the fresh matrix to the bit, on the full mesh and on a coarse one;
+    /// a kept run that stopped before a new landmark froze runs again.
+    #[test]
+    fn kept_runs_give_the_fresh_matrix_bit_for_bit() {
+        let mesh = valid(procedural::grid(120, 20, 6.0, 1.0));
+        let n = mesh.n_vertices() as u32;
+        // Landmarks in the left quarter (x < 1.5, y <= 0.5), then most of them and new
+        // ones: one among them, one beyond (x = 2.25) that only some of their runs froze.
+        let before: Vec<u32> = (0..30)
+            .map(|i| (i * 97) % (n / 2) / 121 * 121 + i)
+            .collect();
+        let mut after: Vec<u32> = before[5..].iter().rev().copied().collect();
+        after.extend([15 * 121 + 10, 5 * 121 + 45]);
+        let bits = |q: &[f64]| q.iter().map(|d| d.to_bits()).collect::<Vec<u64>>();
+        let coarse = crate::decimate::decimate(
+            &mesh,
+            &DecimateOptions {
+                target: 900,
+                locked: before.iter().chain(&after).copied().collect(),
+                ..DecimateOptions::default()
+            },
+            &NoProgress,
+        )
+        .unwrap();
+        let full = GeodesicOptions::new();
+        let on_coarse = GeodesicOptions::new().coarse_mesh(&coarse);
+        for opts in [full, on_coarse] {
+            let mut kept = KeptRows::new(usize::MAX);
+            let first =
+                landmark_distances_kept(&mesh, &before, &opts, Some(&mut kept), &NoProgress);
+            assert_eq!(
+                bits(&first.unwrap()),
+                bits(&landmark_distances(&mesh, &before, &opts, &NoProgress).unwrap())
+            );
+            assert_eq!(kept.reused, 0);
+            let again = landmark_distances_kept(&mesh, &after, &opts, Some(&mut kept), &NoProgress);
+            let fresh = landmark_distances(&mesh, &after, &opts, &NoProgress).unwrap();
+            assert_eq!(bits(&again.unwrap()), bits(&fresh));
+            // Runs from the left stopped before the far right froze: only some are kept.
+            assert!(
+                (1..25).contains(&kept.reused),
+                "{} rows reused",
+                kept.reused
+            );
+            // The same set once more: every run is kept now.
+            let third = landmark_distances_kept(&mesh, &after, &opts, Some(&mut kept), &NoProgress);
+            assert_eq!(bits(&third.unwrap()), bits(&fresh));
+            assert_eq!(kept.reused, after.len());
+        }
+        // Over the budget, nothing is kept.
+        let mut kept = KeptRows::new(8 * mesh.n_vertices());
+        landmark_distances_kept(&mesh, &before, &full, Some(&mut kept), &NoProgress).unwrap();
+        landmark_distances_kept(&mesh, &before, &full, Some(&mut kept), &NoProgress).unwrap();
+        assert_eq!(kept.reused, 0);
     }
 
     #[test]
