@@ -31,9 +31,8 @@ pub enum SearchGoal {
     /// (after a search from the vertex nearest to the query when the answer is far from it
     /// for its face's size: the walk may have stopped on the wrong sheet of a thin part)
     /// against the bounding volume hierarchy. When nothing is found within
-    /// [`LOCAL_BUDGET`] faces, the search runs again from the end of a descent in full
-    /// precision from the walk's end, then from the vertex nearest to the query, then the
-    /// global search answers. Path [`ProjectionPath::Certified`] or
+    /// [`LOCAL_BUDGET`] faces, the search runs again from the vertex nearest to the
+    /// query, then the global search answers. Path [`ProjectionPath::Certified`] or
     /// [`ProjectionPath::Fallback`].
     #[default]
     Closest,
@@ -284,9 +283,8 @@ impl Projector {
             (SearchGoal::FirstHit, Some(b)) => Ok(Self::finish(b, ProjectionPath::Local)),
             (SearchGoal::Closest, Some(b)) => Ok(self.certify(y, b, v, &tried, true)),
             // The walk may end in a local minimum of the distance with no projection
-            // nearby (on another sheet that lies close in R^8), or short of its minimum:
-            // once more from a descent's end or the nearest vertex, much cheaper than the
-            // global search and usually its answer.
+            // nearby (on another sheet that lies close in R^8): once more from the
+            // nearest vertex, much cheaper than the global search and usually its answer.
             (_, None) => match self.search_from_nearest(y, v, goal) {
                 Some((b, _, _)) if goal == SearchGoal::FirstHit => {
                     Ok(Self::finish(b, ProjectionPath::Local))
@@ -324,40 +322,28 @@ impl Projector {
     }
 
     /// After the local search from the walk's end `v` found nothing: the local search from
-    /// the end of a greedy descent in f64 from `v` (the walk's 16-bit coordinates stop it
-    /// a few edges short of the minimum of the distance on a large mesh), then, unless
-    /// that is `v` or the descent's end, from the vertex nearest to `y`: the first answer,
-    /// the vertex it came from and the faces that search tried. Most such queries end
-    /// after the descent, without the search for the nearest vertex (thousands of boxes
-    /// around a query far off a large mesh).
+    /// the vertex nearest to `y` unless that is `v` (the walk ends with a descent in f64,
+    /// so the search for it is bounded by `v`'s distance and opens few boxes): the first
+    /// answer, the vertex it came from and the faces that search tried.
     fn search_from_nearest(
         &self,
         y: &Vec8,
         v: VertexId,
         goal: SearchGoal,
     ) -> Option<(Best, VertexId, FaceSet)> {
-        let from = |u: VertexId| {
-            let cands = self.faces_by_promise(y, u);
-            let mut tried = FaceSet::new();
-            self.local_search(y, u, &cands, goal, &mut tried)
-                .map(|b| (b, u, tried))
-        };
         let d2v = (self.verts[v as usize].x - y).norm_squared();
-        let (w, d2w) = self.descend(y, v, d2v);
-        if w != v {
-            if let Some(found) = from(w) {
-                return Some(found);
-            }
-        }
-        // The next float up keeps every vertex at exactly `w`'s distance (ties to the
+        // The next float up keeps every vertex at exactly `v`'s distance (ties to the
         // lowest index): the nearest vertex.
         let u = self
-            .nearest_vertex_within(y, f64::from_bits(d2w.to_bits() + 1))
-            .unwrap_or(w);
-        if u == v || u == w {
+            .nearest_vertex_within(y, f64::from_bits(d2v.to_bits() + 1))
+            .unwrap_or(v);
+        if u == v {
             return None;
         }
-        from(u)
+        let cands = self.faces_by_promise(y, u);
+        let mut tried = FaceSet::new();
+        self.local_search(y, u, &cands, goal, &mut tried)
+            .map(|b| (b, u, tried))
     }
 
     /// Certifies the local search's answer `local` (from the walk's end `v`): by its zero
