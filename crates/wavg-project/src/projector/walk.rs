@@ -80,9 +80,9 @@ impl Projector {
     }
 
     /// Greedy walk over the vertex graph from `start`: moves to the neighbour closest to
-    /// `y` until no neighbour is closer, then on in f64 (see [`Projector::finish_walk`]);
-    /// returns that vertex (a local minimum of the distance to `y`, a good start for the
-    /// next query near `y`).
+    /// `y` until no neighbour is closer, in compact coordinates and then in f64 (where
+    /// their rounding may have stopped it short); returns that vertex (a local minimum of
+    /// the distance to `y`, a good start for the next query near `y`).
     pub fn walk(&self, y: &Vec8, start: VertexId) -> VertexId {
         let mut ring_d = [0.0f32; 64];
         self.walk_inner(y, start.min(self.verts.len() as u32 - 1), &mut ring_d)
