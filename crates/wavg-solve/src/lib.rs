@@ -57,7 +57,8 @@ pub use verified::{DEFAULT_TOLERANCE, PENALTY_LADDER, RoundTrip, Verified};
 pub use anchors::AnchorSet;
 pub use kernel::{AnchorCoords, DEFAULT_GAMMA, InverseScratch, inverse_weights};
 pub use points::{
-    Anchor, BARY_TOLERANCE, check_point, nearest_corner, resolve_anchor, vertex_point,
+    Anchor, BARY_TOLERANCE, check_barycentrics, check_point, nearest_corner, resolve_anchor,
+    vertex_point,
 };
 pub use weights::{Normalization, WEIGHT_SUM_TOLERANCE, validate_weights};
 

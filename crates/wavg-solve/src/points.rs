@@ -30,6 +30,27 @@ impl From<SurfacePoint> for Anchor {
     }
 }
 
+/// The barycentric rule of [`check_point`], which needs no mesh: finite, none below
+/// `-BARY_TOLERANCE` (outside the face), summing to 1 within [`BARY_TOLERANCE`].
+pub fn check_barycentrics(p: &SurfacePoint) -> Result<(), SolveError> {
+    let bad = |reason| SolveError::BadBarycentrics {
+        face: p.face,
+        bary: p.bary,
+        reason,
+    };
+    if !p.bary.iter().all(|b| b.is_finite()) {
+        return Err(bad("not finite"));
+    }
+    if p.bary.iter().any(|&b| b < -BARY_TOLERANCE) {
+        return Err(bad("negative (the point is outside the face)"));
+    }
+    let sum: f64 = p.bary.iter().sum();
+    if (sum - 1.0).abs() > BARY_TOLERANCE {
+        return Err(bad("they do not sum to 1"));
+    }
+    Ok(())
+}
+
 /// Checks a surface point: face in range, barycentrics finite, none below
 /// `-BARY_TOLERANCE`, summing to 1 within `BARY_TOLERANCE`. Returns it with negatives
 /// clamped to zero and the sum renormalised to 1.
@@ -49,21 +70,7 @@ pub fn check_point(mesh: &TriMesh, p: &SurfacePoint) -> Result<SurfacePoint, Sol
             count: mesh.n_faces(),
         });
     }
-    let bad = |reason| SolveError::BadBarycentrics {
-        face: p.face,
-        bary: p.bary,
-        reason,
-    };
-    if !p.bary.iter().all(|b| b.is_finite()) {
-        return Err(bad("not finite"));
-    }
-    if p.bary.iter().any(|&b| b < -BARY_TOLERANCE) {
-        return Err(bad("negative (the point is outside the face)"));
-    }
-    let sum: f64 = p.bary.iter().sum();
-    if (sum - 1.0).abs() > BARY_TOLERANCE {
-        return Err(bad("they do not sum to 1"));
-    }
+    check_barycentrics(p)?;
     let c = p.bary.map(|b| b.max(0.0));
     let s: f64 = c.iter().sum();
     Ok(SurfacePoint::new(p.face, c.map(|b| b / s)))

@@ -27,7 +27,7 @@ use std::path::Path;
 
 use wavg_io::text::PointSpec;
 use wavg_mesh::{MeshError, SurfacePoint, ValidMesh, VertexId};
-use wavg_solve::{Anchor, BARY_TOLERANCE, SolveError, Vec8};
+use wavg_solve::{Anchor, SolveError, Vec8};
 
 use crate::error::{Error, Result};
 use crate::surface::Surface;
@@ -112,7 +112,7 @@ pub fn write(path: impl AsRef<Path>, anchors: &[Anchor]) -> Result<()> {
     }
     for a in anchors {
         if let Anchor::Point(p) = a {
-            check_bary(p)?;
+            wavg_solve::check_barycentrics(p)?;
         }
     }
     let text = format(anchors);
@@ -122,25 +122,6 @@ pub fn write(path: impl AsRef<Path>, anchors: &[Anchor]) -> Result<()> {
             source,
         }
     })?;
-    Ok(())
-}
-
-/// The barycentric rule of [`wavg_solve::check_point`], which needs no mesh.
-fn check_bary(p: &SurfacePoint) -> std::result::Result<(), SolveError> {
-    let bad = |reason| SolveError::BadBarycentrics {
-        face: p.face,
-        bary: p.bary,
-        reason,
-    };
-    if !p.bary.iter().all(|b| b.is_finite()) {
-        return Err(bad("not finite"));
-    }
-    if p.bary.iter().any(|&b| b < -BARY_TOLERANCE) {
-        return Err(bad("negative (the point is outside the face)"));
-    }
-    if (p.bary.iter().sum::<f64>() - 1.0).abs() > BARY_TOLERANCE {
-        return Err(bad("they do not sum to 1"));
-    }
     Ok(())
 }
 
