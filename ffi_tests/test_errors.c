@@ -226,7 +226,7 @@ int main(void) {
   CHECK(st[1] == WAVG_STATUS_INVALID_ARGUMENT && out[1].face == UINT32_MAX);
   CHECK(isnan(oxyz[3]) && isnan(oxyz[4]) && isnan(oxyz[5]) && isnan(out[1].bary[0]));
   CHECK(st[2] == WAVG_STATUS_INVALID_ARGUMENT && out[2].face == UINT32_MAX);
-  CHECK(strstr(wavg_last_error(), "query 1") != NULL);
+  CHECK(strstr(wavg_last_error(), "query 2") != NULL); /* the second, counted from 1 */
 
   /* Inverse: call-level errors write nothing; bad points are marked. */
   wavg_point pts[3] = {{5, {0.2, 0.3, 0.5}}, bad_face, bad_bary};
