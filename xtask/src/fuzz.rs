@@ -29,26 +29,25 @@ fn max_len(target: &str) -> Option<usize> {
     matches!(target, "mesh_read" | "gltf_read").then_some(4096)
 }
 
-/// The smoke run of `cargo xtask test`: the build and `seconds` of every target, as two
-/// timed steps of `log`.
-pub fn smoke(root: &Path, seconds: u64, log: &mut steps::Log) -> bool {
-    let mut bin_dir = PathBuf::new();
-    log.run("fuzz build (seed corpora, instrumented targets)", || {
-        seed_corpora(root, &root.join("fuzz"))?;
-        bin_dir = build(root)?;
-        Ok(())
-    }) && log.run(
-        &format!("fuzz smoke ({} targets x {seconds} s)", TARGETS.len()),
-        || run_built(root, &bin_dir, seconds, None),
-    )
-}
-
 /// Builds and runs every target (or only `only`) for `seconds` each; `Err` names the first
 /// failure.
+/// Prints each part's wall time (`cargo xtask test` runs this beside other steps, where
+/// only the whole is in its table).
 pub fn run(root: &Path, seconds: u64, only: Option<&str>) -> Result<(), String> {
+    let t = std::time::Instant::now();
     seed_corpora(root, &root.join("fuzz"))?;
     let bin_dir = build(root)?;
-    run_built(root, &bin_dir, seconds, only)
+    eprintln!(
+        "==> fuzz: seed corpora and instrumented build in {:.1} s",
+        t.elapsed().as_secs_f64()
+    );
+    let t = std::time::Instant::now();
+    run_built(root, &bin_dir, seconds, only)?;
+    eprintln!(
+        "==> fuzz: targets run in {:.1} s",
+        t.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 /// Builds the targets with libFuzzer's instrumentation on the workspace's own crates (see

@@ -3,6 +3,7 @@
 
 #![forbid(unsafe_code)]
 
+mod beside;
 mod blender;
 mod cbuild;
 mod cli_docs;
@@ -31,6 +32,8 @@ mod zig_env;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
+
+use beside::Beside;
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -242,8 +245,27 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
                 let args: Vec<&str> = args.iter().map(String::as_str).collect();
                 log.run(name, || steps::command(root, &program, &args))
             })
-        && release(root, data_dir, log)
-        && fuzz::smoke(root, SMOKE_SECONDS, log)
+        && release_and_fuzz(root, data_dir, log)
+}
+
+/// [`release`] with the fuzz targets' build and smoke run beside it ([`beside`]): nothing
+/// after ctest builds into the dev profile's folder, where the instrumented targets go.
+fn release_and_fuzz(root: &Path, data_dir: &Path, log: &mut steps::Log) -> bool {
+    let seconds = SMOKE_SECONDS.to_string();
+    let name = format!(
+        "fuzz build and smoke ({} targets x {SMOKE_SECONDS} s; beside the release steps)",
+        fuzz::TARGETS.len()
+    );
+    let fuzz = match Beside::start(root, &name, "fuzz-smoke", &["fuzz", "--seconds", &seconds]) {
+        Ok(f) => f,
+        Err(e) => return log.record(&name, 0.0, None, Err(e)),
+    };
+    if release(root, data_dir, log) {
+        fuzz.finish(log)
+    } else {
+        fuzz.cancel();
+        false
+    }
 }
 
 /// `cargo xtask dist`, then each artifact installed and used as its users do.

@@ -61,6 +61,20 @@ impl Log {
         let result = step();
         let wall = t.elapsed().as_secs_f64();
         let cpu = cpu::between(cpu_start, cpu::now());
+        self.record(name, wall, cpu, result)
+    }
+
+    /// Records a step timed elsewhere (one run beside others) and prints its end; false
+    /// when it failed.
+    pub fn record(
+        &mut self,
+        name: &str,
+        wall: f64,
+        cpu: Option<f64>,
+        result: Result<(), String>,
+    ) -> bool {
+        self.start
+            .get_or_insert_with(|| (Instant::now(), cpu::now()));
         let cpu_s = cpu::cell(cpu);
         match &result {
             Ok(()) => eprintln!("==> {name} ok in {wall:.1} s ({cpu_s} CPU s)"),

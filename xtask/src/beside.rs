@@ -1,0 +1,75 @@
+//! A step run in a child `cargo xtask` process beside the steps that follow it, its output in
+//! a file so that the two do not interleave. The fuzz targets' build and smoke run go this
+//! way beside the release steps: their build is a chain of single-threaded compiles of the
+//! workspace's crates, and the installed-artifact checks leave most of a core idle, so on a
+//! fresh 2-core machine the two side by side take about two minutes less than one after
+//! the other.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command};
+use std::time::Instant;
+
+use crate::steps;
+
+/// A running child step.
+pub struct Beside {
+    name: String,
+    child: Child,
+    output: PathBuf,
+    start: Instant,
+}
+
+impl Beside {
+    /// Starts `cargo xtask ARGS` (this binary) from `root` as step `name`, its output in
+    /// `FILE.log` in cargo's target directory.
+    pub fn start(root: &Path, name: &str, file: &str, args: &[&str]) -> Result<Self, String> {
+        let xtask = std::env::current_exe().map_err(|e| format!("xtask's own path: {e}"))?;
+        let output = steps::target_dir(root).join(format!("{file}.log"));
+        let out =
+            std::fs::File::create(&output).map_err(|e| format!("{}: {e}", output.display()))?;
+        let err = out
+            .try_clone()
+            .map_err(|e| format!("{}: {e}", output.display()))?;
+        eprintln!(
+            "==> {name}: started beside the next steps (output in {})",
+            output.display()
+        );
+        let child = Command::new(&xtask)
+            .args(args)
+            .current_dir(root)
+            .stdout(out)
+            .stderr(err)
+            .spawn()
+            .map_err(|e| format!("could not start {}: {e}", xtask.display()))?;
+        Ok(Self {
+            name: name.to_string(),
+            child,
+            output,
+            start: Instant::now(),
+        })
+    }
+
+    /// Waits for the step and records it in `log` (its wall time from its start; its CPU
+    /// overlaps the other steps', so the table shows none); on failure prints the end of
+    /// its output. False when it failed.
+    pub fn finish(mut self, log: &mut steps::Log) -> bool {
+        let result = match self.child.wait() {
+            Ok(status) if status.success() => Ok(()),
+            Ok(status) => Err(format!("ended with {status}")),
+            Err(e) => Err(format!("could not wait for it: {e}")),
+        };
+        let result = result.map_err(|e| {
+            let text = std::fs::read_to_string(&self.output).unwrap_or_default();
+            let lines: Vec<&str> = text.lines().collect();
+            let tail = lines[lines.len().saturating_sub(60)..].join("\n");
+            format!("{e}; the end of {}:\n{tail}", self.output.display())
+        });
+        log.record(&self.name, self.start.elapsed().as_secs_f64(), None, result)
+    }
+
+    /// Stops the step (a step before it failed).
+    pub fn cancel(mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
