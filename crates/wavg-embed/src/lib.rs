@@ -46,7 +46,7 @@ pub use scaled::precompute;
 /// The revision of the precomputation's algorithm: raised whenever a change makes it give
 /// other embeddings for the same mesh and options, so that caches keyed on the mesh and the
 /// options ([`PrecomputeOptions`]) do not return embeddings of an earlier algorithm.
-pub const PRECOMPUTE_REVISION: u32 = 6;
+pub const PRECOMPUTE_REVISION: u32 = 7;
 
 // Its result (saved and loaded by the `file` module).
 pub use embedding::{Embedding, EmbeddingParams};

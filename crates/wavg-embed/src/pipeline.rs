@@ -460,7 +460,7 @@ pub(crate) fn precompute_unscaled(
 
     // 4. Least-squares mesh: the landmarks' MDS positions extended to every vertex.
     let t = Instant::now();
-    let mut coords = solver.solve(&mds.points, dim, progress)?;
+    let mut coords = solver.solve(mesh, &mds.points, dim, progress)?;
     drop(solver);
     mark("lsmesh solve");
     progress.report(Stage::LsMesh, 1.0);
@@ -501,7 +501,7 @@ pub(crate) fn precompute_unscaled(
         mds = metric_mds(&q, next.len(), &opts.mds, progress)?;
         stages.mds += secs(t);
         let t = Instant::now();
-        coords = solver.solve(&mds.points, dim, progress)?;
+        coords = solver.solve(mesh, &mds.points, dim, progress)?;
         stages.lsmesh += secs(t);
         added += next.len() - landmarks.len();
         (landmarks, coarse, ls_coarse) = (next, c, ls);

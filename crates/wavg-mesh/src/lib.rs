@@ -33,6 +33,7 @@
 #![forbid(unsafe_code)]
 
 mod analyze;
+mod closest;
 mod defect;
 mod error;
 pub mod geometry;
@@ -48,6 +49,7 @@ mod topology;
 mod valid;
 
 // Meshes and their validation.
+pub use closest::closest_point_barycentric;
 pub use mesh::{FaceId, NONE, TexCoords, TriMesh, VertexId};
 pub use rings::RingSearch;
 pub use topology::Topology;

@@ -23,6 +23,7 @@ use crate::file::MAX_DIM;
 mod cg;
 mod locality;
 mod ordering;
+mod prolong;
 mod stiffness;
 pub(crate) mod two_level;
 

@@ -24,6 +24,7 @@ use wavg_mesh::ValidMesh;
 use super::LsMeshSolver;
 use super::cg::FreeOperator;
 use super::locality::VertexOrder;
+use super::prolong::{FullLevel, prolongate};
 use super::stiffness::Stiffness;
 use crate::decimate::Decimated;
 use crate::error::{EmbedError, Progress, check_cancel};
@@ -66,13 +67,14 @@ impl LsMeshExtension {
     /// [`LsMeshSolver::solve`].
     pub(crate) fn solve(
         &self,
+        mesh: &ValidMesh,
         values: &[Row],
         dim: usize,
         progress: &dyn Progress,
     ) -> Result<Vec<Row>, EmbedError> {
         match self {
             Self::Direct(s) => s.solve(values, dim),
-            Self::TwoLevel(s) => s.solve(values, dim, progress),
+            Self::TwoLevel(s) => s.solve(mesh, values, dim, progress),
         }
     }
 }
@@ -219,13 +221,32 @@ impl TwoLevelLsMesh {
     /// first `dim` entries of each value are used; the rest of the output is zero.
     pub(crate) fn solve(
         &self,
+        mesh: &ValidMesh,
         values: &[Row],
         dim: usize,
         progress: &dyn Progress,
     ) -> Result<Vec<Row>, EmbedError> {
+        if mesh.n_vertices() != self.fixed.len() {
+            return Err(EmbedError::InvalidArgument(format!(
+                "the least-squares system is for {} vertices, the mesh has {}",
+                self.fixed.len(),
+                mesh.n_vertices()
+            )));
+        }
         let coarse = self.coarse.solve(values, dim)?;
         check_cancel(progress)?;
-        let mut x = self.prolongate(&coarse, progress)?;
+        let full = FullLevel {
+            positions: &mesh.positions,
+            order: &self.order,
+            stiffness: &self.stiffness,
+        };
+        let mut x = prolongate(
+            &full,
+            &self.coarse_mesh,
+            &self.coarse_ids,
+            &coarse,
+            progress,
+        )?;
         for (&s, v) in self.landmarks_ordered.iter().zip(values) {
             x[s as usize] = *v;
             x[s as usize][dim..].fill(0.0);
@@ -243,85 +264,6 @@ impl TwoLevelLsMesh {
             ));
         }
         Ok(self.order.to_old(&x))
-    }
-
-    /// Coarse values at the coarse vertices; every other vertex gets the mean of its
-    /// neighbours one breadth-first layer closer to the coarse vertices (a layer in
-    /// parallel), then a few Gauss-Seidel sweeps of neighbour averaging smooth the result.
-    /// In the system's order. Looks at `progress`'s cancellation after each layer and
-    /// sweep (seconds at 10M).
-    fn prolongate(&self, coarse: &[Row], progress: &dyn Progress) -> Result<Vec<Row>, EmbedError> {
-        const SWEEPS: usize = 4;
-        let n = self.fixed.len();
-        let neighbours = |v: usize| {
-            (self.stiffness.col_rows(v).iter())
-                .map(|&u| u as usize)
-                .filter(move |&u| u != v)
-        };
-        let mut x = vec![[0.0; MAX_DIM]; n];
-        let mut known = vec![false; n];
-        let mut is_coarse = vec![false; n];
-        let coarse_ids: Vec<usize> = (self.coarse_ids.iter())
-            .map(|&v| self.order.new_of_old[v as usize] as usize)
-            .collect();
-        for (&v, c) in coarse_ids.iter().zip(coarse) {
-            x[v] = *c;
-            known[v] = true;
-            is_coarse[v] = true;
-        }
-        let mut frontier = coarse_ids;
-        let mut queued = known.clone();
-        while !frontier.is_empty() {
-            // The frontier's neighbours not queued before this layer, gathered in parallel
-            // and in the frontier's order; the first sighting of each is kept, as a serial
-            // walk over the frontier would.
-            let seen: Vec<usize> = (frontier.par_iter())
-                .with_min_len(1024)
-                .flat_map_iter(|&v| neighbours(v).filter(|&u| !queued[u]))
-                .collect();
-            let mut next = Vec::with_capacity(seen.len());
-            for u in seen {
-                if !queued[u] {
-                    queued[u] = true;
-                    next.push(u);
-                }
-            }
-            let layer: Vec<Row> = (next.par_iter())
-                .with_min_len(1024)
-                .map(|&u| {
-                    let (mut sum, mut count) = ([0.0; MAX_DIM], 0.0);
-                    for w in neighbours(u).filter(|&w| known[w]) {
-                        for c in 0..MAX_DIM {
-                            sum[c] += x[w][c];
-                        }
-                        count += 1.0;
-                    }
-                    sum.map(|s| s / count)
-                })
-                .collect();
-            for (&u, value) in next.iter().zip(layer) {
-                x[u] = value;
-                known[u] = true;
-            }
-            frontier = next;
-            check_cancel(progress)?;
-        }
-        for _ in 0..SWEEPS {
-            check_cancel(progress)?;
-            for v in (0..n).filter(|&v| !is_coarse[v]) {
-                let (mut sum, mut count) = ([0.0; MAX_DIM], 0.0);
-                for w in neighbours(v) {
-                    for c in 0..MAX_DIM {
-                        sum[c] += x[w][c];
-                    }
-                    count += 1.0;
-                }
-                if count > 0.0 {
-                    x[v] = sum.map(|s| s / count);
-                }
-            }
-        }
-        Ok(x)
     }
 }
 
@@ -388,7 +330,7 @@ mod tests {
             .unwrap();
         let two = TwoLevelLsMesh::new(mesh, &snap, &lm, cg, &NoProgress)
             .unwrap()
-            .solve(&values, MAX_DIM, &NoProgress)
+            .solve(mesh, &values, MAX_DIM, &NoProgress)
             .unwrap();
         for (&s, v) in lm.iter().zip(&values) {
             assert_eq!(two[s as usize], *v, "landmark {s} moved");
@@ -439,8 +381,8 @@ mod tests {
         let values: Vec<Row> = (fin.landmarks.iter())
             .map(|&l| std::array::from_fn(|k| ((l as usize * 7 + k) % 13) as f64))
             .collect();
-        let a = moved.solve(&values, MAX_DIM, &NoProgress).unwrap();
-        let b = fresh.solve(&values, MAX_DIM, &NoProgress).unwrap();
+        let a = moved.solve(&mesh, &values, MAX_DIM, &NoProgress).unwrap();
+        let b = fresh.solve(&mesh, &values, MAX_DIM, &NoProgress).unwrap();
         assert_eq!(a, b);
         // A landmark off the coarse mesh is refused, as by `new`.
         let off = (0..mesh.n_vertices() as u32)
@@ -479,7 +421,7 @@ mod tests {
                     &NoProgress,
                 )
                 .unwrap()
-                .solve(&values, MAX_DIM, &NoProgress)
+                .solve(&mesh, &values, MAX_DIM, &NoProgress)
                 .unwrap()
             })
         };
