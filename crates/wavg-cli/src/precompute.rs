@@ -21,6 +21,7 @@ use wavg::{MeshError, PrecomputeOptions, Progress, Report, Stage, ValidMesh};
 
 use crate::CliError;
 use crate::common::load_mesh;
+use crate::error::Context;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -95,6 +96,9 @@ fn check_args(args: &Args) -> Result<(), CliError> {
              would not belong to the file; save the repaired mesh as .obj, .off or .ply",
             m.display()
         )));
+    }
+    if let Some(m) = &args.repaired_mesh {
+        wavg::mesh::io::check_save_path(m).context("--repaired-mesh")?;
     }
     let landmarks = args.landmarks.unwrap_or(wavg::DEFAULT_LANDMARKS);
     if let Some(g) = args.geodesic_vertices.filter(|&g| g != 0 && g <= landmarks) {

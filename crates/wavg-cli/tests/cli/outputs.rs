@@ -166,3 +166,73 @@ fn outputs_named_another_way() {
         "v 0\nv 300\nv 600\n"
     );
 }
+
+/// Output names a reader would take for something else (`#NAME` selects a glTF mesh when
+/// reading), formats no writer makes (gzip-compressed glTF), and `-` for an output that is
+/// a folder: refused before any work (status 2), the message naming what to write instead,
+/// and nothing written (no folder named `-`).
+#[test]
+fn output_names_that_would_not_read_back_and_folders_on_stdout() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    for ext in ["gltf.gz", "glb.gz"] {
+        let out = d(&format!("x.{ext}"));
+        for command in ["repair", "subdivide"] {
+            refused(&[command, "builtin:torus", "-o", &out], &format!(".{ext}"));
+            refused(
+                &[command, "builtin:torus", "-o", &out],
+                ".obj, .off or .ply",
+            );
+        }
+    }
+    refused(&["repair", "builtin:torus", "-o", &d("m.stl")], "\".stl\"");
+    refused(
+        &["repair", "builtin:torus", "-o", &d("h.glb#Body")],
+        "#Body selects a mesh",
+    );
+    let control = d("c.txt");
+    std::fs::write(&control, "v 0\nv 300\nv 600\nv 900\n").unwrap();
+    let spline = [
+        "spline",
+        "builtin:torus",
+        "--embedding",
+        "none",
+        "--control",
+        &control,
+        "-o",
+        &d("s.gltf#Curve"),
+    ];
+    refused(&spline, "#Curve selects a mesh");
+    let a = control.as_str();
+    let m = "builtin:icosphere";
+    for out in ["-", "frames.gltf.gz"] {
+        let args = common::pair_args("morph", [m, m], [a, a], out);
+        let r = common::wavg_command()
+            .current_dir(dir.path())
+            .args(&args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{out}: {stderr}");
+        let says = if out == "-" {
+            "a folder of files"
+        } else {
+            ".gltf.gz"
+        };
+        assert!(stderr.contains(says), "{out}: {stderr}");
+        assert!(!dir.path().join(out).exists(), "{out} was made");
+    }
+    let r = common::wavg_command()
+        .current_dir(dir.path())
+        .args(["demo", "--out", "-"])
+        .output()
+        .unwrap();
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("a folder of files"));
+    let mut left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["c.txt"]);
+}
