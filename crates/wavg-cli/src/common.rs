@@ -295,6 +295,20 @@ pub fn check_output_folder(opt: &str, dir: &Path) -> Result<(), CliError> {
     wavg::mesh::io::check_output_name(dir).context(opt)
 }
 
+/// Checks a mesh output (named by its option) before any work: a file whose extension
+/// names a format the library writes (`wavg::mesh::io::check_save_path`), not `-` (the
+/// format follows the extension, and standard output has none). Input errors (exit
+/// status 2).
+pub fn check_mesh_output(opt: &str, path: &Path) -> Result<(), CliError> {
+    if path == Path::new("-") {
+        return Err(CliError::input(format!(
+            "{opt} -: a mesh is written to a file whose extension names its format (.obj, \
+             .off, .ply, .glb, .gltf), not to standard output; give a file name"
+        )));
+    }
+    wavg::mesh::io::check_save_path(path).context(opt)
+}
+
 /// Refuses an output `path` (unless `-`) whose name does not end in `.EXT`: the command
 /// writes only that kind of file (`what` says which).
 pub fn require_extension(path: &Path, ext: &str, what: &str) -> Result<(), CliError> {

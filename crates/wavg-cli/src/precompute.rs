@@ -21,7 +21,6 @@ use wavg::{MeshError, PrecomputeOptions, Progress, Report, Stage, ValidMesh};
 
 use crate::CliError;
 use crate::common::load_mesh;
-use crate::error::Context;
 
 /// Arguments.
 #[derive(clap::Args)]
@@ -98,7 +97,7 @@ fn check_args(args: &Args) -> Result<(), CliError> {
         )));
     }
     if let Some(m) = &args.repaired_mesh {
-        wavg::mesh::io::check_save_path(m).context("--repaired-mesh")?;
+        crate::common::check_mesh_output("--repaired-mesh", m)?;
     }
     let landmarks = args.landmarks.unwrap_or(wavg::DEFAULT_LANDMARKS);
     if let Some(g) = args.geodesic_vertices.filter(|&g| g != 0 && g <= landmarks) {
@@ -107,6 +106,12 @@ fn check_args(args: &Args) -> Result<(), CliError> {
         )));
     }
     let out = &args.output;
+    if out == std::path::Path::new("-") {
+        return Err(CliError::input(
+            "-o -: the embedding is written to a .wavg file, which the commands read by \
+             name, not to standard output; give a file name ending in .wavg",
+        ));
+    }
     if crate::common::same_file(args.mesh.as_ref(), out) {
         return Err(CliError::input(format!(
             "the output {} is the input mesh; write the embedding to a .wavg file",

@@ -169,8 +169,9 @@ fn outputs_named_another_way() {
 
 /// Output names a reader would take for something else (`#NAME` selects a glTF mesh when
 /// reading), formats no writer makes (gzip-compressed glTF), and `-` for an output that is
-/// a folder: refused before any work (status 2), the message naming what to write instead,
-/// and nothing written (no folder named `-`).
+/// a folder or a file read back by name (a mesh, whose format is its extension; an
+/// embedding): refused before any work (status 2), the message naming what to write
+/// instead, and nothing written (no file or folder named `-`).
 #[test]
 fn output_names_that_would_not_read_back_and_folders_on_stdout() {
     let dir = tempfile::tempdir().unwrap();
@@ -222,13 +223,40 @@ fn output_names_that_would_not_read_back_and_folders_on_stdout() {
         assert!(stderr.contains(says), "{out}: {stderr}");
         assert!(!dir.path().join(out).exists(), "{out} was made");
     }
-    let r = common::wavg_command()
-        .current_dir(dir.path())
-        .args(["demo", "--out", "-"])
-        .output()
-        .unwrap();
-    assert_eq!(r.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&r.stderr).contains("a folder of files"));
+    let in_dir = |args: &[&str], says: &str| {
+        let r = common::wavg_command()
+            .current_dir(dir.path())
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+        assert!(r.stdout.is_empty(), "{args:?} printed to stdout");
+    };
+    in_dir(&["demo", "--out", "-"], "a folder of files");
+    // A mesh's format follows its file's extension; the embedding is read back by name.
+    for command in ["repair", "subdivide"] {
+        in_dir(
+            &[command, "builtin:sphere-small", "-o", "-"],
+            "-o -: a mesh is written to a file",
+        );
+    }
+    in_dir(
+        &["precompute", "builtin:sphere-small", "-o", "-"],
+        "give a file name ending in .wavg",
+    );
+    in_dir(
+        &[
+            "precompute",
+            "builtin:sphere-small",
+            "-o",
+            "e.wavg",
+            "--repaired-mesh",
+            "-",
+        ],
+        "--repaired-mesh -: a mesh is written to a file",
+    );
     let mut left: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
