@@ -164,6 +164,16 @@ def test_options_are_checked_once_before_any_job(tmp_path: Path, assets: dict) -
     assert wb._landmarks(np.int64(40)) == 40 and wb._landmarks(0) is None
 
 
+def test_builtin_meshes_are_inputs_too(tmp_path: Path) -> None:
+    m = wb.precompute_all(["builtin:sphere-small"], tmp_path, landmarks=20)
+    assert [j["status"] for j in m] == ["done"], [j["error"] for j in m]
+    out = tmp_path / "sphere-small.wavg"
+    assert m[0]["output"] == str(out) and out.is_file()
+    s = wavg.Surface.open("builtin:sphere-small", embedding=out)
+    assert s.has_embedding and len(s.landmarks) == 20
+    assert [j["status"] for j in wb.precompute_all(["builtin:sphere-small"], tmp_path, landmarks=20)] == ["skipped"]
+
+
 def test_template_failure_fails_every_job(tmp_path: Path, assets: dict) -> None:
     m = wb.correspond_all(assets["invalid"], assets["template_anchors"], assets["targets"][:2], tmp_path, landmarks=LANDMARKS)
     assert [j["status"] for j in m] == ["failed", "failed"]

@@ -32,7 +32,11 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 def _abs(p: PathLike) -> str:
-    return os.path.abspath(os.fspath(p))
+    """A file's absolute path; a builtin mesh's name (``builtin:torus``) as it is."""
+    name = os.fspath(p)
+    if isinstance(name, str) and name.startswith(store.BUILTIN_PREFIX):
+        return name
+    return os.path.abspath(name)
 
 
 def _names(inputs: Sequence[PathLike], suffix: str) -> list[str]:
