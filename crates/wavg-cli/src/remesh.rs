@@ -90,8 +90,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &[("-o", &args.output)],
         args.json,
     )?;
-    let text = std::fs::read_to_string(&args.base)
-        .map_err(|e| CliError::input(format!("{}: {e}", args.base.display())))?;
+    // Comments may hold any bytes (an exporter's Latin-1 name), as in every OBJ read.
+    let text = textio::read_text(&args.base)?;
     let base = BaseMesh::from_obj_str(&text).context(args.base.display())?;
     base.validate().context(args.base.display())?;
     if args.levels > wavg::apps::MAX_LEVELS {

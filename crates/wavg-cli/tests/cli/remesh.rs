@@ -102,3 +102,27 @@ fn bad_bases_write_nothing() {
         assert!(!out.exists());
     }
 }
+
+/// A base's comments may hold any bytes (an exporter's Latin-1 name), as a mesh file's;
+/// its data stays UTF-8.
+#[test]
+fn a_bases_comments_may_hold_any_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("b.obj");
+    let out = dir.path().join("r.obj");
+    let mut latin1 = b"# Cube \xe9crit par un exporteur\n".to_vec();
+    latin1.extend_from_slice(CUBE.as_bytes());
+    std::fs::write(&base, latin1).unwrap();
+    let r = common::remesh_on_sphere(&base, &out, &["--frames", "0"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    std::fs::write(&base, b"v 0 0 \xe9\n").unwrap();
+    std::fs::remove_file(&out).unwrap();
+    let r = common::remesh_on_sphere(&base, &out, &[]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("b.obj:1: the text is not valid UTF-8"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
