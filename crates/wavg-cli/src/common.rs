@@ -309,6 +309,21 @@ pub fn check_mesh_output(opt: &str, path: &Path) -> Result<(), CliError> {
     wavg::mesh::io::check_save_path(path).context(opt)
 }
 
+/// Refuses an output `path` of a command that writes OBJ text (or glTF, by its extension)
+/// when its extension names another mesh format (`.ply`, `.off`, a `.gz`): the file would
+/// not hold what its name says. Other names (`-`, `.obj`, `.txt`) pass. Input error (exit
+/// status 2).
+pub fn refuse_other_mesh_format(path: &Path, what: &str) -> Result<(), CliError> {
+    use wavg::mesh::Format;
+    match Format::from_path(path) {
+        Ok((Format::Obj, false) | (Format::Gltf | Format::Glb, _)) | Err(_) => Ok(()),
+        Ok(_) => Err(CliError::input(format!(
+            "-o {}: {what}: give a name ending in .obj, .glb or .gltf",
+            path.display()
+        ))),
+    }
+}
+
 /// Refuses an output `path` (unless `-`) whose name does not end in `.EXT`: the command
 /// writes only that kind of file (`what` says which).
 pub fn require_extension(path: &Path, ext: &str, what: &str) -> Result<(), CliError> {

@@ -90,6 +90,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &[("-o", &args.output)],
         args.json,
     )?;
+    crate::common::refuse_other_mesh_format(
+        &args.output,
+        "the refined mesh is written as OBJ (its polygons) or glTF",
+    )?;
     // Comments may hold any bytes (an exporter's Latin-1 name), as in every OBJ read.
     let text = textio::read_text(&args.base)?;
     let base = BaseMesh::from_obj_str(&text).context(args.base.display())?;

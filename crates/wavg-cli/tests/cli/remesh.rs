@@ -101,6 +101,19 @@ fn bad_bases_write_nothing() {
         assert!(err.contains(needle), "{needle}: {err}");
         assert!(!out.exists());
     }
+    // The output is OBJ text (or glTF): a name saying PLY, OFF or gzip is refused.
+    std::fs::write(&base, CUBE).unwrap();
+    for name in ["r.ply", "r.off", "r.obj.gz"] {
+        let out = dir.path().join(name);
+        let r = common::remesh_on_sphere(&base, &out, &[]);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{name}: {err}");
+        assert!(
+            err.contains("give a name ending in .obj, .glb or .gltf"),
+            "{err}"
+        );
+        assert!(!out.exists());
+    }
 }
 
 /// A base's comments may hold any bytes (an exporter's Latin-1 name), as a mesh file's;
