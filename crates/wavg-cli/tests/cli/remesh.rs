@@ -80,6 +80,16 @@ fn cube_on_the_sphere() {
     assert_eq!(sizes.iter().filter(|&&n| n == 3).count(), 32);
 }
 
+/// Runs `wavg remesh` of `base` into `out` and asserts it exits 2 saying `says` and
+/// writes nothing.
+fn refused(base: &std::path::Path, out: &std::path::Path, says: &str) {
+    let r = common::remesh_on_sphere(base, out, &[]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{says}: {err}");
+    assert!(err.contains(says), "{says}: {err}");
+    assert!(!out.exists());
+}
+
 #[test]
 fn bad_bases_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -95,24 +105,13 @@ fn bad_bases_write_nothing() {
         ("v 0 0\n", "line 1"),
     ] {
         std::fs::write(&base, text).unwrap();
-        let r = common::remesh_on_sphere(&base, &out, &[]);
-        let err = String::from_utf8_lossy(&r.stderr);
-        assert_eq!(r.status.code(), Some(2), "{text:?}: {err}");
-        assert!(err.contains(needle), "{needle}: {err}");
-        assert!(!out.exists());
+        refused(&base, &out, needle);
     }
     // The output is OBJ text (or glTF): a name saying PLY, OFF or gzip is refused.
     std::fs::write(&base, CUBE).unwrap();
     for name in ["r.ply", "r.off", "r.obj.gz"] {
-        let out = dir.path().join(name);
-        let r = common::remesh_on_sphere(&base, &out, &[]);
-        let err = String::from_utf8_lossy(&r.stderr);
-        assert_eq!(r.status.code(), Some(2), "{name}: {err}");
-        assert!(
-            err.contains("give a name ending in .obj, .glb or .gltf"),
-            "{err}"
-        );
-        assert!(!out.exists());
+        let says = "give a name ending in .obj, .glb or .gltf";
+        refused(&base, &dir.path().join(name), says);
     }
 }
 
@@ -130,12 +129,5 @@ fn a_bases_comments_may_hold_any_bytes() {
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     std::fs::write(&base, b"v 0 0 \xe9\n").unwrap();
     std::fs::remove_file(&out).unwrap();
-    let r = common::remesh_on_sphere(&base, &out, &[]);
-    let err = String::from_utf8_lossy(&r.stderr);
-    assert_eq!(r.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("b.obj:1: the text is not valid UTF-8"),
-        "{err}"
-    );
-    assert!(!out.exists());
+    refused(&base, &out, "b.obj:1: the text is not valid UTF-8");
 }
