@@ -59,6 +59,7 @@ int main(void) {
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_correspond(solver, solver, pts, 0, true, -0.1, out, pos, st));
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_correspond(NULL, solver, pts, NP, true, -0.1, out, pos, st));
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_correspond(solver, solver, pts, NP, true, NAN, out, pos, st));
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_correspond(solver, solver, pts, NP, true, 5.0, out, pos, st));
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_correspond(solver, solver, NULL, NP, true, -0.1, out, pos, st));
   CHECK(memcmp(&out[0], &before, sizeof before) == 0);
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_correspond_vertices(solver, fewer, true, true, -0.1, vout, vpos, vst));
@@ -70,6 +71,7 @@ int main(void) {
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_decal_uv(solver, uv, fx.anchors, 0, -0.1, out_uv, dst));
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_decal_uv(solver, NULL, fx.anchors, NA, -0.1, out_uv, dst));
   CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_decal_uv(solver, uv, fx.anchors, NA, INFINITY, out_uv, dst));
+  CHECK_FAILS(WAVG_STATUS_INVALID_ARGUMENT, wavg_decal_uv(solver, uv, fx.anchors, NA, 0.5, out_uv, dst));
   CHECK(out_uv[0] == saved);
 
   free(vout);

@@ -230,8 +230,8 @@ enum wavg_status wavg_surface_decimate(const struct wavg_surface *surface,
 // `wavg_correspond_vertices`); another failure status with `face = UINT32_MAX` and NaN
 // where there is no image. Returns the first non-OK point's status (with its message) or
 // `WAVG_STATUS_OK`. Call-level errors (`WAVG_STATUS_INVALID_ARGUMENT`: NULL solvers,
-// points or `out`, `n == 0`, different anchor counts, a non-finite `max_negative`) write
-// nothing. Runs in parallel; thread-safe on shared solvers.
+// points or `out`, `n == 0`, different anchor counts, a `max_negative` not finite or
+// above 0) write nothing. Runs in parallel; thread-safe on shared solvers.
 //
 // # Safety
 // The solvers must be NULL or live; `points` and `out` must hold `n` elements,
@@ -277,8 +277,8 @@ enum wavg_status wavg_correspond_vertices(const struct wavg_solver *source,
 // the point through the forward problem, or one is below `max_negative`), the
 // coordinates still written; another failure status, with NaN, where the inverse problem
 // fails. Returns the first non-OK point's status or `WAVG_STATUS_OK`. Call-level errors
-// (`WAVG_STATUS_INVALID_ARGUMENT`: NULL pointers, `n == 0`, non-finite coordinates or
-// `max_negative`) write nothing. Runs in parallel; thread-safe on a shared solver.
+// (`WAVG_STATUS_INVALID_ARGUMENT`: NULL pointers, `n == 0`, non-finite coordinates, a
+// `max_negative` not finite or above 0) write nothing. Runs in parallel; thread-safe on a shared solver.
 //
 // # Safety
 // `solver` must be NULL or live; `anchor_uv` must hold `2 * n_anchors` doubles,
@@ -464,10 +464,12 @@ enum wavg_status wavg_inverse(const struct wavg_solver *solver,
                               enum wavg_status *out_statuses);
 
 // Loads a mesh file (`.obj`, `.off`, `.ply`, each optionally gzipped as `.gz`; `.gltf` or
-// `.glb`, `scene.glb#Name` for one of its meshes; `mesh_path` is a NUL-terminated path) and validates it. On success `*out` is a new surface whose
+// `.glb`, `scene.glb#Name` for one of its meshes; `mesh_path` is a NUL-terminated path), or
+// a builtin mesh (`builtin:torus`, as the `wavg` command takes it), and validates it. On success `*out` is a new surface whose
 // embedding is the vertex positions until one is precomputed or loaded; on failure `*out`
 // is left unchanged. Errors: `WAVG_STATUS_IO` (missing or unreadable file),
-// `WAVG_STATUS_INVALID_MESH` (not an oriented manifold, degenerate faces...).
+// `WAVG_STATUS_INVALID_MESH` (not an oriented manifold, degenerate faces...),
+// `WAVG_STATUS_INVALID_ARGUMENT` (an unknown builtin name).
 //
 // # Safety
 // `mesh_path` must be NULL or NUL-terminated; `out` NULL or writable.

@@ -129,12 +129,13 @@ fn correspond<'py>(
             )));
         }
     };
-    if !max_negative.is_finite() {
-        return Err(value("max_negative must be a finite number"));
-    }
-    if !(max_stretch.is_finite() && max_stretch > 1.0) {
-        return Err(value("max_stretch must be a finite number above 1"));
-    }
+    let opts = CorrespondOptions {
+        verified,
+        max_negative,
+        test,
+        max_stretch,
+    };
+    opts.check().map_err(|e| value(e.to_string()))?;
     let ss = solver_for(py, &src.inner, src_anchors, "src_anchors")?;
     let ts = solver_for(py, &dst.inner, dst_anchors, "dst_anchors")?;
     if ss.n_anchors() != ts.n_anchors() {
@@ -144,12 +145,6 @@ fn correspond<'py>(
             ts.n_anchors()
         )));
     }
-    let opts = CorrespondOptions {
-        verified,
-        max_negative,
-        test,
-        max_stretch,
-    };
     let par = par(threads)?;
     let t = std::time::Instant::now();
     let map = py
@@ -255,9 +250,7 @@ fn decal<'py>(
         )));
     }
     finite(data(&ua), "uv")?;
-    if !max_negative.is_finite() {
-        return Err(value("max_negative must be a finite number"));
-    }
+    wavg::apps::check_max_negative(max_negative).map_err(|e| value(e.to_string()))?;
     let pairs: Vec<[f64; 2]> = data(&ua).chunks_exact(2).map(|c| [c[0], c[1]]).collect();
     let par = par(threads)?;
     let d = py
@@ -306,7 +299,7 @@ fn transfer_texture<'py>(
         None => (texture.width, texture.height),
         Some(s) => image::size_arg(s, "size")?,
     };
-    let stride = stride.within("stride", 1, 64)?;
+    let stride = stride.within("stride", 1, wavg::apps::MAX_STRIDE.into())?;
     let ss = solver_for(py, &src.inner, src_anchors, "src_anchors")?;
     let ts = solver_for(py, &dst.inner, dst_anchors, "dst_anchors")?;
     let opts = TransferOptions {

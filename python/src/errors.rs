@@ -82,6 +82,9 @@ pub(crate) fn type_error(message: impl Into<String>) -> PyErr {
 /// [`require_file`] for a mesh path, whose `#NAME` suffix (one mesh of a glTF file) is not
 /// part of the file's name.
 pub(crate) fn require_mesh_file(path: &Path) -> PyResult<()> {
+    if wavg::builtin_name(path).is_some() {
+        return Ok(());
+    }
     require_file(&wavg::mesh::io::gltf::split_mesh_name(path).0)
 }
 

@@ -33,8 +33,9 @@ use crate::pool::DetachRun;
 /// read_mesh(path) -> (V (n, 3) float64, F (m, 3) int64)
 ///
 /// Reads a mesh file (.obj, .off, .ply, optionally gzipped as .gz; .gltf or .glb, welded
-/// into one surface, ``scene.glb#Name`` for one of its meshes): vertex positions and
-/// 0-based triangles (polygons are triangulated). The mesh is not validated.
+/// into one surface, ``scene.glb#Name`` for one of its meshes) or a builtin mesh
+/// (``builtin:torus``, as the command line takes them): vertex positions and 0-based
+/// triangles (polygons are triangulated). The mesh is not validated.
 #[pyfunction]
 fn read_mesh<'py>(
     py: Python<'py>,
@@ -42,7 +43,7 @@ fn read_mesh<'py>(
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     errors::require_mesh_file(&path)?;
     let mesh = py
-        .detach_run(|| wavg::mesh::io::load(&path))
+        .detach_run(|| wavg::load_mesh(&path))
         .map_err(errors::lib(py))?;
     arrays::mesh_arrays(py, &mesh)
 }

@@ -97,7 +97,8 @@ impl Surface {
     ///
     /// Reads a mesh file (.obj, .off, .ply, optionally .gz; .gltf or .glb, welded into one
     /// surface, ``scene.glb#Name`` for one of its meshes; texture coordinates of .obj and
-    /// glTF are kept) and, when ``embedding`` names a ``.wavg`` file, its embedding.
+    /// glTF are kept) or a builtin mesh (``builtin:torus``, as the command line takes
+    /// them) and, when ``embedding`` names a ``.wavg`` file, its embedding.
     #[staticmethod]
     #[pyo3(signature = (path, embedding=None))]
     fn open(py: Python<'_>, path: PathBuf, embedding: Option<PathBuf>) -> PyResult<Self> {
@@ -107,7 +108,7 @@ impl Surface {
         }
         let (inner, notes) = py
             .detach_run(|| {
-                let (mesh, notes) = wavg::mesh::io::load_with_notes(&path)?;
+                let (mesh, notes) = wavg::load_mesh_with_notes(&path)?;
                 let mesh = wavg::ValidMesh::new(mesh)?;
                 wavg::Surface::from_valid_and_file(mesh, embedding.as_deref()).map(|s| (s, notes))
             })

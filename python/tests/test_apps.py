@@ -51,6 +51,17 @@ def test_decal_anchor_uvs(surface, anchors):
             assert np.allclose(uv[a], want, atol=1e-6)
 
 
+def test_weight_limits_out_of_range_are_refused_with_the_range(surface, anchors):
+    uv_in = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    for bad in (5.0, 0.1, float("nan")):
+        with pytest.raises(ValueError, match="max_negative must be a finite weight of at most 0"):
+            wavg.decal(surface, anchors[:4], uv_in, max_negative=bad)
+        with pytest.raises(ValueError, match="at most 0"):
+            wavg.correspond(surface, surface, anchors, anchors, max_negative=bad)
+    with pytest.raises(ValueError, match="max_stretch must be a finite number above 1"):
+        wavg.correspond(surface, surface, anchors, anchors, max_stretch=0.5)
+
+
 def test_transfer_texture_onto_itself(surface, anchors):
     V, F = surface.vertices, surface.faces
     # A planar uv layout per face corner: the torus's own angles.

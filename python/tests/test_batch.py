@@ -142,6 +142,38 @@ def test_pair_arguments_are_checked(tmp_path: Path, assets: dict) -> None:
     assert not (tmp_path / "one").exists()
 
 
+def test_options_are_checked_once_before_any_job(tmp_path: Path, assets: dict) -> None:
+    meshes = assets["meshes"][:2]
+    for bad, error, says in [
+        ({"landmarks": -1}, ValueError, "landmarks must be an integer from 0 to 4294967295, got -1"),
+        ({"landmarks": 2**32}, ValueError, "landmarks must be"),
+        ({"landmarks": 12.5}, TypeError, "landmarks must be an integer, got 12.5"),
+        ({"seed": -3}, ValueError, "seed must be an integer from 0"),
+    ]:
+        with pytest.raises(error, match=says):
+            wb.precompute_all(meshes, tmp_path / "p", **bad)
+    pair = (assets["template"], assets["texture"], assets["template_anchors"], assets["targets"][:2])
+    with pytest.raises(ValueError, match="size"):
+        wb.transfer_all(*pair, tmp_path / "t", size=(64, 0))
+    with pytest.raises(ValueError, match="landmarks"):
+        wb.transfer_all(*pair, tmp_path / "t", landmarks=-5)
+    with pytest.raises(ValueError, match='validity must be "local" or "paper"'):
+        wb.correspond_all(assets["template"], assets["template_anchors"], assets["targets"][:2], tmp_path / "c", validity="strict")
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    # NumPy integers are integers; 0 is the library's choice, as None.
+    assert wb._landmarks(np.int64(40)) == 40 and wb._landmarks(0) is None
+
+
+def test_builtin_meshes_are_inputs_too(tmp_path: Path) -> None:
+    m = wb.precompute_all(["builtin:sphere-small"], tmp_path, landmarks=20)
+    assert [j["status"] for j in m] == ["done"], [j["error"] for j in m]
+    out = tmp_path / "sphere-small.wavg"
+    assert m[0]["output"] == str(out) and out.is_file()
+    s = wavg.Surface.open("builtin:sphere-small", embedding=out)
+    assert s.has_embedding and len(s.landmarks) == 20
+    assert [j["status"] for j in wb.precompute_all(["builtin:sphere-small"], tmp_path, landmarks=20)] == ["skipped"]
+
+
 def test_template_failure_fails_every_job(tmp_path: Path, assets: dict) -> None:
     m = wb.correspond_all(assets["invalid"], assets["template_anchors"], assets["targets"][:2], tmp_path, landmarks=LANDMARKS)
     assert [j["status"] for j in m] == ["failed", "failed"]

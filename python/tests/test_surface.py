@@ -16,6 +16,18 @@ def test_read_mesh_matches_arrays(tmp_path, torus_mesh):
     assert np.array_equal(V2, V) and np.array_equal(F2, F)
 
 
+def test_builtin_meshes_open_as_on_the_command_line(tmp_path):
+    V, F = wavg.read_mesh("builtin:torus")
+    assert V.shape == (1536, 3) and F.shape == (3072, 3)
+    s = wavg.Surface.open("builtin:torus")
+    assert s.vertex_count == 1536 and np.array_equal(s.vertices, V)
+    with pytest.raises(ValueError, match="unknown builtin mesh 'teapot'; available: icosphere"):
+        wavg.Surface.open("builtin:teapot")
+    # A file of that name elsewhere is still a file.
+    with pytest.raises(FileNotFoundError):
+        wavg.Surface.open(tmp_path / "builtin:torus")
+
+
 def test_properties(surface, torus_mesh):
     V, F = torus_mesh
     assert surface.vertex_count == len(V) and surface.face_count == len(F)

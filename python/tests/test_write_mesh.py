@@ -93,6 +93,11 @@ def test_bad_input_raises_and_writes_nothing(tmp_path, torus_mesh):
         wavg.write_mesh(tmp_path / "a.glb", V, F[:, :2])
     with pytest.raises(wavg.WavgError):
         wavg.write_mesh(tmp_path / "a.stl", V, F)
+    for name in ("a.gltf.gz", "a.glb.gz"):
+        with pytest.raises(wavg.WavgError, match=r"\.gl(tf|b)\.gz is not written.*\.obj, \.off or \.ply"):
+            wavg.write_mesh(tmp_path / name, V, F)
+    with pytest.raises(ValueError, match="#Body selects a mesh"):
+        wavg.write_mesh(tmp_path / "a.glb#Body", V, F)
     V = V.copy()
     V[0, 0] = 1e300  # beyond float32
     with pytest.raises(wavg.WavgError):

@@ -33,6 +33,7 @@ use rayon::prelude::*;
 use wavg_mesh::{SurfacePoint, ValidMesh};
 use wavg_solve::{BatchWeights, ForwardOptions, ForwardResult, Par, RoundTrip, SolveError, Solver};
 
+use crate::decal::check_max_negative;
 use crate::local_test::inconsistent_vertices;
 use crate::metrics::{Distortion, distortion};
 
@@ -65,6 +66,22 @@ pub struct CorrespondOptions {
     /// over-stretched above this many times the map's median edge stretch (image length
     /// over source length).
     pub max_stretch: f64,
+}
+
+impl CorrespondOptions {
+    /// Checks the options' ranges: `max_negative` as [`check_max_negative`] does,
+    /// `max_stretch` finite and above 1.
+    pub fn check(&self) -> Result<(), SolveError> {
+        check_max_negative(self.max_negative)?;
+        if !(self.max_stretch.is_finite() && self.max_stretch > 1.0) {
+            return Err(SolveError::InvalidParameter(format!(
+                "max_stretch must be a finite number above 1 (times the median edge \
+                 stretch), got {}",
+                self.max_stretch
+            )));
+        }
+        Ok(())
+    }
 }
 
 impl Default for CorrespondOptions {
@@ -339,12 +356,7 @@ pub fn correspond_vertices(
     target: &Solver,
     opts: &CorrespondOptions,
 ) -> Result<Correspondence, SolveError> {
-    if !(opts.max_negative.is_finite() && opts.max_stretch.is_finite() && opts.max_stretch > 1.0) {
-        return Err(SolveError::InvalidParameter(format!(
-            "max_negative must be finite and max_stretch finite and above 1 (got {} and {})",
-            opts.max_negative, opts.max_stretch
-        )));
-    }
+    opts.check()?;
     check_paired(source, target)?;
     let t = Instant::now();
     let mesh = source.mesh();

@@ -17,6 +17,27 @@ use crate::metrics::{Distortion, distortion};
 /// every front end.
 pub const DEFAULT_MAX_NEGATIVE: f64 = -0.1;
 
+/// Checks a `max_negative`, the most negative weight a point's weights may hold (decals,
+/// the paper's validity test of a correspondence): finite and at most 0. Above 0 it would
+/// mark nearly every point (most of a point's weights are small), so such a value is a
+/// mistake (a sign left out), refused with the range named.
+///
+/// ```
+/// assert!(wavg_apps::check_max_negative(-0.1).is_ok());
+/// assert!(wavg_apps::check_max_negative(-1e9).is_ok());
+/// let e = wavg_apps::check_max_negative(5.0).unwrap_err().to_string();
+/// assert!(e.contains("at most 0"), "{e}");
+/// ```
+pub fn check_max_negative(max_negative: f64) -> Result<(), SolveError> {
+    if max_negative.is_finite() && max_negative <= 0.0 {
+        return Ok(());
+    }
+    Err(SolveError::InvalidParameter(format!(
+        "max_negative must be a finite weight of at most 0 (the most negative weight \
+         accepted, {DEFAULT_MAX_NEGATIVE} by default), got {max_negative}"
+    )))
+}
+
 /// The coordinates of surface points.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DecalUv {
@@ -61,11 +82,7 @@ pub fn decal_uv(
             "the (u, v) coordinates must be finite, got {bad}"
         )));
     }
-    if !max_negative.is_finite() {
-        return Err(SolveError::InvalidParameter(format!(
-            "max_negative must be finite, got {max_negative}"
-        )));
-    }
+    check_max_negative(max_negative)?;
     let batch = solver.inverse_batch(points);
     let (mut out, mut marked) = (Vec::with_capacity(points.len()), Vec::new());
     // Points not marked by their weights alone; only these need their forward problem.

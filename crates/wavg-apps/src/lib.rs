@@ -16,8 +16,8 @@ pub use basis::{SplineKind, spline_weights, spline_weights_flat};
 pub use remesh::{
     BaseMesh, DEFAULT_CAGE_VERTICES, DEFAULT_LEVELS, DEFAULT_MAX_BASE_DISTANCE,
     DEFAULT_SMOOTH_STEPS, MAX_CAGE_VERTICES, MAX_LEVELS, MAX_POLYGON, MAX_SMOOTH_STEPS,
-    MIN_CAGE_VERTICES, RemeshError, RemeshReport, RemeshResult, Remesher, default_cage_vertices,
-    max_cage_vertices, polygons_to_obj,
+    MIN_CAGE_VERTICES, RemeshError, RemeshReport, RemeshResult, Remesher, check_max_base_distance,
+    default_cage_vertices, max_cage_vertices, polygons_to_obj,
 };
 pub use spline::{
     Curve, CurveReport, DEFAULT_SPLINE_DEGREE, DEFAULT_SPLINE_SAMPLES, SPLINE_CHUNK,
@@ -50,7 +50,8 @@ mod decal_obj;
 mod morph;
 
 pub use decal::{
-    DEFAULT_MAX_NEGATIVE, Decal, DecalReport, DecalUv, decal_uv, decal_vertex_uv, decal_vertices,
+    DEFAULT_MAX_NEGATIVE, Decal, DecalReport, DecalUv, check_max_negative, decal_uv,
+    decal_vertex_uv, decal_vertices,
 };
 pub use decal_obj::{DECAL_MATERIAL, PLAIN_MATERIAL, untextured_faces, write_decal_obj};
 pub use morph::{MorphReport, harmonic_fill, morph_frames};
@@ -69,6 +70,6 @@ pub use render::{
     RenderReport, View, render, viridis,
 };
 pub use transfer::{
-    TextureTransfer, TransferOptions, check_uv, dilate, rasterize_uv, transfer_texture,
+    MAX_STRIDE, TextureTransfer, TransferOptions, check_uv, dilate, rasterize_uv, transfer_texture,
     transfer_texture_with_uv,
 };

@@ -37,6 +37,9 @@ pub struct TransferOptions {
     pub stride: u32,
 }
 
+/// The largest [`TransferOptions::stride`] the front ends accept (1 is the smallest).
+pub const MAX_STRIDE: u32 = 64;
+
 impl Default for TransferOptions {
     fn default() -> Self {
         Self {

@@ -5,31 +5,25 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 
-use wavg::mesh::{io, procedural};
 use wavg::{MeshError, TriMesh, ValidMesh};
 
 use crate::CliError;
+use crate::error::Context;
 
 /// Prefix that names a procedural mesh instead of a file, e.g. `builtin:torus`.
-pub const BUILTIN_PREFIX: &str = "builtin:";
+pub use wavg::BUILTIN_PREFIX;
 
-/// Loads `builtin:NAME` (see `wavg info --builtin`) or a mesh file (.obj/.off/.ply, .gz).
+/// Loads `builtin:NAME` (see `wavg info --builtin`) or a mesh file ([`wavg::load_mesh`]).
 /// Unreadable or unparseable input is a [`CliError::input`] (exit status 2) whose one-line
 /// message names the file and, for parse errors, the line.
 pub fn load_mesh(path_or_builtin: &str) -> Result<TriMesh, CliError> {
-    match path_or_builtin.strip_prefix(BUILTIN_PREFIX) {
-        Some(name) => Ok(procedural::builtin(name)?),
-        None => Ok(io::load(Path::new(path_or_builtin))?),
-    }
+    Ok(wavg::load_mesh(path_or_builtin)?)
 }
 
 /// Like [`load_mesh`], also returning what the file held beyond the triangle mesh
 /// ([`wavg::LoadNotes`]; default for builtins).
 pub fn load_mesh_notes(path_or_builtin: &str) -> Result<(TriMesh, wavg::LoadNotes), CliError> {
-    match path_or_builtin.strip_prefix(BUILTIN_PREFIX) {
-        Some(_) => Ok((load_mesh(path_or_builtin)?, Default::default())),
-        None => Ok(io::load_with_notes(Path::new(path_or_builtin))?),
-    }
+    Ok(wavg::load_mesh_with_notes(path_or_builtin)?)
 }
 
 /// Loads and validates a mesh. When validation fails, the problems (counts and first
@@ -177,6 +171,40 @@ pub fn parse_frames(s: &str) -> Result<usize, String> {
     parse_up_to(s, MAX_FRAMES, "frames")
 }
 
+/// A decimal number option's value.
+fn parse_number(s: &str) -> Result<f64, String> {
+    s.trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number"))
+}
+
+/// Parses a `--max-negative` value: a weight the library accepts
+/// ([`wavg::apps::check_max_negative`]: finite, at most 0).
+pub fn parse_max_negative(s: &str) -> Result<f64, String> {
+    let x = parse_number(s)?;
+    wavg::apps::check_max_negative(x).map_err(|e| e.to_string())?;
+    Ok(x)
+}
+
+/// Parses a `--max-stretch` value: finite and above 1 (`CorrespondOptions::check`).
+pub fn parse_max_stretch(s: &str) -> Result<f64, String> {
+    let x = parse_number(s)?;
+    let opts = wavg::apps::CorrespondOptions {
+        max_stretch: x,
+        ..Default::default()
+    };
+    opts.check().map_err(|e| e.to_string())?;
+    Ok(x)
+}
+
+/// Parses a `--max-distance` value of `wavg remesh`: finite and positive
+/// ([`wavg::apps::check_max_base_distance`]).
+pub fn parse_max_base_distance(s: &str) -> Result<f64, String> {
+    let x = parse_number(s)?;
+    wavg::apps::check_max_base_distance(x).map_err(|e| e.to_string())?;
+    Ok(x)
+}
+
 /// The input files of a command for [`check_outputs`]: those always given and those
 /// given when present.
 pub fn inputs<'a>(
@@ -189,9 +217,10 @@ pub fn inputs<'a>(
 }
 
 /// Checks a command's outputs before any work: each (named by its option, e.g. `-o`)
-/// goes to an existing folder, standard output (`-`) is not also where `--json` prints,
-/// no two outputs are one file and none is one of the `inputs` (whose contents would be
-/// lost). Input errors (exit status 2).
+/// goes to an existing folder under a name a reader would not take for another file
+/// (`wavg::mesh::io::check_output_name`: no `#NAME` after `.glb`, no `.glb.gz`), standard
+/// output (`-`) is not also where `--json` prints, no two outputs are one file and none is
+/// one of the `inputs` (whose contents would be lost). Input errors (exit status 2).
 pub fn check_outputs(
     inputs: &[&Path],
     outputs: &[(&str, &Path)],
@@ -210,6 +239,7 @@ pub fn check_outputs(
         if wavg::mesh::io::is_special_destination(path) {
             continue;
         }
+        wavg::mesh::io::check_output_name(path).context(opt)?;
         if path.is_dir() {
             return Err(CliError::input(format!(
                 "{opt} {}: is a folder; give a file name",
@@ -244,6 +274,54 @@ pub fn check_outputs(
         }
     }
     Ok(())
+}
+
+/// Checks an output folder (named by its option) before any work: not `-` (a folder of
+/// files is no one stream to write to standard output), not an existing file, and a name
+/// [`check_outputs`] would take. Input errors (exit status 2).
+pub fn check_output_folder(opt: &str, dir: &Path) -> Result<(), CliError> {
+    if dir == Path::new("-") {
+        return Err(CliError::input(format!(
+            "{opt} -: this output is a folder of files, which standard output cannot take; \
+             give a folder name (./- for a folder named -)"
+        )));
+    }
+    if dir.is_file() {
+        return Err(CliError::input(format!(
+            "{opt} {}: is a file; {opt} names a folder",
+            dir.display()
+        )));
+    }
+    wavg::mesh::io::check_output_name(dir).context(opt)
+}
+
+/// Checks a mesh output (named by its option) before any work: a file whose extension
+/// names a format the library writes (`wavg::mesh::io::check_save_path`), not `-` (the
+/// format follows the extension, and standard output has none). Input errors (exit
+/// status 2).
+pub fn check_mesh_output(opt: &str, path: &Path) -> Result<(), CliError> {
+    if path == Path::new("-") {
+        return Err(CliError::input(format!(
+            "{opt} -: a mesh is written to a file whose extension names its format (.obj, \
+             .off, .ply, .glb, .gltf), not to standard output; give a file name"
+        )));
+    }
+    wavg::mesh::io::check_save_path(path).context(opt)
+}
+
+/// Refuses an output `path` of a command that writes OBJ text (or glTF, by its extension)
+/// when its extension names another mesh format (`.ply`, `.off`, a `.gz`): the file would
+/// not hold what its name says. Other names (`-`, `.obj`, `.txt`) pass. Input error (exit
+/// status 2).
+pub fn refuse_other_mesh_format(path: &Path, what: &str) -> Result<(), CliError> {
+    use wavg::mesh::Format;
+    match Format::from_path(path) {
+        Ok((Format::Obj, false) | (Format::Gltf | Format::Glb, _)) | Err(_) => Ok(()),
+        Ok(_) => Err(CliError::input(format!(
+            "-o {}: {what}: give a name ending in .obj, .glb or .gltf",
+            path.display()
+        ))),
+    }
 }
 
 /// Refuses an output `path` (unless `-`) whose name does not end in `.EXT`: the command

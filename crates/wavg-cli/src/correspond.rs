@@ -38,14 +38,14 @@ pub struct MapArgs {
     #[arg(long)]
     pub paper_weights: bool,
     /// The most negative weight the paper's validity test accepts.
-    #[arg(long, default_value_t = CorrespondOptions::default().max_negative, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = CorrespondOptions::default().max_negative, allow_negative_numbers = true, value_parser = crate::common::parse_max_negative)]
     pub max_negative: f64,
     /// Validity test.
     #[arg(long, value_enum, default_value_t = Test::Local)]
     pub validity: Test,
     /// Local test: a segment from a vertex to the edge of its neighbourhood is
     /// over-stretched above this many times the map's median edge stretch.
-    #[arg(long, default_value_t = CorrespondOptions::default().max_stretch)]
+    #[arg(long, default_value_t = CorrespondOptions::default().max_stretch, allow_negative_numbers = true, value_parser = crate::common::parse_max_stretch)]
     pub max_stretch: f64,
 }
 

@@ -50,8 +50,8 @@ pub struct Args {
     /// The anchors' coordinates, `U V` per line, as many lines as anchors.
     #[arg(long)]
     pub uv: PathBuf,
-    /// The most negative weight a vertex may have without being marked.
-    #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_NEGATIVE, allow_negative_numbers = true)]
+    /// The most negative weight a vertex may have without being marked (at most 0).
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_NEGATIVE, allow_negative_numbers = true, value_parser = crate::common::parse_max_negative)]
     pub max_negative: f64,
     /// Output OBJ file (`-` for standard output), or .glb/.gltf.
     #[arg(short = 'o', long = "output")]

@@ -138,6 +138,9 @@ fn spline_weights(order: &[usize], samples: usize) -> Result<Vec<Vec<f64>>, CliE
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), CliError> {
+    if let Some(dir) = &args.out {
+        crate::common::check_output_folder("--out", dir)?;
+    }
     if args.anchors.is_some_and(|k| k < 4) {
         return Err(CliError::input(
             "--anchors must be at least 4 (a cubic spline)",

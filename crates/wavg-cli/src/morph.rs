@@ -65,11 +65,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         return Err(CliError::input("--frames must be between 1 and 100000"));
     }
     let gltf = is_gltf_path(&args.output);
-    if !gltf && args.output.is_file() {
-        return Err(CliError::input(format!(
-            "{}: is a file; -o names a folder",
-            args.output.display()
-        )));
+    if gltf {
+        crate::common::check_outputs(&[], &[("-o", &args.output)], args.json)?;
+    } else {
+        crate::common::check_output_folder("-o", &args.output)?;
     }
     let c = compute(&args.map)?;
     let t = Instant::now();

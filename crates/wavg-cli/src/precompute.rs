@@ -96,6 +96,9 @@ fn check_args(args: &Args) -> Result<(), CliError> {
             m.display()
         )));
     }
+    if let Some(m) = &args.repaired_mesh {
+        crate::common::check_mesh_output("--repaired-mesh", m)?;
+    }
     let landmarks = args.landmarks.unwrap_or(wavg::DEFAULT_LANDMARKS);
     if let Some(g) = args.geodesic_vertices.filter(|&g| g != 0 && g <= landmarks) {
         return Err(CliError::input(format!(
@@ -103,6 +106,12 @@ fn check_args(args: &Args) -> Result<(), CliError> {
         )));
     }
     let out = &args.output;
+    if out == std::path::Path::new("-") {
+        return Err(CliError::input(
+            "-o -: the embedding is written to a .wavg file, which the commands read by \
+             name, not to standard output; give a file name ending in .wavg",
+        ));
+    }
     if crate::common::same_file(args.mesh.as_ref(), out) {
         return Err(CliError::input(format!(
             "the output {} is the input mesh; write the embedding to a .wavg file",

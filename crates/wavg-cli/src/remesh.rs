@@ -60,7 +60,7 @@ pub struct Args {
     #[arg(long, default_value_t = wavg::apps::DEFAULT_SMOOTH_STEPS)]
     pub smooth: usize,
     /// Largest distance of a base vertex from the surface, over the bounding-box diagonal.
-    #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_BASE_DISTANCE, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = wavg::apps::DEFAULT_MAX_BASE_DISTANCE, allow_negative_numbers = true, value_parser = crate::common::parse_max_base_distance)]
     pub max_distance: f64,
     /// Recomputations to time while dragging a base vertex (0: none).
     #[arg(long, default_value_t = 10, value_parser = crate::common::parse_frames)]
@@ -90,14 +90,24 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &[("-o", &args.output)],
         args.json,
     )?;
-    let text = std::fs::read_to_string(&args.base)
-        .map_err(|e| CliError::input(format!("{}: {e}", args.base.display())))?;
+    crate::common::refuse_other_mesh_format(
+        &args.output,
+        "the refined mesh is written as OBJ (its polygons) or glTF",
+    )?;
+    // Comments may hold any bytes (an exporter's Latin-1 name), as in every OBJ read.
+    let text = textio::read_text(&args.base)?;
     let base = BaseMesh::from_obj_str(&text).context(args.base.display())?;
     base.validate().context(args.base.display())?;
     if args.levels > wavg::apps::MAX_LEVELS {
         return Err(CliError::input(format!(
             "--levels is at most {}",
             wavg::apps::MAX_LEVELS
+        )));
+    }
+    if args.smooth > wavg::apps::MAX_SMOOTH_STEPS {
+        return Err(CliError::input(format!(
+            "--smooth is at most {}",
+            wavg::apps::MAX_SMOOTH_STEPS
         )));
     }
     if args.frames > 0 && args.drag >= base.positions.len() {

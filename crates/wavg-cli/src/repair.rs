@@ -71,7 +71,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         )));
     }
     // The output's format, from its extension, before any work.
-    wavg::mesh::io::check_save_path(&args.output)?;
+    crate::common::check_mesh_output("-o", &args.output)?;
     let mesh = load_mesh(&args.mesh)?;
     let options = RepairOptions {
         weld: (!args.no_weld).then_some(args.weld),

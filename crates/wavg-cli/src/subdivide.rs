@@ -40,6 +40,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         &[("-o", &args.output)],
         args.json,
     )?;
+    crate::common::check_mesh_output("-o", &args.output)?;
     let input = load_valid(&args.mesh)?;
     let t = Instant::now();
     let (nv0, nf0) = (input.n_vertices(), input.n_faces());

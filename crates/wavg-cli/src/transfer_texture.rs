@@ -70,8 +70,8 @@ pub struct Args {
     #[arg(long)]
     pub paper: bool,
     /// Solve texels on every N-th row and column exactly and interpolate between them
-    /// inside a chart (1: solve every texel).
-    #[arg(long, default_value_t = wavg::apps::TransferOptions::default().stride)]
+    /// inside a chart (1: solve every texel; at most 64).
+    #[arg(long, default_value_t = wavg::apps::TransferOptions::default().stride, value_parser = clap::value_parser!(u32).range(1..=wavg::apps::MAX_STRIDE as i64))]
     pub stride: u32,
     /// Print one JSON object on standard output.
     #[arg(long)]

@@ -855,16 +855,8 @@ mod tests {
     /// stages again.
     #[test]
     fn rounds_reuse_the_kept_rows_and_progress_never_goes_down() {
-        let shape = procedural::FigureShape {
-            height: 1.0315715517724773,
-            girth: 0.9488724982957178,
-            arm_spread: 0.7392461007790216,
-            elbow: 0.6853653952523319,
-            leg_spread: 0.0703057774264497,
-            finger_length: 0.09589633727489663,
-            finger_radius: 0.007367934190795696,
-        };
-        let mesh = ValidMesh::new(procedural::body(&shape)).unwrap();
+        let mesh =
+            ValidMesh::new(procedural::body(&procedural::FigureShape::SQUASHED_HANDS)).unwrap();
         let o = PrecomputeOptions {
             quality_pairs: 0,
             ..Default::default()

@@ -74,8 +74,8 @@ fn solve_failure(e: &wavg::SolveError) -> (wavg_status, String) {
 /// `wavg_correspond_vertices`); another failure status with `face = UINT32_MAX` and NaN
 /// where there is no image. Returns the first non-OK point's status (with its message) or
 /// `WAVG_STATUS_OK`. Call-level errors (`WAVG_STATUS_INVALID_ARGUMENT`: NULL solvers,
-/// points or `out`, `n == 0`, different anchor counts, a non-finite `max_negative`) write
-/// nothing. Runs in parallel; thread-safe on shared solvers.
+/// points or `out`, `n == 0`, different anchor counts, a `max_negative` not finite or
+/// above 0) write nothing. Runs in parallel; thread-safe on shared solvers.
 ///
 /// # Safety
 /// The solvers must be NULL or live; `points` and `out` must hold `n` elements,
@@ -95,9 +95,8 @@ pub unsafe extern "C" fn wavg_correspond(
     guard(|| {
         // SAFETY: per this function's contract.
         let query = unsafe { queries(points, n)? };
-        if !max_negative.is_finite() {
-            return Err(Failure::arg("max_negative must be finite"));
-        }
+        wavg::apps::check_max_negative(max_negative)
+            .map_err(|e| Failure::from(wavg::Error::from(e)))?;
         // SAFETY: per this function's contract.
         let (s, t) = unsafe { (handle(source, "source")?, handle(target, "target")?) };
         if s.inner().n_anchors() != t.inner().n_anchors() {
@@ -211,8 +210,8 @@ pub unsafe extern "C" fn wavg_correspond_vertices(
 /// the point through the forward problem, or one is below `max_negative`), the
 /// coordinates still written; another failure status, with NaN, where the inverse problem
 /// fails. Returns the first non-OK point's status or `WAVG_STATUS_OK`. Call-level errors
-/// (`WAVG_STATUS_INVALID_ARGUMENT`: NULL pointers, `n == 0`, non-finite coordinates or
-/// `max_negative`) write nothing. Runs in parallel; thread-safe on a shared solver.
+/// (`WAVG_STATUS_INVALID_ARGUMENT`: NULL pointers, `n == 0`, non-finite coordinates, a
+/// `max_negative` not finite or above 0) write nothing. Runs in parallel; thread-safe on a shared solver.
 ///
 /// # Safety
 /// `solver` must be NULL or live; `anchor_uv` must hold `2 * n_anchors` doubles,

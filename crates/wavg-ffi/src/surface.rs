@@ -52,10 +52,12 @@ fn give(out: &mut *mut wavg_surface, surface: wavg::Surface) {
 }
 
 /// Loads a mesh file (`.obj`, `.off`, `.ply`, each optionally gzipped as `.gz`; `.gltf` or
-/// `.glb`, `scene.glb#Name` for one of its meshes; `mesh_path` is a NUL-terminated path) and validates it. On success `*out` is a new surface whose
+/// `.glb`, `scene.glb#Name` for one of its meshes; `mesh_path` is a NUL-terminated path), or
+/// a builtin mesh (`builtin:torus`, as the `wavg` command takes it), and validates it. On success `*out` is a new surface whose
 /// embedding is the vertex positions until one is precomputed or loaded; on failure `*out`
 /// is left unchanged. Errors: `WAVG_STATUS_IO` (missing or unreadable file),
-/// `WAVG_STATUS_INVALID_MESH` (not an oriented manifold, degenerate faces...).
+/// `WAVG_STATUS_INVALID_MESH` (not an oriented manifold, degenerate faces...),
+/// `WAVG_STATUS_INVALID_ARGUMENT` (an unknown builtin name).
 ///
 /// # Safety
 /// `mesh_path` must be NULL or NUL-terminated; `out` NULL or writable.

@@ -35,15 +35,21 @@ use crate::surface::Surface;
 pub use wavg_solve::spread::{GOOD_GAP, closed_tour, suggested_count};
 
 /// Reads an anchors file and checks every anchor against `mesh` (a UTF-8 byte order mark
-/// opening the file is skipped). Errors name the file and the line: a malformed line, a
+/// opening the file is skipped; a `#` comment may hold any bytes, the rest must be UTF-8:
+/// [`wavg_io::text::decode`]). Errors name the file and the line: a malformed line, a
 /// vertex or face out of range, bad barycentric coordinates, or a file without anchors
 /// ([`Error::Input`]); an unreadable file is an I/O error. The anchors come back as
 /// written (tiny negative barycentrics are clamped when a solver resolves them).
 pub fn read(path: impl AsRef<Path>, mesh: &ValidMesh) -> Result<Vec<Anchor>> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
         source,
+    })?;
+    let text = wavg_io::text::decode(bytes, 1).map_err(|e| Error::Input {
+        path: path.to_path_buf(),
+        line: e.line,
+        message: e.message,
     })?;
     parse(&text, path, mesh)
 }

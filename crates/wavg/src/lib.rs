@@ -43,6 +43,7 @@ pub mod lines;
 mod memory;
 mod oneoff;
 mod precompute;
+mod source;
 mod surface;
 mod texture;
 
@@ -58,6 +59,7 @@ pub use precompute::{
     CacheOutcome, DEFAULT_LANDMARKS, Provenance, check_embeddable, default_precompute_options,
     embedding_cached, precompute, resolve_landmarks,
 };
+pub use source::{BUILTIN_PREFIX, builtin_name, load_mesh, load_mesh_with_notes};
 pub use surface::{EmbeddingSummary, Surface};
 pub use texture::mesh_texture;
 

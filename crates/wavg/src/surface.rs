@@ -87,19 +87,19 @@ fn to_vec8(coords: Vec<[f64; 8]>) -> Vec<Vec8> {
 
 impl Surface {
     /// Loads a mesh file (`.obj`, `.off`, `.ply`, each optionally gzipped as `.gz`; `.gltf`
-    /// or `.glb`, `scene.glb#Name` for one of its meshes: [`wavg_mesh::io::load`]) and
-    /// validates it. The embedding is the 3-D positions until one is computed or loaded.
+    /// or `.glb`, `scene.glb#Name` for one of its meshes: [`wavg_mesh::io::load`]) or a
+    /// builtin mesh (`builtin:torus`: [`crate::load_mesh`]) and validates it. The
+    /// embedding is the 3-D positions until one is computed or loaded.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
-        let mesh = wavg_mesh::io::load(path.as_ref())?;
-        Self::from_mesh(mesh)
+        Self::from_mesh(crate::load_mesh(path)?)
     }
 
-    /// Reads the mesh file `path`, validates it and builds a surface on it with the
-    /// embedding of the `.wavg` file `embedding` when one is given, the projector built
-    /// once, on that embedding ([`Surface::from_valid_and_file`]): the one-call open of a
-    /// large surface whose embedding was computed before.
+    /// Reads the mesh file (or builtin mesh) `path`, validates it and builds a surface on
+    /// it with the embedding of the `.wavg` file `embedding` when one is given, the
+    /// projector built once, on that embedding ([`Surface::from_valid_and_file`]): the
+    /// one-call open of a large surface whose embedding was computed before.
     pub fn open_with_embedding(path: impl AsRef<Path>, embedding: Option<&Path>) -> Result<Self> {
-        let mesh = ValidMesh::new(wavg_mesh::io::load(path.as_ref())?)?;
+        let mesh = ValidMesh::new(crate::load_mesh(path)?)?;
         Self::from_valid_and_file(mesh, embedding)
     }
 

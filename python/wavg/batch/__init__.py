@@ -13,10 +13,13 @@ when a Client is passed.
 
 from __future__ import annotations
 
+import operator
 import os
 import time
 from pathlib import Path
 from typing import Any, Sequence, Union
+
+import numpy as np
 
 from . import store
 from .executors import Progress, run_all
@@ -29,7 +32,11 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 def _abs(p: PathLike) -> str:
-    return os.path.abspath(os.fspath(p))
+    """A file's absolute path; a builtin mesh's name (``builtin:torus``) as it is."""
+    name = os.fspath(p)
+    if isinstance(name, str) and name.startswith(store.BUILTIN_PREFIX):
+        return name
+    return os.path.abspath(name)
 
 
 def _names(inputs: Sequence[PathLike], suffix: str) -> list[str]:
@@ -92,9 +99,35 @@ def _run(
     return m
 
 
+def _whole(name: str, value: Any, lo: int, hi: int) -> int:
+    """An integer option checked once, before any job (the message ``S.precompute`` gives):
+    ``TypeError`` for a non-integer, ``ValueError`` outside ``lo..=hi``."""
+    try:
+        n = operator.index(value)
+    except TypeError:
+        raise TypeError(f"{name} must be an integer, got {value!r}") from None
+    if not lo <= n <= hi:
+        raise ValueError(f"{name} must be an integer from {lo} to {hi}, got {value!r}")
+    return n
+
+
 def _landmarks(landmarks: int | None) -> int | None:
-    """The ``landmarks`` option: None (or 0) for the library's choice."""
-    return None if landmarks is None or int(landmarks) == 0 else int(landmarks)
+    """The ``landmarks`` option: None (or 0) for the library's choice, else a number of
+    landmarks (checked here, so a bad value fails the call, not every job)."""
+    n = None if landmarks is None else _whole("landmarks", landmarks, 0, 2**32 - 1)
+    return n or None
+
+
+def _size(size: Any) -> Any:
+    """The ``size`` option of :func:`transfer_all`: None, ``W`` or ``(W, H)``, positive."""
+    if size is None:
+        return None
+    sides = [size] if np.ndim(size) == 0 else list(size)
+    if len(sides) not in (1, 2):
+        raise ValueError(f"size: expected W or (W, H), got {size!r}")
+    for i, side in enumerate(sides):
+        _whole(f"size[{i}]" if len(sides) == 2 else "size", side, 1, 2**32 - 1)
+    return size
 
 
 def precompute_all(
@@ -125,7 +158,7 @@ def precompute_all(
     meshes = list(meshes)
     threads = _threads(threads, executor)
     out = Path(out_dir)
-    options = {"landmarks": _landmarks(landmarks), "seed": int(seed)}
+    options = {"landmarks": _landmarks(landmarks), "seed": _whole("seed", seed, 0, 2**64 - 1)}
     jobs = [
         Job("precompute", i, os.fspath(m), str(out / name), {"mesh": _abs(m)}, options, bool(overwrite), threads)
         for i, (m, name) in enumerate(zip(meshes, _names(meshes, ".wavg")))
@@ -253,7 +286,7 @@ def transfer_all(
     (None: the library's choice; the template's once, into ``out_dir/template/``). ``size``: the output's ``W`` or ``(W, H)`` (default: the
     texture's). Manifest figures: ``valid_fraction``, ``texels_per_s``, ``width``, ``height``.
     """
-    options = {"landmarks": _landmarks(landmarks), "seed": 0, "size": size}
+    options = {"landmarks": _landmarks(landmarks), "seed": 0, "size": _size(size)}
     return _pair_jobs(
         "transfer", template, template_anchors, targets, out_dir, executor, ".png",
         {"template_texture": template_texture}, options, embeddings, overwrite, threads, progress,
@@ -281,6 +314,8 @@ def correspond_all(
     Arguments as :func:`transfer_all`'s; ``validity`` is ``wavg.correspond``'s. Manifest
     figures: ``valid_fraction``, ``vertices_per_s``.
     """
+    if validity not in ("local", "paper"):
+        raise ValueError(f'validity must be "local" or "paper", got {validity!r}')
     options = {"landmarks": _landmarks(landmarks), "seed": 0, "validity": validity}
     return _pair_jobs(
         "correspond", template, template_anchors, targets, out_dir, executor, ".npz",

@@ -50,8 +50,9 @@ class Job:
 
 
 def stem(path: str | os.PathLike[str]) -> str:
-    """A mesh file's name without its mesh and compression suffixes (``a/b.obj.gz`` -> ``b``)."""
-    name = Path(path).name
+    """A mesh file's name without its mesh and compression suffixes (``a/b.obj.gz`` -> ``b``;
+    ``builtin:torus`` -> ``torus``)."""
+    name = Path(path).name.removeprefix("builtin:")
     changed = True
     while changed:
         changed = False

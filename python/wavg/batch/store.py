@@ -26,8 +26,15 @@ TMP_MARK = ".wavg-tmp-"
 SIDECAR = ".fingerprint.json"
 
 
+BUILTIN_PREFIX = "builtin:"
+
+
 def file_digest(path: str | os.PathLike[str]) -> str:
-    """SHA-256 of a file's bytes, hex."""
+    """SHA-256 of a file's bytes, hex; of the name for a builtin mesh (``builtin:torus``,
+    made by the package, whose version is part of every fingerprint)."""
+    name = os.fspath(path)
+    if isinstance(name, str) and name.startswith(BUILTIN_PREFIX):
+        return hashlib.sha256(name.encode()).hexdigest()
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):

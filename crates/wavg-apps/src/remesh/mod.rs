@@ -53,6 +53,18 @@ pub const MAX_SMOOTH_STEPS: usize = 1000;
 /// scaled) is refused.
 pub const DEFAULT_MAX_BASE_DISTANCE: f64 = 0.15;
 
+/// Checks a largest base-vertex distance from the surface (over the bounding-box
+/// diagonal): finite and positive.
+pub fn check_max_base_distance(max_distance: f64) -> Result<(), RemeshError> {
+    if max_distance.is_finite() && max_distance > 0.0 {
+        return Ok(());
+    }
+    Err(RemeshError::InvalidParameter(format!(
+        "the largest base distance must be finite and positive (a fraction of the \
+         bounding-box diagonal, {DEFAULT_MAX_BASE_DISTANCE} by default), got {max_distance}"
+    )))
+}
+
 /// The refined mesh of one run.
 #[derive(Clone, Debug)]
 pub struct RemeshResult {
@@ -182,11 +194,7 @@ impl Remesher {
         base: &BaseMesh,
         max_distance: f64,
     ) -> Result<Self, RemeshError> {
-        if !(max_distance.is_finite() && max_distance > 0.0) {
-            return Err(RemeshError::InvalidParameter(format!(
-                "the largest base distance must be finite and positive, got {max_distance}"
-            )));
-        }
+        check_max_base_distance(max_distance)?;
         base.validate()?;
         let emb = projector.embedded().clone();
         let mesh = emb.mesh().clone();

@@ -9,11 +9,13 @@ use crate::CliError;
 
 use super::PointSpec;
 
-/// Reads a whole text file, mapping failures to exit status 2; a UTF-8 byte order mark
-/// opening it (some editors write one) is dropped.
+/// Reads a whole text file of points or numbers, mapping failures to exit status 2: UTF-8
+/// outside `#` comments, which may hold any bytes (`wavg::text::decode`); a UTF-8 byte
+/// order mark opening it (some editors write one) is dropped.
 pub fn read_text(path: &Path) -> Result<String, CliError> {
-    let mut text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+    let mut text = wavg::text::decode(bytes, 1).map_err(|e| located(path, e.line, &e.message))?;
     if text.starts_with('\u{feff}') {
         text.drain(..'\u{feff}'.len_utf8());
     }

@@ -113,3 +113,62 @@ fn a_precomputation_beyond_the_available_memory_is_refused_up_front() {
     );
     assert!(out.exists());
 }
+
+/// Options out of their range are refused while the arguments are read (status 2, before
+/// any mesh is read or embedding computed), the message naming the option and the range.
+#[test]
+fn options_out_of_range_name_their_range() {
+    let refused = |args: &[&str], says: &[&str]| {
+        let out = wavg(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        for s in says {
+            assert!(err.contains(s), "{args:?}: {err}");
+        }
+    };
+    // The files need not exist: the value is refused first.
+    let decal = |v: &str| {
+        let args = [
+            "decal",
+            "missing.obj",
+            "--anchors",
+            "a.txt",
+            "--uv",
+            "uv.txt",
+        ];
+        let mut all: Vec<String> = args.map(String::from).to_vec();
+        all.extend(["--max-negative", v, "-o", "d.obj"].map(String::from));
+        all
+    };
+    for v in ["5", "0.1", "nan", "inf"] {
+        let args = decal(v);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        refused(&args, &["--max-negative", "at most 0"]);
+    }
+    let pair = common::pair_args("correspond", ["s.obj", "t.obj"], ["a", "b"], "m.txt");
+    let mut args: Vec<&str> = pair.iter().map(String::as_str).collect();
+    args.extend(["--max-negative", "2"]);
+    refused(&args, &["--max-negative", "at most 0"]);
+    let mut args: Vec<&str> = pair.iter().map(String::as_str).collect();
+    args.extend(["--max-stretch", "1"]);
+    refused(&args, &["--max-stretch", "above 1"]);
+    refused(
+        &[
+            "remesh",
+            "s.obj",
+            "--base",
+            "b.obj",
+            "--max-distance",
+            "-0.1",
+            "-o",
+            "r.obj",
+        ],
+        &["--max-distance", "finite and positive"],
+    );
+    let pair = common::pair_args("transfer-texture", ["s.obj", "t.obj"], ["a", "b"], "t.png");
+    for v in ["0", "65"] {
+        let mut args: Vec<&str> = pair.iter().map(String::as_str).collect();
+        args.extend(["--stride", v]);
+        refused(&args, &["--stride", "1..=64"]);
+    }
+}

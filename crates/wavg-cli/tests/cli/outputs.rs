@@ -166,3 +166,101 @@ fn outputs_named_another_way() {
         "v 0\nv 300\nv 600\n"
     );
 }
+
+/// Output names a reader would take for something else (`#NAME` selects a glTF mesh when
+/// reading), formats no writer makes (gzip-compressed glTF), and `-` for an output that is
+/// a folder or a file read back by name (a mesh, whose format is its extension; an
+/// embedding): refused before any work (status 2), the message naming what to write
+/// instead, and nothing written (no file or folder named `-`).
+#[test]
+fn output_names_that_would_not_read_back_and_folders_on_stdout() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    for ext in ["gltf.gz", "glb.gz"] {
+        let out = d(&format!("x.{ext}"));
+        for command in ["repair", "subdivide"] {
+            refused(&[command, "builtin:torus", "-o", &out], &format!(".{ext}"));
+            refused(
+                &[command, "builtin:torus", "-o", &out],
+                ".obj, .off or .ply",
+            );
+        }
+    }
+    refused(&["repair", "builtin:torus", "-o", &d("m.stl")], "\".stl\"");
+    refused(
+        &["repair", "builtin:torus", "-o", &d("h.glb#Body")],
+        "#Body selects a mesh",
+    );
+    let control = d("c.txt");
+    std::fs::write(&control, "v 0\nv 300\nv 600\nv 900\n").unwrap();
+    let spline = [
+        "spline",
+        "builtin:torus",
+        "--embedding",
+        "none",
+        "--control",
+        &control,
+        "-o",
+        &d("s.gltf#Curve"),
+    ];
+    refused(&spline, "#Curve selects a mesh");
+    let a = control.as_str();
+    let m = "builtin:icosphere";
+    for out in ["-", "frames.gltf.gz"] {
+        let args = common::pair_args("morph", [m, m], [a, a], out);
+        let r = common::wavg_command()
+            .current_dir(dir.path())
+            .args(&args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{out}: {stderr}");
+        let says = if out == "-" {
+            "a folder of files"
+        } else {
+            ".gltf.gz"
+        };
+        assert!(stderr.contains(says), "{out}: {stderr}");
+        assert!(!dir.path().join(out).exists(), "{out} was made");
+    }
+    let in_dir = |args: &[&str], says: &str| {
+        let r = common::wavg_command()
+            .current_dir(dir.path())
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+        assert!(r.stdout.is_empty(), "{args:?} printed to stdout");
+    };
+    in_dir(&["demo", "--out", "-"], "a folder of files");
+    // A mesh's format follows its file's extension; the embedding is read back by name.
+    for command in ["repair", "subdivide"] {
+        in_dir(
+            &[command, "builtin:sphere-small", "-o", "-"],
+            "-o -: a mesh is written to a file",
+        );
+    }
+    in_dir(
+        &["precompute", "builtin:sphere-small", "-o", "-"],
+        "give a file name ending in .wavg",
+    );
+    in_dir(
+        &[
+            "precompute",
+            "builtin:sphere-small",
+            "-o",
+            "e.wavg",
+            "--repaired-mesh",
+            "-",
+        ],
+        "--repaired-mesh -: a mesh is written to a file",
+    );
+    let mut left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["c.txt"]);
+}

@@ -80,6 +80,16 @@ fn cube_on_the_sphere() {
     assert_eq!(sizes.iter().filter(|&&n| n == 3).count(), 32);
 }
 
+/// Runs `wavg remesh` of `base` into `out` and asserts it exits 2 saying `says` and
+/// writes nothing.
+fn refused(base: &std::path::Path, out: &std::path::Path, says: &str) {
+    let r = common::remesh_on_sphere(base, out, &[]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{says}: {err}");
+    assert!(err.contains(says), "{says}: {err}");
+    assert!(!out.exists());
+}
+
 #[test]
 fn bad_bases_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -95,10 +105,29 @@ fn bad_bases_write_nothing() {
         ("v 0 0\n", "line 1"),
     ] {
         std::fs::write(&base, text).unwrap();
-        let r = common::remesh_on_sphere(&base, &out, &[]);
-        let err = String::from_utf8_lossy(&r.stderr);
-        assert_eq!(r.status.code(), Some(2), "{text:?}: {err}");
-        assert!(err.contains(needle), "{needle}: {err}");
-        assert!(!out.exists());
+        refused(&base, &out, needle);
     }
+    // The output is OBJ text (or glTF): a name saying PLY, OFF or gzip is refused.
+    std::fs::write(&base, CUBE).unwrap();
+    for name in ["r.ply", "r.off", "r.obj.gz"] {
+        let says = "give a name ending in .obj, .glb or .gltf";
+        refused(&base, &dir.path().join(name), says);
+    }
+}
+
+/// A base's comments may hold any bytes (an exporter's Latin-1 name), as a mesh file's;
+/// its data stays UTF-8.
+#[test]
+fn a_bases_comments_may_hold_any_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("b.obj");
+    let out = dir.path().join("r.obj");
+    let mut latin1 = b"# Cube \xe9crit par un exporteur\n".to_vec();
+    latin1.extend_from_slice(CUBE.as_bytes());
+    std::fs::write(&base, latin1).unwrap();
+    let r = common::remesh_on_sphere(&base, &out, &["--frames", "0"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    std::fs::write(&base, b"v 0 0 \xe9\n").unwrap();
+    std::fs::remove_file(&out).unwrap();
+    refused(&base, &out, "b.obj:1: the text is not valid UTF-8");
 }

@@ -244,15 +244,7 @@ fn no_pair_of_a_body_collapses_between_its_landmarks() {
             finger_length: 0.09131830671043327,
             finger_radius: 0.009305440866034579,
         },
-        procedural::FigureShape {
-            height: 1.0315715517724773,
-            girth: 0.9488724982957178,
-            arm_spread: 0.7392461007790216,
-            elbow: 0.6853653952523319,
-            leg_spread: 0.0703057774264497,
-            finger_length: 0.09589633727489663,
-            finger_radius: 0.007367934190795696,
-        },
+        procedural::FigureShape::SQUASHED_HANDS,
     ];
     for shape in shapes {
         let body = Embedded::new(ValidMesh::new(procedural::body(&shape)).unwrap(), true);

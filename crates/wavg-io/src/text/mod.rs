@@ -20,8 +20,10 @@ use std::io::{self, BufRead, Write};
 
 use rayon::prelude::*;
 
+mod decode;
 mod scan;
 
+pub use decode::decode;
 use scan::tokens;
 
 /// Lines parsed or formatted by one task: large enough to amortise scheduling, small
@@ -86,8 +88,8 @@ impl<R: BufRead> LineChunks<R> {
         }
     }
 
-    /// The next chunk, or `None` at the end of the stream. Text that is not UTF-8 is an
-    /// [`io::ErrorKind::InvalidData`] error.
+    /// The next chunk, or `None` at the end of the stream. Text that is not UTF-8 outside
+    /// `#` comments is an [`io::ErrorKind::InvalidData`] error ([`decode`]).
     pub fn next_chunk(&mut self) -> io::Result<Option<Chunk>> {
         // Bytes first, checked once per chunk; sized like the last chunk, so a stream of
         // similar lines is read without growing (and copying) the buffer.
@@ -100,14 +102,8 @@ impl<R: BufRead> LineChunks<R> {
             return Ok(None);
         }
         self.last_bytes = bytes.len();
-        let text = String::from_utf8(bytes).map_err(|e| {
-            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
-            let line = self.next_line + valid.iter().filter(|&&b| b == b'\n').count();
-            io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("line {line}: the text is not valid UTF-8"),
-            )
-        })?;
+        let text = decode(bytes, self.next_line)
+            .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e.to_string()))?;
         let chunk = Chunk {
             first_line: self.next_line,
             text,
@@ -521,11 +517,17 @@ mod tests {
     }
 
     #[test]
-    fn non_utf8_is_an_error() {
+    fn non_utf8_is_an_error_outside_comments() {
         let mut chunks = LineChunks::new(&b"0.5 0.5\n\xff\n"[..], 10);
         let e = chunks.next_chunk().unwrap_err();
         assert_eq!(e.kind(), io::ErrorKind::InvalidData);
         assert!(e.to_string().starts_with("line 2:"), "{e}");
+        let mut chunks = LineChunks::new(&b"# Z\xfcrich\n0.5 0.5\n"[..], 10);
+        let chunk = chunks.next_chunk().unwrap().unwrap();
+        assert_eq!(
+            parse_weights(&chunk.text, 1).unwrap(),
+            [(2, vec![0.5, 0.5])]
+        );
     }
 
     #[test]

@@ -111,12 +111,14 @@ impl Format {
             "gltf" => Format::Gltf,
             "glb" => Format::Glb,
             _ => {
+                let what = match ext.as_str() {
+                    "" => "no extension".to_string(),
+                    _ => format!("unknown extension {:?}", format!(".{ext}")),
+                };
                 return Err(MeshError::Unsupported {
                     path: path.to_path_buf(),
                     message: format!(
-                        "unknown extension {:?} (expected .obj, .off, .ply, optionally .gz, or \
-                         .gltf, .glb)",
-                        ext
+                        "{what} (expected .obj, .off, .ply, optionally .gz, or .gltf, .glb)"
                     ),
                 });
             }

@@ -218,6 +218,7 @@ fn gunzip_bounded(raw: &[u8]) -> Result<Vec<u8>, String> {
 /// The file is written atomically ([`write_atomic`]). A `.glb` or `.gltf` path writes glTF
 /// ([`gltf::GltfScene`]: 32-bit float positions, texture coordinates split at seams).
 pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
+    check_output_name(path)?;
     if gltf::is_gltf_path(path) {
         return gltf::GltfScene::from_mesh(mesh).save(path);
     }
@@ -236,7 +237,9 @@ pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
 }
 
 /// Checks that [`save`] writes the format `path`'s extension names (OBJ, OFF, PLY,
-/// optionally `.gz`, or glTF `.glb`/`.gltf`), before any work is done.
+/// optionally `.gz`, or glTF `.glb`/`.gltf`) and that the name is one to write
+/// ([`check_output_name`]), before any work is done. The error names the extension and
+/// lists those written.
 ///
 /// ```
 /// use std::path::Path;
@@ -244,12 +247,58 @@ pub fn save(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
 /// assert!(check_save_path(Path::new("a.glb")).is_ok());
 /// assert!(check_save_path(Path::new("a.ply.gz")).is_ok());
 /// assert!(check_save_path(Path::new("a.stl")).is_err());
+/// assert!(check_save_path(Path::new("a.gltf.gz")).is_err());
 /// ```
 pub fn check_save_path(path: &Path) -> Result<(), MeshError> {
+    check_output_name(path)?;
     if gltf::is_gltf_path(path) {
         return Ok(());
     }
     Format::from_path(path).map(drop)
+}
+
+/// The extensions [`save`] writes, for messages.
+const WRITTEN: &str = ".obj, .off or .ply (each optionally .gz), .glb or .gltf";
+
+/// Refuses an output file name that the readers would take for another file or that no
+/// writer makes, whatever the output holds: a `#NAME` after `.glb` or `.gltf` (it selects
+/// one mesh when reading, [`gltf::split_mesh_name`], so the file written could not be
+/// read under that name), and gzip-compressed glTF (`.glb.gz`, `.gltf.gz`: glTF files
+/// are written uncompressed). Every command checks its outputs with it before any work.
+///
+/// ```
+/// use std::path::Path;
+/// use wavg_mesh::io::check_output_name;
+/// assert!(check_output_name(Path::new("a.glb")).is_ok());
+/// assert!(check_output_name(Path::new("frames")).is_ok());
+/// assert!(check_output_name(Path::new("m#1.obj")).is_ok());
+/// assert!(check_output_name(Path::new("a.glb#Body")).is_err());
+/// assert!(check_output_name(Path::new("a.gltf.gz")).is_err());
+/// ```
+pub fn check_output_name(path: &Path) -> Result<(), MeshError> {
+    let (file, name) = gltf::split_mesh_name(path);
+    if let Some(name) = name {
+        return Err(MeshError::InvalidArgument(format!(
+            "{}: #{name} selects a mesh when a glTF file is read and is not part of an \
+             output file's name: write {}",
+            path.display(),
+            file.display()
+        )));
+    }
+    if let Ok((f @ (Format::Gltf | Format::Glb), true)) = Format::from_path(path) {
+        let ext = if f == Format::Glb {
+            ".glb.gz"
+        } else {
+            ".gltf.gz"
+        };
+        return Err(MeshError::Unsupported {
+            path: path.to_path_buf(),
+            message: format!(
+                "{ext} is not written (glTF is written uncompressed); write {WRITTEN}"
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Serialises a mesh in memory (uncompressed; `.glb` as one binary glTF file).

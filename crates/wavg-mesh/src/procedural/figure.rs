@@ -50,6 +50,18 @@ impl FigureShape {
         finger_length: 0.095,
         finger_radius: 0.011,
     };
+    /// Arms well out and bent, thin fingers: a [`body`] whose hands an embedding
+    /// extended between its landmarks squashes (the lab's `collapsed_pairs body:4`),
+    /// the case the landmarks added around thin parts must handle.
+    pub const SQUASHED_HANDS: Self = Self {
+        height: 1.0315715517724773,
+        girth: 0.9488724982957178,
+        arm_spread: 0.7392461007790216,
+        elbow: 0.6853653952523319,
+        leg_spread: 0.0703057774264497,
+        finger_length: 0.09589633727489663,
+        finger_radius: 0.007367934190795696,
+    };
 }
 
 fn j(x: f64, y: f64, z: f64, radius: f64, rows: usize) -> Joint {

@@ -211,6 +211,45 @@ fn gltf_with_its_buffer_and_image_beside_it_or_in_data_uris() {
 }
 
 #[test]
+fn buffers_and_images_outside_the_gltf_files_folder_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let sub = dir.path().join("scene");
+    std::fs::create_dir(&sub).unwrap();
+    let (mut g, _) = torus_glb(6, 4, "Torus");
+    std::fs::write(dir.path().join("outside.bin"), &g.bin).unwrap();
+    std::fs::create_dir(sub.join("bin")).unwrap();
+    std::fs::write(sub.join("bin/inside.bin"), &g.bin).unwrap();
+    let path = sub.join("t.gltf");
+    // A folder below the file's is fine.
+    std::fs::write(&path, g.json(Some("bin/inside.bin"))).unwrap();
+    assert_eq!(io::load(&path).unwrap().n_vertices(), 24);
+    let outside = dir.path().join("outside.bin");
+    let absolute = outside.to_string_lossy().into_owned();
+    for uri in [
+        "../outside.bin",
+        "bin/../../outside.bin",
+        "%2E%2E/outside.bin",
+        absolute.as_str(),
+    ] {
+        std::fs::write(&path, g.json(Some(uri))).unwrap();
+        let e = io::load(&path).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains(&format!("{uri:?}")), "{msg}");
+        assert!(msg.contains("outside the glTF file's folder"), "{msg}");
+    }
+    // Images follow the same rule (a material's texture is read with the mesh).
+    std::fs::write(dir.path().join("tex.png"), b"\x89PNG\r\n").unwrap();
+    g.materials
+        .push(r#"{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}"#.to_string());
+    g.textures.push(r#"{"source":0}"#.to_string());
+    g.images.push(r#"{"uri":"../tex.png"}"#.to_string());
+    g.meshes[0] = g.meshes[0].replace(r#""mode":4"#, r#""mode":4,"material":0"#);
+    std::fs::write(&path, g.json(Some("bin/inside.bin"))).unwrap();
+    let e = io::load(&path).unwrap_err().to_string();
+    assert!(e.contains("\"../tex.png\"") && e.contains("outside"), "{e}");
+}
+
+#[test]
 fn primitives_without_texture_coordinates_drop_them_like_obj() {
     let (mut g, _) = torus_glb(6, 4, "Torus");
     let a = g.floats(&[0., 0., 3., 1., 0., 3., 0., 1., 3.], "VEC3");

@@ -32,6 +32,25 @@ fn files_round_trip_and_comments_are_skipped() {
 }
 
 #[test]
+fn comments_may_hold_any_bytes_and_data_lines_stay_utf8() {
+    let s = torus();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("a.txt");
+    // A Latin-1 comment (another tool's export), whole-line and after data.
+    std::fs::write(&path, b"# caf\xe9 \xa9 2024\nv 3 # \xe9paule\nv 5\n").unwrap();
+    assert_eq!(
+        wavg::anchors::read(&path, s.mesh()).unwrap(),
+        [Anchor::Vertex(3), Anchor::Vertex(5)]
+    );
+    std::fs::write(&path, b"v 3\nv \xe95\n").unwrap();
+    let e = wavg::anchors::read(&path, s.mesh()).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::InvalidArgument);
+    let msg = e.to_string();
+    assert!(msg.starts_with(&format!("{}:2: ", path.display())), "{msg}");
+    assert!(msg.contains("UTF-8"), "{msg}");
+}
+
+#[test]
 fn only_what_reads_back_is_written() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("a.txt");

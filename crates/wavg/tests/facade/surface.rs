@@ -22,6 +22,21 @@ fn torus() -> Surface {
 }
 
 #[test]
+fn builtin_meshes_open_wherever_a_mesh_path_is_taken() {
+    let s = Surface::open("builtin:torus").unwrap();
+    assert_eq!(s.mesh().n_vertices(), 1536);
+    let e = Surface::open_with_embedding("builtin:torus", None).unwrap();
+    assert_eq!(e.mesh().triangles, s.mesh().triangles);
+    let bad = Surface::open("builtin:teapot").unwrap_err();
+    assert_eq!(bad.kind(), ErrorKind::InvalidArgument);
+    assert!(bad.to_string().contains("available: icosphere"), "{bad}");
+    // Anything else is a file name.
+    let dir = tempfile::tempdir().unwrap();
+    let missing = Surface::open(dir.path().join("builtin:torus")).unwrap_err();
+    assert_eq!(missing.kind(), ErrorKind::Io);
+}
+
+#[test]
 fn surface_is_send_sync_and_cheap_to_clone() {
     fn check<T: Send + Sync + Clone>() {}
     check::<Surface>();

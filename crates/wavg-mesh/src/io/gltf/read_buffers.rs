@@ -73,14 +73,30 @@ pub(crate) fn container(bytes: &[u8]) -> Result<Container<'_>, String> {
 }
 
 /// Where buffers and images named by relative URIs are looked for: the folder of the
-/// `.gltf` file.
+/// `.gltf` file or a folder below it. A URI that leaves it (a `..` step, an absolute path,
+/// once percent-decoded) is refused, as browsers and most viewers refuse it, so a file
+/// from elsewhere cannot make the reader open any file it likes.
 pub(crate) fn beside(path: &Path, uri: &str) -> Result<PathBuf, String> {
-    if uri.contains("://") || uri.starts_with('/') || uri.starts_with('\\') {
+    let first = uri.split(['/', '\\']).next().unwrap_or("");
+    if first.contains(':') {
         return Err(format!(
             "URI {uri:?}: only data: URIs and relative file names are read"
         ));
     }
     let decoded = percent_decode(uri)?;
+    let outside = decoded.starts_with(['/', '\\'])
+        || decoded.split(['/', '\\']).any(|step| step == "..")
+        || decoded
+            .split(['/', '\\'])
+            .next()
+            .is_some_and(|s| s.contains(':'));
+    if outside {
+        return Err(format!(
+            "URI {uri:?} names a file outside the glTF file's folder; only files in that \
+             folder or below it are read: move the file there (and the URI with it), or \
+             use a .glb"
+        ));
+    }
     let dir = path.parent().unwrap_or(Path::new(""));
     Ok(dir.join(decoded))
 }
@@ -227,9 +243,24 @@ mod tests {
     fn uris_resolve_beside_the_file_and_nowhere_else() {
         let p = beside(Path::new("d/m.gltf"), "my%20mesh.bin").unwrap();
         assert_eq!(p, Path::new("d/my mesh.bin"));
+        let p = beside(Path::new("d/m.gltf"), "./tex/a..b.png").unwrap();
+        assert_eq!(p, Path::new("d/./tex/a..b.png"));
         assert!(beside(Path::new("m.gltf"), "https://x/y.bin").is_err());
-        assert!(beside(Path::new("m.gltf"), "/etc/passwd").is_err());
+        assert!(beside(Path::new("m.gltf"), "file:/etc/passwd").is_err());
         assert!(beside(Path::new("m.gltf"), "%zz").is_err());
+        for uri in [
+            "/etc/passwd",
+            "\\\\server\\x.bin",
+            "../x.bin",
+            "tex/../../x.bin",
+            "tex\\..\\..\\x.bin",
+            "%2E%2E/x.bin",
+            "%2Fetc%2Fpasswd",
+            "C%3A%5Cx.bin",
+        ] {
+            let e = beside(Path::new("d/m.gltf"), uri).unwrap_err();
+            assert!(e.contains(&format!("{uri:?}")), "{e}");
+        }
     }
 
     #[test]
