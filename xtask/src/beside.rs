@@ -25,11 +25,7 @@ impl Beside {
     pub fn start(root: &Path, name: &str, file: &str, args: &[&str]) -> Result<Self, String> {
         let xtask = std::env::current_exe().map_err(|e| format!("xtask's own path: {e}"))?;
         let output = steps::target_dir(root).join(format!("{file}.log"));
-        let out =
-            std::fs::File::create(&output).map_err(|e| format!("{}: {e}", output.display()))?;
-        let err = out
-            .try_clone()
-            .map_err(|e| format!("{}: {e}", output.display()))?;
+        let (out, err) = steps::output_file(&output)?;
         eprintln!(
             "==> {name}: started beside the next steps (output in {})",
             output.display()

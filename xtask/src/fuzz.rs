@@ -136,11 +136,7 @@ fn run_one(
     let artifacts = fuzz_dir.join("artifacts").join(target);
     std::fs::create_dir_all(&artifacts).map_err(|e| format!("{}: {e}", artifacts.display()))?;
     let log_path = logs.join(format!("{target}.log"));
-    let log =
-        std::fs::File::create(&log_path).map_err(|e| format!("{}: {e}", log_path.display()))?;
-    let log_err = log
-        .try_clone()
-        .map_err(|e| format!("{}: {e}", log_path.display()))?;
+    let (log, log_err) = steps::output_file(&log_path)?;
     eprintln!(
         "    fuzz {target} for {seconds} s (output in {})",
         log_path.display()

@@ -122,6 +122,14 @@ impl Log {
     }
 }
 
+/// A new file at `path` for a child's standard output and error (one handle each).
+pub fn output_file(path: &Path) -> Result<(std::fs::File, std::fs::File), String> {
+    let err = |e: std::io::Error| format!("{}: {e}", path.display());
+    let out = std::fs::File::create(path).map_err(err)?;
+    let both = out.try_clone().map_err(err)?;
+    Ok((out, both))
+}
+
 /// Runs `program args` from `dir`; `Err` says how it ended.
 pub fn command(dir: &Path, program: &str, args: &[&str]) -> Result<(), String> {
     command_env(dir, program, args, &[])
