@@ -55,9 +55,6 @@ pub(super) fn prolongate(
         .with_min_len(4096)
         .map(|v| {
             let c = nearest[v];
-            if c == UNREACHED {
-                return [0.0; MAX_DIM];
-            }
             let p = full.positions[full.order.old_of_new[v] as usize];
             let on = |f: u32| {
                 let t = coarse_mesh.triangles[f as usize];
@@ -101,7 +98,8 @@ pub(super) fn prolongate(
 /// For each vertex in the system's order, the coarse vertex (its index in the coarse
 /// mesh) that breadth-first layers from all coarse vertices reach it from first; layers are
 /// gathered in parallel in the frontier's order, so the result does not depend on the
-/// thread count.
+/// thread count. A vertex no coarse vertex reaches is an error (a decimation keeps every
+/// component, so only a mismatched coarse mesh has one).
 fn nearest_coarse(
     full: &FullLevel<'_>,
     coarse_ids: &[u32],
@@ -136,6 +134,12 @@ fn nearest_coarse(
         }
         frontier = next;
         check_cancel(progress)?;
+    }
+    if let Some(v) = nearest.iter().position(|&c| c == UNREACHED) {
+        return Err(EmbedError::InvalidArgument(format!(
+            "vertex {} is in a part of the mesh without coarse vertices",
+            full.order.old_of_new[v]
+        )));
     }
     Ok(nearest)
 }
