@@ -3,7 +3,8 @@
 //! way beside the release steps: their build is a chain of single-threaded compiles of the
 //! workspace's crates, and the installed-artifact checks leave most of a core idle, so on a
 //! fresh 2-core machine the two side by side take about two minutes less than one after
-//! the other.
+//! the other. The crates' verification (`cargo xtask dist --crates`) goes this way beside the
+//! Python, Blender, browser and C steps, whose waits on one process leave a core idle.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
@@ -48,7 +49,12 @@ impl Beside {
     /// Waits for the step and records it in `log` (its wall time from its start; its CPU
     /// overlaps the other steps', so the table shows none); on failure prints the end of
     /// its output. False when it failed.
-    pub fn finish(mut self, log: &mut steps::Log) -> bool {
+    pub fn finish(self, log: &mut steps::Log) -> bool {
+        self.wait().record(log)
+    }
+
+    /// Waits for the step; on failure the outcome holds the end of its output.
+    pub fn wait(mut self) -> Finished {
         let result = match self.child.wait() {
             Ok(status) if status.success() => Ok(()),
             Ok(status) => Err(format!("ended with {status}")),
@@ -60,12 +66,38 @@ impl Beside {
             let tail = lines[lines.len().saturating_sub(60)..].join("\n");
             format!("{e}; the end of {}:\n{tail}", self.output.display())
         });
-        log.record(&self.name, self.start.elapsed().as_secs_f64(), None, result)
+        Finished {
+            name: std::mem::take(&mut self.name),
+            seconds: self.start.elapsed().as_secs_f64(),
+            result,
+        }
     }
 
     /// Stops the step (a step before it failed).
-    pub fn cancel(mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+    pub fn cancel(self) {}
+}
+
+impl Drop for Beside {
+    /// A step neither waited for nor finished is stopped, not left running.
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// The outcome of a [`Beside`] step, to record once the step table is at hand.
+pub struct Finished {
+    name: String,
+    seconds: f64,
+    /// Whether it passed, or why not.
+    pub result: Result<(), String>,
+}
+
+impl Finished {
+    /// Records it in `log`; false when it failed.
+    pub fn record(self, log: &mut steps::Log) -> bool {
+        log.record(&self.name, self.seconds, None, self.result)
     }
 }

@@ -54,8 +54,18 @@ pub fn dist_dir(root: &Path) -> PathBuf {
     steps::target_dir(root).join("dist")
 }
 
-/// Builds every artifact into an emptied `target/dist/` and writes `SHA256SUMS`.
+/// Builds every artifact into an emptied `target/dist/` and writes `SHA256SUMS`, the crates
+/// verified by `cargo package` beside the other builds.
 pub fn run(root: &Path) -> Result<Artifacts, String> {
+    run_with(root, || verify_crates(root))
+}
+
+/// [`run`] with the crates' verification done by `verified` (run beside the other builds;
+/// it may wait for a verification started earlier); the `.crate` files it left are copied.
+pub fn run_with(
+    root: &Path,
+    verified: impl FnOnce() -> Result<(), String> + Send,
+) -> Result<Artifacts, String> {
     version::check(root)?;
     let version = version::workspace(root)?;
     let dist = dist_dir(root);
@@ -68,7 +78,11 @@ pub fn run(root: &Path) -> Result<Artifacts, String> {
     // release builds: each leaves a core idle part of the time (about 40 s of a fresh
     // run's 390 s). The CPU figures printed inside overlap.
     let (built, packaged) = std::thread::scope(|scope| {
-        let packaged = scope.spawn(|| timed("crates", || crates(root, &dist)));
+        let packaged = scope.spawn(|| {
+            timed("crates", || {
+                verified().and_then(|()| copy_crates(root, &dist))
+            })
+        });
         let built = (|| {
             let wheel = timed("wheel", || wheel(root, &dist, &version, &recorder))?;
             let sdist = timed("sdist", || sdist(root, &dist, &version))?;
@@ -352,8 +366,9 @@ fn check_glibc(lib: &Path) -> Result<(), String> {
 }
 
 /// `cargo package --workspace` (each package verified by building it alone), the `.crate`
-/// files copied to `dist/crates/`. The verification builds without debug info: whether a
-/// package builds does not depend on it, and it costs compile and link time.
+/// files left in the `package-verify` target directory ([`copy_crates`] takes them). The
+/// verification builds without debug info: whether a package builds does not depend on it,
+/// and it costs compile and link time.
 ///
 /// Cargo verifies a package against its workspace dependencies unpacked from their own
 /// `.crate` files as if from a registry, and takes a registry crate of a name and version as
@@ -361,8 +376,8 @@ fn check_glibc(lib: &Path) -> Result<(), String> {
 /// from them. So the verification gets a target directory of its own, and both the
 /// unpacked workspace crates and their artifacts there are removed first; otherwise a
 /// crate using a new item of another would be verified against that crate's old source.
-fn crates(root: &Path, dist: &Path) -> Result<(), String> {
-    let verify = steps::target_dir(root).join("package-verify");
+pub fn verify_crates(root: &Path) -> Result<(), String> {
+    let verify = verify_dir(root);
     forget_packaged(cargo_home().as_deref(), &verify)?;
     let verify_arg = verify.to_string_lossy().into_owned();
     let mut args = vec![
@@ -377,8 +392,18 @@ fn crates(root: &Path, dist: &Path) -> Result<(), String> {
     for name in NOT_PACKAGED {
         args.extend(["--exclude", name]);
     }
-    steps::command(root, "cargo", &args)?;
-    let from = verify.join("package");
+    steps::command(root, "cargo", &args)
+}
+
+/// The target directory of the crates' verification.
+fn verify_dir(root: &Path) -> PathBuf {
+    steps::target_dir(root).join("package-verify")
+}
+
+/// Copies the `.crate` files of this version that [`verify_crates`] left into
+/// `dist/crates/`.
+fn copy_crates(root: &Path, dist: &Path) -> Result<(), String> {
+    let from = verify_dir(root).join("package");
     let to = dist.join("crates");
     std::fs::create_dir_all(&to).map_err(|e| format!("{}: {e}", to.display()))?;
     let version = version::workspace(root)?;
@@ -394,6 +419,12 @@ fn crates(root: &Path, dist: &Path) -> Result<(), String> {
             std::fs::copy(&path, to.join(&name)).map_err(|e| format!("{name}: {e}"))?;
             count += 1;
         }
+    }
+    if count == 0 {
+        return Err(format!(
+            "no crates of version {version} in {}: did the verification run?",
+            from.display()
+        ));
     }
     eprintln!("    {count} crates in {}", to.display());
     Ok(())

@@ -70,11 +70,12 @@ fn main() -> ExitCode {
         Some("gltf-validate") if args.len() == 1 => report(gltf::validate(&workspace_root())),
         Some("dist") => match args.get(1).map(String::as_str) {
             None => report(dist::run(&workspace_root()).map(|_| ())),
+            Some("--crates") if args.len() == 2 => report(dist::verify_crates(&workspace_root())),
             Some("--installed") => {
                 let root = workspace_root();
                 let data_dir = report_data_dir(&root);
                 let mut log = steps::Log::default();
-                let ok = release(&root, &data_dir, &mut log);
+                let ok = release(&root, &data_dir, &mut log, None);
                 log.print_table();
                 if ok {
                     ExitCode::SUCCESS
@@ -97,7 +98,7 @@ fn main() -> ExitCode {
 fn usage() -> ExitCode {
     eprintln!(
         "usage: cargo xtask test [--quick] | cargo xtask fuzz [--seconds N] [--target NAME] | \
-         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask cli-docs | cargo xtask venv | cargo xtask wheel | cargo xtask dist [--installed] | \
+         cargo xtask lab [NAME ARGS] | cargo xtask lines | cargo xtask man [DIR] | cargo xtask cli-docs | cargo xtask venv | cargo xtask wheel | cargo xtask dist [--installed | --crates] | \
          cargo xtask blender-addon | cargo xtask blender | cargo xtask web [--check] | cargo xtask gltf-validate\n\n  \
          test   every check, in CI's order (the steps: docs/development.md), then a table of \
          step times\n  \
@@ -110,7 +111,7 @@ fn usage() -> ExitCode {
          cli-docs   write docs/cli.md from the command definitions (help texts and examples)\n  \
          venv   make or update the test virtual environment (target/py-venv, from python/requirements-test.txt) and print its interpreter\n  \
          wheel  build the Python wheel (maturin, dev profile, target/wheels) and print its path\n  \
-         dist   every release artifact (wheel, sdist, Blender zip, C tarball, crates) into target/dist/ with SHA256SUMS (docs/release.md); --installed: then the release steps of `test` (each artifact installed and used)\n  \
+         dist   every release artifact (wheel, sdist, Blender zip, C tarball, crates) into target/dist/ with SHA256SUMS (docs/release.md); --installed: then the release steps of `test` (each artifact installed and used); --crates: only the crates' verification (cargo package --workspace, into target/package-verify)\n  \
          blender-addon   build the Blender add-on target/wavg_blender.zip (the wavg wheel unpacked in its vendor/ folder)\n  \
          blender   the blender step of `test` alone: the add-on's tests in Blender, with a temporary home holding a decoy add-on\n  \
          web    vendor three.js for the page of `wavg serve` into web/vendor/three by npm ci of web/package-lock.json (--check: verify the checked-in files)\n  \
@@ -223,34 +224,60 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
             &[("RUSTDOCFLAGS", "-D warnings")],
         )
     }) && log.run("examples", || examples::run(root))
-        && log.run("python environment", || {
-            python::ensure_venv(root).map(|_| ())
-        })
-        && log.run("python package (wheel, pytest python/tests)", || {
-            python::test_package(root, data_dir)
-        })
-        && log.run("python blocks of README.md and docs/", || {
-            python::docs_blocks(root, data_dir)
-        })
-        && log.run("blender", || blender::test(root))
-        && log.run("web assets", || web::check_assets(root))
-        && log.run("glTF validator (every .glb/.gltf the tests wrote)", || {
-            gltf::validate(root)
-        })
-        && log.run("browser tests", || web::browser_tests(root, data_dir))
-        && log.run("C/C++ packages", cbuild::ensure_packages)
-        && cbuild::steps(root, data_dir)
-            .into_iter()
-            .all(|(name, program, args)| {
-                let args: Vec<&str> = args.iter().map(String::as_str).collect();
-                log.run(name, || steps::command(root, &program, &args))
-            })
-        && release_and_fuzz(root, data_dir, log)
+        && beside_crates(root, log, |log| {
+            log.run("python environment", || python::ensure_venv(root).map(|_| ()))
+                && log.run("python package (wheel, pytest python/tests)", || {
+                    python::test_package(root, data_dir)
+                })
+                && log.run("python blocks of README.md and docs/", || {
+                    python::docs_blocks(root, data_dir)
+                })
+                && log.run("blender", || blender::test(root))
+                && log.run("web assets", || web::check_assets(root))
+                && log.run("glTF validator (every .glb/.gltf the tests wrote)", || {
+                    gltf::validate(root)
+                })
+                && log.run("browser tests", || web::browser_tests(root, data_dir))
+                && log.run("C/C++ packages", cbuild::ensure_packages)
+                && cbuild::steps(root, data_dir)
+                    .into_iter()
+                    .all(|(name, program, args)| {
+                        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+                        log.run(name, || steps::command(root, &program, &args))
+                    })
+        }, |log, crates| release_and_fuzz(root, data_dir, log, crates))
+}
+
+/// Runs `steps` with the crates' verification beside them ([`beside`]: the Python, Blender,
+/// browser and C steps wait on one process much of the time), then `release` given it to
+/// wait for; stops it when a step fails.
+fn beside_crates(
+    root: &Path,
+    log: &mut steps::Log,
+    steps: impl FnOnce(&mut steps::Log) -> bool,
+    release: impl FnOnce(&mut steps::Log, Option<Beside>) -> bool,
+) -> bool {
+    let name = "crates' verification (cargo package --workspace; beside the steps from python)";
+    let crates = match Beside::start(root, name, "crates-verify", &["dist", "--crates"]) {
+        Ok(c) => c,
+        Err(e) => return log.record(name, 0.0, None, Err(e)),
+    };
+    if steps(log) {
+        release(log, Some(crates))
+    } else {
+        crates.cancel();
+        false
+    }
 }
 
 /// [`release`] with the fuzz targets' build and smoke run beside it ([`beside`]): nothing
 /// after ctest builds into the dev profile's folder, where the instrumented targets go.
-fn release_and_fuzz(root: &Path, data_dir: &Path, log: &mut steps::Log) -> bool {
+fn release_and_fuzz(
+    root: &Path,
+    data_dir: &Path,
+    log: &mut steps::Log,
+    crates: Option<Beside>,
+) -> bool {
     let seconds = SMOKE_SECONDS.to_string();
     let name = format!(
         "fuzz build and smoke ({} targets x {SMOKE_SECONDS} s; beside the release steps)",
@@ -258,9 +285,14 @@ fn release_and_fuzz(root: &Path, data_dir: &Path, log: &mut steps::Log) -> bool 
     );
     let fuzz = match Beside::start(root, &name, "fuzz-smoke", &["fuzz", "--seconds", &seconds]) {
         Ok(f) => f,
-        Err(e) => return log.record(&name, 0.0, None, Err(e)),
+        Err(e) => {
+            if let Some(c) = crates {
+                c.cancel();
+            }
+            return log.record(&name, 0.0, None, Err(e));
+        }
     };
-    if release(root, data_dir, log) {
+    if release(root, data_dir, log, crates) {
         fuzz.finish(log)
     } else {
         fuzz.cancel();
@@ -268,13 +300,26 @@ fn release_and_fuzz(root: &Path, data_dir: &Path, log: &mut steps::Log) -> bool 
     }
 }
 
-/// `cargo xtask dist`, then each artifact installed and used as its users do.
-fn release(root: &Path, data_dir: &Path, log: &mut steps::Log) -> bool {
+/// `cargo xtask dist`, then each artifact installed and used as its users do. With
+/// `crates`, the crates' verification already running beside, dist waits for it instead of
+/// running its own.
+fn release(root: &Path, data_dir: &Path, log: &mut steps::Log, crates: Option<Beside>) -> bool {
     let mut built = None;
-    if !log.run("release artifacts (cargo xtask dist)", || {
-        built = Some(dist::run(root)?);
+    let mut lane = None;
+    let dist_ok = log.run("release artifacts (cargo xtask dist)", || {
+        built = Some(match crates {
+            None => dist::run(root)?,
+            Some(c) => dist::run_with(root, || {
+                let finished = c.wait();
+                let result = finished.result.clone();
+                lane = Some(finished);
+                result.map_err(|e| format!("the crates' verification failed: {e}"))
+            })?,
+        });
         Ok(())
-    }) {
+    });
+    let lane_ok = lane.is_none_or(|f| f.record(log));
+    if !(dist_ok && lane_ok) {
         return false;
     }
     let Some(a) = built else { return false };
