@@ -179,7 +179,15 @@ impl FastMarching {
             q_oo: 0.0,
             len: 0.0,
         };
-        let mut entries = vec![empty; offsets[n] as usize];
+        // Filled a block at a time: first touches of fresh memory cost seconds at 10M
+        // vertices (1.5 GB), and a cancellation must not wait for them.
+        let total = offsets[n] as usize;
+        let mut entries = Vec::with_capacity(total);
+        while entries.len() < total {
+            check_cancel(progress)?;
+            let block = (total - entries.len()).min(16 * CANCEL_EVERY);
+            entries.resize(entries.len() + block, empty);
+        }
         let mut put = |v: u32, e: Entry| {
             entries[fill[v as usize] as usize] = e;
             fill[v as usize] += 1;
