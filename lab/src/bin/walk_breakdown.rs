@@ -1,4 +1,7 @@
-//! Where a forward query's time goes: `walk_breakdown MESH EMB [MESH EMB ...]`.
+//! Where a forward query's time goes: `walk_breakdown MESH EMB [MESH EMB ...]`. Modes
+//! (environment): `STEPS=1` the walk's steps and distances, `SLOW=N` the N slowest
+//! projections dissected, `QUICK=1` walk / projection / forward times only, `DUMP=FILE`
+//! every forward answer (face, barycentrics, distance) to compare two builds.
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
@@ -36,6 +39,12 @@ fn main() {
             .collect();
         setups.push((pair[0].clone(), p, s, ws, ys));
     }
+    if std::env::var("SLOW").is_ok() {
+        for (name, p, _, _, ys) in &setups {
+            slow(name, p, ys);
+        }
+        return;
+    }
     if std::env::var("STEPS").is_ok() {
         for (name, p, _, _, ys) in &setups {
             steps(name, p, ys);
@@ -52,6 +61,50 @@ fn main() {
                 assert_eq!(r.len(), rows.len());
             }
             println!("{name}: {:.2} s", t.elapsed().as_secs_f64());
+        }
+        return;
+    }
+    if let Ok(path) = std::env::var("DUMP") {
+        use std::fmt::Write as _;
+        let mut out = String::new();
+        for (name, _, s, ws, _) in &setups {
+            for w in ws {
+                let r = s.forward(w, &ForwardOptions::default()).unwrap();
+                let b = r.point.bary;
+                writeln!(out, "{name} {} {:?} {:e}", r.point.face, b, r.distance).unwrap();
+            }
+        }
+        std::fs::write(path, out).unwrap();
+        return;
+    }
+    if std::env::var("QUICK").is_ok() {
+        // Per round: the walk, the first-hit projection and the forward problem, without
+        // the other stages (a quicker side-by-side of two builds).
+        let rounds: usize = std::env::var("ROUNDS").map_or(5, |r| r.parse().unwrap());
+        for round in 0..rounds {
+            for (name, p, s, ws, ys) in &setups {
+                let t = Instant::now();
+                let mut acc = 0u64;
+                for (y, a) in ys {
+                    acc += u64::from(p.walk(y, p.start_near(y, *a)));
+                }
+                let t_walk = t.elapsed().as_secs_f64() / ys.len() as f64 * 1e6;
+                let t = Instant::now();
+                for (y, a) in ys {
+                    let r = p.project_with(y, p.start_near(y, *a), None, SearchGoal::FirstHit);
+                    acc += u64::from(r.unwrap().point.face);
+                }
+                let t_proj = t.elapsed().as_secs_f64() / ys.len() as f64 * 1e6;
+                let o = ForwardOptions::default();
+                let t = Instant::now();
+                for w in ws {
+                    acc += u64::from(s.forward(w, &o).unwrap().point.face);
+                }
+                let t_fwd = t.elapsed().as_secs_f64() / ys.len() as f64 * 1e6;
+                println!(
+                    "round {round} {name}: walk {t_walk:.3} project {t_proj:.3} forward {t_fwd:.3} us ({acc})"
+                );
+            }
         }
         return;
     }
@@ -244,4 +297,67 @@ fn steps(name: &str, p: &Projector, ys: &[(Vec8, u32)]) {
     println!("  start to walk end, edges: {}", q(&mut cover));
     println!("  query off the surface, edges: {}", q(&mut off));
     println!("  hops walk end to answer face: {}", q(&mut hops));
+}
+
+/// `SLOW=1`: the slowest forward projections (first hit, from the start grid's vertex):
+/// per query its time, the walk's time and end, the nearest vertex (and how far either
+/// lies, in mean embedded edges), the answer's distance and whether the answer's face has
+/// the walk's end or the nearest vertex as a corner, and the closest projection's distance.
+fn slow(name: &str, p: &Projector, ys: &[(Vec8, u32)]) {
+    let m = p.embedded().mesh();
+    let x = p.embedded().coords();
+    let mut edge = 0.0;
+    let mut ne = 0usize;
+    for t in m.triangles.iter().step_by(97) {
+        for k in 0..3 {
+            edge += (x[t[k] as usize] - x[t[(k + 1) % 3] as usize]).norm();
+            ne += 1;
+        }
+    }
+    edge /= ne as f64;
+    for (y, a) in ys {
+        let _ = p.project_with(y, p.start_near(y, *a), None, SearchGoal::FirstHit);
+    }
+    let mut times: Vec<(f64, usize)> = ys
+        .iter()
+        .enumerate()
+        .map(|(i, (y, a))| {
+            let t = Instant::now();
+            let _ = p.project_with(y, p.start_near(y, *a), None, SearchGoal::FirstHit);
+            (t.elapsed().as_secs_f64() * 1e6, i)
+        })
+        .collect();
+    times.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let n: usize = std::env::var("SLOW")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(40);
+    println!("{name}: slowest {n} (us; distances in mean edges {edge:.3e})");
+    for &(t, i) in &times[..n.min(times.len())] {
+        let (y, a) = &ys[i];
+        let s = p.start_near(y, *a);
+        let t0 = Instant::now();
+        let v = p.walk(y, s);
+        let tw = t0.elapsed().as_secs_f64() * 1e6;
+        let t0 = Instant::now();
+        let u = p.nearest_vertex(y);
+        let tn = t0.elapsed().as_secs_f64() * 1e6;
+        let r = p.project_with(y, s, None, SearchGoal::FirstHit).unwrap();
+        let c = p.project_with(y, s, None, SearchGoal::Closest).unwrap();
+        let tri = m.triangles[r.point.face as usize];
+        let d = |w: u32| (x[w as usize] - y).norm() / edge;
+        println!(
+            "  {t:8.1} walk {tw:6.1} nearest {tn:7.1} | v {v} d {:.2} u {u} d {:.2} |v-u| {:.1} | answer {:.3} at v {} at u {} {:?} | closest {:.3} {:?} same {}",
+            d(v),
+            d(u),
+            (x[v as usize] - x[u as usize]).norm() / edge,
+            r.distance / edge,
+            tri.contains(&v),
+            tri.contains(&u),
+            r.path,
+            c.distance / edge,
+            c.path,
+            c.point.face == r.point.face,
+        );
+    }
 }

@@ -193,9 +193,11 @@ impl StartGrid {
     /// neighbouring cell whose vertex is closest to `p` (squared distance in walk units;
     /// ties to the first in [`StartGrid::neighbours`]' order) while that improves and
     /// the current one lies farther than [`NEAR_CELLS`] from `p`; returns the last cell's
-    /// vertex and its squared distance.
+    /// vertex and its squared distance. After each step the walk record (of `records`) of
+    /// the step's vertex is requested: the vertex walk reads it first, and the next grid
+    /// step's reads hide the wait.
     #[inline]
-    pub(super) fn walk(&self, p: &[f32; 8]) -> (VertexId, f32) {
+    pub(super) fn walk(&self, p: &[f32; 8], records: &[WalkPoint]) -> (VertexId, f32) {
         let dist2 = |cell: &Cell| super::layout::dist2_packed(&cell.c, p);
         let mut c = self.cell_of(p).0;
         let mut v = self.cells[c].v;
@@ -249,6 +251,9 @@ impl StartGrid {
                 break;
             }
             c = next;
+            if let Some(r) = records.get(v as usize) {
+                super::prefetch_line(r);
+            }
         }
         (v, d)
     }
@@ -287,7 +292,7 @@ impl Projector {
             return start;
         }
         let yw = self.walk_point(y);
-        let (v, d) = self.starts.walk(&yw);
+        let (v, d) = self.starts.walk(&yw, &self.walk_coords);
         if d < ws.dist2(&yw) { v } else { start }
     }
 }
@@ -354,7 +359,7 @@ mod tests {
                     *x = if k % 2 == 0 { -3e4 } else { 1e5 };
                 }
             }
-            assert_eq!(g.walk(&q), reference(&q), "vertex {v}");
+            assert_eq!(g.walk(&q, &p.walk_coords), reference(&q), "vertex {v}");
             let [d0, d1, d2] = g.dims;
             let c = g.cell_of(&q).0 as u32;
             let (i, j, k) = (c / (d1 * d2), c / d2 % d1, c % d2);
