@@ -4,7 +4,8 @@
 //! workspace's crates, and the installed-artifact checks leave most of a core idle, so on a
 //! fresh 2-core machine the two side by side take about two minutes less than one after
 //! the other. The crates' verification (`cargo xtask dist --crates`) goes this way beside the
-//! Python, Blender, browser and C steps, whose waits on one process leave a core idle.
+//! tests and the Python, Blender, browser and C steps, whose waits on one process leave a
+//! core idle.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};

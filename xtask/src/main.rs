@@ -198,6 +198,17 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
             steps::cargo_workspace(root, &["test", "--lib"], &[])
         });
     }
+    beside_crates(
+        root,
+        log,
+        |log| build_and_use(root, data_dir, log),
+        |log, crates| release_and_fuzz(root, data_dir, log, crates),
+    )
+}
+
+/// The steps from the tests to ctest: the everyday build and its tests, then each way in
+/// (Python, Blender, the browser, C/C++) used from it.
+fn build_and_use(root: &Path, data_dir: &Path, log: &mut steps::Log) -> bool {
     log.run("tests (unit, integration, doc; examples built)", || {
         let gltf_dir = gltf::clear(root)?;
         let gltf_dir = gltf_dir.to_string_lossy();
@@ -224,40 +235,41 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
             &[("RUSTDOCFLAGS", "-D warnings")],
         )
     }) && log.run("examples", || examples::run(root))
-        && beside_crates(root, log, |log| {
-            log.run("python environment", || python::ensure_venv(root).map(|_| ()))
-                && log.run("python package (wheel, pytest python/tests)", || {
-                    python::test_package(root, data_dir)
-                })
-                && log.run("python blocks of README.md and docs/", || {
-                    python::docs_blocks(root, data_dir)
-                })
-                && log.run("blender", || blender::test(root))
-                && log.run("web assets", || web::check_assets(root))
-                && log.run("glTF validator (every .glb/.gltf the tests wrote)", || {
-                    gltf::validate(root)
-                })
-                && log.run("browser tests", || web::browser_tests(root, data_dir))
-                && log.run("C/C++ packages", cbuild::ensure_packages)
-                && cbuild::steps(root, data_dir)
-                    .into_iter()
-                    .all(|(name, program, args)| {
-                        let args: Vec<&str> = args.iter().map(String::as_str).collect();
-                        log.run(name, || steps::command(root, &program, &args))
-                    })
-        }, |log, crates| release_and_fuzz(root, data_dir, log, crates))
+        && log.run("python environment", || {
+            python::ensure_venv(root).map(|_| ())
+        })
+        && log.run("python package (wheel, pytest python/tests)", || {
+            python::test_package(root, data_dir)
+        })
+        && log.run("python blocks of README.md and docs/", || {
+            python::docs_blocks(root, data_dir)
+        })
+        && log.run("blender", || blender::test(root))
+        && log.run("web assets", || web::check_assets(root))
+        && log.run("glTF validator (every .glb/.gltf the tests wrote)", || {
+            gltf::validate(root)
+        })
+        && log.run("browser tests", || web::browser_tests(root, data_dir))
+        && log.run("C/C++ packages", cbuild::ensure_packages)
+        && cbuild::steps(root, data_dir)
+            .into_iter()
+            .all(|(name, program, args)| {
+                let args: Vec<&str> = args.iter().map(String::as_str).collect();
+                log.run(name, || steps::command(root, &program, &args))
+            })
 }
 
-/// Runs `steps` with the crates' verification beside them ([`beside`]: the Python, Blender,
-/// browser and C steps wait on one process much of the time), then `release` given it to
-/// wait for; stops it when a step fails.
+/// Runs `steps` with the crates' verification beside them ([`beside`]: the tests' runs and
+/// the Python, Blender, browser and C steps wait on one process much of the time), then
+/// `release` given it to wait for; stops it when a step fails.
 fn beside_crates(
     root: &Path,
     log: &mut steps::Log,
     steps: impl FnOnce(&mut steps::Log) -> bool,
     release: impl FnOnce(&mut steps::Log, Option<Beside>) -> bool,
 ) -> bool {
-    let name = "crates' verification (cargo package --workspace; beside the steps from python)";
+    let name =
+        "crates' verification (cargo package --workspace; beside the steps from the tests on)";
     let crates = match Beside::start(root, name, "crates-verify", &["dist", "--crates"]) {
         Ok(c) => c,
         Err(e) => return log.record(name, 0.0, None, Err(e)),
