@@ -178,15 +178,7 @@ fn steps(name: &str, p: &Projector, ys: &[(Vec8, u32)]) {
     let m = p.embedded().mesh();
     let topo = m.topology();
     let x = p.embedded().coords();
-    let mut edge = 0.0;
-    let mut ne = 0usize;
-    for t in m.triangles.iter().step_by(97) {
-        for k in 0..3 {
-            edge += (x[t[k] as usize] - x[t[(k + 1) % 3] as usize]).norm();
-            ne += 1;
-        }
-    }
-    edge /= ne as f64;
+    let edge = mean_embedded_edge(p);
     let mut walk = Vec::new();
     let mut cover = Vec::new();
     let mut off = Vec::new();
@@ -299,6 +291,20 @@ fn steps(name: &str, p: &Projector, ys: &[(Vec8, u32)]) {
     println!("  hops walk end to answer face: {}", q(&mut hops));
 }
 
+/// The mean embedded edge length, over every 97th face's edges.
+fn mean_embedded_edge(p: &Projector) -> f64 {
+    let m = p.embedded().mesh();
+    let x = p.embedded().coords();
+    let (mut edge, mut ne) = (0.0, 0usize);
+    for t in m.triangles.iter().step_by(97) {
+        for k in 0..3 {
+            edge += (x[t[k] as usize] - x[t[(k + 1) % 3] as usize]).norm();
+            ne += 1;
+        }
+    }
+    edge / ne as f64
+}
+
 /// `SLOW=1`: the slowest forward projections (first hit, from the start grid's vertex):
 /// per query its time, the walk's time and end, the nearest vertex (and how far either
 /// lies, in mean embedded edges), the answer's distance and whether the answer's face has
@@ -306,15 +312,7 @@ fn steps(name: &str, p: &Projector, ys: &[(Vec8, u32)]) {
 fn slow(name: &str, p: &Projector, ys: &[(Vec8, u32)]) {
     let m = p.embedded().mesh();
     let x = p.embedded().coords();
-    let mut edge = 0.0;
-    let mut ne = 0usize;
-    for t in m.triangles.iter().step_by(97) {
-        for k in 0..3 {
-            edge += (x[t[k] as usize] - x[t[(k + 1) % 3] as usize]).norm();
-            ne += 1;
-        }
-    }
-    edge /= ne as f64;
+    let edge = mean_embedded_edge(p);
     for (y, a) in ys {
         let _ = p.project_with(y, p.start_near(y, *a), None, SearchGoal::FirstHit);
     }
