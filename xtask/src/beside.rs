@@ -3,9 +3,10 @@
 //! way beside the release steps: their build is a chain of single-threaded compiles of the
 //! workspace's crates, and the installed-artifact checks leave most of a core idle, so on a
 //! fresh 2-core machine the two side by side take about two minutes less than one after
-//! the other. The crates' verification (`cargo xtask dist --crates`) goes this way beside the
-//! tests and the Python, Blender, browser and C steps, whose waits on one process leave a
-//! core idle.
+//! the other. The crates' verification (`cargo xtask dist --crates`) goes this way, at the
+//! lowest priority, beside the tests and the Python, Blender, browser and C steps, whose
+//! waits on one process leave a core idle; it has a cargo home of its own
+//! ([`crate::cargo_home`]), so no lock of cargo's makes the two take turns.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
@@ -25,20 +26,47 @@ impl Beside {
     /// Starts `cargo xtask ARGS` (this binary) from `root` as step `name`, its output in
     /// `FILE.log` in cargo's target directory.
     pub fn start(root: &Path, name: &str, file: &str, args: &[&str]) -> Result<Self, String> {
+        Self::spawn(root, name, file, args, false)
+    }
+
+    /// [`Beside::start`] at the lowest priority (`nice -n 19`, where `nice` exists): the
+    /// step takes the cores the steps beside it leave idle, and little more.
+    pub fn start_idle(root: &Path, name: &str, file: &str, args: &[&str]) -> Result<Self, String> {
+        Self::spawn(root, name, file, args, true)
+    }
+
+    fn spawn(
+        root: &Path,
+        name: &str,
+        file: &str,
+        args: &[&str],
+        idle: bool,
+    ) -> Result<Self, String> {
         let xtask = std::env::current_exe().map_err(|e| format!("xtask's own path: {e}"))?;
         let output = steps::target_dir(root).join(format!("{file}.log"));
         let (out, err) = steps::output_file(&output)?;
         eprintln!(
-            "==> {name}: started beside the next steps (output in {})",
+            "==> {name}: started beside the next steps{} (output in {})",
+            if idle { " at the lowest priority" } else { "" },
             output.display()
         );
-        let child = Command::new(&xtask)
-            .args(args)
-            .current_dir(root)
-            .stdout(out)
-            .stderr(err)
-            .spawn()
-            .map_err(|e| format!("could not start {}: {e}", xtask.display()))?;
+        let spawn = |niced: bool| -> std::io::Result<Child> {
+            let mut c = Command::new(if niced { Path::new("nice") } else { &xtask });
+            if niced {
+                c.args(["-n", "19"]).arg(&xtask);
+            }
+            let (out, err) = (out.try_clone()?, err.try_clone()?);
+            c.args(args)
+                .current_dir(root)
+                .stdout(out)
+                .stderr(err)
+                .spawn()
+        };
+        let child = match spawn(idle) {
+            Err(e) if idle && e.kind() == std::io::ErrorKind::NotFound => spawn(false),
+            started => started,
+        }
+        .map_err(|e| format!("could not start {}: {e}", xtask.display()))?;
         Ok(Self {
             name: name.to_string(),
             child,

@@ -376,9 +376,13 @@ fn check_glibc(lib: &Path) -> Result<(), String> {
 /// from them. So the verification gets a target directory of its own, and both the
 /// unpacked workspace crates and their artifacts there are removed first; otherwise a
 /// crate using a new item of another would be verified against that crate's old source.
+/// It also gets a cargo home of its own ([`crate::cargo_home`]), so that it runs beside the
+/// test command's other cargo builds instead of taking turns with them.
 pub fn verify_crates(root: &Path) -> Result<(), String> {
     let verify = verify_dir(root);
-    forget_packaged(cargo_home().as_deref(), &verify)?;
+    let home = crate::cargo_home::beside(cargo_home().as_deref(), &verify.join("cargo-home"))?;
+    forget_packaged(Some(&home), &verify)?;
+    let home = home.to_string_lossy().into_owned();
     let verify_arg = verify.to_string_lossy().into_owned();
     let mut args = vec![
         "package",
@@ -392,7 +396,7 @@ pub fn verify_crates(root: &Path) -> Result<(), String> {
     for name in NOT_PACKAGED {
         args.extend(["--exclude", name]);
     }
-    steps::command(root, "cargo", &args)
+    steps::command_env(root, "cargo", &args, &[("CARGO_HOME", &home)])
 }
 
 /// The target directory of the crates' verification.

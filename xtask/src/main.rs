@@ -5,6 +5,7 @@
 
 mod beside;
 mod blender;
+mod cargo_home;
 mod cbuild;
 mod cli_docs;
 mod cpu;
@@ -259,8 +260,9 @@ fn build_and_use(root: &Path, data_dir: &Path, log: &mut steps::Log) -> bool {
             })
 }
 
-/// Runs `steps` with the crates' verification beside them ([`beside`]: the tests' runs and
-/// the Python, Blender, browser and C steps wait on one process much of the time), then
+/// Runs `steps` with the crates' verification beside them at the lowest priority
+/// ([`Beside::start_idle`]: the tests' runs and the Python, Blender, browser and C steps
+/// wait on one process much of the time, and the verification takes the idle core), then
 /// `release` given it to wait for; stops it when a step fails.
 fn beside_crates(
     root: &Path,
@@ -270,7 +272,7 @@ fn beside_crates(
 ) -> bool {
     let name =
         "crates' verification (cargo package --workspace; beside the steps from the tests on)";
-    let crates = match Beside::start(root, name, "crates-verify", &["dist", "--crates"]) {
+    let crates = match Beside::start_idle(root, name, "crates-verify", &["dist", "--crates"]) {
         Ok(c) => c,
         Err(e) => return log.record(name, 0.0, None, Err(e)),
     };
