@@ -161,3 +161,72 @@ pub(crate) fn check_cancel(p: &dyn Progress) -> Result<(), EmbedError> {
         Ok(())
     }
 }
+
+/// Entries a large buffer gets between two looks at the cancellation in [`filled`].
+pub(crate) const FILL_BLOCK: usize = 1 << 20;
+
+/// `vec![value; len]`, filled [`FILL_BLOCK`] entries at a time with a look at the
+/// cancellation before each block: first touches of fresh memory cost seconds for a buffer
+/// of a gigabyte or more (the fast marching's update table at 10M vertices), and a
+/// cancellation must not wait for them.
+pub(crate) fn filled<T: Clone>(
+    len: usize,
+    value: T,
+    p: &dyn Progress,
+) -> Result<Vec<T>, EmbedError> {
+    let mut v = Vec::with_capacity(len);
+    while v.len() < len {
+        check_cancel(p)?;
+        let block = (len - v.len()).min(FILL_BLOCK);
+        v.resize(v.len() + block, value.clone());
+    }
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// Cancels from its `after`-th look on, counting the looks.
+    struct CancelAfter {
+        after: usize,
+        looks: AtomicUsize,
+    }
+
+    impl Progress for CancelAfter {
+        fn report(&self, _: Stage, _: f64) {}
+        fn cancelled(&self) -> bool {
+            self.looks.fetch_add(1, Ordering::Relaxed) + 1 >= self.after
+        }
+    }
+
+    #[test]
+    fn a_large_buffer_is_filled_a_block_at_a_time_looking_at_the_cancellation() {
+        let never = CancelAfter {
+            after: usize::MAX,
+            looks: AtomicUsize::new(0),
+        };
+        let len = 3 * FILL_BLOCK + 5;
+        let v = filled(len, 7u8, &never).unwrap();
+        assert_eq!(v.len(), len);
+        assert!(v.iter().all(|&x| x == 7));
+        assert_eq!(never.looks.load(Ordering::Relaxed), 4);
+
+        let third = CancelAfter {
+            after: 3,
+            looks: AtomicUsize::new(0),
+        };
+        assert!(matches!(
+            filled(len, 0u8, &third),
+            Err(EmbedError::Cancelled)
+        ));
+        assert_eq!(third.looks.load(Ordering::Relaxed), 3);
+
+        let empty = CancelAfter {
+            after: 1,
+            looks: AtomicUsize::new(0),
+        };
+        assert!(filled(0, 0u8, &empty).unwrap().is_empty());
+    }
+}

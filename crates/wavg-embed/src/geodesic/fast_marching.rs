@@ -2,7 +2,7 @@
 //! loop (stopping at a radius or once given targets are frozen).
 
 use super::*;
-use crate::error::NoProgress;
+use crate::error::{NoProgress, filled};
 
 /// Vertex count of the intermediate mesh for landmark geodesics on large meshes (see the
 /// module documentation), the pipeline's default: a balance between the time of one run
@@ -179,15 +179,8 @@ impl FastMarching {
             q_oo: 0.0,
             len: 0.0,
         };
-        // Filled a block at a time: first touches of fresh memory cost seconds at 10M
-        // vertices (1.5 GB), and a cancellation must not wait for them.
-        let total = offsets[n] as usize;
-        let mut entries = Vec::with_capacity(total);
-        while entries.len() < total {
-            check_cancel(progress)?;
-            let block = (total - entries.len()).min(16 * CANCEL_EVERY);
-            entries.resize(entries.len() + block, empty);
-        }
+        // 1.5 GB at 10M vertices.
+        let mut entries = filled(offsets[n] as usize, empty, progress)?;
         let mut put = |v: u32, e: Entry| {
             entries[fill[v as usize] as usize] = e;
             fill[v as usize] += 1;
