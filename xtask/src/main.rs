@@ -199,12 +199,17 @@ fn run_checks(root: &Path, data_dir: &Path, quick: bool, log: &mut steps::Log) -
             steps::cargo_workspace(root, &["test", "--lib"], &[])
         });
     }
-    beside_crates(
-        root,
-        log,
-        |log| build_and_use(root, data_dir, log),
-        |log, crates| release_and_fuzz(root, data_dir, log, crates),
-    )
+    // The crates' verification beside the steps from the tests on, at the lowest priority
+    // ([`Beside::start_idle`]): the tests' runs and the Python, Blender, browser and C steps
+    // wait on one process much of the time, and it takes the idle core. `dist` waits for
+    // it; when a step fails first, it is dropped unwaited, which stops it.
+    let name =
+        "crates' verification (cargo package --workspace; beside the steps from the tests on)";
+    let crates = match Beside::start_idle(root, name, "crates-verify", &["dist", "--crates"]) {
+        Ok(c) => c,
+        Err(e) => return log.record(name, 0.0, None, Err(e)),
+    };
+    build_and_use(root, data_dir, log) && release_and_fuzz(root, data_dir, log, Some(crates))
 }
 
 /// The steps from the tests to ctest: the everyday build and its tests, then each way in
@@ -258,30 +263,6 @@ fn build_and_use(root: &Path, data_dir: &Path, log: &mut steps::Log) -> bool {
                 let args: Vec<&str> = args.iter().map(String::as_str).collect();
                 log.run(name, || steps::command(root, &program, &args))
             })
-}
-
-/// Runs `steps` with the crates' verification beside them at the lowest priority
-/// ([`Beside::start_idle`]: the tests' runs and the Python, Blender, browser and C steps
-/// wait on one process much of the time, and the verification takes the idle core), then
-/// `release` given it to wait for; stops it when a step fails.
-fn beside_crates(
-    root: &Path,
-    log: &mut steps::Log,
-    steps: impl FnOnce(&mut steps::Log) -> bool,
-    release: impl FnOnce(&mut steps::Log, Option<Beside>) -> bool,
-) -> bool {
-    let name =
-        "crates' verification (cargo package --workspace; beside the steps from the tests on)";
-    let crates = match Beside::start_idle(root, name, "crates-verify", &["dist", "--crates"]) {
-        Ok(c) => c,
-        Err(e) => return log.record(name, 0.0, None, Err(e)),
-    };
-    if steps(log) {
-        release(log, Some(crates))
-    } else {
-        crates.cancel();
-        false
-    }
 }
 
 /// [`release`] with the fuzz targets' build and smoke run beside it ([`beside`]): nothing
