@@ -26,6 +26,7 @@ use cone::Cones;
 mod batch;
 mod certify;
 mod cone;
+mod fine;
 mod layout;
 mod locate;
 mod nearest;
