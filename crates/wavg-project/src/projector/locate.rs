@@ -211,16 +211,15 @@ impl StartGrid {
     /// neighbouring cell whose vertex is closest to `p` (squared distance in walk units;
     /// ties to the first in [`StartGrid::neighbours`]' order) while that improves and
     /// the current one lies farther than [`NEAR_CELLS`] from `p`; returns the last cell's
-    /// vertex and its squared distance. `request` is called with the vertex of the first
-    /// cell and of each step (to request what is read of it next: the next grid step's
-    /// reads hide the wait).
+    /// vertex and its squared distance. After each step the walk record (of `records`) of
+    /// the step's vertex is requested: the vertex walk reads it first, and the next grid
+    /// step's reads hide the wait.
     #[inline]
-    pub(super) fn walk(&self, p: &[f32; 8], request: impl Fn(VertexId)) -> (VertexId, f32) {
+    pub(super) fn walk(&self, p: &[f32; 8], records: &[WalkPoint]) -> (VertexId, f32) {
         let dist2 = |cell: &Cell| super::layout::dist2_packed(&cell.c, p);
         let mut c = self.cell_of(p).0;
         let mut v = self.cells[c].v;
         let mut d = dist2(&self.cells[c]);
-        request(v);
         let near = self.near();
         if d <= near {
             return (v, d);
@@ -270,7 +269,9 @@ impl StartGrid {
                 break;
             }
             c = next;
-            request(v);
+            if let Some(r) = records.get(v as usize) {
+                super::prefetch_line(r);
+            }
         }
         (v, d)
     }
@@ -309,15 +310,7 @@ impl Projector {
             return start;
         }
         let yw = self.walk_point(y);
-        let fine = !self.starts.fine.is_empty();
-        let (v, d) = self.starts.walk(&yw, |v| {
-            if let Some(r) = self.walk_coords.get(v as usize) {
-                prefetch_line(r);
-                if fine {
-                    prefetch_line(&self.verts[v as usize].t);
-                }
-            }
-        });
+        let (v, d) = self.starts.walk(&yw, &self.walk_coords);
         let (v, d) = self.fine_start(&yw, (v, d));
         if d < ws.dist2(&yw) { v } else { start }
     }
@@ -411,7 +404,7 @@ mod tests {
                     *x = if k % 2 == 0 { -3e4 } else { 1e5 };
                 }
             }
-            assert_eq!(g.walk(&q, |_| ()), reference(&q), "vertex {v}");
+            assert_eq!(g.walk(&q, &p.walk_coords), reference(&q), "vertex {v}");
             let [d0, d1, d2] = g.dims;
             let c = g.cell_of(&q).0 as u32;
             let (i, j, k) = (c / (d1 * d2), c / d2 % d1, c % d2);
