@@ -96,6 +96,22 @@ pub mod internal {
         crate::arch::prefetch_lines(r, std::mem::size_of::<T>().min(1024).div_ceil(64));
     }
 
+    /// [`Projector::start_near`] (with `locate`, replacing `starts[k]`) and then
+    /// [`Projector::project_with`] without a hint for up to [`WALK_GROUP`] queries, their
+    /// memory waits overlapped; results pushed to `out` in order, equal to the one-query
+    /// calls'.
+    #[inline]
+    pub fn project_group(
+        proj: &Projector,
+        ys: &[Vec8],
+        starts: &mut [VertexId],
+        locate: bool,
+        goal: crate::SearchGoal,
+        out: &mut Vec<Result<crate::Projection, crate::ProjectError>>,
+    ) {
+        proj.project_group(ys, starts, locate, goal, out);
+    }
+
     /// The faces around vertex `v`, most promising for `y` first.
     #[inline]
     pub fn faces_by_promise(proj: &Projector, y: &Vec8, v: VertexId) -> FaceOrder {

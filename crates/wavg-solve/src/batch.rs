@@ -5,6 +5,7 @@
 
 use wavg_mesh::SurfacePoint;
 use wavg_project::Par;
+use wavg_project::internal::WALK_GROUP;
 
 use crate::aim::CurveAim;
 use crate::error::SolveError;
@@ -106,19 +107,47 @@ impl Solver {
         order.clear();
         order.extend(prepared.iter().enumerate().map(|(i, p)| (p.0, i as u32)));
         par.sort(order)?;
-        // In this order the prepared queries are read at random: each query first waits
-        // for its record, so the record two queries ahead is requested early.
-        const AHEAD: usize = 2;
-        par.map_range(order.len(), SEARCH_CHUNK, done, |k| {
-            if let Some(&(_, j)) = order.get(k + AHEAD) {
-                wavg_project::internal::prefetch(&prepared[j as usize]);
+        done.clear();
+        // Groups of sorted queries whose searches can interleave (see
+        // `Solver::group_goal`) run together; the others one at a time.
+        par.map_chunks(order, SEARCH_CHUNK, done, |chunk| {
+            let mut out = Vec::with_capacity(chunk.len());
+            let mut found = Vec::with_capacity(WALK_GROUP);
+            let mut group: Vec<&Prepared> = Vec::with_capacity(WALK_GROUP);
+            let groups: Vec<&[(u64, u32)]> = chunk.chunks(WALK_GROUP).collect();
+            for (g, ids) in groups.iter().enumerate() {
+                // The prepared queries are read at random in this order: the next group's
+                // records are requested while this group runs.
+                for &(_, j) in groups.get(g + 1).copied().unwrap_or(&[]) {
+                    wavg_project::internal::prefetch(&prepared[j as usize]);
+                }
+                let goal = |i: u32| match &prepared[i as usize].1 {
+                    Ok(p) => Self::group_goal(p, opts),
+                    Err(_) => None,
+                };
+                group.clear();
+                found.clear();
+                if let Some(g) =
+                    goal(ids[0].1).filter(|&g| ids.iter().all(|&(_, i)| goal(i) == Some(g)))
+                {
+                    group.extend(
+                        ids.iter()
+                            .filter_map(|&(_, i)| prepared[i as usize].1.as_ref().ok()),
+                    );
+                    self.forward_group(&group, g, &mut found);
+                } else {
+                    found.extend(ids.iter().map(|&(_, i)| match &prepared[i as usize].1 {
+                        Ok(p) => self.forward_prepared(p, opts),
+                        Err(e) => Err(e.clone()),
+                    }));
+                }
+                out.extend(
+                    ids.iter()
+                        .zip(found.drain(..))
+                        .map(|(&(_, i), r)| f(i as usize, r)),
+                );
             }
-            let i = order[k].1 as usize;
-            let r = match &prepared[i].1 {
-                Ok(p) => self.forward_prepared(p, opts),
-                Err(e) => Err(e.clone()),
-            };
-            f(i, r)
+            out
         })?;
         // Back in input order: one gather, no intermediate lists.
         pos.clear();

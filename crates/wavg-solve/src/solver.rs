@@ -356,7 +356,6 @@ impl Solver {
             hint,
             aim,
         } = *prepared;
-        let mesh = self.mesh();
         if let Start::HighestWeight { anchor, vertex } = start {
             // Here rather than in `prepare`: batches search in spatial order, so the
             // lookups of nearby queries share cached data.
@@ -377,6 +376,79 @@ impl Solver {
                 _ => self.projector.project(&ybar, v),
             },
         };
+        self.forward_result(proj, start)
+    }
+
+    /// The goal of a prepared query's search when it can run in a group of
+    /// [`wavg_project::internal::project_group`] (a cold start and no hint: the start
+    /// lookup, the walk and the local search from its anchor's vertex), else `None`.
+    pub(crate) fn group_goal(prepared: &Prepared, opts: &ForwardOptions) -> Option<SearchGoal> {
+        match (prepared.start, prepared.hint, opts.mode) {
+            (Start::HighestWeight { .. }, None, SearchMode::Fast) => Some(SearchGoal::FirstHit),
+            (Start::HighestWeight { .. }, None, SearchMode::Certified) => Some(SearchGoal::Closest),
+            _ => None,
+        }
+    }
+
+    /// [`Solver::forward_prepared`] for up to `WALK_GROUP` prepared queries that all have
+    /// the [`Solver::group_goal`] `goal`, their memory waits overlapped (the same results);
+    /// pushed to `out` in order.
+    pub(crate) fn forward_group(
+        &self,
+        group: &[&Prepared],
+        goal: SearchGoal,
+        out: &mut Vec<Result<ForwardResult, SolveError>>,
+    ) {
+        use wavg_project::internal::{WALK_GROUP, project_group};
+        let m = group.len().min(WALK_GROUP);
+        let mut ys = [Vec8::zeros(); WALK_GROUP];
+        let mut starts = [0 as VertexId; WALK_GROUP];
+        let mut anchors = [(0usize, 0 as VertexId); WALK_GROUP];
+        for (k, p) in group[..m].iter().enumerate() {
+            ys[k] = p.ybar;
+            if let Start::HighestWeight { anchor, vertex } = p.start {
+                (starts[k], anchors[k]) = (vertex, (anchor, vertex));
+            }
+        }
+        let mut found = Vec::with_capacity(m);
+        project_group(
+            &self.projector,
+            &ys[..m],
+            &mut starts[..m],
+            true,
+            goal,
+            &mut found,
+        );
+        // The answers' corner positions, requested before any is read.
+        for p in found.iter().flatten() {
+            let c = self.projector.face_corners(p.point.face);
+            for v in c {
+                if let Some(x) = self.mesh().positions.get(v as usize) {
+                    wavg_project::internal::prefetch(x);
+                }
+            }
+        }
+        for (k, proj) in found.into_iter().enumerate() {
+            let (anchor, vertex) = anchors[k];
+            let start = if starts[k] == vertex {
+                Start::HighestWeight { anchor, vertex }
+            } else {
+                Start::Located {
+                    anchor,
+                    vertex: starts[k],
+                }
+            };
+            out.push(self.forward_result(proj, start));
+        }
+    }
+
+    /// A forward answer from the projection of the average, searched from `start`.
+    fn forward_result(
+        &self,
+        proj: Result<wavg_project::Projection, ProjectError>,
+        start: Start,
+    ) -> Result<ForwardResult, SolveError> {
+        let mesh = self.mesh();
         let p = proj.map_err(|e| match e {
             ProjectError::NoProjection => SolveError::NoWeightedAverage,
             e => SolveError::Project(e),

@@ -87,34 +87,114 @@ impl Projector {
         // Per group, fixed-size buffers (no allocation per group).
         let mut yc = [Vec8::zeros(); WALK_GROUP];
         let mut sc = [0 as VertexId; WALK_GROUP];
-        let mut ends = [0 as VertexId; WALK_GROUP];
         for group in order.chunks(WALK_GROUP) {
             let m = group.len();
             for (k, &(_, i)) in group.iter().enumerate() {
                 (yc[k], sc[k]) = (ys[i as usize], starts[i as usize]);
             }
-            let (yc, sc, ends) = (&yc[..m], &sc[..m], &mut ends[..m]);
-            let valid = yc.iter().all(|y| y.iter().all(|v| v.is_finite()))
-                && sc.iter().all(|&s| (s as usize) < self.verts.len());
-            if !valid {
-                // The per-query path reports each error.
-                out.extend((0..m).map(|k| self.project(&yc[k], sc[k])));
-                continue;
-            }
-            self.walk_group(yc, sc, ends);
-            // Every candidate order first (each requests its first face's data), then the
-            // solves, so those requests overlap.
-            let cands: [FaceOrder; WALK_GROUP] = std::array::from_fn(|k| {
-                if k < m {
-                    self.order_faces(&yc[k], ends[k], &self.ring_dists(&yc[k], ends[k]))
-                } else {
-                    FaceOrder::EMPTY
-                }
-            });
-            out.extend(
-                (0..m).map(|k| self.search_from(&yc[k], ends[k], &cands[k], SearchGoal::Closest)),
-            );
+            self.project_group(&yc[..m], &mut sc[..m], false, SearchGoal::Closest, &mut out);
         }
         out
+    }
+
+    /// [`Projector::project_with`] without a hint for up to [`WALK_GROUP`] queries `ys`
+    /// from `starts`, their memory waits overlapped: with `locate`, first each start
+    /// becomes its [`Projector::start_near`] vertex (in place); then the greedy walks
+    /// advance in turn, each step requesting the records the next step reads; then the
+    /// first candidate face of every query is requested before any is solved. Pushes the
+    /// results to `out`, in order; they and the starts equal the one-query calls'.
+    pub(crate) fn project_group(
+        &self,
+        ys: &[Vec8],
+        starts: &mut [VertexId],
+        locate: bool,
+        goal: SearchGoal,
+        out: &mut Vec<Result<Projection, ProjectError>>,
+    ) {
+        let m = ys.len().min(starts.len()).min(WALK_GROUP);
+        let (ys, starts) = (&ys[..m], &mut starts[..m]);
+        let valid = ys.iter().all(|y| y.iter().all(|v| v.is_finite()))
+            && starts.iter().all(|&s| (s as usize) < self.verts.len());
+        if !valid {
+            // The per-query path reports each error.
+            for (y, s) in ys.iter().zip(starts) {
+                if locate {
+                    *s = self.start_near(y, *s);
+                }
+                out.push(self.project_with(y, *s, None, goal));
+            }
+            return;
+        }
+        if locate {
+            self.starts_near_group(ys, starts);
+        }
+        let mut ends = [0 as VertexId; WALK_GROUP];
+        let ends = &mut ends[..m];
+        self.walk_group(ys, starts, ends);
+        // Every candidate order first (each requests its first face's data), then the
+        // solves, so those requests overlap.
+        let cands: [FaceOrder; WALK_GROUP] = std::array::from_fn(|k| {
+            if k < m {
+                self.order_faces(&ys[k], ends[k], &self.ring_dists(&ys[k], ends[k]))
+            } else {
+                FaceOrder::EMPTY
+            }
+        });
+        out.extend((0..m).map(|k| self.search_from(&ys[k], ends[k], &cands[k], goal)));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wavg_mesh::{ValidMesh, procedural};
+
+    /// Groups (full, short, and holding a bad query) give the starts and projections of
+    /// [`Projector::start_near`] and [`Projector::project_with`] one query at a time, for
+    /// both goals, on a grid capped so that the fine cells take part.
+    #[test]
+    fn groups_equal_one_query_at_a_time() {
+        let m = ValidMesh::new(procedural::with_noise(procedural::icosphere(5), 0.005, 2));
+        let emb = Arc::new(EmbeddedMesh::from_positions(Arc::new(m.unwrap())));
+        let mut p = Projector::new(emb.clone()).unwrap();
+        p.starts = StartGrid::with_max_cells(&p.walk_coords, 4);
+        assert!(!p.starts.fine.is_empty());
+        let x = emb.coords();
+        let n = x.len() as VertexId;
+        let mut ys: Vec<Vec8> = (0..61)
+            .map(|k| x[(k * 167) % x.len()] * [1.0, 1.08, 0.93, 1.4][k % 4])
+            .collect();
+        let mut starts: Vec<VertexId> = (0..61).map(|k| (k as VertexId * 7919) % n).collect();
+        ys[20][3] = f64::NAN;
+        starts[29] = n + 5;
+        let (mut moved, mut fine_moved) = (0, 0);
+        for goal in [SearchGoal::FirstHit, SearchGoal::Closest] {
+            for locate in [true, false] {
+                let mut got = Vec::new();
+                let mut s = starts.clone();
+                for (ys, s) in ys.chunks(WALK_GROUP).zip(s.chunks_mut(WALK_GROUP)) {
+                    p.project_group(ys, s, locate, goal, &mut got);
+                }
+                assert_eq!(got.len(), ys.len());
+                for k in 0..ys.len() {
+                    let s0 = if locate {
+                        p.start_near(&ys[k], starts[k])
+                    } else {
+                        starts[k]
+                    };
+                    assert_eq!(s[k], s0, "query {k}: start");
+                    assert_eq!(got[k], p.project_with(&ys[k], s0, None, goal), "query {k}");
+                    moved += usize::from(s0 != starts[k]);
+                    let yw = p.walk_point(&ys[k]);
+                    let coarse = p.starts.walk(&yw, &p.walk_coords).0;
+                    fine_moved += usize::from(locate && s0 != starts[k] && s0 != coarse);
+                }
+                assert!(got[20].is_err() && got[29].is_err());
+            }
+        }
+        assert!(
+            moved > 40 && fine_moved > 20,
+            "{moved} starts moved, {fine_moved} by the fine cells"
+        );
     }
 }

@@ -133,6 +133,17 @@ impl FineCells {
         }
     }
 
+    /// Starts loading the slot where [`FineCells::vertex_at`]'s probe for `p` begins (for
+    /// interleaved lookups); no effect on results.
+    #[inline]
+    pub(super) fn prefetch(&self, p: &[f32; 8]) {
+        if let Some((key, _)) = self.key_of(p) {
+            if let Some(slot) = self.slots.get(self.home(key)) {
+                super::prefetch_line(slot);
+            }
+        }
+    }
+
     /// Whether the table holds any cell.
     #[inline]
     pub(super) fn is_empty(&self) -> bool {

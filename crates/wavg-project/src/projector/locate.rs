@@ -64,7 +64,7 @@ impl StartGrid {
     }
 
     /// [`StartGrid::new`] with at most `max_cells` cells along an axis.
-    fn with_max_cells(walk: &[WalkPoint], max_cells: u32) -> Self {
+    pub(super) fn with_max_cells(walk: &[WalkPoint], max_cells: u32) -> Self {
         let (lo, hi) = walk
             .par_iter()
             .with_min_len(4096)
@@ -320,24 +320,81 @@ impl Projector {
     /// distance), else `best`.
     #[inline]
     fn fine_start(&self, yw: &[f32; 8], best: (VertexId, f32)) -> (VertexId, f32) {
-        let fine = &self.starts.fine;
-        if fine.is_empty() {
+        if self.starts.fine.is_empty() {
             return best;
         }
-        let (v, d) = best;
+        let foot = self.foot(yw, best.0);
+        self.closer_start(yw, best, self.starts.fine.vertex_at(&foot))
+    }
+
+    /// The foot of walk point `yw` on the tangent plane of vertex `v` (walk units).
+    #[inline]
+    fn foot(&self, yw: &[f32; 8], v: VertexId) -> [f32; 8] {
         let x = self.walk_coords[v as usize].unpack();
         let t = &self.verts[v as usize].t;
         let r: [f32; 8] = std::array::from_fn(|k| yw[k] - x[k]);
         let t0: &[f32; 8] = t[..8].try_into().unwrap();
         let t1: &[f32; 8] = t[8..].try_into().unwrap();
         let (a, b) = (super::layout::wdot(t0, &r), super::layout::wdot(t1, &r));
-        let foot: [f32; 8] = std::array::from_fn(|k| x[k] + a * t0[k] + b * t1[k]);
-        match fine.vertex_at(&foot) {
-            Some(u) if u != v => {
+        std::array::from_fn(|k| x[k] + a * t0[k] + b * t1[k])
+    }
+
+    /// `candidate` (a fine cell's vertex) if it is closer to `yw` than `best`, else `best`.
+    #[inline]
+    fn closer_start(
+        &self,
+        yw: &[f32; 8],
+        best: (VertexId, f32),
+        candidate: Option<VertexId>,
+    ) -> (VertexId, f32) {
+        match candidate {
+            Some(u) if u != best.0 => {
                 let du = self.walk_coords[u as usize].dist2(yw);
-                if du < d { (u, du) } else { best }
+                if du < best.1 { (u, du) } else { best }
             }
             _ => best,
+        }
+    }
+
+    /// [`Projector::start_near`] for each query `ys[k]` from `starts[k]`, in place, the
+    /// queries' lookups interleaved stage by stage (each stage requests what the next one
+    /// reads, so the queries' memory waits overlap); the same starts as one at a time.
+    /// Every start must be in range and every query finite.
+    pub(super) fn starts_near_group(&self, ys: &[Vec8], starts: &mut [VertexId]) {
+        let m = starts.len();
+        let fine = &self.starts.fine;
+        let mut yw = [[0.0f32; 8]; WALK_GROUP];
+        let mut best = [(0 as VertexId, 0.0f32); WALK_GROUP];
+        for k in 0..m {
+            yw[k] = self.walk_point(&ys[k]);
+            prefetch_line(&self.walk_coords[starts[k] as usize]);
+            best[k] = self.starts.walk(&yw[k], &self.walk_coords);
+            if !fine.is_empty() {
+                prefetch(&self.verts[best[k].0 as usize]);
+            }
+        }
+        if !fine.is_empty() {
+            let mut foot = [[0.0f32; 8]; WALK_GROUP];
+            for k in 0..m {
+                foot[k] = self.foot(&yw[k], best[k].0);
+                fine.prefetch(&foot[k]);
+            }
+            let mut cand = [None; WALK_GROUP];
+            for k in 0..m {
+                cand[k] = fine.vertex_at(&foot[k]);
+                if let Some(u) = cand[k] {
+                    prefetch_line(&self.walk_coords[u as usize]);
+                }
+            }
+            for k in 0..m {
+                best[k] = self.closer_start(&yw[k], best[k], cand[k]);
+            }
+        }
+        for k in 0..m {
+            let (v, d) = best[k];
+            if d < self.walk_coords[starts[k] as usize].dist2(&yw[k]) {
+                starts[k] = v;
+            }
         }
     }
 }

@@ -312,6 +312,16 @@ fn batches_equal_sequential_for_any_thread_count() {
             );
         });
     }
+    // Every search mode, and a warm start shared by the whole batch.
+    let warm = ForwardOptions::default().warm(pts[0]);
+    for o in [SearchMode::Certified, SearchMode::Exact]
+        .map(|mode| ForwardOptions { mode, ..opts })
+        .into_iter()
+        .chain([warm])
+    {
+        let seq: Vec<_> = weights.iter().map(|w| s.forward(w, &o)).collect();
+        assert_eq!(s.forward_batch(&weights, &o), seq, "{o:?}");
+    }
     // The explicit layer: every parallelism, buffers reused from one call to the next.
     let mut scratch = ForwardScratch::default();
     let (mut fb, mut warm, mut bw) = (Vec::new(), Vec::new(), BatchWeights::default());
