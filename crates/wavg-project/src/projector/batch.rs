@@ -1,6 +1,7 @@
 //! Batches of projections: queries sorted in Morton order so nearby ones run together,
 //! their greedy walks interleaved in groups, chunks of the sorted queries in parallel.
 
+use super::search::{Exit, FaceSet, Resume};
 use super::*;
 use crate::Par;
 
@@ -140,7 +141,90 @@ impl Projector {
                 FaceOrder::EMPTY
             }
         });
-        out.extend((0..m).map(|k| self.search_from(&ys[k], ends[k], &cands[k], goal)));
+        if goal == SearchGoal::FirstHit {
+            self.first_hits_group(ys, ends, &cands[..m], out);
+        } else {
+            out.extend((0..m).map(|k| self.search_from(&ys[k], ends[k], &cands[k], goal)));
+        }
+    }
+
+    /// The first-hit searches of a group from the walks' ends `ends` (candidates
+    /// `cands`): the walks over faces from each query's first candidate (Newton's exits)
+    /// advance in turn, each step requesting what the query's next step reads (a face's
+    /// record, then its corners'), so the queries' waits overlap; a search whose walk
+    /// ends without a projection goes on alone where [`Projector::search_from`] would.
+    fn first_hits_group(
+        &self,
+        ys: &[Vec8],
+        ends: &[VertexId],
+        cands: &[FaceOrder],
+        out: &mut Vec<Result<Projection, ProjectError>>,
+    ) {
+        let m = cands.len();
+        let adjacency = self.emb.mesh().topology().adjacency();
+        let mut tried: [FaceSet; WALK_GROUP] = std::array::from_fn(|_| FaceSet::new());
+        let mut found: [Option<Best>; WALK_GROUP] = [None; WALK_GROUP];
+        // The face each walk tries next (NONE once it is over), and whether its corners
+        // were requested (its record in hand: the candidates' by `order_faces`).
+        let mut cur = [NONE; WALK_GROUP];
+        let mut ready = [true; WALK_GROUP];
+        let mut left = 0;
+        for k in 0..m {
+            if let Some(&f) = cands[k].as_slice().first() {
+                cur[k] = f;
+                left += 1;
+            }
+        }
+        while left > 0 {
+            for k in 0..m {
+                let f = cur[k];
+                if f == NONE {
+                    continue;
+                }
+                if !ready[k] {
+                    for v in self.faces[f as usize].v {
+                        prefetch(&self.verts[v as usize]);
+                    }
+                    prefetch_line(&adjacency[f as usize]);
+                    ready[k] = true;
+                    continue;
+                }
+                match self.exit_step(&ys[k], f, &mut tried[k]) {
+                    Exit::Found(b) => {
+                        found[k] = Some(b);
+                        cur[k] = NONE;
+                        left -= 1;
+                    }
+                    Exit::Next(g) if !tried[k].contains(g) && !tried[k].full() => {
+                        cur[k] = g;
+                        ready[k] = false;
+                        prefetch(&self.faces[g as usize]);
+                    }
+                    _ => {
+                        cur[k] = NONE;
+                        left -= 1;
+                    }
+                }
+            }
+        }
+        for (k, tried) in tried.into_iter().take(m).enumerate() {
+            out.push(match found[k] {
+                Some(b) => Ok(Self::finish(b, ProjectionPath::Local)),
+                // The walk from the first candidate is over: the second is next.
+                None if cands[k].n > 0 => self.search_resumed(
+                    &ys[k],
+                    ends[k],
+                    &cands[k],
+                    SearchGoal::FirstHit,
+                    tried,
+                    Resume {
+                        index: 1,
+                        face: None,
+                    },
+                ),
+                None => self.search_from(&ys[k], ends[k], &cands[k], SearchGoal::FirstHit),
+            });
+        }
     }
 }
 
@@ -149,9 +233,67 @@ mod tests {
     use super::*;
     use wavg_mesh::{ValidMesh, procedural};
 
+    /// Runs `ys` from `starts` in groups, with and without the start lookup, for both
+    /// goals, against [`Projector::start_near`] and [`Projector::project_with`] one query
+    /// at a time. Returns how many starts the lookup moved, how many of those the fine
+    /// cells moved, and how many first-hit searches another candidate of the first ring
+    /// answered after the first candidate's walk over faces ended without a projection.
+    fn check_groups(p: &Projector, ys: &[Vec8], starts: &[VertexId]) -> [usize; 3] {
+        let mut counts = [0; 3];
+        for goal in [SearchGoal::FirstHit, SearchGoal::Closest] {
+            for locate in [true, false] {
+                let mut got = Vec::new();
+                let mut s = starts.to_vec();
+                for (ys, s) in ys.chunks(WALK_GROUP).zip(s.chunks_mut(WALK_GROUP)) {
+                    p.project_group(ys, s, locate, goal, &mut got);
+                }
+                assert_eq!(got.len(), ys.len());
+                for k in 0..ys.len() {
+                    let s0 = if locate {
+                        p.start_near(&ys[k], starts[k])
+                    } else {
+                        starts[k]
+                    };
+                    assert_eq!(s[k], s0, "query {k}: start");
+                    assert_eq!(got[k], p.project_with(&ys[k], s0, None, goal), "query {k}");
+                    if !(locate && goal == SearchGoal::FirstHit) || !ys[k][0].is_finite() {
+                        continue;
+                    }
+                    let yw = p.walk_point(&ys[k]);
+                    counts[0] += usize::from(s0 != starts[k]);
+                    counts[1] += usize::from(s0 != p.starts.walk(&yw, &p.walk_coords).0);
+                    let Some(s0) = p.walk_coords.get(s0 as usize).map(|_| s0) else {
+                        continue;
+                    };
+                    let end = p.walk(&ys[k], s0);
+                    let cands = p.order_faces(&ys[k], end, &p.ring_dists(&ys[k], end));
+                    let mut tried = FaceSet::new();
+                    let mut cur = cands.as_slice()[0];
+                    loop {
+                        match p.exit_step(&ys[k], cur, &mut tried) {
+                            Exit::Next(g) if !tried.contains(g) => cur = g,
+                            Exit::Found(_) => break,
+                            _ => {
+                                // Whether a later candidate of the first ring answers.
+                                let on = |index| {
+                                    let r = Resume { index, face: None };
+                                    let t = tried.clone();
+                                    p.search_resumed(&ys[k], end, &cands, goal, t, r)
+                                };
+                                counts[2] += usize::from(on(1) != on(64));
+                                break;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        counts
+    }
+
     /// Groups (full, short, and holding a bad query) give the starts and projections of
-    /// [`Projector::start_near`] and [`Projector::project_with`] one query at a time, for
-    /// both goals, on a grid capped so that the fine cells take part.
+    /// one query at a time: on a sphere whose start grid is capped (so the fine cells take
+    /// part) and on a coarse, very noisy sphere with queries far inside and outside it.
     #[test]
     fn groups_equal_one_query_at_a_time() {
         let m = ValidMesh::new(procedural::with_noise(procedural::icosphere(5), 0.005, 2));
@@ -167,34 +309,28 @@ mod tests {
         let mut starts: Vec<VertexId> = (0..61).map(|k| (k as VertexId * 7919) % n).collect();
         ys[20][3] = f64::NAN;
         starts[29] = n + 5;
-        let (mut moved, mut fine_moved) = (0, 0);
-        for goal in [SearchGoal::FirstHit, SearchGoal::Closest] {
-            for locate in [true, false] {
-                let mut got = Vec::new();
-                let mut s = starts.clone();
-                for (ys, s) in ys.chunks(WALK_GROUP).zip(s.chunks_mut(WALK_GROUP)) {
-                    p.project_group(ys, s, locate, goal, &mut got);
-                }
-                assert_eq!(got.len(), ys.len());
-                for k in 0..ys.len() {
-                    let s0 = if locate {
-                        p.start_near(&ys[k], starts[k])
-                    } else {
-                        starts[k]
-                    };
-                    assert_eq!(s[k], s0, "query {k}: start");
-                    assert_eq!(got[k], p.project_with(&ys[k], s0, None, goal), "query {k}");
-                    moved += usize::from(s0 != starts[k]);
-                    let yw = p.walk_point(&ys[k]);
-                    let coarse = p.starts.walk(&yw, &p.walk_coords).0;
-                    fine_moved += usize::from(locate && s0 != starts[k] && s0 != coarse);
-                }
-                assert!(got[20].is_err() && got[29].is_err());
-            }
-        }
+        let [moved, fine_moved, _] = check_groups(&p, &ys, &starts);
         assert!(
             moved > 40 && fine_moved > 20,
             "{moved} starts moved, {fine_moved} by the fine cells"
         );
+
+        // Coarse and very noisy: the first candidate's walk over faces sometimes ends
+        // without a projection where another candidate of the ring holds one.
+        let m = ValidMesh::new(procedural::with_noise(procedural::icosphere(2), 0.15, 2));
+        let emb = Arc::new(EmbeddedMesh::from_positions(Arc::new(m.unwrap())));
+        let p = Projector::new(emb.clone()).unwrap();
+        let (nf, nv) = (emb.mesh().n_faces(), emb.coords().len());
+        let ys: Vec<Vec8> = (0..2400)
+            .map(|k| {
+                let a = (k * 7 % 10) as f64 * 0.09;
+                let b = (k * 3 % 11) as f64 / 110.0;
+                let on = SurfacePoint::new((k * 37 % nf) as FaceId, [a, b, 1.0 - a - b]);
+                emb.point(&on) * [1.3, 0.2, 2.0, 0.8, 1.1][k % 5]
+            })
+            .collect();
+        let starts: Vec<VertexId> = (0..2400).map(|k| (k * 131 % nv) as VertexId).collect();
+        let [.., resumed] = check_groups(&p, &ys, &starts);
+        assert!(resumed >= 3, "{resumed} first-hit searches went on");
     }
 }

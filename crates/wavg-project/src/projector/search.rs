@@ -47,6 +47,7 @@ pub enum SearchGoal {
 }
 
 /// Fixed-capacity set of face ids (no allocation per query).
+#[derive(Clone)]
 pub(super) struct FaceSet {
     ids: [FaceId; LOCAL_BUDGET],
     n: usize,
@@ -68,7 +69,7 @@ impl FaceSet {
         self.n == LOCAL_BUDGET
     }
     #[inline]
-    fn push(&mut self, f: FaceId) {
+    pub(super) fn push(&mut self, f: FaceId) {
         self.ids[self.n] = f;
         self.n += 1;
     }
@@ -117,7 +118,40 @@ const THIN_PART: f64 = 0.2;
 /// Faces the closest goal's point-location walk may step through.
 const LOCATE_STEPS: usize = 8;
 
+/// Where the first-hit search's walk over faces goes after trying one face.
+pub(super) enum Exit {
+    /// The face holds a valid projection.
+    Found(Best),
+    /// Newton's method left the face across an edge, into this face.
+    Next(FaceId),
+    /// Newton's method failed otherwise, or left across a boundary edge.
+    Stop,
+}
+
+/// Where [`Projector::local_search`] takes up a first-hit search that was begun elsewhere
+/// (the faces tried so far in its `tried`): at candidate `index` of the first ring, whose
+/// walk over faces stands at `face` (`None`: at the candidate itself).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Resume {
+    pub(super) index: usize,
+    pub(super) face: Option<FaceId>,
+}
+
 impl Projector {
+    /// Tries face `cur` for the first hit, recording it in `tried` (which must have room).
+    #[inline]
+    pub(super) fn exit_step(&self, y: &Vec8, cur: FaceId, tried: &mut FaceSet) -> Exit {
+        tried.push(cur);
+        match self.try_face_or_exit(cur, y) {
+            Ok(b) => Exit::Found(b),
+            Err(Some(k)) => match self.emb.mesh().topology().face_neighbors(cur)[(k + 1) % 3] {
+                NONE => Exit::Stop,
+                g => Exit::Next(g),
+            },
+            Err(None) => Exit::Stop,
+        }
+    }
+
     /// The local search from the walk's end `v`, the faces around it in the order `cands`
     /// first. For [`SearchGoal::FirstHit`], the first valid projection; for
     /// [`SearchGoal::Closest`], the closest one in the first ring of faces (around `v`,
@@ -131,9 +165,11 @@ impl Projector {
         cands: &FaceOrder,
         goal: SearchGoal,
         tried: &mut FaceSet,
+        resume: Resume,
     ) -> Option<Best> {
         let topo = self.emb.mesh().topology();
         let first_hit = goal == SearchGoal::FirstHit;
+        let mut resume = first_hit.then_some(resume);
         let mut seen = FaceSet::new();
         let mut order = [(0.0f32, 0 as FaceId); LOCAL_BUDGET];
         // First ring: the candidates in order, then any faces beyond the 64 they cover.
@@ -159,20 +195,18 @@ impl Projector {
             }
         }
         loop {
-            for &(_, f) in &order[..level.len()] {
+            // A resumed search skips the first ring's candidates already walked from.
+            let r = resume.take().unwrap_or_default();
+            for (i, &(_, f)) in order[..level.len()].iter().enumerate().skip(r.index) {
                 if first_hit {
                     // Newton's exits lead on to the face beyond (a short walk over faces
                     // towards the projection), then the ring's order resumes.
-                    let mut cur = f;
+                    let mut cur = if i == r.index { r.face.unwrap_or(f) } else { f };
                     while !tried.contains(cur) && !tried.full() {
-                        tried.push(cur);
-                        match self.try_face_or_exit(cur, y) {
-                            Ok(b) => return Some(b),
-                            Err(Some(k)) => cur = topo.face_neighbors(cur)[(k + 1) % 3],
-                            Err(None) => break,
-                        }
-                        if cur == NONE {
-                            break;
+                        match self.exit_step(y, cur, tried) {
+                            Exit::Found(b) => return Some(b),
+                            Exit::Next(g) => cur = g,
+                            Exit::Stop => break,
                         }
                     }
                 } else if !tried.contains(f) && !tried.full() {
@@ -272,8 +306,21 @@ impl Projector {
         cands: &FaceOrder,
         goal: SearchGoal,
     ) -> Result<Projection, ProjectError> {
-        let mut tried = FaceSet::new();
-        let local = self.local_search(y, v, cands, goal, &mut tried);
+        self.search_resumed(y, v, cands, goal, FaceSet::new(), Resume::default())
+    }
+
+    /// [`Projector::search_from`] taking up a first-hit search begun elsewhere, which
+    /// tried the faces in `tried` and stands at `resume`.
+    pub(super) fn search_resumed(
+        &self,
+        y: &Vec8,
+        v: VertexId,
+        cands: &FaceOrder,
+        goal: SearchGoal,
+        mut tried: FaceSet,
+        resume: Resume,
+    ) -> Result<Projection, ProjectError> {
+        let local = self.local_search(y, v, cands, goal, &mut tried, resume);
         let global = |y: &Vec8| {
             self.exhaustive(y)
                 .map(|b| Self::finish(b, ProjectionPath::Fallback))
@@ -317,7 +364,14 @@ impl Projector {
         }
         let cands = self.faces_by_promise(y, u);
         let mut tried = FaceSet::new();
-        let b = self.local_search(y, u, &cands, SearchGoal::Closest, &mut tried)?;
+        let b = self.local_search(
+            y,
+            u,
+            &cands,
+            SearchGoal::Closest,
+            &mut tried,
+            Resume::default(),
+        )?;
         (b.d2 < local.d2).then_some((b, u, tried))
     }
 
@@ -342,7 +396,7 @@ impl Projector {
         }
         let cands = self.faces_by_promise(y, u);
         let mut tried = FaceSet::new();
-        self.local_search(y, u, &cands, goal, &mut tried)
+        self.local_search(y, u, &cands, goal, &mut tried, Resume::default())
             .map(|b| (b, u, tried))
     }
 
