@@ -256,7 +256,10 @@ mod tests {
                     };
                     assert_eq!(s[k], s0, "query {k}: start");
                     assert_eq!(got[k], p.project_with(&ys[k], s0, None, goal), "query {k}");
-                    if !(locate && goal == SearchGoal::FirstHit) || !ys[k][0].is_finite() {
+                    if !(locate
+                        && goal == SearchGoal::FirstHit
+                        && ys[k].iter().all(|v| v.is_finite()))
+                    {
                         continue;
                     }
                     let yw = p.walk_point(&ys[k]);
