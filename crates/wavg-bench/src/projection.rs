@@ -8,7 +8,7 @@
 //! within [`SAME_POINT`] mean edge lengths on a face sharing a vertex). Times are the
 //! calling thread's CPU time per query (wall time without a clock), best of [`REPEATS`]
 //! passes, as the machine may be shared; the queries go through
-//! [`Projector::project_batch_into`] on one thread, which interleaves the walks of 8
+//! [`Projector::project_batch_into`] on one thread, which interleaves the walks of 16
 //! queries, and once more through one [`Projector::project`] call at a time, whose
 //! answers must be the same. (b) The same with the points offset from the surface by 0.1
 //! mean edge length along the 3-D face normal (or a seeded random direction of R^8

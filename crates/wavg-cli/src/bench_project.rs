@@ -23,7 +23,7 @@ global search (Projector::project_exhaustive) on those queries (null when none n
 --json prints exactly those keys plus mesh, vertices, faces, queries.
 
 Times are the calling thread's CPU time per query, best of three passes, on one thread
-through Projector::project_batch (queries visited in spatial order, the greedy walks of 8
+through Projector::project_batch (queries visited in spatial order, the greedy walks of 16
 queries interleaved; the answers equal one Projector::project call per query, which is
 checked). The table also shows the time of one project call at a time.")]
 pub struct Args {

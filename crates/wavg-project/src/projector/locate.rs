@@ -370,7 +370,8 @@ impl Projector {
             prefetch_line(&self.walk_coords[starts[k] as usize]);
             best[k] = self.starts.walk(&yw[k], &self.walk_coords);
             if !fine.is_empty() {
-                prefetch(&self.verts[best[k].0 as usize]);
+                // The foot reads the vertex's frame (its record's second line).
+                prefetch_line(&self.verts[best[k].0 as usize].t);
             }
         }
         if !fine.is_empty() {
