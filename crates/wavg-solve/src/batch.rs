@@ -46,7 +46,7 @@ impl Solver {
     /// [`Solver::forward_batch`] into `out`, with explicit buffers and parallelism. The
     /// weight rows are read once, in input order, into their averages; the searches then
     /// run in the Morton order of the averages (nearby queries together, so they share
-    /// cached mesh data). Each still starts where [`Solver::forward`] would (its
+    /// cached mesh data), cold starts in groups whose cache misses overlap. Each still starts where [`Solver::forward`] would (its
     /// highest-weight anchor, a vertex near its average or its warm start), so the results equal [`Solver::forward`]'s for any `par`. Fails only when
     /// `par`'s threads cannot start.
     pub fn forward_batch_into<W: AsRef<[f64]> + Sync>(
@@ -114,11 +114,10 @@ impl Solver {
             let mut out = Vec::with_capacity(chunk.len());
             let mut found = Vec::with_capacity(WALK_GROUP);
             let mut group: Vec<&Prepared> = Vec::with_capacity(WALK_GROUP);
-            let groups: Vec<&[(u64, u32)]> = chunk.chunks(WALK_GROUP).collect();
-            for (g, ids) in groups.iter().enumerate() {
+            for (g, ids) in chunk.chunks(WALK_GROUP).enumerate() {
                 // The prepared queries are read at random in this order: the next group's
                 // records are requested while this group runs.
-                for &(_, j) in groups.get(g + 1).copied().unwrap_or(&[]) {
+                for &(_, j) in chunk.iter().skip((g + 1) * WALK_GROUP).take(WALK_GROUP) {
                     wavg_project::internal::prefetch(&prepared[j as usize]);
                 }
                 let goal = |i: u32| match &prepared[i as usize].1 {

@@ -1,7 +1,7 @@
 //! Batches of projections: queries sorted in Morton order so nearby ones run together,
 //! their greedy walks interleaved in groups, chunks of the sorted queries in parallel.
 
-use super::search::{Exit, FaceSet, Resume};
+use super::search::{Exit, FaceSet};
 use super::*;
 use crate::Par;
 
@@ -211,17 +211,9 @@ impl Projector {
             out.push(match found[k] {
                 Some(b) => Ok(Self::finish(b, ProjectionPath::Local)),
                 // The walk from the first candidate is over: the second is next.
-                None if cands[k].n > 0 => self.search_resumed(
-                    &ys[k],
-                    ends[k],
-                    &cands[k],
-                    SearchGoal::FirstHit,
-                    tried,
-                    Resume {
-                        index: 1,
-                        face: None,
-                    },
-                ),
+                None if cands[k].n > 0 => {
+                    self.search_resumed(&ys[k], ends[k], &cands[k], SearchGoal::FirstHit, tried, 1)
+                }
                 None => self.search_from(&ys[k], ends[k], &cands[k], SearchGoal::FirstHit),
             });
         }
@@ -265,9 +257,9 @@ mod tests {
                     let yw = p.walk_point(&ys[k]);
                     counts[0] += usize::from(s0 != starts[k]);
                     counts[1] += usize::from(s0 != p.starts.walk(&yw, &p.walk_coords).0);
-                    let Some(s0) = p.walk_coords.get(s0 as usize).map(|_| s0) else {
+                    if s0 as usize >= p.walk_coords.len() {
                         continue;
-                    };
+                    }
                     let end = p.walk(&ys[k], s0);
                     let cands = p.order_faces(&ys[k], end, &p.ring_dists(&ys[k], end));
                     let mut tried = FaceSet::new();
@@ -278,10 +270,9 @@ mod tests {
                             Exit::Found(_) => break,
                             _ => {
                                 // Whether a later candidate of the first ring answers.
-                                let on = |index| {
-                                    let r = Resume { index, face: None };
+                                let on = |skip| {
                                     let t = tried.clone();
-                                    p.search_resumed(&ys[k], end, &cands, goal, t, r)
+                                    p.search_resumed(&ys[k], end, &cands, goal, t, skip)
                                 };
                                 counts[2] += usize::from(on(1) != on(64));
                                 break;

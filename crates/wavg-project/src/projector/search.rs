@@ -128,15 +128,6 @@ pub(super) enum Exit {
     Stop,
 }
 
-/// Where [`Projector::local_search`] takes up a first-hit search that was begun elsewhere
-/// (the faces tried so far in its `tried`): at candidate `index` of the first ring, whose
-/// walk over faces stands at `face` (`None`: at the candidate itself).
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Resume {
-    pub(super) index: usize,
-    pub(super) face: Option<FaceId>,
-}
-
 impl Projector {
     /// Tries face `cur` for the first hit, recording it in `tried` (which must have room).
     #[inline]
@@ -165,11 +156,12 @@ impl Projector {
         cands: &FaceOrder,
         goal: SearchGoal,
         tried: &mut FaceSet,
-        resume: Resume,
+        skip: usize,
     ) -> Option<Best> {
         let topo = self.emb.mesh().topology();
         let first_hit = goal == SearchGoal::FirstHit;
-        let mut resume = first_hit.then_some(resume);
+        // Only the first ring's candidates may be skipped, and only by a first-hit search.
+        let mut skip = if first_hit { skip } else { 0 };
         let mut seen = FaceSet::new();
         let mut order = [(0.0f32, 0 as FaceId); LOCAL_BUDGET];
         // First ring: the candidates in order, then any faces beyond the 64 they cover.
@@ -196,12 +188,11 @@ impl Projector {
         }
         loop {
             // A resumed search skips the first ring's candidates already walked from.
-            let r = resume.take().unwrap_or_default();
-            for (i, &(_, f)) in order[..level.len()].iter().enumerate().skip(r.index) {
+            for &(_, f) in order[..level.len()].iter().skip(std::mem::take(&mut skip)) {
                 if first_hit {
                     // Newton's exits lead on to the face beyond (a short walk over faces
                     // towards the projection), then the ring's order resumes.
-                    let mut cur = if i == r.index { r.face.unwrap_or(f) } else { f };
+                    let mut cur = f;
                     while !tried.contains(cur) && !tried.full() {
                         match self.exit_step(y, cur, tried) {
                             Exit::Found(b) => return Some(b),
@@ -306,11 +297,11 @@ impl Projector {
         cands: &FaceOrder,
         goal: SearchGoal,
     ) -> Result<Projection, ProjectError> {
-        self.search_resumed(y, v, cands, goal, FaceSet::new(), Resume::default())
+        self.search_resumed(y, v, cands, goal, FaceSet::new(), 0)
     }
 
     /// [`Projector::search_from`] taking up a first-hit search begun elsewhere, which
-    /// tried the faces in `tried` and stands at `resume`.
+    /// tried the faces in `tried` and walked from the first `skip` candidates of `cands`.
     pub(super) fn search_resumed(
         &self,
         y: &Vec8,
@@ -318,9 +309,9 @@ impl Projector {
         cands: &FaceOrder,
         goal: SearchGoal,
         mut tried: FaceSet,
-        resume: Resume,
+        skip: usize,
     ) -> Result<Projection, ProjectError> {
-        let local = self.local_search(y, v, cands, goal, &mut tried, resume);
+        let local = self.local_search(y, v, cands, goal, &mut tried, skip);
         let global = |y: &Vec8| {
             self.exhaustive(y)
                 .map(|b| Self::finish(b, ProjectionPath::Fallback))
@@ -364,14 +355,7 @@ impl Projector {
         }
         let cands = self.faces_by_promise(y, u);
         let mut tried = FaceSet::new();
-        let b = self.local_search(
-            y,
-            u,
-            &cands,
-            SearchGoal::Closest,
-            &mut tried,
-            Resume::default(),
-        )?;
+        let b = self.local_search(y, u, &cands, SearchGoal::Closest, &mut tried, 0)?;
         (b.d2 < local.d2).then_some((b, u, tried))
     }
 
@@ -396,7 +380,7 @@ impl Projector {
         }
         let cands = self.faces_by_promise(y, u);
         let mut tried = FaceSet::new();
-        self.local_search(y, u, &cands, goal, &mut tried, Resume::default())
+        self.local_search(y, u, &cands, goal, &mut tried, 0)
             .map(|b| (b, u, tried))
     }
 
