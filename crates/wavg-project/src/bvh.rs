@@ -100,6 +100,22 @@ impl Bvh {
         keep: impl Fn(usize, &[f32; 8], &[f32; 8]) -> bool,
         mut visit: impl FnMut(u32, &mut f64),
     ) {
+        self.search_leaves(y, best, keep, |faces, best| {
+            for &f in faces {
+                visit(f, best);
+            }
+        });
+    }
+
+    /// [`Bvh::search_pruned`] visiting a leaf's faces at once: `visit(faces, best)` (so
+    /// the visitor can request all their data before reading any).
+    pub(crate) fn search_leaves(
+        &self,
+        y: &Vec8,
+        best: &mut f64,
+        keep: impl Fn(usize, &[f32; 8], &[f32; 8]) -> bool,
+        mut visit: impl FnMut(&[u32], &mut f64),
+    ) {
         if self.nodes.is_empty() {
             return;
         }
@@ -118,9 +134,10 @@ impl Bvh {
                 continue;
             }
             if node.n > 0 {
-                for &f in &self.items[node.a as usize..(node.a + node.n) as usize] {
-                    visit(f, best);
-                }
+                visit(
+                    &self.items[node.a as usize..(node.a + node.n) as usize],
+                    best,
+                );
                 continue;
             }
             let (l, r) = (ni + 1, node.a as usize);
@@ -134,8 +151,8 @@ impl Bvh {
             };
             if sp + 2 > STACK {
                 // Cannot happen with median splits; be safe: visit the subtree exhaustively.
-                self.visit_all(first, &mut visit, best);
-                self.visit_all(second, &mut visit, best);
+                self.visit_all(first, &mut |f, b| visit(&[f], b), best);
+                self.visit_all(second, &mut |f, b| visit(&[f], b), best);
                 continue;
             }
             if df < *best {

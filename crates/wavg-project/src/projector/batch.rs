@@ -311,7 +311,7 @@ mod tests {
 
         // Coarse and very noisy: the first candidate's walk over faces sometimes ends
         // without a projection where another candidate of the ring holds one.
-        let m = ValidMesh::new(procedural::with_noise(procedural::icosphere(2), 0.15, 2));
+        let m = ValidMesh::new(procedural::with_noise(procedural::icosphere(3), 0.2, 2));
         let emb = Arc::new(EmbeddedMesh::from_positions(Arc::new(m.unwrap())));
         let p = Projector::new(emb.clone()).unwrap();
         let (nf, nv) = (emb.mesh().n_faces(), emb.coords().len());
