@@ -104,6 +104,16 @@ pub(super) struct VertexRec {
     pub(super) t: Frame32,
 }
 
+impl VertexRec {
+    /// The frame's two tangent vectors (orthonormal in R^8, so also in walk units up to
+    /// the walk's uniform scale).
+    #[inline(always)]
+    pub(super) fn tangents(&self) -> (&[f32; 8], &[f32; 8]) {
+        let (t0, t1) = self.t.split_at(8);
+        (t0.try_into().unwrap(), t1.try_into().unwrap())
+    }
+}
+
 /// What a query reads of a face, in two cache lines: its blend matrices and corners.
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C, align(64))]

@@ -331,10 +331,8 @@ impl Projector {
     #[inline]
     fn foot(&self, yw: &[f32; 8], v: VertexId) -> [f32; 8] {
         let x = self.walk_coords[v as usize].unpack();
-        let t = &self.verts[v as usize].t;
+        let (t0, t1) = self.verts[v as usize].tangents();
         let r: [f32; 8] = std::array::from_fn(|k| yw[k] - x[k]);
-        let t0: &[f32; 8] = t[..8].try_into().unwrap();
-        let t1: &[f32; 8] = t[8..].try_into().unwrap();
         let (a, b) = (super::layout::wdot(t0, &r), super::layout::wdot(t1, &r));
         std::array::from_fn(|k| x[k] + a * t0[k] + b * t1[k])
     }

@@ -101,8 +101,8 @@ mod tests {
     use wavg_mesh::{ValidMesh, procedural};
 
     /// The unbounded search finds the nearest vertex (brute force), and from any start the
-    /// descent and the bounded search find it too; queries on, near and far off a mesh (scale 0: the centre, about equally far
-    /// from every vertex).
+    /// descent and the bounded search find it too; queries on, near and far off a mesh
+    /// (scale 0: the centre, about equally far from every vertex).
     #[test]
     fn the_nearest_vertex_from_any_start_is_the_nearest_vertex() {
         let m = Arc::new(ValidMesh::new(procedural::icosphere(4)).unwrap());

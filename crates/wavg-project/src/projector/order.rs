@@ -111,9 +111,7 @@ impl Projector {
             // that corner): `y - v` and the edges `u_j - v`, each as two coordinates.
             let yw = self.walk_point(y);
             let wv = self.walk_coords[v as usize].unpack();
-            let t = &self.verts[v as usize].t;
-            let t0: &[f32; 8] = t[..8].try_into().unwrap();
-            let t1: &[f32; 8] = t[8..].try_into().unwrap();
+            let (t0, t1) = self.verts[v as usize].tangents();
             let in_plane = |p: &[f32; 8]| {
                 let d: [f32; 8] = std::array::from_fn(|k| p[k] - wv[k]);
                 [wdot(t0, &d), wdot(t1, &d)]
