@@ -51,6 +51,9 @@ pub(super) struct StartGrid {
     /// Cells per walk unit.
     inv_cell: f32,
     dims: [u32; 3],
+    /// Index offsets of a cell's 26 neighbours (in [`StartGrid::neighbours`]' order) for
+    /// cells off the grid's sides.
+    offsets: [isize; 26],
     cells: Vec<Cell>,
     /// Where [`MAX_CELLS`] caps the cells: finer ones (empty otherwise).
     pub(super) fine: FineCells,
@@ -100,6 +103,7 @@ impl StartGrid {
             origin: axes.map(|a| lo[a] as f32),
             inv_cell,
             dims,
+            offsets: neighbour_offsets(dims),
             cells: Vec::new(),
             fine: FineCells::default(),
         };
@@ -216,70 +220,137 @@ impl StartGrid {
     /// step's reads hide the wait.
     #[inline]
     pub(super) fn walk(&self, p: &[f32; 8], records: &[WalkPoint]) -> (VertexId, f32) {
-        let dist2 = |cell: &Cell| super::layout::dist2_packed(&cell.c, p);
         let mut c = self.cell_of(p).0;
-        let mut v = self.cells[c].v;
-        let mut d = dist2(&self.cells[c]);
+        let cell = &self.cells[c];
+        let mut best = (cell.v, super::layout::dist2_packed(&cell.c, p));
         let near = self.near();
-        if d <= near {
-            return (v, d);
-        }
-        let [d0, d1, d2] = self.dims.map(|d| d as usize);
-        // Index offsets of the 26 neighbours of a cell off the grid's sides, in
-        // `neighbours`' order.
-        let mut offsets = [0isize; 26];
-        let mut m = 0;
-        for di in -1isize..=1 {
-            for dj in -1isize..=1 {
-                for dk in -1isize..=1 {
-                    if (di, dj, dk) != (0, 0, 0) {
-                        offsets[m] = (di * d1 as isize + dj) * d2 as isize + dk;
-                        m += 1;
-                    }
-                }
-            }
-        }
         for _ in 0..MAX_CELL_STEPS {
-            if d <= near {
+            if best.1 <= near {
                 break;
             }
-            let mut next = c;
-            let (i, j, k) = (c / (d1 * d2), c / d2 % d1, c % d2);
-            let inside = (1..d0.saturating_sub(1)).contains(&i)
-                && (1..d1.saturating_sub(1)).contains(&j)
-                && (1..d2.saturating_sub(1)).contains(&k);
-            let mut visit = |n: usize| {
-                let cell = &self.cells[n];
-                let du = dist2(cell);
-                if du < d {
-                    (next, v, d) = (n, cell.v, du);
-                }
-            };
-            if inside {
-                offsets
-                    .iter()
-                    .for_each(|&o| visit(c.wrapping_add_signed(o)));
-            } else {
-                self.neighbours(c, true)
-                    .into_iter()
-                    .flatten()
-                    .for_each(visit);
-            }
+            let next = self.step(c, p, &mut best);
             if next == c {
                 break;
             }
             c = next;
-            if let Some(r) = records.get(v as usize) {
+            if let Some(r) = records.get(best.0 as usize) {
                 super::prefetch_line(r);
             }
         }
-        (v, d)
+        best
+    }
+
+    /// [`StartGrid::walk`] for each walk point of `ps` (up to [`WALK_GROUP`]) into
+    /// `out`, the walks advancing a step each in turn, each step requesting the cells the
+    /// next one reads (so the walks' waits overlap): the same vertices and distances.
+    pub(super) fn walk_group(&self, ps: &[[f32; 8]], out: &mut [(VertexId, f32)]) {
+        let m = out.len();
+        let near = self.near();
+        let mut cell = [0usize; WALK_GROUP];
+        for k in 0..m {
+            cell[k] = self.cell_of(&ps[k]).0;
+            super::prefetch_line(&self.cells[cell[k]]);
+        }
+        let mut live = [false; WALK_GROUP];
+        for k in 0..m {
+            let c = &self.cells[cell[k]];
+            out[k] = (c.v, super::layout::dist2_packed(&c.c, &ps[k]));
+            live[k] = out[k].1 > near;
+            if live[k] {
+                self.prefetch_around(cell[k]);
+            }
+        }
+        for _ in 0..MAX_CELL_STEPS {
+            let mut any = false;
+            for k in 0..m {
+                if !live[k] {
+                    continue;
+                }
+                let next = self.step(cell[k], &ps[k], &mut out[k]);
+                live[k] = next != cell[k] && out[k].1 > near;
+                cell[k] = next;
+                if live[k] {
+                    self.prefetch_around(next);
+                    any = true;
+                }
+            }
+            if !any {
+                break;
+            }
+        }
+    }
+
+    /// One step of the walk over the cells for walk point `p` from cell `c`, whose best
+    /// vertex so far is `best` (vertex, squared distance): the neighbouring cell whose
+    /// vertex is closest to `p` if it is strictly closer than `best` (which becomes it;
+    /// ties to the first in [`StartGrid::neighbours`]' order), else `c`.
+    #[inline]
+    fn step(&self, c: usize, p: &[f32; 8], best: &mut (VertexId, f32)) -> usize {
+        let [d0, d1, d2] = self.dims.map(|d| d as usize);
+        let (i, j, k) = (c / (d1 * d2), c / d2 % d1, c % d2);
+        let inside = (1..d0.saturating_sub(1)).contains(&i)
+            && (1..d1.saturating_sub(1)).contains(&j)
+            && (1..d2.saturating_sub(1)).contains(&k);
+        let mut next = c;
+        let mut visit = |n: usize| {
+            let cell = &self.cells[n];
+            let du = super::layout::dist2_packed(&cell.c, p);
+            if du < best.1 {
+                (next, *best) = (n, (cell.v, du));
+            }
+        };
+        if inside {
+            self.offsets
+                .iter()
+                .for_each(|&o| visit(c.wrapping_add_signed(o)));
+        } else {
+            self.neighbours(c, true)
+                .into_iter()
+                .flatten()
+                .for_each(visit);
+        }
+        next
+    }
+
+    /// Requests the cells around cell `c` (the nine rows of three that a step reads).
+    #[inline]
+    fn prefetch_around(&self, c: usize) {
+        let [_, d1, d2] = self.dims.map(|d| d as isize);
+        for di in -1..=1 {
+            for dj in -1..=1 {
+                let mid = c as isize + (di * d1 + dj) * d2;
+                for e in [mid - 1, mid + 1] {
+                    if let Some(cell) = self.cells.get(e as usize) {
+                        super::prefetch_line(cell);
+                    }
+                }
+            }
+        }
     }
 
     /// Heap bytes used.
     pub(super) fn bytes(&self) -> usize {
         std::mem::size_of_val(&self.cells[..]) + self.fine.bytes()
     }
+}
+
+/// Index offsets of a cell's 26 neighbours in a grid of `dims` cells, in
+/// [`StartGrid::neighbours`]' order (for cells off the grid's sides).
+fn neighbour_offsets(dims: [u32; 3]) -> [isize; 26] {
+    let [d1, d2] = [dims[1] as isize, dims[2] as isize];
+    let mut offsets = [0isize; 26];
+    let mut m = 0;
+    for di in -1isize..=1 {
+        for dj in -1isize..=1 {
+            for dk in -1isize..=1 {
+                if (di, dj, dk) != (0, 0, 0) {
+                    offsets[m] = (di * d1 + dj) * d2 + dk;
+                    m += 1;
+                }
+            }
+        }
+    }
+    offsets
 }
 
 impl Projector {
@@ -366,9 +437,13 @@ impl Projector {
         for k in 0..m {
             yw[k] = self.walk_point(&ys[k]);
             prefetch_line(&self.walk_coords[starts[k] as usize]);
-            best[k] = self.starts.walk(&yw[k], &self.walk_coords);
+        }
+        self.starts.walk_group(&yw[..m], &mut best[..m]);
+        for k in 0..m {
+            // Both the comparisons below and the walk over the vertices read the walk
+            // record; the foot reads the vertex's frame (its record's second line).
+            prefetch_line(&self.walk_coords[best[k].0 as usize]);
             if !fine.is_empty() {
-                // The foot reads the vertex's frame (its record's second line).
                 prefetch_line(&self.verts[best[k].0 as usize].t);
             }
         }
@@ -403,7 +478,8 @@ mod tests {
     use super::*;
     use wavg_mesh::{ValidMesh, procedural};
 
-    /// Every cell holds a vertex; an occupied cell's vertex lies in it; the grid is the
+    /// Every cell holds a vertex; an occupied cell's vertex lies in it; walks over the
+    /// cells, one at a time or interleaved, equal a plain reference walk; the grid is the
     /// same on one thread as on several.
     #[test]
     fn grid_cells_hold_their_own_vertices_whatever_the_threads() {
@@ -428,10 +504,12 @@ mod tests {
         assert!(own.iter().any(|&o| !o), "some cells are empty (and filled)");
         // The walk's inner-cell shortcut visits the neighbours of `neighbours` in its
         // order: the same walk as through `neighbours` alone, from everywhere.
+        // The last vertex, its squared distance and the steps taken.
         let reference = |p: &[f32; 8]| {
             let dist2 = |cell: &Cell| crate::projector::layout::dist2_packed(&cell.c, p);
             let mut c = g.cell_of(p).0;
             let (mut v, mut d) = (g.cells[c].v, dist2(&g.cells[c]));
+            let mut steps = 0;
             for _ in 0..MAX_CELL_STEPS {
                 if d <= g.near() {
                     break;
@@ -447,10 +525,12 @@ mod tests {
                     break;
                 }
                 c = next;
+                steps += 1;
             }
-            (v, d)
+            ((v, d), steps)
         };
         let mut inner = 0;
+        let mut points = Vec::new();
         for (v, w) in p.walk_coords.iter().enumerate().step_by(7) {
             let mut q = w.unpack();
             // Off the surface in every coordinate, some points past the grid's sides.
@@ -460,13 +540,49 @@ mod tests {
                     *x = if k % 2 == 0 { -3e4 } else { 1e5 };
                 }
             }
-            assert_eq!(g.walk(&q, &p.walk_coords), reference(&q), "vertex {v}");
+            // Most of a cell from a vertex in each of the grid's axes: walks that step
+            // to a near cell's vertex.
+            if v % 5 == 2 {
+                for &a in &g.axes {
+                    q[a] = w.unpack()[a] + 0.7 / g.inv_cell;
+                }
+            }
+            // Inside the surface and off it along the axes the grid leaves out: never near
+            // a cell's vertex, walks of several steps.
+            if v % 5 == 1 {
+                for (k, x) in q.iter_mut().enumerate() {
+                    *x = match g.axes.contains(&k) {
+                        true => 32768.0 + (*x - 32768.0) * 0.4,
+                        false => *x + 2e4,
+                    };
+                }
+            }
+            assert_eq!(g.walk(&q, &p.walk_coords), reference(&q).0, "vertex {v}");
+            points.push(q);
             let [d0, d1, d2] = g.dims;
             let c = g.cell_of(&q).0 as u32;
             let (i, j, k) = (c / (d1 * d2), c / d2 % d1, c % d2);
             inner += usize::from(i > 0 && j > 0 && k > 0 && i + 1 < d0 && j + 1 < d1 && k + 1 < d2);
         }
         assert!(inner > 50, "{inner} walks started inside");
+        // Interleaved, in groups of every size up to the most: the same walks. Counted:
+        // walks of no step, one step, more; walks that end near after a step.
+        let mut kinds = [0usize; 4];
+        for (n, group) in points.chunks(WALK_GROUP).enumerate() {
+            let group = &group[..group.len().min(n % WALK_GROUP + 1)];
+            let mut out = [(0, 0.0); WALK_GROUP];
+            g.walk_group(group, &mut out[..group.len()]);
+            for (q, &got) in group.iter().zip(&out) {
+                let (want, steps) = reference(q);
+                assert_eq!(got, want);
+                kinds[steps.min(2)] += 1;
+                kinds[3] += usize::from(steps > 0 && got.1 <= g.near());
+            }
+        }
+        assert!(
+            kinds[..3].iter().all(|&k| k > 10) && kinds[3] > 5,
+            "{kinds:?}"
+        );
         for threads in [1, 3] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
