@@ -134,13 +134,11 @@ impl Projector {
         self.walk_group(ys, starts, ends);
         // Every candidate order first (each requests its first face's data), then the
         // solves, so those requests overlap.
-        let cands: [FaceOrder; WALK_GROUP] = std::array::from_fn(|k| {
-            if k < m {
-                self.order_faces(&ys[k], ends[k], &self.ring_dists(&ys[k], ends[k]))
-            } else {
-                FaceOrder::EMPTY
-            }
-        });
+        let mut cands = [FaceOrder::EMPTY; WALK_GROUP];
+        for k in 0..m {
+            let ring_d = self.ring_dists(&ys[k], ends[k]);
+            self.order_faces_into(&ys[k], ends[k], &ring_d, &mut cands[k]);
+        }
         if goal == SearchGoal::FirstHit {
             self.first_hits_group(ys, ends, &cands[..m], out);
         } else {
@@ -207,11 +205,12 @@ impl Projector {
                 }
             }
         }
-        for (k, tried) in tried.into_iter().take(m).enumerate() {
+        for k in 0..m {
             out.push(match found[k] {
                 Some(b) => Ok(Self::finish(b, ProjectionPath::Local)),
                 // The walk from the first candidate is over: the second is next.
                 None if cands[k].n > 0 => {
+                    let tried = tried[k].clone();
                     self.search_resumed(&ys[k], ends[k], &cands[k], SearchGoal::FirstHit, tried, 1)
                 }
                 None => self.search_from(&ys[k], ends[k], &cands[k], SearchGoal::FirstHit),

@@ -102,6 +102,19 @@ impl Projector {
     /// [`Projector::faces_by_promise`]; `ring_d` (squared walk distances of `v`'s
     /// neighbours) orders the faces of rings too long for the exact score.
     pub(super) fn order_faces(&self, y: &Vec8, v: VertexId, ring_d: &[f32; 64]) -> FaceOrder {
+        let mut out = FaceOrder::EMPTY;
+        self.order_faces_into(y, v, ring_d, &mut out);
+        out
+    }
+
+    /// [`Projector::order_faces`] into `out` (a group's orders stay in place: no copies).
+    pub(super) fn order_faces_into(
+        &self,
+        y: &Vec8,
+        v: VertexId,
+        ring_d: &[f32; 64],
+        out: &mut FaceOrder,
+    ) {
         let topo = self.emb.mesh().topology();
         let ring = self.walk_coords[v as usize].ring(topo, v);
         let faces = self.walk_coords[v as usize].faces(topo, v);
@@ -154,16 +167,16 @@ impl Projector {
             let f = order[0].1;
             self.prefetch_face(f, v, ring, faces);
         }
-        FaceOrder {
-            faces: std::array::from_fn(|j| order[j].1),
-            n: m,
-            // Scores are outside measures only for rings of up to 64 vertices.
-            first_outside: if m > 0 && ring.len() <= 64 {
-                order[0].0
-            } else {
-                f32::INFINITY
-            },
+        for (f, o) in out.faces.iter_mut().zip(&order[..m]) {
+            *f = o.1;
         }
+        out.n = m;
+        // Scores are outside measures only for rings of up to 64 vertices.
+        out.first_outside = if m > 0 && ring.len() <= 64 {
+            order[0].0
+        } else {
+            f32::INFINITY
+        };
     }
 
     /// Starts loading face `f` (around `v`) and its three corners' records. The corners
