@@ -61,8 +61,22 @@ impl Projector {
     /// The vertex closest to `y` (ties to the lowest index) if one is strictly closer
     /// than `sqrt(within2)`: a small radius keeps the branch and bound to a few boxes.
     pub(super) fn nearest_vertex_within(&self, y: &Vec8, within2: f64) -> Option<VertexId> {
+        self.nearest_vertex_over(y, within2, usize::MAX).0
+    }
+
+    /// [`Projector::nearest_vertex_within`] over at most `leaves` leaves of the
+    /// hierarchy: the closest vertex met strictly within `sqrt(within2)` (ties to the
+    /// lowest index) and whether the search was complete (then it is the nearest).
+    pub(super) fn nearest_vertex_over(
+        &self,
+        y: &Vec8,
+        within2: f64,
+        leaves: usize,
+    ) -> (Option<VertexId>, bool) {
         let mut best = (within2, NONE);
         let mut bound = within2;
+        let mut opened = 0;
+        let mut complete = true;
         // A leaf's faces are requested, then all their corners, before any is read: the
         // search is a chain of cold reads otherwise (a query 70 mean edges off a 10.3M
         // vertex mesh opens about 3,400 faces).
@@ -71,6 +85,13 @@ impl Projector {
             &mut bound,
             |_, _, _| true,
             |leaf, bound| {
+                if opened == leaves {
+                    // No box lies below a negative bound: the search ends.
+                    complete = false;
+                    *bound = -1.0;
+                    return;
+                }
+                opened += 1;
                 for &f in leaf {
                     prefetch_line(&self.faces[f as usize].v);
                 }
@@ -91,7 +112,7 @@ impl Projector {
                 }
             },
         );
-        (best.1 != NONE).then_some(best.1)
+        ((best.1 != NONE).then_some(best.1), complete)
     }
 }
 
@@ -131,5 +152,47 @@ mod tests {
             }
         }
         assert!(moved > 300, "{moved}");
+    }
+
+    /// A first-hit search that stops looking for the nearest vertex after a few leaves
+    /// answers from the closest vertex met, with a projection (solving on its face again
+    /// gives it); unlimited, from the nearest vertex.
+    #[test]
+    fn first_hits_from_a_vertex_met_early_are_projections() {
+        let mut mesh = procedural::icosphere(4);
+        for (i, x) in mesh.positions.iter_mut().enumerate() {
+            *x *= 1.0 + 0.05 * ((i * 7919 % 13) as f64 / 13.0);
+        }
+        let m = Arc::new(ValidMesh::new(mesh).unwrap());
+        let emb = Arc::new(EmbeddedMesh::from_positions(m.clone()));
+        let p = Projector::new(emb.clone()).unwrap();
+        let n = m.n_vertices() as u32;
+        let (mut early, mut nearest) = (0, 0);
+        for q in (0..n).step_by(29) {
+            let y = emb.coords()[q as usize] * 1.1;
+            // A far vertex as the walk's end: a loose bound, so many leaves to open.
+            let far = (q * 7919 + n / 2) % n;
+            let full = p.search_from_nearest_over(&y, far, SearchGoal::FirstHit, usize::MAX);
+            assert_eq!(full.as_ref().map(|f| f.1), Some(p.nearest_vertex(&y)));
+            for leaves in [1, 3, 10] {
+                let (b, u, _) = p
+                    .search_from_nearest_over(&y, far, SearchGoal::FirstHit, leaves)
+                    .expect("a projection");
+                let again = p.try_face(b.face, &y).expect("a projection on its face");
+                let gap = (0..3)
+                    .map(|k| (again.xi[k] - b.xi[k]).abs())
+                    .fold(0.0, f64::max);
+                assert!(gap < 1e-9, "query {q}, {leaves} leaves: {gap}");
+                assert!((again.d2 - b.d2).abs() <= 1e-12 * b.d2.max(1.0));
+                match u == full.as_ref().unwrap().1 {
+                    true => nearest += 1,
+                    false => early += 1,
+                }
+            }
+        }
+        assert!(
+            early > 10 && nearest > 10,
+            "{early} early, {nearest} nearest"
+        );
     }
 }
