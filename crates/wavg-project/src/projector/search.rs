@@ -370,8 +370,9 @@ impl Projector {
 
     /// After the local search from the walk's end `v` found nothing: the local search from
     /// the vertex nearest to `y` unless that is `v` (the walk ends with a descent in f64,
-    /// so the search for it is bounded by `v`'s distance and opens few boxes): the first
-    /// answer, the vertex it came from and the faces that search tried.
+    /// so the search for it is bounded by `v`'s distance), for a first hit from the
+    /// closest vertex met within [`FIRST_HIT_LEAVES`] leaves first: the first answer, the
+    /// vertex it came from and the faces that search tried.
     fn search_from_nearest(
         &self,
         y: &Vec8,
